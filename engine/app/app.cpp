@@ -1,0 +1,47 @@
+#include "engine/app/app.h"
+
+#include <chrono>
+
+namespace engine::app {
+
+App::App(AppOptions options) : options_(options), jobs_(options.jobs) {
+  world_.insert_resource<Time>();
+  world_.resource<Time>().delta_seconds = options_.fixed_delta_seconds > 0 ? options_.fixed_delta_seconds : 0.0;
+  world_.insert_resource<AppExit>();
+}
+
+App& App::add_plugin(std::unique_ptr<Plugin> plugin) {
+  std::string name(plugin->name());
+  if (plugin_names_.contains(name)) return *this;
+  plugin_names_.insert(name);
+  plugin->build(*this);
+  plugins_.push_back(std::move(plugin));
+  return *this;
+}
+
+void App::update() {
+  using clock = std::chrono::steady_clock;
+  const auto start = clock::now();
+  if (!started_) {
+    schedule_.run_phase(world_, schedule::Phase::Startup, &jobs_);
+    started_ = true;
+  }
+  for (schedule::Phase p : schedule::kFramePhases) schedule_.run_phase(world_, p, &jobs_);
+
+  auto& time = world_.resource<Time>();
+  if (options_.fixed_delta_seconds <= 0)
+    time.delta_seconds = std::chrono::duration<double>(clock::now() - start).count();
+  time.elapsed_seconds += time.delta_seconds;
+  ++time.frame;
+}
+
+int App::run(std::optional<std::uint64_t> max_frames) {
+  std::uint64_t frames = 0;
+  while (!world_.resource<AppExit>().requested && (!max_frames || frames < *max_frames)) {
+    update();
+    ++frames;
+  }
+  return world_.resource<AppExit>().code;
+}
+
+}  // namespace engine::app
