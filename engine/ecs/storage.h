@@ -40,6 +40,8 @@ class StorageBase {
     return slot;
   }
 
+  static constexpr std::uint32_t kNoSlotPublic = 0xffffffffu;
+
   struct Removal {
     Entity entity;
     Tick tick;

@@ -4,6 +4,8 @@
 // entity the view hands out mutably is stamped as changed at this_run (any
 // mutable access counts as a change, as in Bevy's Mut<T>).
 #include <algorithm>
+#include <array>
+#include <utility>
 #include <cstddef>
 #include <tuple>
 #include <type_traits>
@@ -33,7 +35,7 @@ class View<Get<Ts...>, Exclude<Xs...>> {
     const StorageBase* driver = smallest();
     if (!driver) return;
     const auto& owners = driver->entities();
-    for (std::size_t i = 0; i < owners.size(); ++i) visit(owners[i], fn);
+    for (std::size_t i = 0; i < owners.size(); ++i) visit(driver, static_cast<std::uint32_t>(i), owners[i], fn);
   }
 
   // Data-parallel each(): fn must only touch this entity's components. The
@@ -45,7 +47,8 @@ class View<Get<Ts...>, Exclude<Xs...>> {
     const auto& owners = driver->entities();
     jobs::parallel_for(std::size_t{0}, owners.size(), grain,
                        [&](std::size_t begin, std::size_t end) {
-                         for (std::size_t i = begin; i < end; ++i) visit(owners[i], fn);
+                         for (std::size_t i = begin; i < end; ++i)
+                           visit(driver, static_cast<std::uint32_t>(i), owners[i], fn);
                        });
   }
 
@@ -118,23 +121,37 @@ class View<Get<Ts...>, Exclude<Xs...>> {
             ... || false);
   }
 
+  // Dense slot of e in T's storage, or kNone. The driver's slot is known.
   template <class T>
-  T& fetch(Entity e) const {
+  std::uint32_t slot_in(const StorageBase* driver, std::uint32_t driver_slot, Entity e) const {
     auto* s = std::get<StoragePtr<T>>(get_);
-    const std::uint32_t slot = s->slot_of(e);
+    if (static_cast<const StorageBase*>(s) == driver) return driver_slot;
+    return s->slot_or_none(e);
+  }
+
+  template <class T>
+  T& fetch_slot(std::uint32_t slot) const {
+    auto* s = std::get<StoragePtr<T>>(get_);
     if constexpr (!std::is_const_v<T>) s->mark_changed_slot(slot, this_run_);
     return s->at_slot(slot);
   }
 
   template <class Fn>
-  void visit(Entity e, Fn& fn) const {
-    if (!(std::get<StoragePtr<Ts>>(get_)->contains(e) && ...)) return;
+  void visit(const StorageBase* driver, std::uint32_t driver_slot, Entity e, Fn& fn) const {
+    const std::array<std::uint32_t, sizeof...(Ts)> slots{slot_in<Ts>(driver, driver_slot, e)...};
+    for (std::uint32_t s : slots)
+      if (s == StorageBase::kNoSlotPublic) return;
     if (excluded(e)) return;
+    call(fn, e, slots, std::index_sequence_for<Ts...>{});
+  }
+
+  template <class Fn, std::size_t... I>
+  void call(Fn& fn, Entity e, const std::array<std::uint32_t, sizeof...(Ts)>& slots, std::index_sequence<I...>) const {
     if constexpr (std::is_invocable_v<Fn&, Entity, Ts&...>) {
-      fn(e, fetch<Ts>(e)...);
+      fn(e, fetch_slot<Ts>(slots[I])...);
     } else {
       static_assert(std::is_invocable_v<Fn&, Ts&...>, "each() callback must take (Entity, Ts&...) or (Ts&...)");
-      fn(fetch<Ts>(e)...);
+      fn(fetch_slot<Ts>(slots[I])...);
     }
   }
 
