@@ -1,0 +1,68 @@
+#pragma once
+// The glTF 2.0 reference BRDF (spec Appendix B), in a local shading frame
+// whose +z is the shading normal. Both wo and wi point away from the surface.
+//
+//   fr         = Schlick(F0 = min(0.04 specular_color, 1), wo.h)        (per channel)
+//   dielectric = Lambert(base) * C(wo, wi) + s * fr * GGX
+//   metal      = Schlick(F0 = base, wo.h) * GGX
+//   f          = mix(dielectric, metal, metallic)
+//
+// GGX = D * V with height-correlated Smith V; alpha = roughness^2.
+// s = specularFactor and specular_color = specularColorFactor come from
+// KHR_materials_specular (s = 0 gives a pure Lambertian surface).
+//
+// The layer coupling C differs from the spec's fresnel_mix on purpose. The
+// spec weights the diffuse by (1 - s max(fr(wo.h))), which gains energy at
+// grazing view angles (white furnace albedo 1.84 at cos = 0.02, measured by
+// tests/engine/brdf_test.cpp before this change). Weighting by F(n.wo), as
+// shared/tools/cycles_render.py does, conserves energy but is not reciprocal.
+// We use the reciprocal, energy-conserving albedo scaling of Kelemen and
+// Szirmay-Kalos (2001):
+//   C = (1 - s E(wo)) (1 - s E(wi)) / (1 - s E_avg)
+// with E the specular lobe's directional albedo (specular_albedo.h), so the
+// dielectric's albedo is exactly s E(wo) + base (1 - s E(wo)) <= 1.
+#include <glm/glm.hpp>
+
+namespace engine::material {
+
+struct BrdfParams {
+  glm::vec3 base_color{0.8f};
+  float metallic = 0.0f;
+  float roughness = 0.5f;
+  float specular = 1.0f;                  // s above
+  glm::vec3 specular_color{1.0f};
+};
+
+// Roughness below this is clamped: a perfect mirror is represented by a very
+// sharp GGX lobe (alpha = 1e-6 would overflow D in float).
+inline constexpr float kMinAlpha = 1e-3f;
+
+struct BrdfSample {
+  glm::vec3 wi{0.0f};
+  glm::vec3 f{0.0f};  // BRDF value (not multiplied by cos)
+  float pdf = 0.0f;   // combined (one-sample MIS) pdf of wi
+  bool specular_lobe = false;
+};
+
+// f(wo, wi). Zero when either direction is below the surface.
+glm::vec3 brdf_eval(const BrdfParams& p, const glm::vec3& wo, const glm::vec3& wi);
+// Density with which brdf_sample() produces wi.
+float brdf_pdf(const BrdfParams& p, const glm::vec3& wo, const glm::vec3& wi);
+// Picks the GGX lobe (visible-normal sampling, Heitz 2018) or the cosine lobe
+// with probability spec_probability(), and reports the combined pdf. Returns
+// false when no valid direction was produced.
+bool brdf_sample(const BrdfParams& p, const glm::vec3& wo, glm::vec2 u, float u_lobe, BrdfSample& out);
+
+// Probability of choosing the GGX lobe: the lobes' estimated albedos.
+float spec_probability(const BrdfParams& p, float cos_o);
+
+// Pieces, exposed for tests.
+float ggx_d(float alpha, float cos_h);
+float smith_g1(float alpha, float cos_v);
+float smith_v_height_correlated(float alpha, float cos_o, float cos_i);  // G2 / (4 cos_o cos_i)
+glm::vec3 schlick_fresnel(const glm::vec3& f0, float cos_theta);
+glm::vec3 sample_ggx_vndf(float alpha, const glm::vec3& wo, glm::vec2 u);  // a half vector
+// C(wo, wi) per channel, for a dielectric with Fresnel F0 = f0.
+glm::vec3 diffuse_coupling(const BrdfParams& p, const glm::vec3& f0, float alpha, float cos_o, float cos_i);
+
+}  // namespace engine::material

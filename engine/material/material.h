@@ -1,0 +1,38 @@
+#pragma once
+// glTF 2.0 metallic-roughness material, with KHR_materials_emissive_strength
+// and KHR_materials_specular (factor and colour).
+#include <cstdint>
+#include <string>
+
+#include <glm/glm.hpp>
+
+namespace engine::material {
+
+inline constexpr std::int32_t kNoTexture = -1;
+
+enum class AlphaMode : std::uint8_t { Opaque, Mask, Blend };
+
+struct Material {
+  std::string name;
+  glm::vec4 base_color_factor{1.0f};
+  std::int32_t base_color_texture = kNoTexture;  // sRGB, alpha in .a
+  float metallic_factor = 1.0f;
+  float roughness_factor = 1.0f;
+  std::int32_t metallic_roughness_texture = kNoTexture;  // linear: G = roughness, B = metallic
+  glm::vec3 emissive_factor{0.0f};
+  float emissive_strength = 1.0f;
+  std::int32_t emissive_texture = kNoTexture;  // sRGB
+  float specular_factor = 1.0f;               // KHR_materials_specular
+  glm::vec3 specular_color_factor{1.0f};
+  AlphaMode alpha_mode = AlphaMode::Opaque;
+  float alpha_cutoff = 0.5f;
+  bool double_sided = false;
+
+  [[nodiscard]] glm::vec3 emission() const { return emissive_factor * emissive_strength; }
+  [[nodiscard]] bool is_emissive() const {
+    const glm::vec3 e = emission();
+    return e.r > 0 || e.g > 0 || e.b > 0;
+  }
+};
+
+}  // namespace engine::material

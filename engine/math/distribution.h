@@ -1,0 +1,46 @@
+#pragma once
+// Piecewise-constant 1D and 2D distributions (pbrt-v4 style) for importance
+// sampling tabulated functions such as environment maps.
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace engine::math {
+
+class Distribution1D {
+ public:
+  Distribution1D() = default;
+  // f must be non-negative and finite; an all-zero f becomes uniform.
+  explicit Distribution1D(std::span<const float> f);
+
+  [[nodiscard]] std::size_t size() const { return func_.size(); }
+  [[nodiscard]] double integral() const { return integral_; }
+  // Continuous sample in [0, 1); pdf is the density w.r.t. [0, 1).
+  [[nodiscard]] float sample_continuous(float u, float* pdf, std::size_t* index) const;
+  [[nodiscard]] float pdf(float x) const;
+
+ private:
+  std::vector<float> func_;
+  std::vector<double> cdf_;
+  double integral_ = 0;
+};
+
+class Distribution2D {
+ public:
+  Distribution2D() = default;
+  // f is row-major, width x height, rows are v.
+  Distribution2D(std::span<const float> f, int width, int height);
+
+  // Returns (u, v) in [0,1)^2 and its density w.r.t. the unit square.
+  [[nodiscard]] glm::vec2 sample(glm::vec2 u, float* pdf) const;
+  [[nodiscard]] float pdf(glm::vec2 uv) const;
+  [[nodiscard]] bool empty() const { return rows_.empty(); }
+
+ private:
+  std::vector<Distribution1D> rows_;
+  Distribution1D marginal_;
+};
+
+}  // namespace engine::math
