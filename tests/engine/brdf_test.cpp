@@ -121,7 +121,9 @@ TEST(Brdf, PdfIntegratesToTheSamplersSuccessRate) {
         const double success = static_cast<double>(ok) / trials;
         EXPECT_NEAR(integral, success, 0.01) << "roughness " << roughness << " metallic " << metallic << " cos_o "
                                              << cos_o << ": expected " << success << ", got " << integral;
-        if (metallic == 0.0f) EXPECT_GT(success, 0.9) << "the cosine lobe never fails";
+        if (metallic == 0.0f) {
+          EXPECT_GT(success, 0.9) << "the cosine lobe never fails";
+        }
       }
 }
 

@@ -1,0 +1,146 @@
+#include "engine/image/metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace engine::image {
+
+namespace {
+
+void check_sizes(const ImageRGB& a, const ImageRGB& b) {
+  if (a.width != b.width || a.height != b.height)
+    throw ImageError("image sizes differ: " + std::to_string(a.width) + "x" + std::to_string(a.height) + " vs " +
+                     std::to_string(b.width) + "x" + std::to_string(b.height));
+  if (a.empty()) throw ImageError("cannot compare empty images");
+}
+
+double clamp01(float v) { return std::clamp(static_cast<double>(v), 0.0, 1.0); }
+
+std::vector<double> luminance_clamped(const ImageRGB& img) {
+  std::vector<double> y(img.size());
+  for (std::size_t i = 0; i < y.size(); ++i) {
+    const glm::vec3& p = img.pixels[i];
+    y[i] = 0.2126 * clamp01(p.r) + 0.7152 * clamp01(p.g) + 0.0722 * clamp01(p.b);
+  }
+  return y;
+}
+
+}  // namespace
+
+double rmse_clamped(const ImageRGB& a, const ImageRGB& b) {
+  check_sizes(a, b);
+  double sum = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double d = clamp01(a.pixels[i][c]) - clamp01(b.pixels[i][c]);
+      sum += d * d;
+    }
+  return std::sqrt(sum / (3.0 * static_cast<double>(a.size())));
+}
+
+double l1_clamped(const ImageRGB& a, const ImageRGB& b) {
+  check_sizes(a, b);
+  double sum = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (int c = 0; c < 3; ++c) sum += std::abs(clamp01(a.pixels[i][c]) - clamp01(b.pixels[i][c]));
+  return sum / (3.0 * static_cast<double>(a.size()));
+}
+
+double relmse(const ImageRGB& a, const ImageRGB& b) {
+  check_sizes(a, b);
+  double sum = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double r = b.pixels[i][c];
+      const double d = static_cast<double>(a.pixels[i][c]) - r;
+      sum += d * d / (r * r + kRelMseEpsilon);
+    }
+  return sum / (3.0 * static_cast<double>(a.size()));
+}
+
+double ssim_luminance(const ImageRGB& a, const ImageRGB& b) {
+  check_sizes(a, b);
+  constexpr int kWindow = 11;
+  constexpr double kSigma = 1.5, kC1 = 0.01 * 0.01, kC2 = 0.03 * 0.03;
+  if (a.width < kWindow || a.height < kWindow)
+    throw ImageError("SSIM needs images of at least 11x11 pixels, got " + std::to_string(a.width) + "x" +
+                     std::to_string(a.height));
+  double g[kWindow];
+  double gsum = 0;
+  for (int i = 0; i < kWindow; ++i) {
+    const double x = i - kWindow / 2;
+    g[i] = std::exp(-x * x / (2 * kSigma * kSigma));
+    gsum += g[i];
+  }
+  for (double& v : g) v /= gsum;
+
+  const std::vector<double> ya = luminance_clamped(a), yb = luminance_clamped(b);
+  const int w = a.width, h = a.height;
+  // Separable filtering of the five moment images, 'valid' region only.
+  auto filter = [&](auto&& value) {
+    const int ow = w - kWindow + 1, oh = h - kWindow + 1;
+    std::vector<double> rows(static_cast<std::size_t>(ow) * h), out(static_cast<std::size_t>(ow) * oh);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < ow; ++x) {
+        double s = 0;
+        for (int k = 0; k < kWindow; ++k) s += g[k] * value(static_cast<std::size_t>(y) * w + x + k);
+        rows[static_cast<std::size_t>(y) * ow + x] = s;
+      }
+    for (int y = 0; y < oh; ++y)
+      for (int x = 0; x < ow; ++x) {
+        double s = 0;
+        for (int k = 0; k < kWindow; ++k) s += g[k] * rows[static_cast<std::size_t>(y + k) * ow + x];
+        out[static_cast<std::size_t>(y) * ow + x] = s;
+      }
+    return out;
+  };
+  const auto mu_a = filter([&](std::size_t i) { return ya[i]; });
+  const auto mu_b = filter([&](std::size_t i) { return yb[i]; });
+  const auto aa = filter([&](std::size_t i) { return ya[i] * ya[i]; });
+  const auto bb = filter([&](std::size_t i) { return yb[i] * yb[i]; });
+  const auto ab = filter([&](std::size_t i) { return ya[i] * yb[i]; });
+  double sum = 0;
+  for (std::size_t i = 0; i < mu_a.size(); ++i) {
+    const double ma = mu_a[i], mb = mu_b[i];
+    const double va = aa[i] - ma * ma, vb = bb[i] - mb * mb, cov = ab[i] - ma * mb;
+    sum += ((2 * ma * mb + kC1) * (2 * cov + kC2)) / ((ma * ma + mb * mb + kC1) * (va + vb + kC2));
+  }
+  return sum / static_cast<double>(mu_a.size());
+}
+
+ErrorMetrics compare_images(const ImageRGB& a, const ImageRGB& b) {
+  return {rmse_clamped(a, b), l1_clamped(a, b), ssim_luminance(a, b), relmse(a, b)};
+}
+
+Rgb8Image error_heatmap(const ImageRGB& a, const ImageRGB& b, double max_error, double* used_max) {
+  check_sizes(a, b);
+  std::vector<double> err(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    double s = 0;
+    for (int c = 0; c < 3; ++c) s += std::abs(clamp01(a.pixels[i][c]) - clamp01(b.pixels[i][c]));
+    err[i] = s / 3.0;
+  }
+  if (max_error <= 0) {
+    std::vector<double> sorted = err;
+    const auto k = static_cast<std::size_t>(0.99 * static_cast<double>(sorted.size() - 1));
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(k), sorted.end());
+    max_error = std::max(sorted[k], 1e-6);
+  }
+  if (used_max) *used_max = max_error;
+  Rgb8Image out(a.width, a.height);
+  for (std::size_t i = 0; i < err.size(); ++i) {
+    const double t = std::clamp(err[i] / max_error, 0.0, 1.0);
+    // Black -> red -> yellow -> white, monotone in luminance.
+    const double r = std::clamp(3.0 * t, 0.0, 1.0);
+    const double gch = std::clamp(3.0 * t - 1.0, 0.0, 1.0);
+    const double bch = std::clamp(3.0 * t - 2.0, 0.0, 1.0);
+    out.pixels[i * 3 + 0] = static_cast<std::uint8_t>(std::lround(r * 255));
+    out.pixels[i * 3 + 1] = static_cast<std::uint8_t>(std::lround(gch * 255));
+    out.pixels[i * 3 + 2] = static_cast<std::uint8_t>(std::lround(bch * 255));
+  }
+  return out;
+}
+
+}  // namespace engine::image

@@ -1,0 +1,33 @@
+#pragma once
+// Image error metrics, defined in docs/metrics.md. A is the test image, B the
+// reference. RMSE, L1 and SSIM use both images clamped to [0, 1] in linear
+// space (the paper's convention); relMSE uses the unclamped HDR values.
+#include "engine/image/image.h"
+#include "engine/image/png.h"
+
+namespace engine::image {
+
+struct ErrorMetrics {
+  double rmse = 0;
+  double l1 = 0;
+  double ssim = 0;
+  double relmse = 0;
+};
+
+inline constexpr double kRelMseEpsilon = 1e-2;
+
+// Throws ImageError if the sizes differ or an image is smaller than the SSIM window.
+ErrorMetrics compare_images(const ImageRGB& a, const ImageRGB& b);
+double rmse_clamped(const ImageRGB& a, const ImageRGB& b);
+double l1_clamped(const ImageRGB& a, const ImageRGB& b);
+// Wang et al. 2004: 11x11 Gaussian window (sigma 1.5), K1 0.01, K2 0.03,
+// L = 1, on Rec.709 luminance; mean over the 'valid' windows (no padding).
+double ssim_luminance(const ImageRGB& a, const ImageRGB& b);
+double relmse(const ImageRGB& a, const ImageRGB& b);
+
+// Per-pixel mean absolute clamped error mapped through a perceptually
+// ordered colour map (black-red-yellow-white); `max_error` maps to white.
+// max_error <= 0 picks the 99th percentile of the errors.
+Rgb8Image error_heatmap(const ImageRGB& a, const ImageRGB& b, double max_error = 0, double* used_max = nullptr);
+
+}  // namespace engine::image

@@ -1,0 +1,230 @@
+#include <gtest/gtest.h>
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfTiledOutputFile.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include "engine/image/exr.h"
+#include "engine/image/metrics.h"
+#include "engine/image/tonemap.h"
+
+namespace fs = std::filesystem;
+using namespace engine::image;
+
+namespace {
+
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    path = fs::temp_directory_path() / ("image_test_" + std::to_string(::getpid()) + "_" +
+                                        std::to_string(reinterpret_cast<std::uintptr_t>(this)));
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+void expect_error_mentions(const std::function<void()>& fn, const std::string& a, const std::string& b) {
+  try {
+    fn();
+    FAIL() << "expected ImageError mentioning '" << a << "' and '" << b << "'";
+  } catch (const ImageError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(a), std::string::npos) << msg;
+    EXPECT_NE(msg.find(b), std::string::npos) << msg;
+  }
+}
+
+ImageRGB ramp(int w, int h) {
+  ImageRGB img(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) img.at(x, y) = {0.1f * static_cast<float>(x), 1000.0f * static_cast<float>(y), -2.5f};
+  return img;
+}
+
+void write_raw(const fs::path& p, const std::string& bytes) {
+  std::ofstream f(p, std::ios::binary);
+  f << bytes;
+}
+
+}  // namespace
+
+TEST(Exr, FloatRoundTripIsExact) {
+  TempDir d;
+  const ImageRGB img = ramp(7, 5);
+  write_exr(d.path / "a.exr", img, ExrPixelType::Float);
+  const ImageRGB back = read_exr(d.path / "a.exr");
+  ASSERT_EQ(back.width, 7);
+  ASSERT_EQ(back.height, 5);
+  for (std::size_t i = 0; i < img.size(); ++i) EXPECT_EQ(back.pixels[i], img.pixels[i]) << "pixel " << i;
+}
+
+TEST(Exr, HalfRoundTripWithinHalfPrecisionAndClampsToHalfRange) {
+  TempDir d;
+  ImageRGB img = ramp(4, 3);
+  img.at(0, 0) = {1e6f, -1e6f, 0.333f};
+  write_exr(d.path / "h.exr", img, ExrPixelType::Half);
+  const ImageRGB back = read_exr(d.path / "h.exr");
+  EXPECT_EQ(back.at(0, 0).r, 65504.0f) << "values above the half range clamp to its maximum";
+  EXPECT_EQ(back.at(0, 0).g, -65504.0f);
+  for (std::size_t i = 1; i < img.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(back.pixels[i][c], img.pixels[i][c], std::abs(img.pixels[i][c]) * 1e-3f + 1e-4f) << i;
+}
+
+TEST(Exr, WritingNonFiniteIsRefusedAndKeepsTheOldFile) {
+  TempDir d;
+  write_exr(d.path / "keep.exr", ramp(2, 2));
+  ImageRGB bad = ramp(2, 2);
+  bad.at(1, 1).g = std::numeric_limits<float>::quiet_NaN();
+  expect_error_mentions([&] { write_exr(d.path / "keep.exr", bad); }, "keep.exr", "pixel (1, 1)");
+  EXPECT_EQ(read_exr(d.path / "keep.exr").at(1, 1), ramp(2, 2).at(1, 1));
+}
+
+TEST(Exr, RejectsMalformedFilesWithTheFileNamed) {
+  TempDir d;
+  expect_error_mentions([&] { read_exr(d.path / "missing.exr"); }, "missing.exr", "not found");
+  expect_error_mentions([&] { read_exr(d.path); }, d.path.string(), "not a regular file");
+  write_raw(d.path / "garbage.exr", "this is not an exr file at all");
+  expect_error_mentions([&] { read_exr(d.path / "garbage.exr"); }, "garbage.exr", "magic");
+
+  // A valid file cut in half.
+  write_exr(d.path / "full.exr", ramp(64, 64));
+  std::ifstream in(d.path / "full.exr", std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  write_raw(d.path / "truncated.exr", bytes.substr(0, bytes.size() / 2));
+  expect_error_mentions([&] { read_exr(d.path / "truncated.exr"); }, "truncated.exr", "malformed");
+
+  // Version flags for tiled, deep and multi-part files are checked up front.
+  for (auto [name, flag, word] : {std::tuple{"tiled.exr", 0x200, "tiled"}, std::tuple{"deep.exr", 0x800, "deep"},
+                                  std::tuple{"multi.exr", 0x1000, "multi-part"}}) {
+    std::string patched = bytes;
+    patched[5] = static_cast<char>(patched[5] | (flag >> 8));
+    write_raw(d.path / name, patched);
+    expect_error_mentions([&, n = name] { read_exr(d.path / n); }, name, word);
+  }
+}
+
+TEST(Exr, RejectsARealTiledFile) {
+  TempDir d;
+  const fs::path p = d.path / "real_tiled.exr";
+  Imf::Header header(16, 16);
+  header.channels().insert("R", Imf::Channel(Imf::FLOAT));
+  header.setTileDescription(Imf::TileDescription(8, 8, Imf::ONE_LEVEL));
+  { Imf::TiledOutputFile out(p.c_str(), header); }
+  expect_error_mentions([&] { read_exr(p); }, "real_tiled.exr", "tiled");
+}
+
+TEST(Exr, RejectsNonFinitePixelsOnRead) {
+  TempDir d;
+  const fs::path p = d.path / "nan.exr";
+  std::vector<float> r(4, 1.0f), g(4, 1.0f), b(4, 1.0f);
+  b[3] = std::numeric_limits<float>::infinity();
+  Imf::Header header(2, 2);
+  for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+  {
+    Imf::OutputFile out(p.c_str(), header);
+    Imf::FrameBuffer fb;
+    fb.insert("R", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(r.data()), 4, 8));
+    fb.insert("G", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(g.data()), 4, 8));
+    fb.insert("B", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(b.data()), 4, 8));
+    out.setFrameBuffer(fb);
+    out.writePixels(2);
+  }
+  expect_error_mentions([&] { read_exr(p); }, "nan.exr", "pixel (1, 1)");
+}
+
+TEST(Exr, SizeCapIsEnforced) {
+  TempDir d;
+  write_exr(d.path / "big.exr", ramp(40, 30));
+  ExrLimits limits;
+  limits.max_dimension = 32;
+  expect_error_mentions([&] { read_exr(d.path / "big.exr", limits); }, "big.exr", "size limit");
+}
+
+TEST(Tonemap, SrgbKnownValues) {
+  EXPECT_NEAR(linear_to_srgb(0.0f), 0.0f, 1e-7f);
+  EXPECT_NEAR(linear_to_srgb(1.0f), 1.0f, 1e-6f);
+  EXPECT_NEAR(linear_to_srgb(0.18f), 0.46135613f, 1e-5f);  // middle grey
+  EXPECT_NEAR(srgb_to_linear(linear_to_srgb(0.3f)), 0.3f, 1e-5f);
+  ImageRGB img(1, 1, glm::vec3(0.25f));
+  EXPECT_EQ(to_srgb8(img, 2.0f).pixels[0], 255) << "+2 stops turns 0.25 into 1.0";
+}
+
+// ---- metrics, against values computed by hand --------------------------------
+
+TEST(Metrics, RmseL1AndRelMseHandComputed) {
+  // 1x2 image pair. Clamped differences per channel: pixel 0 (0.5,0,0), pixel 1 (0,0,0.5)
+  // (A's 2.0 clamps to 1.0 vs B's 1.0, and -1 clamps to 0 vs 0).
+  ImageRGB a(2, 1), b(2, 1);
+  a.pixels = {{1.0f, 0.5f, 0.0f}, {2.0f, -1.0f, 0.5f}};
+  b.pixels = {{0.5f, 0.5f, 0.0f}, {1.0f, 0.0f, 0.0f}};
+  // sum of squares = 0.25 + 0.25 = 0.5 over 6 values -> rmse = sqrt(1/12)
+  EXPECT_NEAR(rmse_clamped(a, b), std::sqrt(1.0 / 12.0), 1e-12);
+  EXPECT_NEAR(l1_clamped(a, b), 1.0 / 6.0, 1e-12);
+  // relMSE (unclamped): (0.5^2/(0.25+0.01) + 0 + 0 + 1^2/(1+0.01) + 1^2/(0+0.01) + 0.5^2/(0+0.01)) / 6
+  const double expected = (0.25 / 0.26 + 1.0 / 1.01 + 1.0 / 0.01 + 0.25 / 0.01) / 6.0;
+  EXPECT_NEAR(relmse(a, b), expected, 1e-9);
+}
+
+TEST(Metrics, SsimOfIdenticalImagesIsOne) {
+  ImageRGB a(16, 13);
+  for (std::size_t i = 0; i < a.size(); ++i) a.pixels[i] = glm::vec3(static_cast<float>(i % 7) / 7.0f);
+  EXPECT_NEAR(ssim_luminance(a, a), 1.0, 1e-12);
+}
+
+TEST(Metrics, SsimOfTwoConstantImagesIsTheLuminanceTerm) {
+  // No variance: SSIM = (2 mu_a mu_b + C1) / (mu_a^2 + mu_b^2 + C1).
+  const ImageRGB a(12, 12, glm::vec3(0.2f)), b(12, 12, glm::vec3(0.6f));
+  const double c1 = 1e-4, ma = 0.2, mb = 0.6;
+  const double expected = (2 * ma * mb + c1) / (ma * ma + mb * mb + c1);
+  EXPECT_NEAR(ssim_luminance(a, b), expected, 1e-6);
+}
+
+TEST(Metrics, SsimMatchesADirectSingleWindowComputation) {
+  // An 11x11 pair has exactly one window: compute it with explicit weights.
+  ImageRGB a(11, 11), b(11, 11);
+  for (int y = 0; y < 11; ++y)
+    for (int x = 0; x < 11; ++x) {
+      a.at(x, y) = glm::vec3(static_cast<float>((x * 3 + y * 5) % 11) / 10.0f);
+      b.at(x, y) = glm::vec3(static_cast<float>((x * 7 + y) % 11) / 12.0f);
+    }
+  double w[11][11], wsum = 0;
+  for (int y = 0; y < 11; ++y)
+    for (int x = 0; x < 11; ++x) wsum += (w[y][x] = std::exp(-((x - 5) * (x - 5) + (y - 5) * (y - 5)) / 4.5));
+  double ma = 0, mb = 0, saa = 0, sbb = 0, sab = 0;
+  for (int y = 0; y < 11; ++y)
+    for (int x = 0; x < 11; ++x) {
+      const double k = w[y][x] / wsum, ya = a.at(x, y).r, yb = b.at(x, y).r;  // grey: Y = value
+      ma += k * ya;
+      mb += k * yb;
+      saa += k * ya * ya;
+      sbb += k * yb * yb;
+      sab += k * ya * yb;
+    }
+  const double c1 = 1e-4, c2 = 9e-4;
+  const double expected = ((2 * ma * mb + c1) * (2 * (sab - ma * mb) + c2)) /
+                          ((ma * ma + mb * mb + c1) * ((saa - ma * ma) + (sbb - mb * mb) + c2));
+  EXPECT_NEAR(ssim_luminance(a, b), expected, 1e-6) << "expected " << expected;
+}
+
+TEST(Metrics, SizeMismatchIsAnError) {
+  EXPECT_THROW(compare_images(ImageRGB(12, 12), ImageRGB(12, 13)), ImageError);
+  EXPECT_THROW(ssim_luminance(ImageRGB(5, 5), ImageRGB(5, 5)), ImageError);
+}
+
+TEST(Metrics, HeatmapScalesToThe99thPercentile) {
+  ImageRGB a(10, 10), b(10, 10);
+  for (std::size_t i = 0; i < a.size(); ++i) a.pixels[i] = glm::vec3(static_cast<float>(i) / 100.0f);
+  double used = 0;
+  const Rgb8Image h = error_heatmap(a, b, 0, &used);
+  EXPECT_NEAR(used, 0.98, 1e-6);
+  EXPECT_EQ(h.pixels[0], 0);                  // zero error is black
+  EXPECT_EQ(h.pixels[99 * 3 + 2], 255);       // the largest error saturates to white
+}
