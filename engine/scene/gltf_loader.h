@@ -1,0 +1,47 @@
+#pragma once
+// glTF 2.0 import (.gltf and .glb) into entities.
+//
+// The importer takes control of everything tinygltf would otherwise do on
+// its own with untrusted input: file access (regular files inside the
+// scene's folder, size-capped, no shell expansion), JSON nesting depth and
+// the GLB container (checked before parsing), image decoding (PNG/JPEG by
+// magic bytes, dimension caps) and every buffer access (range-checked before
+// any byte is read). Failures throw GltfError naming the file and the field.
+//
+// Result: one entity per node of the default scene with Transform (+ Parent),
+// Name, and MeshInstance / Camera / PunctualLight as the node has them; the
+// SceneAssets resource holds meshes (one per glTF mesh, shared by every node
+// that uses it), materials, textures and the environment light read from
+// scenes[s].extras.environment (docs/scene-format.md).
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "engine/ecs/world.h"
+
+namespace engine::scene {
+
+class GltfError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct GltfLoadOptions {
+  std::uint64_t max_file_bytes = 1ull << 30;  // per file: the .gltf/.glb, each buffer, each image
+  int max_json_depth = 64;
+  int max_texture_dimension = 16384;
+  bool load_environment = true;
+};
+
+struct GltfLoadResult {
+  std::vector<ecs::Entity> entities;  // in node order of the default scene (depth first)
+  std::size_t mesh_count = 0;
+  std::size_t triangle_count = 0;
+  std::vector<std::string> warnings;
+};
+
+GltfLoadResult load_gltf(ecs::World& world, const std::filesystem::path& path, const GltfLoadOptions& options = {});
+
+}  // namespace engine::scene
