@@ -441,6 +441,7 @@ GltfLoadResult load_gltf(ecs::World& world, const fs::path& path, const GltfLoad
     if (!kSupportedExtensions.contains(ext)) c.fail("extensionsRequired", "extension '" + ext + "' is not supported");
 
   SceneAssets sa;
+  sa.generation = next_scene_generation();
   sa.source = path;
   sa.textures = load_textures(c);
   sa.materials = load_materials(c);

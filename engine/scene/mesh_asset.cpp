@@ -1,8 +1,16 @@
 #include "engine/scene/mesh_asset.h"
 
+#include <atomic>
 #include <limits>
 
+#include "engine/scene/scene_assets.h"
+
 namespace engine::scene {
+
+std::uint64_t next_scene_generation() {
+  static std::atomic<std::uint64_t> next{1};
+  return next.fetch_add(1);
+}
 
 void MeshAsset::compute_bounds() {
   if (positions.empty()) {

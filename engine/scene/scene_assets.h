@@ -4,6 +4,9 @@
 #include <memory>
 #include <optional>
 #include <vector>
+#include <cstdint>
+
+
 
 #include "engine/material/material.h"
 #include "engine/scene/environment.h"
@@ -13,11 +16,16 @@
 namespace engine::scene {
 
 struct SceneAssets {
+  // Unique per loaded scene, so mirrors (ray tracing, GPU) notice a reload.
+  std::uint64_t generation = 0;
   std::filesystem::path source;
   std::vector<std::shared_ptr<const MeshAsset>> meshes;
   std::vector<material::Material> materials;
   std::vector<Texture> textures;
   std::optional<Environment> environment;
 };
+
+// Next value for SceneAssets::generation.
+std::uint64_t next_scene_generation();
 
 }  // namespace engine::scene

@@ -1,0 +1,85 @@
+#pragma once
+// Embree scene mirrored from the ECS. One RTCScene per mesh asset (built
+// once) and a dynamic top-level scene with one instance per entity that has
+// MeshInstance + WorldTransform. Moving an entity costs
+// rtcSetGeometryTransform and a top-level commit, never a mesh rebuild.
+//
+// Queries are thread-safe between syncs. Rays with non-finite origin or
+// direction are rejected before Embree sees them (it does not check) and
+// counted in rejected_rays().
+#include <atomic>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "engine/ecs/entity.h"
+#include "engine/rt/ray.h"
+#include "engine/scene/scene_assets.h"
+#include "engine/transform/transform.h"
+
+namespace engine::rt {
+
+class RtError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct InstanceRecord {
+  ecs::Entity entity;
+  std::uint32_t mesh = 0;
+  transform::Similarity to_world;
+  bool active = false;
+};
+
+struct RtStats {
+  std::size_t blas_builds = 0;        // mesh scenes built so far
+  std::size_t instances_added = 0;
+  std::size_t instances_moved = 0;
+  std::size_t instances_removed = 0;
+  std::size_t top_level_commits = 0;
+};
+
+class RtScene {
+ public:
+  RtScene();
+  ~RtScene();
+  RtScene(const RtScene&) = delete;
+  RtScene& operator=(const RtScene&) = delete;
+
+  // Mirror maintenance (called by the sync system; not thread-safe).
+  // The assets must outlive their use here; a different pointer or
+  // generation drops every instance and mesh scene.
+  void set_assets(const scene::SceneAssets* assets);
+  void upsert_instance(ecs::Entity e, std::uint32_t mesh, const transform::Similarity& to_world);
+  void remove_instance(ecs::Entity e);
+  void commit();
+
+  // Queries.
+  bool intersect(const Ray& ray, Hit& hit) const;
+  bool occluded(const Ray& ray) const;
+
+  [[nodiscard]] const InstanceRecord* instance(std::uint32_t id) const;
+  [[nodiscard]] const InstanceRecord* instance_of(ecs::Entity e) const;
+  [[nodiscard]] const scene::SceneAssets* assets() const { return assets_; }
+  [[nodiscard]] const RtStats& stats() const { return stats_; }
+  [[nodiscard]] std::uint64_t rejected_rays() const { return rejected_.load(std::memory_order_relaxed); }
+  [[nodiscard]] bool empty() const { return entity_to_id_.empty(); }
+  // World-space bounds of all instances (valid after commit()).
+  [[nodiscard]] glm::vec3 bounds_min() const { return bounds_min_; }
+  [[nodiscard]] glm::vec3 bounds_max() const { return bounds_max_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  const scene::SceneAssets* assets_ = nullptr;
+  std::uint64_t generation_ = 0;
+  std::vector<InstanceRecord> instances_;  // by top-level geometry id
+  std::unordered_map<ecs::Entity, std::uint32_t> entity_to_id_;
+  RtStats stats_;
+  bool dirty_ = false;
+  glm::vec3 bounds_min_{0.0f}, bounds_max_{0.0f};
+  mutable std::atomic<std::uint64_t> rejected_{0};
+};
+
+}  // namespace engine::rt
