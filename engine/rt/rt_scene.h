@@ -60,6 +60,12 @@ class RtScene {
   bool occluded(const Ray& ray) const;
 
   [[nodiscard]] const InstanceRecord* instance(std::uint32_t id) const;
+  // Calls fn(const InstanceRecord&) for every live instance, in id order.
+  template <class Fn>
+  void for_each_instance(Fn&& fn) const {
+    for (const InstanceRecord& r : instances_)
+      if (r.active) fn(r);
+  }
   [[nodiscard]] const InstanceRecord* instance_of(ecs::Entity e) const;
   [[nodiscard]] const scene::SceneAssets* assets() const { return assets_; }
   [[nodiscard]] const RtStats& stats() const { return stats_; }

@@ -1,0 +1,50 @@
+#include "engine/render/camera_rays.h"
+
+#include <array>
+#include <cmath>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "engine/math/distribution.h"
+#include "engine/math/sampling.h"
+
+namespace engine::render {
+
+CameraRays::CameraRays(const scene::Camera& camera, const transform::Similarity& to_world, int width, int height)
+    : origin_(to_world.translation),
+      rotation_(glm::mat3_cast(to_world.rotation)),
+      width_(width),
+      height_(height) {
+  tan_half_y_ = std::tan(0.5f * camera.yfov_radians);
+  const float aspect = static_cast<float>(width) / static_cast<float>(height);
+  tan_half_x_ = tan_half_y_ * aspect;
+}
+
+rt::Ray CameraRays::generate(glm::vec2 film) const {
+  const float sx = (2.0f * film.x / static_cast<float>(width_) - 1.0f) * tan_half_x_;
+  const float sy = (1.0f - 2.0f * film.y / static_cast<float>(height_)) * tan_half_y_;
+  rt::Ray r;
+  r.origin = origin_;
+  r.direction = glm::normalize(rotation_ * glm::vec3(sx, sy, -1.0f));
+  return r;
+}
+
+glm::vec2 sample_pixel_filter(glm::vec2 u, float width) {
+  // Tabulated inverse CDF of the 1D Blackman-Harris window over [-w/2, w/2].
+  static const math::Distribution1D table = [] {
+    constexpr int n = 256;
+    std::array<float, n> f{};
+    for (int i = 0; i < n; ++i) {
+      const double x = (i + 0.5) / n;  // window position in [0, 1]
+      const double a = 2.0 * math::kPi * x;
+      f[static_cast<std::size_t>(i)] =
+          static_cast<float>(0.35875 - 0.48829 * std::cos(a) + 0.14128 * std::cos(2 * a) - 0.01168 * std::cos(3 * a));
+    }
+    return math::Distribution1D(f);
+  }();
+  const float x = table.sample_continuous(u.x, nullptr, nullptr);
+  const float y = table.sample_continuous(u.y, nullptr, nullptr);
+  return {(x - 0.5f) * width, (y - 0.5f) * width};
+}
+
+}  // namespace engine::render

@@ -1,0 +1,156 @@
+#include "engine/render/path_tracer.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+#include "engine/jobs/parallel_for.h"
+#include "engine/render/surface.h"
+
+namespace engine::render {
+
+namespace {
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+float max_component(const glm::vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
+bool black(const glm::vec3& v) { return v.x <= 0 && v.y <= 0 && v.z <= 0; }
+}  // namespace
+
+const char* pass_name(Pass p) {
+  switch (p) {
+    case Pass::Direct: return "direct";
+    case Pass::Gi: return "gi";
+    default: return "full";
+  }
+}
+
+PathTracer::PathTracer(const rt::RtScene& scene, const LightSet& lights, CameraRays camera, int width, int height,
+                       PathTracerSettings settings)
+    : scene_(scene),
+      lights_(lights),
+      camera_(camera),
+      width_(width),
+      height_(height),
+      settings_(settings),
+      sum_full_(static_cast<std::size_t>(width) * height, glm::dvec3(0.0)),
+      sum_direct_(sum_full_.size(), glm::dvec3(0.0)),
+      sum_gi_(sum_full_.size(), glm::dvec3(0.0)) {}
+
+PathRadiance PathTracer::trace(rt::Ray ray, math::Pcg32& rng) const {
+  PathRadiance L;
+  glm::vec3 beta(1.0f);
+  float prev_bsdf_pdf = 0.0f;
+  const scene::Environment* env = lights_.environment();
+  // Light reaching scattering vertex k straight from an emitter is "direct"
+  // when k == 0 (the camera-visible point); emission seen by the camera is
+  // direct too. emitter_vertex = index of the vertex whose incoming light it is + 1.
+  auto add = [&](const glm::vec3& c, int emitter_vertex) {
+    L.full += c;
+    (emitter_vertex <= 1 ? L.direct : L.gi) += c;
+  };
+
+  for (int depth = 0;; ++depth) {
+    rt::Hit hit;
+    if (!scene_.intersect(ray, hit)) {
+      if (env) {
+        const glm::vec3 le = env->radiance(ray.direction);
+        const float w = depth == 0 ? 1.0f : math::power_heuristic(prev_bsdf_pdf, lights_.pdf_environment(ray.direction));
+        add(beta * le * w, depth);
+      }
+      break;
+    }
+    const Surface s = make_surface(scene_, hit, ray.direction);
+    if (!black(s.emission)) {
+      float w = 1.0f;
+      if (depth > 0) {
+        const float light_pdf = lights_.pdf_area_light(hit.entity, hit.primitive, ray.direction, hit.t, s.geometric_normal);
+        w = math::power_heuristic(prev_bsdf_pdf, light_pdf);
+      }
+      add(beta * s.emission * w, depth);
+    }
+    if (depth >= settings_.max_depth) break;
+
+    const glm::vec3 wo = s.frame.to_local(-ray.direction);
+    if (wo.z <= 0) break;  // the shading normal disagrees with the view: no reflection
+    const glm::vec3 origin = rt::offset_ray_origin(s.position, s.geometric_normal);
+
+    // Next-event estimation.
+    LightSample ls;
+    const float u_sel = rng.next_float();
+    const glm::vec2 u_light(rng.next_float(), rng.next_float());
+    if (lights_.sample(s.position, u_sel, u_light, ls) && glm::dot(ls.direction, s.geometric_normal) > 0) {
+      const glm::vec3 wi = s.frame.to_local(ls.direction);
+      const glm::vec3 f = wi.z > 0 ? material::brdf_eval(s.brdf, wo, wi) : glm::vec3(0.0f);
+      if (!black(f) && !black(ls.radiance)) {
+        rt::Ray shadow{origin, ls.direction, 0.0f,
+                       std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f)};
+        if (!scene_.occluded(shadow)) {
+          const float w = ls.delta ? 1.0f : math::power_heuristic(ls.pdf, material::brdf_pdf(s.brdf, wo, wi));
+          const glm::vec3 c = beta * f * wi.z * ls.radiance * (ls.delta ? w : w / ls.pdf);
+          add(c, depth + 1);
+        }
+      }
+    }
+
+    // Continue the path by sampling the BRDF.
+    material::BrdfSample bs;
+    const glm::vec2 u_brdf(rng.next_float(), rng.next_float());
+    const float u_lobe = rng.next_float();
+    if (!material::brdf_sample(s.brdf, wo, u_brdf, u_lobe, bs)) break;
+    const glm::vec3 dir = s.frame.to_world(bs.wi);
+    if (glm::dot(dir, s.geometric_normal) <= 0) break;
+    beta *= bs.f * (bs.wi.z / bs.pdf);
+    prev_bsdf_pdf = bs.pdf;
+    if (depth + 1 >= settings_.roulette_start) {
+      const float q = std::max(0.05f, 1.0f - max_component(beta));
+      if (rng.next_float() < q) break;
+      beta /= 1.0f - q;
+    }
+    if (black(beta)) break;
+    ray = rt::Ray{origin, dir};
+  }
+  return L;
+}
+
+void PathTracer::render(int spp, const std::function<void(int, int)>& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  std::atomic<std::uint64_t> discarded{0};
+  const int target = spp_ + spp;
+  while (spp_ < target) {
+    const int batch = std::min(settings_.batch_spp, target - spp_);
+    const int first = spp_;
+    jobs::parallel_for(0, height_, 1, [&](int y0, int y1) {
+      for (int y = y0; y < y1; ++y)
+        for (int x = 0; x < width_; ++x) {
+          const std::size_t pixel = static_cast<std::size_t>(y) * width_ + x;
+          for (int s = first; s < first + batch; ++s) {
+            math::Pcg32 rng = math::make_rng(settings_.seed, pixel, static_cast<std::uint64_t>(s));
+            const glm::vec2 jitter = sample_pixel_filter({rng.next_float(), rng.next_float()}, settings_.filter_width);
+            const rt::Ray ray = camera_.generate(glm::vec2(x + 0.5f, y + 0.5f) + jitter);
+            const PathRadiance L = trace(ray, rng);
+            if (!finite(L.full) || !finite(L.direct) || !finite(L.gi)) {
+              discarded.fetch_add(1, std::memory_order_relaxed);
+              continue;  // counts as a zero sample
+            }
+            sum_full_[pixel] += glm::dvec3(L.full);
+            sum_direct_[pixel] += glm::dvec3(L.direct);
+            sum_gi_[pixel] += glm::dvec3(L.gi);
+          }
+        }
+    });
+    spp_ += batch;
+    if (progress) progress(spp_ - (target - spp), spp);
+  }
+  stats_.samples += static_cast<std::uint64_t>(spp) * width_ * height_;
+  stats_.discarded_non_finite += discarded.load();
+  stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+image::ImageRGB PathTracer::image(Pass pass) const {
+  const auto& sums = pass == Pass::Direct ? sum_direct_ : pass == Pass::Gi ? sum_gi_ : sum_full_;
+  image::ImageRGB out(width_, height_);
+  const double inv = spp_ > 0 ? 1.0 / spp_ : 0.0;
+  for (std::size_t i = 0; i < sums.size(); ++i) out.pixels[i] = glm::vec3(sums[i] * inv);
+  return out;
+}
+
+}  // namespace engine::render

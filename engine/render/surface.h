@@ -1,0 +1,31 @@
+#pragma once
+// Shading data at a ray hit: world-space position and normals (both turned
+// to face the incoming ray, so every surface is two-sided as in Cycles),
+// texture coordinates, and the material evaluated there.
+#include "engine/material/brdf.h"
+#include "engine/math/sampling.h"
+#include "engine/rt/rt_scene.h"
+
+namespace engine::render {
+
+struct Surface {
+  glm::vec3 position{0.0f};
+  glm::vec3 geometric_normal{0.0f, 0.0f, 1.0f};  // unit, facing the incoming ray
+  glm::vec3 shading_normal{0.0f, 0.0f, 1.0f};    // unit, same side as geometric_normal
+  glm::vec2 uv{0.0f};
+  glm::vec3 emission{0.0f};
+  material::BrdfParams brdf;
+  std::uint32_t material = 0;
+  float area_scale = 1.0f;  // world area / object area (uniform scale squared)
+  math::Frame frame;        // around shading_normal
+};
+
+// incoming_dir: the direction of the ray that found the hit.
+Surface make_surface(const rt::RtScene& scene, const rt::Hit& hit, const glm::vec3& incoming_dir);
+
+// The material at a point on a mesh (base colour, roughness, ... from
+// factors and textures). Shared by the renderer and the bake.
+material::BrdfParams evaluate_material(const scene::SceneAssets& assets, std::uint32_t material, glm::vec2 uv);
+glm::vec3 evaluate_emission(const scene::SceneAssets& assets, std::uint32_t material, glm::vec2 uv);
+
+}  // namespace engine::render

@@ -1,0 +1,164 @@
+// Known-answer tests for the reference path tracer (pbrt style): analytic
+// radiance of a diffuse sphere under a uniform sky, the GI furnace
+// L = Le / (1 - a), a point light's analytic irradiance, full = direct + gi
+// across independent renders, and thread-count-independent determinism.
+#include <gtest/gtest.h>
+
+#include "engine/app/app.h"
+#include "engine/jobs/job_system.h"
+#include "engine/math/sampling.h"
+#include "engine/render/path_tracer.h"
+#include "engine/rt/rt_plugin.h"
+#include "engine/scene/procedural.h"
+#include "engine/scene/scene_assets.h"
+
+using namespace engine;
+using namespace engine::render;
+using engine::ecs::Entity;
+
+namespace {
+
+material::Material lambert(glm::vec3 albedo, glm::vec3 emission = glm::vec3(0.0f)) {
+  material::Material m;
+  m.base_color_factor = glm::vec4(albedo, 1.0f);
+  m.metallic_factor = 0.0f;
+  m.roughness_factor = 1.0f;
+  m.specular_factor = 0.0f;  // pure Lambert: albedo is exactly the base colour
+  m.emissive_factor = glm::min(emission, glm::vec3(1.0f));
+  m.emissive_strength = 1.0f;
+  return m;
+}
+
+// A world holding the given meshes (one entity each, at the origin) and a camera.
+struct Scene {
+  app::App app{app::AppOptions{.jobs = {.threads = 2}}};
+  Entity camera;
+
+  Scene(std::vector<scene::MeshAsset> meshes, std::vector<material::Material> materials, glm::vec3 eye,
+        glm::quat look = glm::quat(1, 0, 0, 0), std::optional<scene::Environment> env = std::nullopt) {
+    scene::SceneAssets assets;
+    assets.generation = scene::next_scene_generation();
+    for (auto& m : meshes) assets.meshes.push_back(std::make_shared<scene::MeshAsset>(std::move(m)));
+    assets.materials = std::move(materials);
+    assets.environment = std::move(env);
+    app.world().insert_resource<scene::SceneAssets>(std::move(assets));
+    app.add_plugin<rt::RtPlugin>();
+    for (std::uint32_t i = 0; i < app.world().resource<scene::SceneAssets>().meshes.size(); ++i) {
+      const Entity e = app.world().spawn();
+      app.world().emplace<transform::Transform>(e);
+      app.world().emplace<scene::MeshInstance>(e, scene::MeshInstance{i});
+    }
+    camera = app.world().spawn();
+    transform::Transform ct = transform::Transform::from_translation(eye);
+    ct.rotation = look;
+    app.world().emplace<transform::Transform>(camera, ct);
+    app.world().emplace<scene::Camera>(camera, scene::Camera{.yfov_radians = 0.5f});
+  }
+
+  Entity add_point_light(glm::vec3 at, float intensity) {
+    const Entity e = app.world().spawn();
+    app.world().emplace<transform::Transform>(e, transform::Transform::from_translation(at));
+    app.world().emplace<scene::PunctualLight>(e, scene::PunctualLight{.intensity = intensity});
+    return e;
+  }
+
+  // Renders all passes at w x h, spp samples, on `threads` threads.
+  std::array<image::ImageRGB, 3> render(int w, int h, int spp, std::uint64_t seed, int threads = 2) {
+    app.update();  // propagate transforms, sync Embree
+    auto& world = app.world();
+    const auto& rt_scene = world.resource<rt::RtScene>();
+    const auto& assets = world.resource<scene::SceneAssets>();
+    const LightSet lights(rt_scene, gather_punctual_lights(world), assets.environment ? &*assets.environment : nullptr);
+    const CameraRays cam(world.get<scene::Camera>(camera), world.get<transform::WorldTransform>(camera), w, h);
+    PathTracer pt(rt_scene, lights, cam, w, h, PathTracerSettings{.seed = seed});
+    jobs::JobSystem jobs({.threads = threads});
+    jobs.run([&] { pt.render(spp); });
+    EXPECT_EQ(pt.stats().discarded_non_finite, 0u);
+    return {pt.image(Pass::Full), pt.image(Pass::Direct), pt.image(Pass::Gi)};
+  }
+};
+
+double mean_luminance(const image::ImageRGB& img, int x0, int y0, int x1, int y1) {
+  double s = 0;
+  int n = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x, ++n) s += math::luminance(img.at(x, y));
+  return s / n;
+}
+
+}  // namespace
+
+TEST(PathTracer, DiffuseSphereUnderUniformSkyHasRadianceAlbedoTimesSky) {
+  // A convex Lambertian sphere of albedo a under uniform radiance Ls
+  // reflects exactly a * Ls everywhere (no interreflection); all of it is
+  // direct light. Pixels that see the sky read Ls.
+  const float a = 0.6f, sky = 1.5f;
+  Scene s({scene::make_uv_sphere(1.0f, 128, 64)}, {lambert(glm::vec3(a))}, {0, 0, 6}, glm::quat(1, 0, 0, 0),
+          scene::uniform_environment(glm::vec3(sky)));
+  const auto [full, direct, gi] = s.render(32, 32, 64, 7);
+  // The sphere (radius 1 at distance 6, yfov 0.5) spans ~ +-11 px from the centre; take the middle 8x8.
+  const double sphere = mean_luminance(full, 12, 12, 20, 20);
+  EXPECT_NEAR(sphere, a * sky, 0.02 * a * sky) << "expected a * Ls = " << a * sky << ", got " << sphere;
+  EXPECT_NEAR(mean_luminance(direct, 12, 12, 20, 20), a * sky, 0.02 * a * sky);
+  EXPECT_NEAR(mean_luminance(gi, 12, 12, 20, 20), 0.0, 1e-6) << "a convex object under a sky has no GI";
+  EXPECT_NEAR(mean_luminance(full, 0, 0, 3, 3), sky, 1e-5) << "corner pixels see the sky directly";
+}
+
+TEST(PathTracer, FurnaceWithGiConvergesToEmissionOverOneMinusAlbedo) {
+  // Inside a closed room whose walls all emit Le and reflect with albedo a,
+  // L = Le + a L, so L = Le / (1 - a); direct = Le (1 + a) (the emitter seen
+  // plus its light reflected once), gi = Le a^2 / (1 - a).
+  for (float a : {0.5f, 0.8f}) {
+    const float le = 1.0f;
+    Scene s({scene::make_box(glm::vec3(2.0f), /*inward=*/true)}, {lambert(glm::vec3(a), glm::vec3(le))}, {0.3f, 0.2f, 0.1f});
+    const auto [full, direct, gi] = s.render(16, 16, 256, 3);
+    const double L = mean_luminance(full, 0, 0, 16, 16), D = mean_luminance(direct, 0, 0, 16, 16),
+                 G = mean_luminance(gi, 0, 0, 16, 16);
+    EXPECT_NEAR(L, le / (1 - a), 0.02 * le / (1 - a)) << "albedo " << a << ": expected " << le / (1 - a) << " got " << L;
+    EXPECT_NEAR(D, le * (1 + a), 0.02 * le * (1 + a)) << "albedo " << a;
+    EXPECT_NEAR(G, le * a * a / (1 - a), 0.03 * le * a * a / (1 - a)) << "albedo " << a;
+  }
+}
+
+TEST(PathTracer, PointLightOverAPlaneMatchesTheInverseSquareLaw) {
+  // Camera looks straight down at a Lambertian floor; a point light of
+  // intensity I at height h above the centre: L = a / pi * I / h^2 there.
+  const float a = 0.5f, I = 20.0f, h = 2.0f;
+  Scene s({scene::make_quad({50, 50})}, {lambert(glm::vec3(a))}, {0, 5, 0},
+          glm::angleAxis(-glm::half_pi<float>(), glm::vec3(1, 0, 0)));
+  s.add_point_light({0, h, 0}, I);
+  const auto [full, direct, gi] = s.render(33, 33, 16, 1);
+  const double expected = a / math::kPi * I / (h * h);
+  const double got = mean_luminance(direct, 16, 16, 17, 17);
+  EXPECT_NEAR(got, expected, 0.01 * expected) << "expected " << expected << " got " << got;
+  EXPECT_NEAR(mean_luminance(gi, 0, 0, 33, 33), 0.0, 1e-9) << "an open plane under one light has no GI";
+}
+
+TEST(PathTracer, FullEqualsDirectPlusGiAcrossIndependentRenders) {
+  // A Cornell-like room: white walls, red and green sides, an area light.
+  std::vector<scene::MeshAsset> meshes = {scene::make_box({1, 1, 1}, true, 0), scene::make_box({0.3f, 0.3f, 0.3f}, false, 1)};
+  auto light = scene::make_quad({0.3f, 0.3f}, 2);
+  for (auto& p : light.positions) p.y = 0.99f;
+  for (auto& n : light.normals) n = {0, -1, 0};
+  meshes.push_back(light);
+  Scene s(meshes, {lambert(glm::vec3(0.7f)), lambert({0.7f, 0.2f, 0.2f}), lambert(glm::vec3(0.5f), glm::vec3(1.0f))},
+          {0, 0, 0.95f});
+  auto first = s.render(24, 24, 64, 11);
+  auto second = s.render(24, 24, 64, 12);
+  const double full = mean_luminance(first[0], 0, 0, 24, 24);
+  const double parts = mean_luminance(second[1], 0, 0, 24, 24) + mean_luminance(second[2], 0, 0, 24, 24);
+  EXPECT_NEAR(full, parts, 0.02 * full) << "full " << full << " vs direct + gi " << parts;
+  EXPECT_GT(mean_luminance(second[2], 0, 0, 24, 24), 0.05 * full) << "a closed room must have GI";
+}
+
+TEST(PathTracer, SameSeedSameImageWhateverTheThreadCount) {
+  Scene s({scene::make_box({1, 1, 1}, true), scene::make_uv_sphere(0.4f, 32, 16, 1)},
+          {lambert(glm::vec3(0.6f), glm::vec3(0.3f)), lambert({0.2f, 0.4f, 0.9f})}, {0, 0, 0.9f});
+  const auto one = s.render(16, 12, 8, 5, 1);
+  const auto two = s.render(16, 12, 8, 5, 2);
+  for (int p = 0; p < 3; ++p)
+    for (std::size_t i = 0; i < one[p].size(); ++i)
+      ASSERT_EQ(one[p].pixels[i], two[p].pixels[i]) << "pass " << p << " pixel " << i;
+  const auto other_seed = s.render(16, 12, 8, 6, 2);
+  EXPECT_NE(one[0].pixels, other_seed[0].pixels) << "a different seed must give different noise";
+}
