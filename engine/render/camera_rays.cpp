@@ -44,7 +44,7 @@ glm::vec2 sample_pixel_filter(glm::vec2 u, float width) {
   }();
   const float x = table.sample_continuous(u.x, nullptr, nullptr);
   const float y = table.sample_continuous(u.y, nullptr, nullptr);
-  return {(x - 0.5f) * width, (y - 0.5f) * width};
+  return {(2.0f * x - 1.0f) * width, (2.0f * y - 1.0f) * width};
 }
 
 }  // namespace engine::render

@@ -20,9 +20,11 @@ struct CameraRays {
   int width_, height_;
 };
 
-// Samples a pixel-filter offset in [-width/2, width/2]^2 (separable
-// Blackman-Harris, the shape Cycles uses; width 1.5 px by default), so the
-// estimate converges to the filtered image without per-sample weights.
+// Samples a pixel-filter offset (separable Blackman-Harris, sampled by its
+// tabulated inverse CDF, so the estimate converges to the filtered image
+// without per-sample weights). `width` follows Cycles' "filter width": for
+// Blackman-Harris Cycles doubles it (film.cpp, width *= 2), so the window
+// spans [-width, width]; 1.5 px therefore covers 3 px.
 glm::vec2 sample_pixel_filter(glm::vec2 u, float width = 1.5f);
 
 }  // namespace engine::render

@@ -1,0 +1,226 @@
+// Generates the bundled scenes deterministically (same bytes every run):
+//   test_scenes/cornell_box/   Cornell box with an emissive area light
+//   test_scenes/furnace/       a diffuse sphere under a uniform white sky
+//   levels/living_room/        the sample level: a room with a window lit by
+//                              a sky map, a ceiling area light, large diffuse
+//                              pieces, a glossy metal sphere, a mirror panel
+//                              and a rough plastic object
+//
+//   content_generator --out DIR
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "engine/image/exr.h"
+#include "engine/math/sampling.h"
+#include "engine/scene/environment.h"
+#include "engine/scene/gltf_writer.h"
+#include "engine/scene/procedural.h"
+
+namespace {
+
+using namespace engine;
+using scene::GltfNodeDesc;
+using scene::GltfSceneDesc;
+
+material::Material diffuse(std::string name, glm::vec3 albedo) {
+  material::Material m;
+  m.name = std::move(name);
+  m.base_color_factor = glm::vec4(albedo, 1.0f);
+  m.metallic_factor = 0.0f;
+  m.roughness_factor = 1.0f;
+  m.specular_factor = 0.0f;  // pure Lambertian, as the converted Bitterli scenes
+  m.specular_color_factor = glm::vec3(0.0f);
+  m.double_sided = true;
+  return m;
+}
+material::Material emitter(std::string name, glm::vec3 color, float strength) {
+  material::Material m = diffuse(std::move(name), glm::vec3(0.0f));
+  m.emissive_factor = color;
+  m.emissive_strength = strength;
+  return m;
+}
+material::Material metal(std::string name, glm::vec3 f0, float roughness) {
+  material::Material m;
+  m.name = std::move(name);
+  m.base_color_factor = glm::vec4(f0, 1.0f);
+  m.metallic_factor = 1.0f;
+  m.roughness_factor = roughness;
+  m.double_sided = true;
+  return m;
+}
+material::Material plastic(std::string name, glm::vec3 albedo, float roughness) {
+  material::Material m;
+  m.name = std::move(name);
+  m.base_color_factor = glm::vec4(albedo, 1.0f);
+  m.metallic_factor = 0.0f;
+  m.roughness_factor = roughness;
+  m.double_sided = true;
+  return m;
+}
+
+// Adds a mesh and a node placing it; returns the node index.
+int add(GltfSceneDesc& s, scene::MeshAsset mesh, std::string name, glm::vec3 at, glm::quat rot = glm::quat(1, 0, 0, 0)) {
+  mesh.name = name;
+  s.meshes.push_back(std::move(mesh));
+  GltfNodeDesc n;
+  n.name = std::move(name);
+  n.mesh = static_cast<int>(s.meshes.size() - 1);
+  n.transform.translation = at;
+  n.transform.rotation = rot;
+  s.nodes.push_back(n);
+  s.roots.push_back(static_cast<int>(s.nodes.size() - 1));
+  return static_cast<int>(s.nodes.size() - 1);
+}
+
+void add_camera(GltfSceneDesc& s, glm::vec3 eye, glm::vec3 target, float yfov_degrees, float aspect) {
+  GltfNodeDesc n;
+  n.name = "Camera";
+  n.transform.translation = eye;
+  // Camera looks down its local -Z with +Y up.
+  n.transform.rotation = glm::quatLookAtRH(glm::normalize(target - eye), glm::vec3(0, 1, 0));
+  n.camera = scene::Camera{.yfov_radians = glm::radians(yfov_degrees), .aspect_ratio = aspect, .znear = 0.05f};
+  s.nodes.push_back(n);
+  s.roots.push_back(static_cast<int>(s.nodes.size() - 1));
+}
+
+scene::MeshAsset box(glm::vec3 half, std::uint32_t material) { return scene::make_box(half, false, material); }
+
+// ---- Cornell box ------------------------------------------------------------
+
+GltfSceneDesc cornell_box() {
+  GltfSceneDesc s;
+  s.materials = {diffuse("White", {0.725f, 0.71f, 0.68f}), diffuse("Red", {0.63f, 0.065f, 0.05f}),
+                 diffuse("Green", {0.14f, 0.45f, 0.091f}), emitter("Light", {1.0f, 0.706f, 0.235f}, 17.0f)};
+  // Walls as thin slabs: floor, ceiling, back, left (red), right (green). The front is open.
+  add(s, box({1.0f, 0.01f, 1.0f}, 0), "Floor", {0, -0.01f, 0});
+  add(s, box({1.0f, 0.01f, 1.0f}, 0), "Ceiling", {0, 2.01f, 0});
+  add(s, box({1.0f, 1.0f, 0.01f}, 0), "Back", {0, 1, -1.01f});
+  add(s, box({0.01f, 1.0f, 1.0f}, 1), "Left", {-1.01f, 1, 0});
+  add(s, box({0.01f, 1.0f, 1.0f}, 2), "Right", {1.01f, 1, 0});
+  add(s, box({0.3f, 0.6f, 0.3f}, 0), "TallBox", {-0.33f, 0.6f, -0.29f}, glm::angleAxis(glm::radians(17.0f), glm::vec3(0, 1, 0)));
+  add(s, box({0.3f, 0.3f, 0.3f}, 0), "ShortBox", {0.33f, 0.3f, 0.28f}, glm::angleAxis(glm::radians(-17.0f), glm::vec3(0, 1, 0)));
+  scene::MeshAsset light = scene::make_quad({0.235f, 0.19f}, 3);
+  for (auto& n : light.normals) n = {0, -1, 0};  // face down into the box
+  for (auto& t : light.triangles) std::swap(t.y, t.z);
+  add(s, light, "AreaLight", {0, 1.998f, 0});
+  add_camera(s, {0, 1, 3.9f}, {0, 1, 0}, 39.3f, 1.0f);
+  return s;
+}
+
+// ---- furnace ------------------------------------------------------------------
+
+GltfSceneDesc furnace() {
+  GltfSceneDesc s;
+  s.materials = {diffuse("Albedo08", glm::vec3(0.8f))};
+  add(s, scene::make_uv_sphere(1.0f, 96, 48, 0), "Sphere", {0, 0, 0});
+  add_camera(s, {0, 0, 4}, {0, 0, 0}, 40.0f, 1.0f);
+  s.environment = scene::GltfEnvironmentDesc{"white_sky.exr", 1.0f, glm::mat4(1.0f)};
+  return s;
+}
+
+// ---- sky for the sample level ------------------------------------------------------
+
+// A clear sky in the Mitsuba lat-long convention: blue zenith, pale horizon,
+// dark ground and a small bright sun.
+image::ImageRGB sky_map(glm::vec3 sun_dir) {
+  const int w = 256, h = 128;
+  image::ImageRGB img(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const glm::vec3 d = scene::Environment::uv_to_direction({(static_cast<float>(x) + 0.5f) / static_cast<float>(w), (static_cast<float>(y) + 0.5f) / static_cast<float>(h)});
+      glm::vec3 c;
+      if (d.y >= 0) {
+        const float t = std::pow(1.0f - d.y, 3.0f);
+        c = glm::mix(glm::vec3(0.25f, 0.45f, 0.9f), glm::vec3(0.95f, 0.95f, 1.0f), t) * 1.2f;
+      } else {
+        c = glm::vec3(0.25f, 0.22f, 0.2f);
+      }
+      const float cos_sun = glm::dot(d, sun_dir);
+      if (cos_sun > std::cos(glm::radians(2.5f))) c += glm::vec3(2000.0f, 1800.0f, 1500.0f);
+      img.at(x, y) = c;
+    }
+  return img;
+}
+
+GltfSceneDesc living_room() {
+  GltfSceneDesc s;
+  enum : std::uint32_t { Wall, Floor, Ceiling, Sofa, Wood, Rug, Gold, Mirror, BluePlastic, Lamp, Frame };
+  s.materials = {diffuse("Walls", {0.75f, 0.72f, 0.66f}),      diffuse("Floor", {0.45f, 0.3f, 0.18f}),
+                 diffuse("Ceiling", {0.85f, 0.85f, 0.85f}),    diffuse("Sofa", {0.3f, 0.38f, 0.5f}),
+                 diffuse("TableWood", {0.35f, 0.2f, 0.1f}),    diffuse("Rug", {0.6f, 0.15f, 0.12f}),
+                 metal("Gold", {1.0f, 0.78f, 0.34f}, 0.25f),   metal("Mirror", {0.95f, 0.95f, 0.95f}, 0.02f),
+                 plastic("BluePlastic", {0.08f, 0.3f, 0.7f}, 0.45f), emitter("CeilingLamp", {1.0f, 0.9f, 0.75f}, 12.0f),
+                 diffuse("MirrorFrame", {0.1f, 0.1f, 0.1f})};
+  // Room interior: x in [-3, 3], y in [0, 3], z in [-2.5, 2.5]; walls 0.1 thick.
+  add(s, box({3.1f, 0.05f, 2.6f}, Floor), "Floor", {0, -0.05f, 0});
+  add(s, box({3.1f, 0.05f, 2.6f}, Ceiling), "Ceiling", {0, 3.05f, 0});
+  add(s, box({3.1f, 1.5f, 0.05f}, Wall), "BackWall", {0, 1.5f, -2.55f});
+  add(s, box({3.1f, 1.5f, 0.05f}, Wall), "FrontWall", {0, 1.5f, 2.55f});
+  add(s, box({0.05f, 1.5f, 2.6f}, Wall), "LeftWall", {-3.05f, 1.5f, 0});
+  // Right wall (+X) with a window: z in [-1.4, 0.6], y in [0.8, 2.5].
+  add(s, box({0.05f, 0.4f, 2.6f}, Wall), "RightWallBelow", {3.05f, 0.4f, 0});
+  add(s, box({0.05f, 0.25f, 2.6f}, Wall), "RightWallAbove", {3.05f, 2.75f, 0});
+  add(s, box({0.05f, 0.85f, 0.55f}, Wall), "RightWallBack", {3.05f, 1.65f, -1.95f});
+  add(s, box({0.05f, 0.85f, 0.95f}, Wall), "RightWallFront", {3.05f, 1.65f, 1.55f});
+  // Furniture.
+  add(s, box({1.1f, 0.22f, 0.45f}, Sofa), "SofaSeat", {-1.6f, 0.22f, -1.9f});
+  add(s, box({1.1f, 0.4f, 0.12f}, Sofa), "SofaBack", {-1.6f, 0.62f, -2.33f});
+  add(s, box({1.6f, 0.01f, 1.1f}, Rug), "Rug", {-0.4f, 0.01f, -0.6f});
+  add(s, box({0.7f, 0.03f, 0.45f}, Wood), "TableTop", {-0.4f, 0.5f, -0.6f});
+  // Four legs sharing one mesh.
+  scene::MeshAsset leg = box({0.03f, 0.235f, 0.03f}, Wood);
+  leg.name = "TableLeg";
+  s.meshes.push_back(leg);
+  const int leg_mesh = static_cast<int>(s.meshes.size() - 1);
+  for (int i = 0; i < 4; ++i) {
+    GltfNodeDesc n;
+    n.name = "TableLeg" + std::to_string(i);
+    n.mesh = leg_mesh;
+    n.transform.translation = {-0.4f + (i % 2 ? 0.62f : -0.62f), 0.235f, -0.6f + (i / 2 ? 0.38f : -0.38f)};
+    s.nodes.push_back(n);
+    s.roots.push_back(static_cast<int>(s.nodes.size() - 1));
+  }
+  add(s, scene::make_uv_sphere(0.18f, 48, 24, Gold), "GoldSphere", {-0.6f, 0.71f, -0.55f});
+  add(s, box({0.2f, 0.2f, 0.2f}, BluePlastic), "PlasticCube", {1.4f, 0.2f, 0.4f},
+      glm::angleAxis(glm::radians(30.0f), glm::vec3(0, 1, 0)));
+  add(s, scene::make_uv_sphere(0.25f, 48, 24, BluePlastic), "PlasticBall", {1.0f, 0.25f, -1.3f});
+  // Mirror panel on the left wall, in a dark frame.
+  add(s, box({0.02f, 0.75f, 0.55f}, Frame), "MirrorFrame", {-2.98f, 1.5f, 0.3f});
+  add(s, box({0.01f, 0.7f, 0.5f}, Mirror), "MirrorPanel", {-2.95f, 1.5f, 0.3f});
+  // Ceiling lamp: an emissive panel facing down.
+  scene::MeshAsset lamp = scene::make_quad({0.3f, 0.3f}, Lamp);
+  for (auto& n : lamp.normals) n = {0, -1, 0};
+  for (auto& t : lamp.triangles) std::swap(t.y, t.z);
+  add(s, lamp, "CeilingLamp", {0.0f, 2.99f, 0.0f});
+  add_camera(s, {-2.4f, 1.6f, 2.2f}, {0.6f, 0.9f, -0.9f}, 60.0f, 16.0f / 9.0f);
+  s.environment = scene::GltfEnvironmentDesc{"sky.exr", 1.0f, glm::mat4(1.0f)};
+  return s;
+}
+
+int usage() {
+  std::fprintf(stderr, "usage: content_generator --out DIR\n");
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 3 || std::string(argv[1]) != "--out") return usage();
+  const std::filesystem::path out = argv[2];
+  try {
+    scene::write_gltf(out / "test_scenes/cornell_box/scene.gltf", cornell_box());
+    image::write_exr(out / "test_scenes/furnace/white_sky.exr", image::ImageRGB(8, 4, glm::vec3(1.0f)), image::ExrPixelType::Half);
+    scene::write_gltf(out / "test_scenes/furnace/scene.gltf", furnace());
+    const glm::vec3 sun = glm::normalize(glm::vec3(1.0f, 0.55f, -0.25f));
+    image::write_exr(out / "levels/living_room/sky.exr", sky_map(sun), image::ExrPixelType::Half);
+    scene::write_gltf(out / "levels/living_room/scene.gltf", living_room());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "content_generator: %s\n", e.what());
+    return 1;
+  }
+  std::printf("content written to %s\n", out.string().c_str());
+  return 0;
+}

@@ -1,0 +1,30 @@
+#include <cstdio>
+
+#include "cli/args.h"
+#include "cli/commands.h"
+#include "engine/image/exr.h"
+#include "engine/image/metrics.h"
+
+namespace transgi::cli {
+
+int run_compare(const std::vector<std::string>& argv) {
+  const Args args("compare", argv, {"heatmap", "heatmap-max"});
+  if (args.positional().size() != 2) throw UsageError("compare: expected two EXR files: A.exr B.exr (B is the reference)");
+  const auto a = engine::image::read_exr(args.positional()[0]);
+  const auto b = engine::image::read_exr(args.positional()[1]);
+  if (a.width != b.width || a.height != b.height)
+    throw std::runtime_error("image sizes differ: " + args.positional()[0] + " is " + std::to_string(a.width) + "x" +
+                             std::to_string(a.height) + ", " + args.positional()[1] + " is " + std::to_string(b.width) +
+                             "x" + std::to_string(b.height));
+  const auto m = engine::image::compare_images(a, b);
+  if (args.has("heatmap")) {
+    double used = 0;
+    const auto heat = engine::image::error_heatmap(a, b, args.number("heatmap-max", 0, 1e9, 0.0), &used);
+    engine::image::write_png(args.str("heatmap"), heat);
+    std::fprintf(stderr, "heat map: black = 0, white = %.4g mean absolute error (clamped linear RGB)\n", used);
+  }
+  std::printf("{\"rmse\": %.8g, \"l1\": %.8g, \"ssim\": %.8g, \"relmse\": %.8g}\n", m.rmse, m.l1, m.ssim, m.relmse);
+  return 0;
+}
+
+}  // namespace transgi::cli

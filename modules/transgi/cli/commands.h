@@ -1,0 +1,12 @@
+#pragma once
+#include <string>
+#include <vector>
+
+namespace transgi::cli {
+
+// Each returns the process exit code; they throw UsageError for bad options
+// and std::exception for failures at run time (main reports both in one line).
+int run_render(const std::vector<std::string>& args);
+int run_compare(const std::vector<std::string>& args);
+
+}  // namespace transgi::cli

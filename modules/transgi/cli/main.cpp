@@ -1,0 +1,44 @@
+// transgi: one executable for rendering, comparing, baking and evaluating.
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "cli/args.h"
+#include "cli/commands.h"
+
+namespace {
+void usage() {
+  std::fprintf(stderr,
+               "usage: transgi <command> [options]\n"
+               "  render   --scene S.gltf --method reference --pass full|direct|gi|all --spp N --width W --height H\n"
+               "           --out F.exr [--camera NAME] [--seed K] [--threads T] [--png F.png] [--exposure EV]\n"
+               "  compare  A.exr B.exr [--heatmap out.png] [--heatmap-max E]\n");
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    usage();
+    return 2;
+  }
+  const std::string command = argv[1];
+  const std::vector<std::string> args(argv + 2, argv + argc);
+  try {
+    if (command == "render") return transgi::cli::run_render(args);
+    if (command == "compare") return transgi::cli::run_compare(args);
+    if (command == "--help" || command == "help") {
+      usage();
+      return 0;
+    }
+    std::fprintf(stderr, "transgi: unknown command '%s'\n", command.c_str());
+    usage();
+    return 2;
+  } catch (const transgi::cli::UsageError& e) {
+    std::fprintf(stderr, "transgi %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "transgi %s: %s\n", command.c_str(), e.what());
+    return 1;
+  }
+}
