@@ -8,5 +8,6 @@ namespace transgi::cli {
 // and std::exception for failures at run time (main reports both in one line).
 int run_render(const std::vector<std::string>& args);
 int run_compare(const std::vector<std::string>& args);
+int run_tonemap(const std::vector<std::string>& args);
 
 }  // namespace transgi::cli

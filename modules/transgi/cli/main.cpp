@@ -13,7 +13,8 @@ void usage() {
                "usage: transgi <command> [options]\n"
                "  render   --scene S.gltf --method reference --pass full|direct|gi|all --spp N --width W --height H\n"
                "           --out F.exr [--camera NAME] [--seed K] [--threads T] [--png F.png] [--exposure EV]\n"
-               "  compare  A.exr B.exr [--heatmap out.png] [--heatmap-max E]\n");
+               "  compare  A.exr B.exr [--heatmap out.png] [--heatmap-max E]\n"
+               "  tonemap  IN.exr OUT.png [--exposure EV]\n");
 }
 }  // namespace
 
@@ -27,6 +28,7 @@ int main(int argc, char** argv) {
   try {
     if (command == "render") return transgi::cli::run_render(args);
     if (command == "compare") return transgi::cli::run_compare(args);
+    if (command == "tonemap") return transgi::cli::run_tonemap(args);
     if (command == "--help" || command == "help") {
       usage();
       return 0;
