@@ -6,7 +6,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config git
-  libtbb-dev libglm-dev libstb-dev libopenexr-dev libtinygltf-dev nlohmann-json3-dev libembree-dev
+  libtbb-dev libglm-dev libstb-dev libopenexr-dev libtinygltf-dev nlohmann-json3-dev libembree-dev libdnnl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 
