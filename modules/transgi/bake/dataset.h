@@ -1,0 +1,57 @@
+#pragma once
+// Training data for the neural transfer model: surface points sampled by
+// area over every mesh, each with several outgoing directions and their
+// ground-truth transfer (bake/transfer.h). Points, not samples, are split
+// into training and validation, so no validation target shares rays with a
+// training target.
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "bake/transfer.h"
+
+namespace transgi::bake {
+
+struct DatasetSettings {
+  // Surface points over the whole scene, split between meshes by area. Higher
+  // = better coverage of the transfer function, at the cost of bake time.
+  int points = 16384;
+  // Every mesh gets at least this many points, so small objects are learned too.
+  int min_points_per_mesh = 32;
+  // Outgoing directions per point; they share the point's rays. Higher = more
+  // view-dependence per traced ray, at the cost of fewer distinct points.
+  int outgoing_per_point = 8;
+  // Rays per point (the paper uses 2000). Higher = less noisy targets, at the cost of time.
+  int rays = 2000;
+  // Visibility distance t as a fraction of each mesh's bounding-box diagonal.
+  float visibility_fraction = 0.5f;
+  float validation_fraction = 0.05f;
+  std::uint64_t seed = 1;
+};
+
+struct TransferSample {
+  std::uint32_t mesh = 0;
+  std::uint32_t triangle = 0;
+  glm::vec2 barycentric{0.0f};
+  glm::vec3 normal{0.0f};  // object space, unit
+  glm::vec3 wo{0.0f};      // object space, unit
+  glm::vec3 albedo{0.0f};
+};
+
+struct TransferDataset {
+  std::vector<TransferSample> samples;  // training samples first, then validation
+  std::vector<float> targets;           // kTransferValues per sample
+  std::size_t training_count = 0;
+  double seconds = 0;
+
+  [[nodiscard]] const float* target(std::size_t i) const { return targets.data() + i * kTransferValues; }
+  [[nodiscard]] std::size_t validation_count() const { return samples.size() - training_count; }
+};
+
+// progress(points_done, points_total). Deterministic for a seed, whatever the thread count.
+TransferDataset generate_dataset(const engine::scene::SceneAssets& assets, const DatasetSettings& settings,
+                                 const std::function<void(std::size_t, std::size_t)>& progress = {});
+
+}  // namespace transgi::bake

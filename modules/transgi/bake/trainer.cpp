@@ -1,0 +1,235 @@
+#include "bake/trainer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace transgi::bake {
+
+using model::kTransferInputExtra;
+
+namespace {
+constexpr float kBeta1 = 0.9f, kBeta2 = 0.999f, kEps = 1e-8f;
+constexpr int kSnapshotEvery = 100;
+
+int band_of(int k) { return k < 1 ? 0 : k < 4 ? 1 : k < 9 ? 2 : k < 16 ? 3 : 4; }
+}  // namespace
+
+model::TransferModel make_untrained_model(const engine::scene::SceneAssets& assets, int latent_dim,
+                                          model::MlpLayout layout, std::uint64_t seed) {
+  layout.inputs = latent_dim + kTransferInputExtra;
+  layout.outputs = kTransferValues;
+  model::TransferModel m;
+  m.latent_dim = latent_dim;
+  m.decoder = model::Mlp(layout);
+  m.decoder.initialise(seed);
+  engine::math::Pcg32 rng(seed, 0x1a7e);
+  for (std::uint32_t i = 0; i < assets.meshes.size(); ++i) {
+    model::MeshLatents ml;
+    ml.name = assets.meshes[i]->name;
+    ml.content_hash = model::mesh_content_hash(assets, i);
+    ml.latents = model::make_latent_table(*assets.meshes[i], latent_dim);
+    for (float& v : ml.latents.values) v = 0.1f * (2.0f * rng.next_float() - 1.0f);
+    m.meshes.push_back(std::move(ml));
+  }
+  return m;
+}
+
+Trainer::Trainer(const TransferDataset& data, const engine::scene::SceneAssets& assets, model::TransferModel& model,
+                 TrainSettings settings)
+    : data_(data), assets_(assets), model_(model), settings_(std::move(settings)), rng_(settings_.seed, 0x7a41) {
+  if (data.training_count == 0) throw std::invalid_argument("the dataset has no training samples");
+  if (model.meshes.size() != assets.meshes.size()) throw std::invalid_argument("model and scene have different mesh counts");
+  for (const auto& m : model_.meshes) {
+    latent_offset_.push_back(latent_count_);
+    latent_count_ += m.latents.values.size();
+  }
+  m_.assign(parameter_count(), 0.0f);
+  v_.assign(parameter_count(), 0.0f);
+  grad_.assign(parameter_count(), 0.0f);
+  snapshot();
+}
+
+std::size_t Trainer::parameter_count() const { return model_.decoder.params().size() + latent_count_; }
+
+float* Trainer::latent_ptr(std::size_t flat) {
+  const auto it = std::upper_bound(latent_offset_.begin(), latent_offset_.end(), flat) - 1;
+  const std::size_t mesh = static_cast<std::size_t>(it - latent_offset_.begin());
+  return model_.meshes[mesh].latents.values.data() + (flat - *it);
+}
+
+float Trainer::current_learning_rate() const {
+  float lr = settings_.learning_rate * lr_scale_;
+  for (float f : settings_.milestones)
+    if (iteration_ >= static_cast<int>(f * static_cast<float>(settings_.iterations))) lr *= settings_.decay;
+  return lr;
+}
+
+void Trainer::predict(std::span<const std::size_t> idx, std::vector<float>& x, std::vector<float>& y,
+                      model::MlpWorkspace& ws) const {
+  const int in = model_.decoder.layout().inputs, d = model_.latent_dim;
+  x.resize(idx.size() * static_cast<std::size_t>(in));
+  y.resize(idx.size() * kTransferValues);
+  std::vector<float> z(static_cast<std::size_t>(d));
+  for (std::size_t i = 0; i < idx.size(); ++i) {
+    const TransferSample& s = data_.samples[idx[i]];
+    model_.meshes[s.mesh].latents.interpolate(*assets_.meshes[s.mesh], s.triangle, s.barycentric, z.data());
+    model::assemble_input(z.data(), d, s.albedo, s.normal, s.wo, x.data() + i * static_cast<std::size_t>(in));
+  }
+  model_.decoder.forward(x.data(), static_cast<int>(idx.size()), y.data(), ws, settings_.backend);
+}
+
+float Trainer::step() {
+  const int batch = settings_.batch;
+  std::vector<std::size_t> idx(static_cast<std::size_t>(batch));
+  for (auto& i : idx) i = rng_.next_u32() % data_.training_count;
+  std::vector<float> x, y;
+  predict(idx, x, y, ws_);
+
+  // L1 loss and its gradient.
+  const float scale = 1.0f / static_cast<float>(static_cast<std::size_t>(batch) * kTransferValues);
+  std::vector<float> dy(y.size());
+  double loss = 0;
+  for (std::size_t i = 0; i < idx.size(); ++i) {
+    const float* t = data_.target(idx[i]);
+    for (int k = 0; k < kTransferValues; ++k) {
+      const float diff = y[i * kTransferValues + static_cast<std::size_t>(k)] - t[k];
+      loss += std::abs(diff);
+      dy[i * kTransferValues + static_cast<std::size_t>(k)] = diff > 0 ? scale : diff < 0 ? -scale : 0.0f;
+    }
+  }
+  loss *= scale;
+
+  std::fill(grad_.begin(), grad_.end(), 0.0f);
+  const std::size_t n_dec = model_.decoder.params().size();
+  const int in = model_.decoder.layout().inputs, d = model_.latent_dim;
+  std::vector<float> dx(x.size());
+  model_.decoder.backward(x.data(), batch, dy.data(), ws_, std::span(grad_).first(n_dec), dx.data(), settings_.backend);
+  for (std::size_t i = 0; i < idx.size(); ++i) {
+    const TransferSample& s = data_.samples[idx[i]];
+    model_.meshes[s.mesh].latents.scatter_gradient(*assets_.meshes[s.mesh], s.triangle, s.barycentric,
+                                                   dx.data() + i * static_cast<std::size_t>(in),
+                                                   std::span(grad_).subspan(n_dec + latent_offset_[s.mesh]));
+  }
+  (void)d;
+
+  bool finite = std::isfinite(loss);
+  for (std::size_t i = 0; finite && i < grad_.size(); ++i) finite = std::isfinite(grad_[i]);
+  if (!finite) {
+    rollback();
+    return static_cast<float>(loss);
+  }
+
+  // Adam with bias correction; the latents get their own rate.
+  ++iteration_;
+  const float lr = current_learning_rate();
+  const float lr_latent = settings_.latent_learning_rate * (lr / settings_.learning_rate);
+  const float c1 = 1.0f - std::pow(kBeta1, static_cast<float>(iteration_));
+  const float c2 = 1.0f - std::pow(kBeta2, static_cast<float>(iteration_));
+  auto update = [&](std::size_t i, float& p, float rate) {
+    const float g = grad_[i];
+    m_[i] = kBeta1 * m_[i] + (1 - kBeta1) * g;
+    v_[i] = kBeta2 * v_[i] + (1 - kBeta2) * g * g;
+    p -= rate * (m_[i] / c1) / (std::sqrt(v_[i] / c2) + kEps);
+  };
+  auto& params = model_.decoder.params();
+  for (std::size_t i = 0; i < n_dec; ++i) update(i, params[i], lr);
+  std::size_t flat = 0;
+  for (auto& mesh : model_.meshes)
+    for (float& p : mesh.latents.values) update(n_dec + flat++, p, lr_latent);
+  if (iteration_ % kSnapshotEvery == 0) snapshot();
+  return static_cast<float>(loss);
+}
+
+void Trainer::snapshot() {
+  good_params_ = model_.decoder.params();
+  good_latents_.clear();
+  for (const auto& m : model_.meshes) good_latents_.insert(good_latents_.end(), m.latents.values.begin(), m.latents.values.end());
+  good_m_ = m_;
+  good_v_ = v_;
+  good_iteration_ = iteration_;
+}
+
+void Trainer::rollback() {
+  model_.decoder.params() = good_params_;
+  std::size_t at = 0;
+  for (auto& m : model_.meshes) {
+    std::copy_n(good_latents_.begin() + static_cast<std::ptrdiff_t>(at), m.latents.values.size(), m.latents.values.begin());
+    at += m.latents.values.size();
+  }
+  m_ = good_m_;
+  v_ = good_v_;
+  iteration_ = good_iteration_;
+  lr_scale_ *= 0.5f;
+  ++rollbacks_;
+}
+
+BandErrors Trainer::validate() const {
+  BandErrors e;
+  std::array<double, 5> sums{};
+  std::array<std::size_t, 5> counts{};
+  double total = 0;
+  const std::size_t n = data_.validation_count();
+  if (n == 0) return e;
+  model::MlpWorkspace ws;
+  std::vector<float> x, y;
+  std::vector<std::size_t> idx;
+  for (std::size_t start = 0; start < n; start += 4096) {
+    idx.clear();
+    for (std::size_t i = start; i < std::min(n, start + 4096); ++i) idx.push_back(data_.training_count + i);
+    predict(idx, x, y, ws);
+    for (std::size_t i = 0; i < idx.size(); ++i) {
+      const float* t = data_.target(idx[i]);
+      for (int c = 0; c < 3; ++c)
+        for (int k = 0; k < 25; ++k) {
+          const double diff = y[i * kTransferValues + static_cast<std::size_t>(c * 25 + k)] - t[c * 25 + k];
+          sums[static_cast<std::size_t>(band_of(k))] += diff * diff;
+          ++counts[static_cast<std::size_t>(band_of(k))];
+          total += diff * diff;
+        }
+    }
+  }
+  for (int b = 0; b < 5; ++b) e.rmse[static_cast<std::size_t>(b)] = std::sqrt(sums[static_cast<std::size_t>(b)] / static_cast<double>(counts[static_cast<std::size_t>(b)]));
+  e.total = std::sqrt(total / static_cast<double>(n * kTransferValues));
+  return e;
+}
+
+BandErrors Trainer::constant_predictor() const {
+  std::array<double, kTransferValues> mean{};
+  for (std::size_t i = 0; i < data_.training_count; ++i)
+    for (int k = 0; k < kTransferValues; ++k) mean[static_cast<std::size_t>(k)] += data_.target(i)[k];
+  for (double& v : mean) v /= static_cast<double>(data_.training_count);
+  BandErrors e;
+  std::array<double, 5> sums{};
+  std::array<std::size_t, 5> counts{};
+  double total = 0;
+  const std::size_t n = data_.validation_count();
+  for (std::size_t i = 0; i < n; ++i) {
+    const float* t = data_.target(data_.training_count + i);
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 25; ++k) {
+        const double diff = mean[static_cast<std::size_t>(c * 25 + k)] - t[c * 25 + k];
+        sums[static_cast<std::size_t>(band_of(k))] += diff * diff;
+        ++counts[static_cast<std::size_t>(band_of(k))];
+        total += diff * diff;
+      }
+  }
+  for (int b = 0; b < 5; ++b)
+    e.rmse[static_cast<std::size_t>(b)] = counts[static_cast<std::size_t>(b)] ? std::sqrt(sums[static_cast<std::size_t>(b)] / static_cast<double>(counts[static_cast<std::size_t>(b)])) : 0;
+  e.total = n ? std::sqrt(total / static_cast<double>(n * kTransferValues)) : 0;
+  return e;
+}
+
+Trainer::State Trainer::state() const { return {iteration_, lr_scale_, rollbacks_, m_, v_}; }
+
+void Trainer::restore(const State& s) {
+  if (s.m.size() != m_.size() || s.v.size() != v_.size()) throw std::invalid_argument("checkpoint does not match this model");
+  iteration_ = s.iteration;
+  lr_scale_ = s.lr_scale;
+  rollbacks_ = s.rollbacks;
+  m_ = s.m;
+  v_ = s.v;
+  snapshot();
+}
+
+}  // namespace transgi::bake

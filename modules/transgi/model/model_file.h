@@ -1,0 +1,36 @@
+#pragma once
+// The .tgm model file.
+//
+//   header (24 bytes): magic "TGM\0", u32 format version, u64 payload bytes,
+//                      u64 FNV-1a 64 checksum of the payload
+//   payload: decoder layout and weights, latent dimension, per mesh its name,
+//            content hash, vertex-to-latent map and latents, then the bake
+//            settings and metrics as JSON text. Little-endian throughout.
+//
+// Writing goes to a temporary file, fsync, then rename. Reading rejects a
+// truncated, corrupt or newer-version file, and validate_model() rejects a
+// model whose meshes no longer match the scene, each with a message that
+// says what to do.
+#include <filesystem>
+#include <stdexcept>
+
+#include "model/transfer_model.h"
+
+namespace transgi::model {
+
+inline constexpr std::uint32_t kModelFormatVersion = 1;
+
+class ModelFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+void save_model(const std::filesystem::path& path, const TransferModel& model);
+TransferModel load_model(const std::filesystem::path& path);
+
+// Throws ModelFileError if the model does not belong to these assets (mesh
+// count, names or content hashes differ), naming the first stale mesh.
+void validate_model(const TransferModel& model, const engine::scene::SceneAssets& assets,
+                    const std::filesystem::path& model_path);
+
+}  // namespace transgi::model

@@ -1,0 +1,43 @@
+#pragma once
+// A baked object-centric neural transfer model: the scene-wide decoder plus
+// each mesh asset's welded per-vertex latents, and how it was made.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "engine/scene/scene_assets.h"
+#include "model/latent_mesh.h"
+#include "model/mlp.h"
+
+namespace transgi::model {
+
+struct MeshLatents {
+  std::string name;
+  std::uint64_t content_hash = 0;  // of the mesh and its materials, see mesh_content_hash()
+  LatentTable latents;
+};
+
+struct TransferModel {
+  Mlp decoder;
+  int latent_dim = 7;
+  std::vector<MeshLatents> meshes;  // by SceneAssets::meshes index
+  std::string bake_settings_json;   // what produced it (free-form JSON)
+  std::string metrics_json;         // training and validation results (free-form JSON)
+
+  [[nodiscard]] std::size_t decoder_bytes() const { return decoder.params().size() * sizeof(float); }
+  [[nodiscard]] std::size_t latent_bytes() const;
+};
+
+// Inputs after the latent: albedo (3), normal (3), wo (3).
+inline constexpr int kTransferInputExtra = 9;
+
+// Decoder input for one shading point: [z (latent_dim), albedo (3), normal (3), wo (3)],
+// all in the object's space. Writes latent_dim + 9 floats.
+void assemble_input(const float* latent, int latent_dim, const glm::vec3& albedo, const glm::vec3& normal,
+                    const glm::vec3& wo, float* out);
+
+// FNV-1a 64 over the mesh's positions, triangles, normals, UVs and the
+// parameters (and texture texels) of the materials its triangles use.
+std::uint64_t mesh_content_hash(const engine::scene::SceneAssets& assets, std::uint32_t mesh);
+
+}  // namespace transgi::model

@@ -1,0 +1,177 @@
+// Training and the model file, on a tiny scene made in the test.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include "bake/trainer.h"
+#include "engine/scene/procedural.h"
+#include "model/model_file.h"
+
+using namespace transgi;
+using namespace engine;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A diffuse floor with a glossy gold sphere sitting on it (two meshes).
+scene::SceneAssets tiny_scene() {
+  scene::SceneAssets a;
+  a.generation = scene::next_scene_generation();
+  a.source = "tiny.gltf";
+  auto floor = scene::make_quad({1, 1}, 0);
+  auto ball = scene::make_uv_sphere(0.3f, 16, 8, 1);
+  for (auto& p : ball.positions) p.y += 0.3f;
+  ball.compute_bounds();
+  a.meshes = {std::make_shared<scene::MeshAsset>(floor), std::make_shared<scene::MeshAsset>(ball)};
+  material::Material diffuse;
+  diffuse.base_color_factor = glm::vec4(0.7f, 0.5f, 0.3f, 1);
+  diffuse.metallic_factor = 0;
+  diffuse.specular_factor = 0;
+  material::Material gold;
+  gold.base_color_factor = glm::vec4(1.0f, 0.8f, 0.35f, 1);
+  gold.metallic_factor = 1;
+  gold.roughness_factor = 0.35f;
+  a.materials = {diffuse, gold};
+  return a;
+}
+
+// Enough points that the glossy lobe is determined (with 600 points the net
+// overfits: validation RMSE 0.068 vs 0.072 for the constant predictor; with
+// 4000 points it reaches 0.027).
+bake::DatasetSettings tiny_data() {
+  bake::DatasetSettings s;
+  s.points = 4000;
+  s.min_points_per_mesh = 64;
+  s.outgoing_per_point = 4;
+  s.rays = 512;
+  s.validation_fraction = 0.1f;
+  return s;
+}
+
+struct TempDir {
+  fs::path path = fs::temp_directory_path() / ("bake_test_" + std::to_string(::getpid()));
+  TempDir() { fs::create_directories(path); }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+void expect_load_error(const fs::path& p, const std::string& fragment) {
+  try {
+    model::load_model(p);
+    ADD_FAILURE() << "expected ModelFileError containing '" << fragment << "'";
+  } catch (const model::ModelFileError& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(p.filename().string()), std::string::npos) << "must name the file: " << e.what();
+  }
+}
+
+}  // namespace
+
+TEST(Dataset, IsDeterministicForASeed) {
+  const auto assets = tiny_scene();
+  auto s = tiny_data();
+  s.points = 100;
+  s.rays = 64;
+  const auto a = bake::generate_dataset(assets, s), b = bake::generate_dataset(assets, s);
+  ASSERT_EQ(a.targets.size(), b.targets.size());
+  EXPECT_EQ(a.targets, b.targets);
+  EXPECT_GT(a.validation_count(), 0u);
+  EXPECT_EQ(a.training_count % 4, 0u) << "split by point: whole groups of 4 outgoing directions";
+}
+
+TEST(Trainer, LowersValidationErrorWellBelowAConstantPredictor) {
+  const auto assets = tiny_scene();
+  const auto data = bake::generate_dataset(assets, tiny_data());
+  auto m = bake::make_untrained_model(assets, 7, model::MlpLayout{.width = 64, .hidden_layers = 3}, 3);
+  bake::TrainSettings ts;
+  ts.iterations = 1500;
+  ts.batch = 256;
+  ts.learning_rate = 3e-3f;
+  bake::Trainer trainer(data, assets, m, ts);
+  const auto constant = trainer.constant_predictor();
+  const auto before = trainer.validate();
+  for (int i = 0; i < ts.iterations; ++i) trainer.step();
+  const auto after = trainer.validate();
+  EXPECT_EQ(trainer.rollbacks(), 0);
+  EXPECT_LT(after.total, 0.5 * constant.total) << "constant predictor RMSE " << constant.total << ", trained " << after.total
+                                               << " (untrained " << before.total << ")";
+  EXPECT_LT(after.rmse[0], 0.5 * constant.rmse[0]) << "band 0";
+  EXPECT_LT(after.rmse[1], 0.5 * constant.rmse[1]) << "band 1";
+  EXPECT_LT(after.rmse[4], 0.8 * constant.rmse[4]) << "band 4";
+}
+
+TEST(Trainer, NonFiniteValuesRollBackAndNeverReachTheWeights) {
+  const auto assets = tiny_scene();
+  auto s = tiny_data();
+  s.points = 150;
+  s.rays = 64;
+  auto data = bake::generate_dataset(assets, s);
+  // Poison one in 20 training targets: most batches of 64 then contain one.
+  for (std::size_t i = 0; i < data.training_count; i += 20) data.targets[i * bake::kTransferValues] = std::numeric_limits<float>::infinity();
+  auto m = bake::make_untrained_model(assets, 7, model::MlpLayout{.width = 32, .hidden_layers = 2}, 3);
+  bake::TrainSettings ts;
+  ts.iterations = 50;
+  ts.batch = 64;
+  bake::Trainer trainer(data, assets, m, ts);
+  for (int i = 0; i < 50; ++i) trainer.step();
+  EXPECT_GT(trainer.rollbacks(), 0) << "the guard must have fired";
+  EXPECT_LT(trainer.current_learning_rate(), ts.learning_rate) << "each rollback lowers the learning rate";
+  for (float p : m.decoder.params()) ASSERT_TRUE(std::isfinite(p));
+  for (const auto& mesh : m.meshes)
+    for (float v : mesh.latents.values) ASSERT_TRUE(std::isfinite(v));
+}
+
+TEST(ModelFile, RoundTripsExactly) {
+  TempDir d;
+  const auto assets = tiny_scene();
+  auto m = bake::make_untrained_model(assets, 7, model::MlpLayout{.width = 16, .hidden_layers = 1}, 9);
+  m.bake_settings_json = R"({"points": 600})";
+  m.metrics_json = R"({"rmse": 0.1})";
+  model::save_model(d.path / "m.tgm", m);
+  const auto back = model::load_model(d.path / "m.tgm");
+  EXPECT_EQ(back.decoder.layout(), m.decoder.layout());
+  EXPECT_EQ(back.decoder.params(), m.decoder.params());
+  ASSERT_EQ(back.meshes.size(), 2u);
+  EXPECT_EQ(back.meshes[1].latents.values, m.meshes[1].latents.values);
+  EXPECT_EQ(back.meshes[1].latents.vertex_to_latent, m.meshes[1].latents.vertex_to_latent);
+  EXPECT_EQ(back.metrics_json, m.metrics_json);
+  EXPECT_NO_THROW(model::validate_model(back, assets, d.path / "m.tgm"));
+}
+
+TEST(ModelFile, RejectsTruncatedCorruptNewerAndStaleFiles) {
+  TempDir d;
+  const auto assets = tiny_scene();
+  const auto m = bake::make_untrained_model(assets, 7, model::MlpLayout{.width = 16, .hidden_layers = 1}, 9);
+  const fs::path good = d.path / "good.tgm";
+  model::save_model(good, m);
+  std::ifstream in(good, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto write = [&](const std::string& name, const std::string& content) {
+    std::ofstream(d.path / name, std::ios::binary) << content;
+    return d.path / name;
+  };
+  expect_load_error(write("cut.tgm", bytes.substr(0, bytes.size() / 2)), "truncated");
+  expect_load_error(write("tiny.tgm", bytes.substr(0, 10)), "truncated");
+  std::string flipped = bytes;
+  flipped[bytes.size() / 2] ^= 0x40;
+  expect_load_error(write("flip.tgm", flipped), "checksum");
+  std::string newer = bytes;
+  newer[4] = 2;
+  expect_load_error(write("newer.tgm", newer), "newer TransGI");
+  expect_load_error(write("junk.tgm", std::string(64, 'x')), "bad magic");
+  expect_load_error(d.path / "absent.tgm", "not found");
+
+  auto changed = tiny_scene();
+  changed.materials[1].roughness_factor = 0.6f;  // the sphere's material changed after the bake
+  try {
+    model::validate_model(model::load_model(good), changed, good);
+    ADD_FAILURE() << "expected a stale-model error";
+  } catch (const model::ModelFileError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("stale"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("mesh 1"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("transgi bake"), std::string::npos) << "must say what to do: " << msg;
+  }
+}
