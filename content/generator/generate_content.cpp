@@ -1,6 +1,8 @@
 // Generates the bundled scenes deterministically (same bytes every run):
 //   test_scenes/cornell_box/   Cornell box with an emissive area light
 //   test_scenes/furnace/       a diffuse sphere under a uniform white sky
+//   test_scenes/object_metal/  a glossy metal teapot-like object under a studio map
+//   test_scenes/object_textured/ a textured diffuse object under the same map
 //   levels/living_room/        the sample level: a room with a window lit by
 //                              a sky map, a ceiling area light, large diffuse
 //                              pieces, a glossy metal sphere, a mirror panel
@@ -14,6 +16,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "engine/image/exr.h"
+#include "engine/image/png.h"
 #include "engine/math/sampling.h"
 #include "engine/scene/environment.h"
 #include "engine/scene/gltf_writer.h"
@@ -200,6 +203,88 @@ GltfSceneDesc living_room() {
   return s;
 }
 
+// ---- object-scale scenes (the paper's Fig. 7 setting) ----------------------------
+
+// A studio-like environment: dim gradient plus two soft key lights, smooth
+// enough that degree-4 SH can represent most of it.
+image::ImageRGB studio_map() {
+  const int w = 128, h = 64;
+  image::ImageRGB img(w, h);
+  const glm::vec3 key = glm::normalize(glm::vec3(0.6f, 0.7f, 0.4f)), fill = glm::normalize(glm::vec3(-0.7f, 0.3f, -0.5f));
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const glm::vec3 d = scene::Environment::uv_to_direction({(static_cast<float>(x) + 0.5f) / static_cast<float>(w),
+                                                               (static_cast<float>(y) + 0.5f) / static_cast<float>(h)});
+      glm::vec3 c = glm::mix(glm::vec3(0.05f, 0.05f, 0.06f), glm::vec3(0.35f, 0.4f, 0.5f), 0.5f + 0.5f * d.y);
+      c += glm::vec3(6.0f, 5.5f, 5.0f) * std::pow(std::max(0.0f, glm::dot(d, key)), 24.0f);
+      c += glm::vec3(1.2f, 1.4f, 2.0f) * std::pow(std::max(0.0f, glm::dot(d, fill)), 8.0f);
+      img.at(x, y) = c;
+    }
+  return img;
+}
+
+// A teapot-like object: body, lid knob, spout and handle, so it shadows and
+// reflects itself.
+scene::MeshAsset teapot_like(std::uint32_t material) {
+  scene::MeshAsset body = scene::make_uv_sphere(0.5f, 64, 32, material);
+  for (auto& p : body.positions) p.y *= 0.8f;
+  for (auto& n : body.normals) n = glm::normalize(glm::vec3(n.x, n.y / 0.8f, n.z));
+  scene::MeshAsset knob = scene::make_uv_sphere(0.08f, 16, 8, material);
+  for (auto& p : knob.positions) p.y += 0.44f;
+  scene::append_mesh(body, knob);
+  scene::MeshAsset spout = scene::make_tube(0.09f, 0.45f, 24, 0.5f, material);
+  const glm::quat tilt = glm::angleAxis(glm::radians(-50.0f), glm::vec3(0, 0, 1));
+  for (auto& p : spout.positions) p = tilt * p + glm::vec3(0.38f, -0.05f, 0);
+  for (auto& n : spout.normals) n = tilt * n;
+  scene::append_mesh(body, spout);
+  scene::MeshAsset handle = scene::make_torus(0.2f, 0.04f, 48, 12, material);
+  const glm::quat stand = glm::angleAxis(glm::radians(90.0f), glm::vec3(1, 0, 0));
+  for (auto& p : handle.positions) p = stand * p + glm::vec3(-0.5f, 0.02f, 0);
+  for (auto& n : handle.normals) n = stand * n;
+  scene::append_mesh(body, handle);
+  body.name = "Teapot";
+  return body;
+}
+
+GltfSceneDesc object_metal() {
+  GltfSceneDesc s;
+  s.materials = {metal("GlossyCopper", {0.95f, 0.64f, 0.54f}, 0.3f)};
+  add(s, teapot_like(0), "Teapot", {0, 0, 0});
+  add_camera(s, {0.2f, 0.6f, 2.3f}, {0, 0, 0}, 40.0f, 1.0f);
+  s.environment = scene::GltfEnvironmentDesc{"studio.exr", 1.0f, glm::mat4(1.0f)};
+  return s;
+}
+
+GltfSceneDesc object_textured() {
+  GltfSceneDesc s;
+  material::Material m = diffuse("CheckerDiffuse", glm::vec3(1.0f));
+  m.base_color_texture = 0;
+  s.materials = {m};
+  s.images = {"checker.png"};
+  scene::MeshAsset vase = scene::make_uv_sphere(0.45f, 64, 32, 0);
+  scene::MeshAsset ring = scene::make_torus(0.42f, 0.12f, 64, 16, 0);
+  for (auto& p : ring.positions) p.y += 0.3f;
+  scene::append_mesh(vase, ring);
+  vase.name = "TexturedVase";
+  add(s, vase, "TexturedVase", {0, 0, 0});
+  add_camera(s, {0.3f, 0.8f, 2.2f}, {0, 0.05f, 0}, 40.0f, 1.0f);
+  s.environment = scene::GltfEnvironmentDesc{"studio.exr", 1.0f, glm::mat4(1.0f)};
+  return s;
+}
+
+image::Rgb8Image checker_texture() {
+  image::Rgb8Image img(64, 64);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const bool on = ((x / 8) + (y / 8)) % 2 == 0;
+      std::uint8_t* p = img.at(x, y);
+      p[0] = on ? 220 : 40;
+      p[1] = on ? 180 : 90;
+      p[2] = on ? 60 : 160;
+    }
+  return img;
+}
+
 int usage() {
   std::fprintf(stderr, "usage: content_generator --out DIR\n");
   return 2;
@@ -217,6 +302,11 @@ int main(int argc, char** argv) {
     const glm::vec3 sun = glm::normalize(glm::vec3(1.0f, 0.55f, -0.25f));
     image::write_exr(out / "levels/living_room/sky.exr", sky_map(sun), image::ExrPixelType::Half);
     scene::write_gltf(out / "levels/living_room/scene.gltf", living_room());
+    for (const char* dir : {"test_scenes/object_metal", "test_scenes/object_textured"})
+      image::write_exr(out / dir / "studio.exr", studio_map(), image::ExrPixelType::Half);
+    scene::write_gltf(out / "test_scenes/object_metal/scene.gltf", object_metal());
+    image::write_png(out / "test_scenes/object_textured/checker.png", checker_texture());
+    scene::write_gltf(out / "test_scenes/object_textured/scene.gltf", object_textured());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "content_generator: %s\n", e.what());
     return 1;

@@ -27,6 +27,8 @@ class Environment {
   [[nodiscard]] float pdf(const glm::vec3& world_dir) const;
 
   [[nodiscard]] const image::ImageRGB& image() const { return image_; }
+  // Map-local direction to world (the matrix's rotation).
+  [[nodiscard]] glm::vec3 to_world(const glm::vec3& local) const { return to_world_ * local; }
   [[nodiscard]] float strength() const { return strength_; }
   [[nodiscard]] bool valid() const { return !image_.empty(); }
 

@@ -50,6 +50,7 @@ json material_json(const material::Material& m, std::set<std::string>& used) {
               {"metallicFactor", m.metallic_factor},
               {"roughnessFactor", m.roughness_factor}}},
             {"doubleSided", m.double_sided}};
+  if (m.base_color_texture >= 0) j["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", m.base_color_texture}};
   if (m.is_emissive()) {
     j["emissiveFactor"] = vec(m.emissive_factor);
     if (m.emissive_strength != 1.0f) {
@@ -137,6 +138,16 @@ void write_gltf(const std::filesystem::path& path, const GltfSceneDesc& scene) {
                {"bufferViews", bin.views},
                {"buffers", {{{"uri", bin_name}, {"byteLength", bin.bytes.size()}}}}};
   if (!cameras.empty()) root["cameras"] = cameras;
+  if (!scene.images.empty()) {
+    json images = json::array(), textures = json::array();
+    for (std::size_t i = 0; i < scene.images.size(); ++i) {
+      images.push_back({{"uri", scene.images[i]}});
+      textures.push_back({{"source", i}, {"sampler", 0}});
+    }
+    root["images"] = images;
+    root["textures"] = textures;
+    root["samplers"] = json::array({json::object({{"wrapS", 10497}, {"wrapT", 10497}})});
+  }
   if (!lights.empty()) root["extensions"]["KHR_lights_punctual"] = {{"lights", lights}};
   if (!used.empty()) root["extensionsUsed"] = used;
   if (scene.environment) {

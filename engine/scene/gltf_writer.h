@@ -30,6 +30,9 @@ struct GltfEnvironmentDesc {
 };
 
 struct GltfSceneDesc {
+  // Image URIs (PNG/JPEG next to the .gltf); texture i samples image i with
+  // repeat wrapping. Materials refer to textures by index.
+  std::vector<std::string> images;
   std::vector<MeshAsset> meshes;
   std::vector<material::Material> materials;
   std::vector<GltfNodeDesc> nodes;

@@ -175,3 +175,72 @@ TEST(ModelFile, RejectsTruncatedCorruptNewerAndStaleFiles) {
     EXPECT_NE(msg.find("transgi bake"), std::string::npos) << "must say what to do: " << msg;
   }
 }
+
+// ---- the bake job: resume after an interruption, never a torn output ----------
+
+#include "bake/bake_job.h"
+
+namespace {
+struct Interrupted : std::runtime_error {
+  Interrupted() : std::runtime_error("interrupted") {}
+};
+bake::BakeSettings small_bake() {
+  bake::BakeSettings s;
+  s.data = tiny_data();
+  s.data.points = 300;
+  s.data.rays = 64;
+  s.train.iterations = 600;
+  s.train.batch = 64;
+  s.layout.width = 16;
+  s.layout.hidden_layers = 1;
+  s.checkpoint_every = 200;
+  return s;
+}
+}  // namespace
+
+TEST(BakeJob, ResumeContinuesFromTheLastCheckpointAndReusesTheDataset) {
+  TempDir d;
+  const auto assets = tiny_scene();
+  const fs::path out = d.path / "m.tgm";
+  auto s = small_bake();
+  bake::BakeCallbacks kill_at_450;
+  kill_at_450.training = [](int it, int, float) {
+    if (it == 450) throw Interrupted();
+  };
+  EXPECT_THROW(bake::run_bake(assets, out, s, kill_at_450), Interrupted);
+  EXPECT_FALSE(fs::exists(out)) << "no model is written before training finishes";
+  EXPECT_TRUE(fs::exists(bake::dataset_cache_path(out)));
+  EXPECT_TRUE(fs::exists(bake::checkpoint_path(out)));
+
+  s.resume = true;
+  const auto report = bake::run_bake(assets, out, s);
+  EXPECT_TRUE(report.dataset_from_cache);
+  EXPECT_EQ(report.resumed_from, 400) << "the last checkpoint before the interruption";
+  EXPECT_EQ(report.iterations, 600);
+  const auto m = model::load_model(out);
+  EXPECT_NO_THROW(model::validate_model(m, assets, out));
+  EXPECT_FALSE(fs::exists(bake::checkpoint_path(out))) << "checkpoints are cleaned up after success";
+}
+
+TEST(BakeJob, AKilledBakeLeavesTheOldModelIntact) {
+  TempDir d;
+  const auto assets = tiny_scene();
+  const fs::path out = d.path / "m.tgm";
+  auto s = small_bake();
+  s.train.iterations = 200;
+  bake::run_bake(assets, out, s);
+  std::ifstream before_in(out, std::ios::binary);
+  const std::string before((std::istreambuf_iterator<char>(before_in)), std::istreambuf_iterator<char>());
+
+  s.train.iterations = 600;
+  s.data.seed = 99;
+  bake::BakeCallbacks kill;
+  kill.training = [](int it, int, float) {
+    if (it == 300) throw Interrupted();
+  };
+  EXPECT_THROW(bake::run_bake(assets, out, s, kill), Interrupted);
+  std::ifstream after_in(out, std::ios::binary);
+  const std::string after((std::istreambuf_iterator<char>(after_in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(before, after) << "the previous model must survive an interrupted bake byte for byte";
+  EXPECT_NO_THROW(model::load_model(out));
+}

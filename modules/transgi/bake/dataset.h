@@ -17,7 +17,7 @@ namespace transgi::bake {
 struct DatasetSettings {
   // Surface points over the whole scene, split between meshes by area. Higher
   // = better coverage of the transfer function, at the cost of bake time.
-  int points = 16384;
+  int points = 32768;
   // Every mesh gets at least this many points, so small objects are learned too.
   int min_points_per_mesh = 32;
   // Outgoing directions per point; they share the point's rays. Higher = more

@@ -14,7 +14,7 @@
 namespace transgi::bake {
 
 struct TrainSettings {
-  int iterations = 6000;  // higher = lower error, at the cost of time (the paper trains 200k on a GPU)
+  int iterations = 20000;  // higher = lower error, at the cost of time (the paper trains 200k on a GPU)
   int batch = 2048;
   // The paper uses 1e-4 over 200k iterations; with ~30x fewer steps on a CPU
   // a larger rate converges further in the same time (docs/bake.md).

@@ -11,6 +11,8 @@
 #include "engine/rt/rt_plugin.h"
 #include "engine/scene/gltf_loader.h"
 #include "engine/scene/scene_assets.h"
+#include "model/model_file.h"
+#include "render/transfer_renderer.h"
 
 namespace transgi::cli {
 
@@ -28,13 +30,53 @@ ecs::Entity find_camera(ecs::World& world, const std::vector<ecs::Entity>& node_
   throw std::runtime_error("--camera: no camera node named '" + name + "'");
 }
 
+// Object-scale TransGI (paper Fig. 7): the environment projected to SH is
+// the only light; compare with the reference's direct pass.
+int render_transgi_object_scale(const Args& args, app::App& app, ecs::Entity cam, int width, int height,
+                                const std::string& out, double exposure) {
+  ecs::World& world = app.world();
+  const auto& assets = world.resource<scene::SceneAssets>();
+  if (!assets.environment) throw std::runtime_error("--method transgi needs an environment light in the scene (scenes[0].extras.environment)");
+  const std::string model_path = args.str("model");
+  const std::string transfer = args.choice("transfer", {"network", "ground-truth"}, "network");
+  transgi::render::TransferRenderSettings rs;
+  rs.spp = static_cast<int>(args.integer("spp", 1, 4096, 4));
+  rs.ground_truth_rays = static_cast<int>(args.integer("gt-rays", 1, 1'000'000, 2048));
+  rs.seed = static_cast<std::uint64_t>(args.integer("seed", 0, INT64_MAX, 0));
+  const auto model = transgi::model::load_model(model_path);
+  if (transfer == "network") transgi::model::validate_model(model, assets, model_path);
+  const auto light = transgi::render::project_environment(*assets.environment);
+  const engine::render::CameraRays camera(world.get<scene::Camera>(cam), world.get<transform::WorldTransform>(cam), width, height);
+  transgi::render::TransferRenderResult r;
+  app.jobs().run([&] {
+    r = transgi::render::render_transfer(world.resource<rt::RtScene>(), assets, model, camera, width, height, light,
+                                         &*assets.environment,
+                                         transfer == "network" ? transgi::render::TransferSource::Network
+                                                               : transgi::render::TransferSource::GroundTruth,
+                                         rs);
+  });
+  image::write_exr(out, r.image);
+  if (args.has("png")) image::write_png_srgb(args.str("png"), r.image, static_cast<float>(exposure));
+  if (args.has("coefficient-maps")) {
+    const std::string prefix = args.str("coefficient-maps");
+    const char* names[3] = {"_sh00.exr", "_sh10.exr", "_sh20.exr"};
+    for (int i = 0; i < 3; ++i) image::write_exr(prefix + names[i], r.coefficient_maps[static_cast<std::size_t>(i)]);
+  }
+  std::printf("rendered %s (transgi, %s transfer, environment SH light) %dx%d at %d spp: %zu shaded samples\n", out.c_str(),
+              transfer.c_str(), width, height, rs.spp, r.shaded_samples);
+  std::printf("  stage times (ms): G-buffer %.2f, generate network input %.2f, network inference %.2f, SH multiplication %.2f\n",
+              r.timings.gbuffer_ms, r.timings.inputs_ms, r.timings.inference_ms, r.timings.shading_ms);
+  return 0;
+}
+
 }  // namespace
 
 int run_render(const std::vector<std::string>& argv) {
   const Args args("render", argv,
-                  {"scene", "method", "pass", "spp", "width", "height", "out", "camera", "seed", "threads", "png", "exposure"});
+                  {"scene", "method", "pass", "spp", "width", "height", "out", "camera", "seed", "threads", "png", "exposure",
+                   "model", "transfer", "gt-rays", "coefficient-maps"});
   const std::string scene_path = args.str("scene");
-  const std::string method = args.choice("method", {"reference"}, "reference");
+  const std::string method = args.choice("method", {"reference", "transgi"}, "reference");
   const std::string pass_name = args.choice("pass", {"full", "direct", "gi", "all"}, "full");
   const int spp = static_cast<int>(args.integer("spp", 1, 1'000'000, 64));
   const int width = static_cast<int>(args.integer("width", 1, 16384, 320));
@@ -43,7 +85,7 @@ int run_render(const std::vector<std::string>& argv) {
   const auto seed = static_cast<std::uint64_t>(args.integer("seed", 0, INT64_MAX, 0));
   const int threads = static_cast<int>(args.integer("threads", 0, 1024, 0));
   const double exposure = args.number("exposure", -30, 30, 0.0);
-  const render::Pass pass = pass_name == "direct" ? render::Pass::Direct : pass_name == "gi" ? render::Pass::Gi : render::Pass::Full;
+  const engine::render::Pass pass = pass_name == "direct" ? engine::render::Pass::Direct : pass_name == "gi" ? engine::render::Pass::Gi : engine::render::Pass::Full;
 
   app::App app(app::AppOptions{.jobs = {.threads = threads}});
   app.add_plugin<rt::RtPlugin>();
@@ -55,11 +97,12 @@ int run_render(const std::vector<std::string>& argv) {
   const ecs::Entity cam = find_camera(world, loaded.entities, args.str("camera", std::string()));
   const auto& assets = world.resource<scene::SceneAssets>();
   const auto& rt_scene = world.resource<rt::RtScene>();
-  const render::LightSet lights(rt_scene, render::gather_punctual_lights(world),
+  if (method == "transgi") return render_transgi_object_scale(args, app, cam, width, height, out, exposure);
+  const engine::render::LightSet lights(rt_scene, engine::render::gather_punctual_lights(world),
                                 assets.environment ? &*assets.environment : nullptr);
   if (lights.empty()) std::fprintf(stderr, "warning: the scene has no lights; the image will be black\n");
-  const render::CameraRays camera(world.get<scene::Camera>(cam), world.get<transform::WorldTransform>(cam), width, height);
-  render::PathTracer tracer(rt_scene, lights, camera, width, height, render::PathTracerSettings{.seed = seed});
+  const engine::render::CameraRays camera(world.get<scene::Camera>(cam), world.get<transform::WorldTransform>(cam), width, height);
+  engine::render::PathTracer tracer(rt_scene, lights, camera, width, height, engine::render::PathTracerSettings{.seed = seed});
 
   std::fprintf(stderr, "%s: %zu meshes, %zu triangles, %zu emissive triangles, %zu punctual lights, environment %s\n",
                scene_path.c_str(), loaded.mesh_count, loaded.triangle_count, lights.emissive_triangle_count(),
@@ -76,14 +119,14 @@ int run_render(const std::vector<std::string>& argv) {
   const image::ImageRGB img = tracer.image(pass);
   image::write_exr(out, img);
   if (pass_name == "all") {
-    image::write_exr(sibling(out, "_direct"), tracer.image(render::Pass::Direct));
-    image::write_exr(sibling(out, "_gi"), tracer.image(render::Pass::Gi));
+    image::write_exr(sibling(out, "_direct"), tracer.image(engine::render::Pass::Direct));
+    image::write_exr(sibling(out, "_gi"), tracer.image(engine::render::Pass::Gi));
   }
   if (args.has("png")) {
     image::write_png_srgb(args.str("png"), img, static_cast<float>(exposure));
     if (pass_name == "all") {
-      image::write_png_srgb(sibling(args.str("png"), "_direct"), tracer.image(render::Pass::Direct), static_cast<float>(exposure));
-      image::write_png_srgb(sibling(args.str("png"), "_gi"), tracer.image(render::Pass::Gi), static_cast<float>(exposure));
+      image::write_png_srgb(sibling(args.str("png"), "_direct"), tracer.image(engine::render::Pass::Direct), static_cast<float>(exposure));
+      image::write_png_srgb(sibling(args.str("png"), "_gi"), tracer.image(engine::render::Pass::Gi), static_cast<float>(exposure));
     }
   }
   const double seconds = tracer.stats().seconds;

@@ -9,5 +9,7 @@ namespace transgi::cli {
 int run_render(const std::vector<std::string>& args);
 int run_compare(const std::vector<std::string>& args);
 int run_tonemap(const std::vector<std::string>& args);
+int run_bake(const std::vector<std::string>& args);
+int run_transfer_study(const std::vector<std::string>& args);
 
 }  // namespace transgi::cli

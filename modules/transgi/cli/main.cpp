@@ -13,8 +13,13 @@ void usage() {
                "usage: transgi <command> [options]\n"
                "  render   --scene S.gltf --method reference --pass full|direct|gi|all --spp N --width W --height H\n"
                "           --out F.exr [--camera NAME] [--seed K] [--threads T] [--png F.png] [--exposure EV]\n"
+               "  render   --scene S.gltf --method transgi --model M.tgm [--transfer network|ground-truth] [--gt-rays N]\n"
+               "           [--coefficient-maps PREFIX] ... (object scale: environment SH light)\n"
                "  compare  A.exr B.exr [--heatmap out.png] [--heatmap-max E]\n"
-               "  tonemap  IN.exr OUT.png [--exposure EV]\n");
+               "  tonemap  IN.exr OUT.png [--exposure EV]\n"
+               "  bake     --scene S.gltf --out M.tgm [--points N] [--dirs D] [--outgoing K] [--iters I] [--batch B]\n"
+               "           [--lr R] [--latent-dim K] [--width W] [--depth L] [--threads T] [--seed S] [--resume] [--keep-dataset]\n"
+               "  transfer-study --scene S.gltf [--points N] [--outgoing K] [--reference-rays R]\n");
 }
 }  // namespace
 
@@ -29,6 +34,8 @@ int main(int argc, char** argv) {
     if (command == "render") return transgi::cli::run_render(args);
     if (command == "compare") return transgi::cli::run_compare(args);
     if (command == "tonemap") return transgi::cli::run_tonemap(args);
+    if (command == "bake") return transgi::cli::run_bake(args);
+    if (command == "transfer-study") return transgi::cli::run_transfer_study(args);
     if (command == "--help" || command == "help") {
       usage();
       return 0;

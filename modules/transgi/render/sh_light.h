@@ -1,0 +1,26 @@
+#pragma once
+// Light as SH coefficients (25 per RGB channel), laid out [c * 25 + k] like
+// the transfer, so shading is one dot product per channel.
+#include <array>
+
+#include <glm/glm.hpp>
+
+#include "engine/math/sh.h"
+#include "engine/scene/environment.h"
+
+namespace transgi::render {
+
+using ShRgb = std::array<float, 3 * engine::math::kShCount>;
+
+// Projects the environment's radiance onto the SH basis (world space), by
+// summing every texel with its solid angle in double precision.
+ShRgb project_environment(const engine::scene::Environment& env);
+
+// Coefficients of the same light seen in an object's frame: if the object's
+// rotation is R (object to world), L_obj(d) = L_world(R d).
+ShRgb rotate_to_object(const ShRgb& world, const glm::quat& object_rotation);
+
+// sum_c sum_k light[c][k] * transfer[c][k], per channel.
+glm::vec3 shade(const ShRgb& light, const float* transfer);
+
+}  // namespace transgi::render

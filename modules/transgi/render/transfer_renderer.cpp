@@ -1,0 +1,185 @@
+#include "render/transfer_renderer.h"
+
+#include <chrono>
+#include <mutex>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "bake/transfer.h"
+#include "engine/jobs/parallel_for.h"
+#include "engine/math/rng.h"
+#include "engine/render/surface.h"
+
+namespace transgi::render {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+struct Sample {
+  bool hit = false;
+  engine::ecs::Entity entity;
+  std::uint32_t mesh = 0, triangle = 0;
+  glm::vec2 bary{0.0f};
+  glm::vec3 normal_obj{0.0f}, wo_obj{0.0f}, albedo{0.0f}, background{0.0f};
+};
+
+constexpr std::array<int, 3> kMapCoefficients = {0, 2, 6};  // (0,0), (1,0), (2,0)
+
+}  // namespace
+
+TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
+                                     const model::TransferModel& model, const engine::render::CameraRays& camera,
+                                     int width, int height, const ShRgb& world_light,
+                                     const engine::scene::Environment* background, TransferSource source,
+                                     const TransferRenderSettings& s) {
+  using namespace engine;
+  TransferRenderResult result;
+  const std::size_t pixels = static_cast<std::size_t>(width) * height;
+  const std::size_t n = pixels * static_cast<std::size_t>(s.spp);
+
+  // 1. G-buffer: one filtered primary ray per sample.
+  auto t0 = Clock::now();
+  std::vector<Sample> samples(n);
+  jobs::parallel_for(0, height, 1, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < width; ++x)
+        for (int si = 0; si < s.spp; ++si) {
+          const std::size_t pixel = static_cast<std::size_t>(y) * width + x;
+          math::Pcg32 rng = math::make_rng(s.seed, pixel, static_cast<std::uint64_t>(si));
+          const glm::vec2 jitter = engine::render::sample_pixel_filter({rng.next_float(), rng.next_float()}, s.filter_width);
+          const rt::Ray ray = camera.generate(glm::vec2(x + 0.5f, y + 0.5f) + jitter);
+          Sample& out = samples[pixel * static_cast<std::size_t>(s.spp) + static_cast<std::size_t>(si)];
+          rt::Hit hit;
+          if (!scene.intersect(ray, hit)) {
+            if (background) out.background = background->radiance(ray.direction);
+            continue;
+          }
+          const rt::InstanceRecord& inst = *scene.instance_of(hit.entity);
+          const scene::MeshAsset& mesh = *assets.meshes[hit.mesh];
+          const glm::uvec3 t = mesh.triangles[hit.primitive];
+          const float b1 = hit.barycentric.x, b2 = hit.barycentric.y, b0 = 1 - b1 - b2;
+          glm::vec3 nobj = glm::normalize(b0 * mesh.normals[t.x] + b1 * mesh.normals[t.y] + b2 * mesh.normals[t.z]);
+          const glm::quat inv = glm::conjugate(inst.to_world.rotation);
+          const glm::vec3 wo = glm::normalize(inv * -ray.direction);
+          if (glm::dot(nobj, wo) < 0) nobj = -nobj;  // seen from the back of a two-sided surface
+          glm::vec2 uv(0.0f);
+          if (!mesh.uvs.empty()) uv = b0 * mesh.uvs[t.x] + b1 * mesh.uvs[t.y] + b2 * mesh.uvs[t.z];
+          out.hit = true;
+          out.entity = hit.entity;
+          out.mesh = hit.mesh;
+          out.triangle = hit.primitive;
+          out.bary = hit.barycentric;
+          out.normal_obj = nobj;
+          out.wo_obj = wo;
+          out.albedo = engine::render::evaluate_material(assets, mesh.triangle_material[hit.primitive], uv).base_color;
+        }
+  });
+  result.timings.gbuffer_ms = ms_since(t0);
+
+  std::vector<std::size_t> hits;
+  for (std::size_t i = 0; i < n; ++i)
+    if (samples[i].hit) hits.push_back(i);
+  result.shaded_samples = hits.size();
+  std::vector<float> transfer(hits.size() * bake::kTransferValues, 0.0f);
+
+  if (source == TransferSource::Network) {
+    // 2. Network inputs, 3. batched inference.
+    t0 = Clock::now();
+    const int in_size = model.decoder.layout().inputs;
+    std::vector<float> inputs(hits.size() * static_cast<std::size_t>(in_size));
+    jobs::parallel_for<std::size_t>(0, hits.size(), 1024, [&](std::size_t b, std::size_t e) {
+      std::vector<float> z(static_cast<std::size_t>(model.latent_dim));
+      for (std::size_t i = b; i < e; ++i) {
+        const Sample& smp = samples[hits[i]];
+        model.meshes[smp.mesh].latents.interpolate(*assets.meshes[smp.mesh], smp.triangle, smp.bary, z.data());
+        model::assemble_input(z.data(), model.latent_dim, smp.albedo, smp.normal_obj, smp.wo_obj,
+                              inputs.data() + i * static_cast<std::size_t>(in_size));
+      }
+    });
+    result.timings.inputs_ms = ms_since(t0);
+    t0 = Clock::now();
+    model::MlpWorkspace ws;
+    constexpr std::size_t kChunk = 8192;
+    for (std::size_t b = 0; b < hits.size(); b += kChunk) {
+      const std::size_t count = std::min(kChunk, hits.size() - b);
+      model.decoder.forward(inputs.data() + b * static_cast<std::size_t>(in_size), static_cast<int>(count),
+                            transfer.data() + b * bake::kTransferValues, ws, model::default_gemm_backend());
+    }
+    result.timings.inference_ms = ms_since(t0);
+  } else {
+    // Ground truth: integrate each sample's transfer with the bake's estimator.
+    t0 = Clock::now();
+    std::vector<std::unique_ptr<engine::rt::RtScene>> tracers(assets.meshes.size());
+    std::vector<std::unique_ptr<bake::MeshTransfer>> transfers(assets.meshes.size());
+    for (std::size_t i : hits) {
+      const std::uint32_t m = samples[i].mesh;
+      if (!transfers[m]) {
+        tracers[m] = bake::make_object_tracer(assets, m);
+        transfers[m] = std::make_unique<bake::MeshTransfer>(*tracers[m], *assets.meshes[m], assets,
+                                                            bake::default_visibility_distance(*assets.meshes[m]));
+      }
+    }
+    jobs::parallel_for<std::size_t>(0, hits.size(), 16, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        const Sample& smp = samples[hits[i]];
+        const scene::MeshAsset& mesh = *assets.meshes[smp.mesh];
+        const glm::uvec3 t = mesh.triangles[smp.triangle];
+        const float b1 = smp.bary.x, b2 = smp.bary.y, b0 = 1 - b1 - b2;
+        bake::SurfacePoint p;
+        p.triangle = smp.triangle;
+        p.barycentric = smp.bary;
+        p.position = b0 * mesh.positions[t.x] + b1 * mesh.positions[t.y] + b2 * mesh.positions[t.z];
+        p.shading_normal = smp.normal_obj;
+        glm::vec3 ng = glm::normalize(glm::cross(mesh.positions[t.y] - mesh.positions[t.x], mesh.positions[t.z] - mesh.positions[t.x]));
+        p.geometric_normal = glm::dot(ng, p.shading_normal) < 0 ? -ng : ng;
+        glm::vec2 uv(0.0f);
+        if (!mesh.uvs.empty()) uv = b0 * mesh.uvs[t.x] + b1 * mesh.uvs[t.y] + b2 * mesh.uvs[t.z];
+        p.uv = uv;
+        p.brdf = engine::render::evaluate_material(assets, mesh.triangle_material[smp.triangle], uv);
+        math::Pcg32 rng = math::make_rng(s.seed ^ 0x67ull, hits[i], 0);
+        transfers[smp.mesh]->estimate(p, std::span(&smp.wo_obj, 1), s.ground_truth_rays, rng,
+                                      std::span(transfer).subspan(i * bake::kTransferValues, bake::kTransferValues));
+      }
+    });
+    result.timings.inference_ms = ms_since(t0);
+  }
+
+  // 4. SH product with the light in each object's frame.
+  t0 = Clock::now();
+  std::unordered_map<engine::ecs::Entity, ShRgb> object_light;
+  for (std::size_t i : hits)
+    if (!object_light.contains(samples[i].entity))
+      object_light[samples[i].entity] = rotate_to_object(world_light, scene.instance_of(samples[i].entity)->to_world.rotation);
+  result.image = image::ImageRGB(width, height);
+  for (auto& m : result.coefficient_maps) m = image::ImageRGB(width, height);
+  std::vector<glm::vec3> shaded(n, glm::vec3(0.0f));
+  for (std::size_t j = 0; j < hits.size(); ++j) shaded[hits[j]] = shade(object_light.at(samples[hits[j]].entity), transfer.data() + j * bake::kTransferValues);
+  std::vector<std::size_t> hit_slot(n, SIZE_MAX);
+  for (std::size_t j = 0; j < hits.size(); ++j) hit_slot[hits[j]] = j;
+  const float inv = 1.0f / static_cast<float>(s.spp);
+  for (std::size_t p = 0; p < pixels; ++p) {
+    glm::vec3 sum(0.0f);
+    std::array<float, 3> maps{};
+    for (int si = 0; si < s.spp; ++si) {
+      const std::size_t i = p * static_cast<std::size_t>(s.spp) + static_cast<std::size_t>(si);
+      if (!samples[i].hit) {
+        sum += samples[i].background;
+        continue;
+      }
+      sum += shaded[i];
+      const float* t = transfer.data() + hit_slot[i] * bake::kTransferValues;
+      for (std::size_t m = 0; m < 3; ++m) {
+        const int k = kMapCoefficients[m];
+        maps[m] += 0.2126f * t[k] + 0.7152f * t[25 + k] + 0.0722f * t[50 + k];
+      }
+    }
+    result.image.pixels[p] = sum * inv;
+    for (std::size_t m = 0; m < 3; ++m) result.coefficient_maps[m].pixels[p] = glm::vec3(maps[m] * inv);
+  }
+  result.timings.shading_ms = ms_since(t0);
+  return result;
+}
+
+}  // namespace transgi::render
