@@ -1,10 +1,13 @@
 #include <cstdio>
 #include <cstdlib>
+#include <span>
 
 #include "bake/bake_job.h"
 #include "cli/args.h"
 #include "cli/commands.h"
 #include "engine/core/progress.h"
+#include "engine/image/svg_plot.h"
+#include "engine/io/atomic_file.h"
 #include "engine/jobs/job_system.h"
 #include "engine/scene/gltf_loader.h"
 #include "engine/scene/scene_assets.h"
@@ -14,7 +17,7 @@ namespace transgi::cli {
 int run_bake(const std::vector<std::string>& argv) {
   const Args args("bake", argv,
                   {"scene", "out", "points", "dirs", "outgoing", "iters", "batch", "lr", "latent-dim", "width", "depth",
-                   "threads", "seed"},
+                   "threads", "seed", "curve"},
                   {"resume", "keep-dataset"});
   bake::BakeSettings s;
   const std::string scene_path = args.str("scene");
@@ -58,6 +61,31 @@ int run_bake(const std::vector<std::string>& argv) {
   bake::BakeReport r;
   jobs.run([&] { r = bake::run_bake(assets, out, s, cb); });
 
+  if (args.has("curve")) {
+    // Training curve: mean batch L1 per 100 iterations and validation RMSE per 1000.
+    const std::string prefix = args.str("curve");
+    std::string csv = "iteration,train_l1,validation_rmse\n";
+    std::vector<double> it, l1, vit, vrmse;
+    for (const auto& [i, l] : r.loss_curve) {
+      it.push_back(i);
+      l1.push_back(l);
+    }
+    for (const auto& [i, v] : r.validation_curve) {
+      vit.push_back(i);
+      vrmse.push_back(v);
+    }
+    std::size_t vi = 0;
+    for (const auto& [i, l] : r.loss_curve) {
+      csv += std::to_string(i) + "," + std::to_string(l) + ",";
+      if (vi < r.validation_curve.size() && r.validation_curve[vi].first == i) csv += std::to_string(r.validation_curve[vi++].second);
+      csv += "\n";
+    }
+    engine::io::write_file_atomically(prefix + ".csv", std::as_bytes(std::span(csv.data(), csv.size())));
+    engine::image::write_svg_plot(prefix + ".svg",
+                                  {.title = "Training curve: " + scene_path, .x_label = "iteration", .y_label = "error", .log_y = true},
+                                  {{"train L1 (mean per 100 it)", it, l1, "#1f77b4", false},
+                                   {"validation RMSE", vit, vrmse, "#d62728", true}});
+  }
   std::printf("baked %s -> %s\n", scene_path.c_str(), out.c_str());
   std::printf("  data:     %zu samples (%zu train, %zu validation) from %d points x %d directions, %d rays each, %.1f s%s\n",
               r.samples, r.training_samples, r.validation_samples, s.data.points, s.data.outgoing_per_point,

@@ -12,7 +12,7 @@
 #include "engine/scene/gltf_loader.h"
 #include "engine/scene/scene_assets.h"
 #include "model/model_file.h"
-#include "render/transfer_renderer.h"
+#include "shading/transfer_renderer.h"
 
 namespace transgi::cli {
 
@@ -39,20 +39,20 @@ int render_transgi_object_scale(const Args& args, app::App& app, ecs::Entity cam
   if (!assets.environment) throw std::runtime_error("--method transgi needs an environment light in the scene (scenes[0].extras.environment)");
   const std::string model_path = args.str("model");
   const std::string transfer = args.choice("transfer", {"network", "ground-truth"}, "network");
-  transgi::render::TransferRenderSettings rs;
+  transgi::shading::TransferRenderSettings rs;
   rs.spp = static_cast<int>(args.integer("spp", 1, 4096, 4));
   rs.ground_truth_rays = static_cast<int>(args.integer("gt-rays", 1, 1'000'000, 2048));
   rs.seed = static_cast<std::uint64_t>(args.integer("seed", 0, INT64_MAX, 0));
   const auto model = transgi::model::load_model(model_path);
   if (transfer == "network") transgi::model::validate_model(model, assets, model_path);
-  const auto light = transgi::render::project_environment(*assets.environment);
+  const auto light = transgi::shading::project_environment(*assets.environment);
   const engine::render::CameraRays camera(world.get<scene::Camera>(cam), world.get<transform::WorldTransform>(cam), width, height);
-  transgi::render::TransferRenderResult r;
+  transgi::shading::TransferRenderResult r;
   app.jobs().run([&] {
-    r = transgi::render::render_transfer(world.resource<rt::RtScene>(), assets, model, camera, width, height, light,
+    r = transgi::shading::render_transfer(world.resource<rt::RtScene>(), assets, model, camera, width, height, light,
                                          &*assets.environment,
-                                         transfer == "network" ? transgi::render::TransferSource::Network
-                                                               : transgi::render::TransferSource::GroundTruth,
+                                         transfer == "network" ? transgi::shading::TransferSource::Network
+                                                               : transgi::shading::TransferSource::GroundTruth,
                                          rs);
   });
   image::write_exr(out, r.image);

@@ -16,7 +16,7 @@ void usage() {
                "  render   --scene S.gltf --method transgi --model M.tgm [--transfer network|ground-truth] [--gt-rays N]\n"
                "           [--coefficient-maps PREFIX] ... (object scale: environment SH light)\n"
                "  compare  A.exr B.exr [--heatmap out.png] [--heatmap-max E]\n"
-               "  tonemap  IN.exr OUT.png [--exposure EV]\n"
+               "  tonemap  IN.exr OUT.png [--exposure EV] [--signed SCALE] [--minus B.exr]\n"
                "  bake     --scene S.gltf --out M.tgm [--points N] [--dirs D] [--outgoing K] [--iters I] [--batch B]\n"
                "           [--lr R] [--latent-dim K] [--width W] [--depth L] [--threads T] [--seed S] [--resume] [--keep-dataset]\n"
                "  transfer-study --scene S.gltf [--points N] [--outgoing K] [--reference-rays R]\n");

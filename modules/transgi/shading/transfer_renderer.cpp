@@ -1,4 +1,4 @@
-#include "render/transfer_renderer.h"
+#include "shading/transfer_renderer.h"
 
 #include <chrono>
 #include <mutex>
@@ -10,7 +10,7 @@
 #include "engine/math/rng.h"
 #include "engine/render/surface.h"
 
-namespace transgi::render {
+namespace transgi::shading {
 
 namespace {
 
@@ -182,4 +182,4 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
   return result;
 }
 
-}  // namespace transgi::render
+}  // namespace transgi::shading

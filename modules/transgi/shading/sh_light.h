@@ -8,7 +8,7 @@
 #include "engine/math/sh.h"
 #include "engine/scene/environment.h"
 
-namespace transgi::render {
+namespace transgi::shading {
 
 using ShRgb = std::array<float, 3 * engine::math::kShCount>;
 
@@ -23,4 +23,4 @@ ShRgb rotate_to_object(const ShRgb& world, const glm::quat& object_rotation);
 // sum_c sum_k light[c][k] * transfer[c][k], per channel.
 glm::vec3 shade(const ShRgb& light, const float* transfer);
 
-}  // namespace transgi::render
+}  // namespace transgi::shading

@@ -11,9 +11,9 @@
 #include "engine/render/camera_rays.h"
 #include "engine/rt/rt_scene.h"
 #include "model/transfer_model.h"
-#include "render/sh_light.h"
+#include "shading/sh_light.h"
 
-namespace transgi::render {
+namespace transgi::shading {
 
 enum class TransferSource {
   Network,      // decoded by the model (TransGI)
@@ -46,4 +46,4 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
                                      const engine::scene::Environment* background, TransferSource source,
                                      const TransferRenderSettings& settings);
 
-}  // namespace transgi::render
+}  // namespace transgi::shading
