@@ -1,0 +1,72 @@
+// Decoder throughput: forward (inference) and forward+backward (training) at
+// batch 2048 on the oneDNN backend, and a whole Trainer::step() on a small
+// dataset; the counters report samples/s and GFLOP/s so the share of time
+// spent outside the GEMMs is visible (docs/bake.md).
+#include <benchmark/benchmark.h>
+
+#include <vector>
+
+#include "bake/trainer.h"
+#include "engine/math/rng.h"
+#include "engine/scene/procedural.h"
+#include "model/mlp.h"
+
+using namespace transgi;
+
+namespace {
+constexpr int kBatch = 2048;
+
+std::vector<float> random_inputs(std::size_t n) {
+  engine::math::Pcg32 rng(1, 2);
+  std::vector<float> v(n);
+  for (float& x : v) x = 2 * rng.next_float() - 1;
+  return v;
+}
+
+void BM_DecoderForward(benchmark::State& state) {
+  model::Mlp net(model::MlpLayout{});
+  net.initialise(1);
+  const auto x = random_inputs(static_cast<std::size_t>(kBatch) * 16);
+  std::vector<float> y(static_cast<std::size_t>(kBatch) * 75);
+  model::MlpWorkspace ws;
+  for (auto _ : state) net.forward(x.data(), kBatch, y.data(), ws, model::GemmBackend::OneDnn);
+  state.counters["samples/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * kBatch, benchmark::Counter::kIsRate);
+  state.counters["GFLOP/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * kBatch * 88832.0 * 1e-9, benchmark::Counter::kIsRate);
+}
+
+void BM_DecoderForwardBackward(benchmark::State& state) {
+  model::Mlp net(model::MlpLayout{});
+  net.initialise(1);
+  const auto x = random_inputs(static_cast<std::size_t>(kBatch) * 16);
+  const auto dy = random_inputs(static_cast<std::size_t>(kBatch) * 75);
+  std::vector<float> y(dy.size()), grad(net.params().size()), dx(x.size());
+  model::MlpWorkspace ws;
+  for (auto _ : state) {
+    net.forward(x.data(), kBatch, y.data(), ws, model::GemmBackend::OneDnn);
+    net.backward(x.data(), kBatch, dy.data(), ws, grad, dx.data(), model::GemmBackend::OneDnn);
+  }
+  // backward ~ 2x forward FLOPs
+  state.counters["samples/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * kBatch, benchmark::Counter::kIsRate);
+  state.counters["GFLOP/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * kBatch * 3 * 88832.0 * 1e-9, benchmark::Counter::kIsRate);
+}
+
+void BM_TrainerStep(benchmark::State& state) {
+  engine::scene::SceneAssets a;
+  a.generation = engine::scene::next_scene_generation();
+  a.meshes = {std::make_shared<engine::scene::MeshAsset>(engine::scene::make_uv_sphere(1, 64, 32))};
+  a.materials.resize(1);
+  bake::DatasetSettings ds;
+  ds.points = 2000;
+  ds.rays = 32;
+  const auto data = bake::generate_dataset(a, ds);
+  auto m = bake::make_untrained_model(a, 7, model::MlpLayout{}, 1);
+  bake::Trainer trainer(data, a, m, {});
+  for (auto _ : state) trainer.step();
+  state.counters["samples/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * kBatch, benchmark::Counter::kIsRate);
+}
+}  // namespace
+
+BENCHMARK(BM_DecoderForward)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DecoderForwardBackward)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TrainerStep)->Unit(benchmark::kMillisecond);
+BENCHMARK_MAIN();

@@ -1,0 +1,42 @@
+#pragma once
+// A regular grid of probes over an axis-aligned box (8 x 8 x 8 by default),
+// probe 0 at `min`, the last at `max`.
+#include <array>
+
+#include <glm/glm.hpp>
+
+namespace transgi::probes {
+
+struct ProbeGrid {
+  glm::vec3 min{0.0f}, max{1.0f};
+  glm::ivec3 dims{8};
+
+  [[nodiscard]] int count() const { return dims.x * dims.y * dims.z; }
+  [[nodiscard]] int index(glm::ivec3 c) const { return (c.z * dims.y + c.y) * dims.x + c.x; }
+  [[nodiscard]] glm::ivec3 coords(int i) const { return {i % dims.x, (i / dims.x) % dims.y, i / (dims.x * dims.y)}; }
+  [[nodiscard]] glm::vec3 spacing() const { return (max - min) / glm::vec3(glm::max(dims - 1, glm::ivec3(1))); }
+  [[nodiscard]] glm::vec3 position(int i) const { return min + glm::vec3(coords(i)) * spacing(); }
+
+  // The 8 probes around p (clamped to the grid) and their trilinear weights.
+  struct Cage {
+    std::array<int, 8> probes{};
+    std::array<float, 8> weights{};
+  };
+  [[nodiscard]] Cage cage(const glm::vec3& p) const;
+
+  // Probe q's 3x3x3 neighbourhood (itself included), clamped to the grid;
+  // calls fn(neighbour index).
+  template <class Fn>
+  void for_each_neighbour(int q, Fn&& fn) const {
+    const glm::ivec3 c = coords(q);
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const glm::ivec3 n = c + glm::ivec3(dx, dy, dz);
+          if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, dims))) continue;
+          fn(index(n));
+        }
+  }
+};
+
+}  // namespace transgi::probes

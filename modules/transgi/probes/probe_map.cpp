@@ -1,0 +1,104 @@
+#include "probes/probe_map.h"
+
+#include <cmath>
+#include <limits>
+
+namespace transgi::probes {
+
+void ProbeMapState::reset(int texels) {
+  const auto n = static_cast<std::size_t>(texels);
+  radiance.assign(n, glm::vec3(0.0f));
+  sampled.assign(n, 0.0f);
+  depth.mean.assign(n, std::numeric_limits<float>::quiet_NaN());
+  depth_squared.assign(n, 0.0f);
+  depth_weight.assign(n, 0.0f);
+}
+
+namespace {
+float luminance(const glm::vec3& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
+}  // namespace
+
+void accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSettings& s) {
+  for (std::size_t t = 0; t < st.radiance.size(); ++t) {
+    if (f.count[t] <= 0) continue;  // nothing new: keep the history
+    const glm::vec3 mean = f.sum[t] / f.count[t];
+    if (st.sampled[t] == 0.0f) {
+      st.radiance[t] = mean;
+      st.sampled[t] = 1.0f;
+      continue;
+    }
+    const float old_l = luminance(st.radiance[t]), new_l = luminance(mean);
+    const bool changed = std::abs(new_l - old_l) > s.change_threshold * std::max(old_l, 1e-3f);
+    const float h = changed ? s.fast_hysteresis : s.hysteresis;
+    st.radiance[t] = h * st.radiance[t] + (1.0f - h) * mean;
+  }
+}
+
+void update_own_depth(ProbeMapState& st, const MapLayout& layout, const std::vector<ShadedPoint>& own,
+                      const AccumulationSettings& s) {
+  for (const ShadedPoint& p : own) {
+    if (!std::isfinite(p.distance)) continue;
+    const auto t = static_cast<std::size_t>(layout.texel_of(p.direction));
+    if (st.depth_weight[t] == 0.0f) {
+      st.depth.mean[t] = p.distance;
+      st.depth_squared[t] = p.distance * p.distance;
+      st.depth_weight[t] = 1.0f;
+    } else {
+      const float h = s.hysteresis;
+      st.depth.mean[t] = h * st.depth.mean[t] + (1 - h) * p.distance;
+      st.depth_squared[t] = h * st.depth_squared[t] + (1 - h) * p.distance * p.distance;
+    }
+  }
+}
+
+std::vector<glm::vec3> filled_radiance(const ProbeMapState& st, const MapLayout& layout, int passes) {
+  std::vector<glm::vec3> r = st.radiance;
+  std::vector<float> known = st.sampled;
+  const int w = layout.width, h = layout.height;
+  for (int pass = 0; pass < passes; ++pass) {
+    std::vector<glm::vec3> next = r;
+    std::vector<float> next_known = known;
+    bool any_missing = false;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t t = static_cast<std::size_t>(y * w + x);
+        if (known[t] > 0) continue;
+        glm::vec3 sum(0.0f);
+        int n = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int yy = y + dy;
+            if (yy < 0 || yy >= h) continue;
+            const int xx = (x + dx + w) % w;  // u wraps around
+            const std::size_t q = static_cast<std::size_t>(yy * w + xx);
+            if (known[q] > 0) {
+              sum += r[q];
+              ++n;
+            }
+          }
+        if (n > 0) {
+          next[t] = sum / static_cast<float>(n);
+          next_known[t] = 1.0f;
+        } else {
+          any_missing = true;
+        }
+      }
+    r.swap(next);
+    known.swap(next_known);
+    if (!any_missing) return r;
+  }
+  // What dilation could not reach gets the mean of everything known.
+  glm::dvec3 sum(0.0);
+  double wsum = 0;
+  for (int t = 0; t < layout.texel_count(); ++t)
+    if (known[static_cast<std::size_t>(t)] > 0) {
+      sum += glm::dvec3(r[static_cast<std::size_t>(t)]) * layout.solid_angle(t);
+      wsum += layout.solid_angle(t);
+    }
+  const glm::vec3 mean = wsum > 0 ? glm::vec3(sum / wsum) : glm::vec3(0.0f);
+  for (std::size_t t = 0; t < r.size(); ++t)
+    if (known[t] <= 0) r[t] = mean;
+  return r;
+}
+
+}  // namespace transgi::probes

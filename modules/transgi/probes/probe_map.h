@@ -1,0 +1,46 @@
+#pragma once
+// One probe's accumulated state: its radiance map over frames, its own
+// hit-distance moments (for the sharing depth guard and Chebyshev
+// visibility), and the SH projection shading reads.
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "probes/radiance_sharing.h"
+
+namespace transgi::probes {
+
+struct AccumulationSettings {
+  // Weight of history per frame. Higher = smoother and less noisy, at the
+  // cost of slower reaction to lighting changes.
+  float hysteresis = 0.95f;
+  // When a texel's new mean differs from its history by more than this
+  // fraction, that texel uses `fast_hysteresis` instead (adapts to changes).
+  float change_threshold = 0.25f;
+  float fast_hysteresis = 0.5f;
+  // Dilation passes that fill never-sampled texels from sampled neighbours
+  // before the map-wide mean fills the rest. Higher = better hole filling,
+  // at the cost of time.
+  int fill_passes = 4;
+};
+
+struct ProbeMapState {
+  std::vector<glm::vec3> radiance;   // history, per texel
+  std::vector<float> sampled;        // 0 until a texel receives its first sample
+  DepthMap depth;                    // own mean hit distance (NaN = never hit)
+  std::vector<float> depth_squared;  // own mean squared hit distance
+  std::vector<float> depth_weight;
+
+  void reset(int texels);
+};
+
+// Blends this frame's samples into the history.
+void accumulate(ProbeMapState& state, const FrameSamples& frame, const AccumulationSettings& settings);
+// Updates the own-depth moments from this probe's own shaded points.
+void update_own_depth(ProbeMapState& state, const MapLayout& layout, const std::vector<ShadedPoint>& own,
+                      const AccumulationSettings& settings);
+// The radiance to project: texels never sampled are filled from sampled
+// neighbours (then the map's solid-angle-weighted mean), never read as black.
+std::vector<glm::vec3> filled_radiance(const ProbeMapState& state, const MapLayout& layout, int passes);
+
+}  // namespace transgi::probes

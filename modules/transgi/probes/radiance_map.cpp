@@ -1,0 +1,82 @@
+#include "probes/radiance_map.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "engine/math/sampling.h"
+#include "engine/scene/environment.h"
+
+namespace transgi::probes {
+
+using engine::math::kShCount;
+
+int MapLayout::texel_of(const glm::vec3& d) const {
+  const glm::vec2 uv = engine::scene::Environment::direction_to_uv(d);
+  const int x = std::min(width - 1, static_cast<int>(uv.x * static_cast<float>(width)));
+  const int y = std::min(height - 1, static_cast<int>(uv.y * static_cast<float>(height)));
+  return y * width + x;
+}
+
+glm::vec3 MapLayout::direction_of(int t) const {
+  const int x = t % width, y = t / width;
+  return engine::scene::Environment::uv_to_direction(
+      {(static_cast<float>(x) + 0.5f) / static_cast<float>(width), (static_cast<float>(y) + 0.5f) / static_cast<float>(height)});
+}
+
+double MapLayout::solid_angle(int t) const {
+  const int y = t / width;
+  const double pi = engine::math::kPi;
+  return (2.0 * pi / width) * (std::cos(pi * y / height) - std::cos(pi * (y + 1.0) / height));
+}
+
+MapProjector::MapProjector(MapLayout layout, int sub) : layout_(layout), basis_integrals_(static_cast<std::size_t>(layout.texel_count())) {
+  const double pi = engine::math::kPi;
+  for (int t = 0; t < layout.texel_count(); ++t) {
+    const int x = t % layout.width, y = t / layout.width;
+    std::array<double, kShCount> acc{};
+    for (int sy = 0; sy < sub; ++sy) {
+      const double v0 = (y + static_cast<double>(sy) / sub) / layout.height, v1 = (y + (sy + 1.0) / sub) / layout.height;
+      const double d_omega = (2.0 * pi / (static_cast<double>(layout.width) * sub)) * (std::cos(pi * v0) - std::cos(pi * v1));
+      for (int sx = 0; sx < sub; ++sx) {
+        const double u = (x + (sx + 0.5) / sub) / layout.width;
+        const auto b = engine::math::sh_eval(engine::scene::Environment::uv_to_direction(
+            {static_cast<float>(u), static_cast<float>(0.5 * (v0 + v1))}));
+        for (int k = 0; k < kShCount; ++k) acc[static_cast<std::size_t>(k)] += b[static_cast<std::size_t>(k)] * d_omega;
+      }
+    }
+    for (int k = 0; k < kShCount; ++k) basis_integrals_[static_cast<std::size_t>(t)][static_cast<std::size_t>(k)] = static_cast<float>(acc[static_cast<std::size_t>(k)]);
+  }
+}
+
+void MapProjector::project(const glm::vec3* radiance, float* out) const {
+  std::array<double, 3 * kShCount> acc{};
+  for (int t = 0; t < layout_.texel_count(); ++t) {
+    const glm::vec3 L = radiance[t];
+    if (L.r == 0 && L.g == 0 && L.b == 0) continue;
+    const auto& b = basis_integrals_[static_cast<std::size_t>(t)];
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < kShCount; ++k) acc[static_cast<std::size_t>(c * kShCount + k)] += static_cast<double>(L[c]) * b[static_cast<std::size_t>(k)];
+  }
+  for (int i = 0; i < 3 * kShCount; ++i) out[i] = static_cast<float>(acc[static_cast<std::size_t>(i)]);
+}
+
+void apply_hanning_window(float* c, int degree) {
+  for (int l = 1; l <= degree; ++l) {
+    const float w = 0.5f * (1.0f + std::cos(engine::math::kPi * static_cast<float>(l) / static_cast<float>(degree + 1)));
+    for (int ch = 0; ch < 3; ++ch)
+      for (int m = -l; m <= l; ++m) c[ch * kShCount + engine::math::sh_index(l, m)] *= w;
+  }
+}
+
+glm::vec3 evaluate_clamped(const float* c, const glm::vec3& d) {
+  const auto b = engine::math::sh_eval(d);
+  glm::vec3 out(0.0f);
+  for (int ch = 0; ch < 3; ++ch) {
+    float s = 0;
+    for (int k = 0; k < kShCount; ++k) s += c[ch * kShCount + k] * b[static_cast<std::size_t>(k)];
+    out[ch] = std::max(0.0f, s);
+  }
+  return out;
+}
+
+}  // namespace transgi::probes

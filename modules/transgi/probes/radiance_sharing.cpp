@@ -1,0 +1,56 @@
+#include "probes/radiance_sharing.h"
+
+#include <atomic>
+#include <cmath>
+
+#include "engine/jobs/parallel_for.h"
+
+namespace transgi::probes {
+
+SharingStats rasterize_shared(const ProbeGrid& grid, const MapLayout& layout,
+                              const std::vector<std::vector<ShadedPoint>>& points, const std::vector<DepthMap>& own_depth,
+                              const SharingSettings& s, std::vector<FrameSamples>& out) {
+  const int n = grid.count();
+  out.resize(static_cast<std::size_t>(n));
+  std::atomic<std::size_t> accepted{0}, rejected{0};
+  engine::jobs::parallel_for(0, n, 8, [&](int b, int e) {
+    std::size_t acc = 0, rej = 0;
+    for (int p = b; p < e; ++p) {
+      FrameSamples& fs = out[static_cast<std::size_t>(p)];
+      fs.reset(layout.texel_count());
+      const glm::vec3 origin = grid.position(p);
+      const DepthMap* depth = own_depth.empty() ? nullptr : &own_depth[static_cast<std::size_t>(p)];
+      grid.for_each_neighbour(p, [&](int q) {
+        for (const ShadedPoint& pt : points[static_cast<std::size_t>(q)]) {
+          if (!std::isfinite(pt.distance)) {
+            if (q != p) continue;  // an escaped ray has no position to share
+            const int t = layout.texel_of(pt.direction);
+            fs.count[static_cast<std::size_t>(t)] += 1.0f;  // a zero sample: the probes hold indirect light only
+            ++acc;
+            continue;
+          }
+          glm::vec3 d = pt.position - origin;
+          const float dist = glm::length(d);
+          if (!(dist > 1e-6f)) continue;
+          d /= dist;
+          const int t = layout.texel_of(d);
+          if (q != p && s.mode == SharingMode::DepthGuard && depth) {
+            const float own = depth->mean[static_cast<std::size_t>(t)];
+            if (std::isfinite(own) && dist > own * (1.0f + s.relative_tolerance) + s.absolute_tolerance) {
+              ++rej;
+              continue;
+            }
+          }
+          fs.sum[static_cast<std::size_t>(t)] += pt.radiance;
+          fs.count[static_cast<std::size_t>(t)] += 1.0f;
+          ++acc;
+        }
+      });
+    }
+    accepted += acc;
+    rejected += rej;
+  });
+  return {accepted.load(), rejected.load()};
+}
+
+}  // namespace transgi::probes

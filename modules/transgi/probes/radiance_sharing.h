@@ -1,0 +1,67 @@
+#pragma once
+// Across-probe radiance sharing (paper Section 5.2). Every probe shoots M
+// rays; each hit becomes a shaded point (position and the radiance leaving it
+// towards the probe). A probe's map then accumulates the points of itself
+// and its 26 neighbours, each in the texel of the direction from that probe
+// to the point.
+//
+// On the GPU this is an atomic scatter; here each target probe gathers from
+// its neighbourhood, so no two threads ever write one texel and the result
+// does not depend on thread scheduling.
+//
+// A neighbour's point can lie behind a wall that the target probe's own rays
+// hit first. With the depth guard on, such a point is rejected when its
+// distance exceeds the target's own mean hit distance in that texel by more
+// than the tolerance. SharingMode::PaperFaithful keeps every point (ablation).
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "probes/probe_grid.h"
+#include "probes/radiance_map.h"
+
+namespace transgi::probes {
+
+struct ShadedPoint {
+  glm::vec3 position{0.0f};
+  glm::vec3 radiance{0.0f};  // leaving the point towards its own probe
+  glm::vec3 direction{0.0f}; // unit, from the shooting probe
+  float distance = 0.0f;     // from the shooting probe; infinity when the ray escaped
+};
+
+enum class SharingMode { DepthGuard, PaperFaithful };
+
+struct SharingSettings {
+  SharingMode mode = SharingMode::DepthGuard;
+  // A neighbour's point is rejected beyond own_depth * (1 + relative) + absolute.
+  float relative_tolerance = 0.1f;
+  float absolute_tolerance = 0.05f;  // world units
+};
+
+// This frame's samples of one probe's map.
+struct FrameSamples {
+  std::vector<glm::vec3> sum;
+  std::vector<float> count;
+  void reset(int texels) {
+    sum.assign(static_cast<std::size_t>(texels), glm::vec3(0.0f));
+    count.assign(static_cast<std::size_t>(texels), 0.0f);
+  }
+};
+
+// Mean own hit distance per texel (NaN where the probe's own rays never hit),
+// which the guard compares against.
+struct DepthMap {
+  std::vector<float> mean;
+};
+
+struct SharingStats {
+  std::size_t accepted = 0, rejected_by_guard = 0;
+};
+
+// points[q] are probe q's shaded points this frame. out[p] receives probe
+// p's frame samples. Escaped rays add a zero sample to their own probe only.
+SharingStats rasterize_shared(const ProbeGrid& grid, const MapLayout& layout,
+                              const std::vector<std::vector<ShadedPoint>>& points, const std::vector<DepthMap>& own_depth,
+                              const SharingSettings& settings, std::vector<FrameSamples>& out);
+
+}  // namespace transgi::probes

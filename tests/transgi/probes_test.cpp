@@ -1,0 +1,157 @@
+// Probe building blocks against known answers: exact projection of a
+// constant map, the window reducing measured ringing, the trilinear cage,
+// radiance sharing placing points in the right texels, the depth guard
+// stopping a leak through a wall, and unsampled texels never read as black.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "engine/math/rng.h"
+#include "engine/math/sampling.h"
+#include "probes/probe_map.h"
+#include "probes/radiance_sharing.h"
+
+using namespace transgi::probes;
+
+TEST(RadianceMap, SolidAnglesSumToTheSphereAndTexelsRoundTrip) {
+  const MapLayout m;
+  double total = 0;
+  for (int t = 0; t < m.texel_count(); ++t) {
+    total += m.solid_angle(t);
+    ASSERT_EQ(m.texel_of(m.direction_of(t)), t) << "texel " << t;
+  }
+  EXPECT_NEAR(total, 4 * engine::math::kPi, 1e-9);
+}
+
+TEST(RadianceMap, ConstantMapProjectsToBandZeroOnly) {
+  const MapLayout m;
+  const MapProjector proj(m);
+  const std::vector<glm::vec3> L(static_cast<std::size_t>(m.texel_count()), glm::vec3(2.0f));
+  float c[75];
+  proj.project(L.data(), c);
+  EXPECT_NEAR(c[0], 2 * 2 * std::sqrt(engine::math::kPi), 1e-4) << "2 x 2 sqrt(pi)";
+  for (int k = 1; k < 25; ++k) EXPECT_NEAR(c[k], 0.0f, 2e-4f) << "coefficient " << k;
+  // 24 residuals below 2e-4 (4x4 sub-samples per texel) add up at the pole.
+  EXPECT_NEAR(evaluate_clamped(c, glm::vec3(0, 1, 0)).g, 2.0f, 1e-3f);
+}
+
+TEST(RadianceMap, HanningWindowReducesRingingOfAStep) {
+  // Upper hemisphere 1, lower 0: degree-4 SH overshoots and goes negative
+  // near the edge. The window must shrink both, at the cost of a softer edge.
+  const MapLayout m;
+  const MapProjector proj(m);
+  std::vector<glm::vec3> L(static_cast<std::size_t>(m.texel_count()));
+  for (int t = 0; t < m.texel_count(); ++t) L[static_cast<std::size_t>(t)] = glm::vec3(m.direction_of(t).y > 0 ? 1.0f : 0.0f);
+  float raw[75], windowed[75];
+  proj.project(L.data(), raw);
+  std::copy(raw, raw + 75, windowed);
+  apply_hanning_window(windowed);
+  auto extremes = [&](const float* c) {
+    float lo = 1e9f, hi = -1e9f;
+    for (int i = 0; i <= 180; ++i) {
+      const float th = engine::math::kPi * i / 180.0f;
+      const glm::vec3 d(std::sin(th), std::cos(th), 0);
+      const auto b = engine::math::sh_eval(d);
+      float v = 0;
+      for (int k = 0; k < 25; ++k) v += c[k] * b[static_cast<std::size_t>(k)];
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+    return std::pair(lo, hi);
+  };
+  const auto [raw_lo, raw_hi] = extremes(raw);
+  const auto [win_lo, win_hi] = extremes(windowed);
+  EXPECT_LT(raw_lo, -0.02f) << "an unwindowed step rings below zero";
+  EXPECT_GT(win_lo, raw_lo) << "the window reduces the undershoot";
+  EXPECT_LT(win_hi - 1.0f, raw_hi - 1.0f) << "and the overshoot";
+}
+
+TEST(ProbeGrid, CageWeightsReproduceLinearFunctions) {
+  ProbeGrid g{{-1, 0, -2}, {3, 2, 2}, {5, 3, 4}};
+  engine::math::Pcg32 rng(1, 1);
+  for (int i = 0; i < 100; ++i) {
+    const glm::vec3 p = g.min + (g.max - g.min) * glm::vec3(rng.next_float(), rng.next_float(), rng.next_float());
+    const auto c = g.cage(p);
+    float wsum = 0;
+    glm::vec3 interp(0.0f);
+    for (int k = 0; k < 8; ++k) {
+      wsum += c.weights[static_cast<std::size_t>(k)];
+      interp += c.weights[static_cast<std::size_t>(k)] * g.position(c.probes[static_cast<std::size_t>(k)]);
+    }
+    EXPECT_NEAR(wsum, 1.0f, 1e-5f);
+    EXPECT_NEAR(glm::length(interp - p), 0.0f, 1e-4f) << "trilinear weights reproduce the position itself";
+  }
+}
+
+TEST(RadianceSharing, NeighbourPointsLandInTheDirectionFromTheTargetProbe) {
+  const ProbeGrid g{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}};
+  const MapLayout m{32, 16};
+  std::vector<std::vector<ShadedPoint>> pts(static_cast<std::size_t>(g.count()));
+  // Probe 7 at (1,1,1) sees a point at (0.5, 1.5, 0.5) with radiance 3.
+  const glm::vec3 q = g.position(7), point(0.5f, 1.5f, 0.5f);
+  pts[7].push_back({point, glm::vec3(3.0f), glm::normalize(point - q), glm::length(point - q)});
+  std::vector<FrameSamples> out;
+  const auto stats = rasterize_shared(g, m, pts, {}, {}, out);
+  EXPECT_EQ(stats.accepted, 8u) << "every probe of a 2x2x2 grid neighbours probe 7";
+  for (int p = 0; p < g.count(); ++p) {
+    const int t = m.texel_of(glm::normalize(point - g.position(p)));
+    EXPECT_EQ(out[static_cast<std::size_t>(p)].count[static_cast<std::size_t>(t)], 1.0f) << "probe " << p;
+    EXPECT_EQ(out[static_cast<std::size_t>(p)].sum[static_cast<std::size_t>(t)], glm::vec3(3.0f));
+  }
+}
+
+TEST(RadianceSharing, DepthGuardStopsALeakThroughAWall) {
+  // Two probes along x; a wall at x = 0.5 between them. Probe 0's own ray
+  // towards +x hits the wall at distance 0.5. Probe 1 (beyond the wall) sees
+  // a bright point at x = 2 in the same direction: sharing it with probe 0
+  // would leak light through the wall.
+  const ProbeGrid g{{0, 0, 0}, {1, 0, 0}, {2, 1, 1}};
+  const MapLayout m{32, 16};
+  std::vector<std::vector<ShadedPoint>> pts(2);
+  pts[0].push_back({{0.5f, 0, 0}, glm::vec3(0.1f), {1, 0, 0}, 0.5f});
+  pts[1].push_back({{2.0f, 0, 0}, glm::vec3(50.0f), {1, 0, 0}, 1.0f});
+  std::vector<ProbeMapState> states(2);
+  for (auto& s : states) s.reset(m.texel_count());
+  update_own_depth(states[0], m, pts[0], {});
+  update_own_depth(states[1], m, pts[1], {});
+  const std::vector<DepthMap> depth = {states[0].depth, states[1].depth};
+  const int t = m.texel_of({1, 0, 0});
+
+  std::vector<FrameSamples> guarded, faithful;
+  const auto gs = rasterize_shared(g, m, pts, depth, {.mode = SharingMode::DepthGuard}, guarded);
+  rasterize_shared(g, m, pts, depth, {.mode = SharingMode::PaperFaithful}, faithful);
+  EXPECT_EQ(gs.rejected_by_guard, 1u);
+  EXPECT_EQ(guarded[0].sum[static_cast<std::size_t>(t)], glm::vec3(0.1f)) << "only the wall's own radiance";
+  EXPECT_EQ(faithful[0].sum[static_cast<std::size_t>(t)], glm::vec3(50.1f)) << "the paper-faithful mode leaks";
+}
+
+TEST(ProbeMap, UnsampledTexelsAreFilledNotBlack) {
+  const MapLayout m{16, 8};
+  ProbeMapState st;
+  st.reset(m.texel_count());
+  FrameSamples f;
+  f.reset(m.texel_count());
+  f.sum[0] = glm::vec3(4.0f);
+  f.count[0] = 2.0f;  // one texel sampled, mean 2
+  accumulate(st, f, {});
+  const auto filled = filled_radiance(st, m, 2);
+  for (std::size_t t = 0; t < filled.size(); ++t) EXPECT_EQ(filled[t], glm::vec3(2.0f)) << "texel " << t;
+}
+
+TEST(ProbeMap, HysteresisAdaptsToLargeChanges) {
+  const MapLayout m{4, 2};
+  ProbeMapState st;
+  st.reset(m.texel_count());
+  FrameSamples f;
+  f.reset(m.texel_count());
+  f.sum[0] = glm::vec3(1.0f);
+  f.count[0] = 1;
+  accumulate(st, f, {});
+  f.sum[0] = glm::vec3(1.1f);  // small change: slow blend (h = 0.95)
+  accumulate(st, f, {});
+  EXPECT_NEAR(st.radiance[0].r, 0.95f * 1.0f + 0.05f * 1.1f, 1e-6f);
+  f.sum[0] = glm::vec3(0.0f);  // the light went off: fast blend (h = 0.5)
+  accumulate(st, f, {});
+  EXPECT_NEAR(st.radiance[0].r, 0.5f * 1.005f, 1e-5f);
+}
