@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "engine/io/atomic_file.h"
@@ -67,16 +68,24 @@ void save_dataset(const fs::path& p, std::uint64_t key, const TransferDataset& d
   engine::io::write_file_atomically(p, std::as_bytes(std::span(out.data(), out.size())));
 }
 
-// A cache that is missing, damaged or for other inputs is simply not used.
-bool load_dataset(const fs::path& p, std::uint64_t key, TransferDataset& d) {
+// Reads a file written as magic + body + FNV-1a of both; returns the body,
+// or nothing if the file is missing, foreign or damaged.
+std::optional<std::string> read_checked(const fs::path& p, const char* magic) {
   std::ifstream in(p, std::ios::binary);
-  if (!in) return false;
+  if (!in) return std::nullopt;
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (bytes.size() < 12 || bytes.compare(0, 4, "TGD1") != 0) return false;
+  if (bytes.size() < 12 || bytes.compare(0, 4, magic) != 0) return std::nullopt;
   std::uint64_t stored;
   std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);
-  if (fnv(bytes.data(), bytes.size() - 8) != stored) return false;
-  std::istringstream s(bytes.substr(4, bytes.size() - 12));
+  if (fnv(bytes.data(), bytes.size() - 8) != stored) return std::nullopt;
+  return bytes.substr(4, bytes.size() - 12);
+}
+
+// A cache that is missing, damaged or for other inputs is simply not used.
+bool load_dataset(const fs::path& p, std::uint64_t key, TransferDataset& d) {
+  const auto body = read_checked(p, "TGD1");
+  if (!body) return false;
+  std::istringstream s(*body);
   std::uint64_t k = 0, training = 0;
   if (!get(s, k) || k != key || !get(s, training) || !get(s, d.seconds)) return false;
   if (!get_vec(s, d.samples, 1ull << 32) || !get_vec(s, d.targets, 1ull << 36)) return false;
@@ -102,13 +111,9 @@ bool load_checkpoint(const fs::path& out, const engine::scene::SceneAssets& asse
     model::TransferModel loaded = model::load_model(checkpoint_path(out));
     model::validate_model(loaded, assets, checkpoint_path(out));
     if (!(loaded.decoder.layout() == m.decoder.layout()) || loaded.latent_dim != m.latent_dim) return false;
-    std::ifstream in(checkpoint_path(out).string() + ".state", std::ios::binary);
-    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (bytes.size() < 12 || bytes.compare(0, 4, "TGC1") != 0) return false;
-    std::uint64_t stored;
-    std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);
-    if (fnv(bytes.data(), bytes.size() - 8) != stored) return false;
-    std::istringstream s(bytes.substr(4, bytes.size() - 12));
+    const auto body = read_checked(checkpoint_path(out).string() + ".state", "TGC1");
+    if (!body) return false;
+    std::istringstream s(*body);
     if (!get(s, st.iteration) || !get(s, st.lr_scale) || !get(s, st.rollbacks) || !get_vec(s, st.m, 1ull << 32) ||
         !get_vec(s, st.v, 1ull << 32))
       return false;

@@ -13,6 +13,30 @@ constexpr float kBeta1 = 0.9f, kBeta2 = 0.999f, kEps = 1e-8f;
 constexpr int kSnapshotEvery = 100;
 
 int band_of(int k) { return k < 1 ? 0 : k < 4 ? 1 : k < 9 ? 2 : k < 16 ? 3 : 4; }
+
+// Squared errors summed per SH band (over RGB) and overall.
+struct BandAccumulator {
+  std::array<double, 5> sums{};
+  std::array<std::size_t, 5> counts{};
+  double total = 0;
+  std::size_t values = 0;
+  void add(const float* predicted, const float* target) {
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 25; ++k) {
+        const double diff = static_cast<double>(predicted[c * 25 + k]) - target[c * 25 + k];
+        sums[static_cast<std::size_t>(band_of(k))] += diff * diff;
+        ++counts[static_cast<std::size_t>(band_of(k))];
+        total += diff * diff;
+        ++values;
+      }
+  }
+  [[nodiscard]] BandErrors result() const {
+    BandErrors e;
+    for (std::size_t b = 0; b < 5; ++b) e.rmse[b] = counts[b] ? std::sqrt(sums[b] / static_cast<double>(counts[b])) : 0.0;
+    e.total = values ? std::sqrt(total / static_cast<double>(values)) : 0.0;
+    return e;
+  }
+};
 }  // namespace
 
 model::TransferModel make_untrained_model(const engine::scene::SceneAssets& assets, int latent_dim,
@@ -165,12 +189,8 @@ void Trainer::rollback() {
 }
 
 BandErrors Trainer::validate() const {
-  BandErrors e;
-  std::array<double, 5> sums{};
-  std::array<std::size_t, 5> counts{};
-  double total = 0;
+  BandAccumulator acc;
   const std::size_t n = data_.validation_count();
-  if (n == 0) return e;
   model::MlpWorkspace ws;
   std::vector<float> x, y;
   std::vector<std::size_t> idx;
@@ -178,46 +198,20 @@ BandErrors Trainer::validate() const {
     idx.clear();
     for (std::size_t i = start; i < std::min(n, start + 4096); ++i) idx.push_back(data_.training_count + i);
     predict(idx, x, y, ws);
-    for (std::size_t i = 0; i < idx.size(); ++i) {
-      const float* t = data_.target(idx[i]);
-      for (int c = 0; c < 3; ++c)
-        for (int k = 0; k < 25; ++k) {
-          const double diff = y[i * kTransferValues + static_cast<std::size_t>(c * 25 + k)] - t[c * 25 + k];
-          sums[static_cast<std::size_t>(band_of(k))] += diff * diff;
-          ++counts[static_cast<std::size_t>(band_of(k))];
-          total += diff * diff;
-        }
-    }
+    for (std::size_t i = 0; i < idx.size(); ++i) acc.add(y.data() + i * kTransferValues, data_.target(idx[i]));
   }
-  for (int b = 0; b < 5; ++b) e.rmse[static_cast<std::size_t>(b)] = std::sqrt(sums[static_cast<std::size_t>(b)] / static_cast<double>(counts[static_cast<std::size_t>(b)]));
-  e.total = std::sqrt(total / static_cast<double>(n * kTransferValues));
-  return e;
+  return acc.result();
 }
 
 BandErrors Trainer::constant_predictor() const {
   std::array<double, kTransferValues> mean{};
   for (std::size_t i = 0; i < data_.training_count; ++i)
     for (int k = 0; k < kTransferValues; ++k) mean[static_cast<std::size_t>(k)] += data_.target(i)[k];
-  for (double& v : mean) v /= static_cast<double>(data_.training_count);
-  BandErrors e;
-  std::array<double, 5> sums{};
-  std::array<std::size_t, 5> counts{};
-  double total = 0;
-  const std::size_t n = data_.validation_count();
-  for (std::size_t i = 0; i < n; ++i) {
-    const float* t = data_.target(data_.training_count + i);
-    for (int c = 0; c < 3; ++c)
-      for (int k = 0; k < 25; ++k) {
-        const double diff = mean[static_cast<std::size_t>(c * 25 + k)] - t[c * 25 + k];
-        sums[static_cast<std::size_t>(band_of(k))] += diff * diff;
-        ++counts[static_cast<std::size_t>(band_of(k))];
-        total += diff * diff;
-      }
-  }
-  for (int b = 0; b < 5; ++b)
-    e.rmse[static_cast<std::size_t>(b)] = counts[static_cast<std::size_t>(b)] ? std::sqrt(sums[static_cast<std::size_t>(b)] / static_cast<double>(counts[static_cast<std::size_t>(b)])) : 0;
-  e.total = n ? std::sqrt(total / static_cast<double>(n * kTransferValues)) : 0;
-  return e;
+  std::array<float, kTransferValues> prediction{};
+  for (std::size_t k = 0; k < mean.size(); ++k) prediction[k] = static_cast<float>(mean[k] / static_cast<double>(data_.training_count));
+  BandAccumulator acc;
+  for (std::size_t i = 0; i < data_.validation_count(); ++i) acc.add(prediction.data(), data_.target(data_.training_count + i));
+  return acc.result();
 }
 
 Trainer::State Trainer::state() const { return {iteration_, lr_scale_, rollbacks_, m_, v_}; }
