@@ -67,6 +67,19 @@ TEST(RadianceMap, HanningWindowReducesRingingOfAStep) {
   EXPECT_LT(win_hi - 1.0f, raw_hi - 1.0f) << "and the overshoot";
 }
 
+TEST(ProbeGrid, FlatGridsHaveFiniteCages) {
+  // One probe thick along y and z: no spacing there, still finite weights.
+  const ProbeGrid g{{0, 0, 0}, {1, 0, 0}, {2, 1, 1}};
+  const auto c = g.cage({0.25f, 0.3f, -0.2f});
+  float sum = 0;
+  for (float w : c.weights) {
+    ASSERT_TRUE(std::isfinite(w));
+    sum += w;
+  }
+  EXPECT_NEAR(sum, 1.0f, 1e-6f);
+  EXPECT_EQ(g.min_spacing(), 1.0f);
+}
+
 TEST(ProbeGrid, CageWeightsReproduceLinearFunctions) {
   ProbeGrid g{{-1, 0, -2}, {3, 2, 2}, {5, 3, 4}};
   engine::math::Pcg32 rng(1, 1);
@@ -154,4 +167,78 @@ TEST(ProbeMap, HysteresisAdaptsToLargeChanges) {
   f.sum[0] = glm::vec3(0.0f);  // the light went off: fast blend (h = 0.5)
   accumulate(st, f, {});
   EXPECT_NEAR(st.radiance[0].r, 0.5f * 1.005f, 1e-5f);
+}
+
+// ---- interpolation ---------------------------------------------------------------
+
+#include "probes/interpolation.h"
+
+namespace {
+std::vector<ProbeMapState> open_space_states(const ProbeGrid& g, const MapLayout& m) {
+  std::vector<ProbeMapState> s(static_cast<std::size_t>(g.count()));
+  for (auto& st : s) st.reset(m.texel_count());  // no hits recorded: nothing occludes
+  return s;
+}
+}  // namespace
+
+TEST(Interpolation, UnprunedWeightsAreTrilinear) {
+  const ProbeGrid g{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}};
+  const MapLayout m{32, 16};
+  const auto states = open_space_states(g, m);
+  const glm::vec3 p(0.3f, 0.6f, 0.2f);
+  const auto r = interpolate_probes(g, m, states, p, glm::normalize(glm::vec3(1, 1, 1)), {.prune_back_facing = false});
+  const auto c = g.cage(p);
+  for (std::size_t i = 0; i < 8; ++i) EXPECT_NEAR(r.weights[i], c.weights[i], 1e-6f);
+  EXPECT_EQ(r.pruned, 0);
+}
+
+TEST(Interpolation, BackFacingProbesArePruned) {
+  const ProbeGrid g{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}};
+  const MapLayout m{32, 16};
+  const auto states = open_space_states(g, m);
+  // A floor at y = 0.5 facing up: the four probes at y = 0 are below it.
+  const auto r = interpolate_probes(g, m, states, {0.5f, 0.5f, 0.5f}, {0, 1, 0}, {});
+  EXPECT_EQ(r.pruned, 4);
+  for (std::size_t i = 0; i < 8; ++i) {
+    const bool below = g.position(r.probes[i]).y < 0.5f;
+    EXPECT_NEAR(r.weights[i], below ? 0.0f : 0.25f, 1e-6f) << "probe " << r.probes[i];
+  }
+}
+
+TEST(Interpolation, OccludedProbeIsPrunedByChebyshev) {
+  const ProbeGrid g{{0, 0, 0}, {1, 0, 0}, {2, 1, 1}};
+  const MapLayout m{32, 16};
+  auto states = open_space_states(g, m);
+  // Probe 1 at x = 1 has a wall at x = 0.8: its own rays towards -x hit it.
+  std::vector<ShadedPoint> wall_hits;
+  for (int t = 0; t < m.texel_count(); ++t) {
+    const glm::vec3 d = m.direction_of(t);
+    if (d.x < -0.1f) wall_hits.push_back({glm::vec3(1, 0, 0) + d * (0.2f / -d.x), glm::vec3(0), d, 0.2f / -d.x});
+  }
+  update_own_depth(states[1], m, wall_hits, {});
+  // A point at x = 0.4 facing +y (so neither probe is behind it): probe 1
+  // must not see it through the wall, probe 0 takes all the weight.
+  const auto r = interpolate_probes(g, m, states, {0.4f, 0, 0}, {0, 1, 0}, {});
+  EXPECT_FALSE(r.fallback);
+  float w0 = 0, w1 = 0;
+  for (std::size_t i = 0; i < 8; ++i) (r.probes[i] == 0 ? w0 : w1) += r.weights[i];
+  EXPECT_EQ(w1, 0.0f) << "probe 1 is occluded";
+  EXPECT_NEAR(w0, 1.0f, 1e-6f);
+  EXPECT_NEAR(chebyshev_visibility(0.2f, 0.04f, 0.6f), 0.0f, 1e-3f);
+  EXPECT_EQ(chebyshev_visibility(0.2f, 0.04f, 0.1f), 1.0f) << "closer than the wall: visible";
+}
+
+TEST(Interpolation, AllPrunedFallsBackToDistanceAndCosineWeights) {
+  const ProbeGrid g{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}};
+  const MapLayout m{32, 16};
+  const auto states = open_space_states(g, m);
+  // A point above the whole grid facing up: every probe is behind it.
+  const auto r = interpolate_probes(g, m, states, {0.5f, 1.5f, 0.5f}, {0, 1, 0}, {});
+  EXPECT_TRUE(r.fallback);
+  float sum = 0;
+  for (float w : r.weights) {
+    EXPECT_GT(w, 0.0f);
+    sum += w;
+  }
+  EXPECT_NEAR(sum, 1.0f, 1e-5f);
 }

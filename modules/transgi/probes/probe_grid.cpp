@@ -2,11 +2,23 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace transgi::probes {
 
+float ProbeGrid::min_spacing() const {
+  const glm::vec3 s = spacing();
+  float m = std::numeric_limits<float>::infinity();
+  for (int a = 0; a < 3; ++a)
+    if (dims[a] > 1 && s[a] > 0) m = std::min(m, s[a]);
+  return std::isfinite(m) ? m : 1.0f;
+}
+
 ProbeGrid::Cage ProbeGrid::cage(const glm::vec3& p) const {
-  const glm::vec3 g = glm::clamp((p - min) / spacing(), glm::vec3(0.0f), glm::vec3(dims - 1));
+  const glm::vec3 s = spacing();
+  glm::vec3 g(0.0f);
+  for (int a = 0; a < 3; ++a)
+    if (dims[a] > 1 && s[a] > 0) g[a] = std::clamp((p[a] - min[a]) / s[a], 0.0f, static_cast<float>(dims[a] - 1));
   const glm::ivec3 base = glm::min(glm::ivec3(glm::floor(g)), glm::max(dims - 2, glm::ivec3(0)));
   const glm::vec3 f = glm::clamp(g - glm::vec3(base), glm::vec3(0.0f), glm::vec3(1.0f));
   Cage c;

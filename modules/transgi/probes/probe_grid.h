@@ -14,7 +14,10 @@ struct ProbeGrid {
   [[nodiscard]] int count() const { return dims.x * dims.y * dims.z; }
   [[nodiscard]] int index(glm::ivec3 c) const { return (c.z * dims.y + c.y) * dims.x + c.x; }
   [[nodiscard]] glm::ivec3 coords(int i) const { return {i % dims.x, (i / dims.x) % dims.y, i / (dims.x * dims.y)}; }
+  // Distance between neighbouring probes per axis; an axis with a single
+  // probe has no spacing (0) and is ignored by cage() and min_spacing().
   [[nodiscard]] glm::vec3 spacing() const { return (max - min) / glm::vec3(glm::max(dims - 1, glm::ivec3(1))); }
+  [[nodiscard]] float min_spacing() const;
   [[nodiscard]] glm::vec3 position(int i) const { return min + glm::vec3(coords(i)) * spacing(); }
 
   // The 8 probes around p (clamped to the grid) and their trilinear weights.

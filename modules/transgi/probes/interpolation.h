@@ -1,0 +1,45 @@
+#pragma once
+// Probe interpolation at a shading point (paper Section 5.3): trilinear over
+// the 8 probes of the cage, pruning a probe that is on the back side of the
+// surface (its direction from the point against the normal) or occluded (a
+// Chebyshev test on its own hit-distance moments in the point's direction).
+// When all 8 are pruned, the probes are averaged with distance and cosine
+// weights instead, as the paper says.
+#include <array>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "probes/probe_grid.h"
+#include "probes/probe_map.h"
+
+namespace transgi::probes {
+
+struct InterpolationSettings {
+  // The visibility test starts this far along the normal (in units of the
+  // grid spacing's smallest axis), so a surface does not shadow itself.
+  // Higher = fewer false occlusions, at the cost of more leaks at thin walls.
+  float normal_bias = 0.1f;
+  // A probe whose Chebyshev visibility bound is below this is occluded.
+  float visibility_threshold = 0.2f;
+  bool prune_back_facing = true;
+  bool prune_occluded = true;
+};
+
+struct InterpolationResult {
+  std::array<int, 8> probes{};
+  std::array<float, 8> weights{};  // sum to 1
+  int pruned = 0;
+  bool fallback = false;
+};
+
+// states[i] is probe i's accumulated state (its depth moments are read).
+InterpolationResult interpolate_probes(const ProbeGrid& grid, const MapLayout& layout,
+                                       const std::vector<ProbeMapState>& states, const glm::vec3& position,
+                                       const glm::vec3& normal, const InterpolationSettings& settings);
+
+// Chebyshev upper bound on the probability that the probe sees a point at
+// `distance`, from its mean and mean-squared hit distance in that direction.
+float chebyshev_visibility(float mean, float mean_squared, float distance);
+
+}  // namespace transgi::probes
