@@ -14,9 +14,14 @@ struct AccumulationSettings {
   // Weight of history per frame. Higher = smoother and less noisy, at the
   // cost of slower reaction to lighting changes.
   float hysteresis = 0.95f;
-  // When a texel's new mean differs from its history by more than this
-  // fraction, that texel uses `fast_hysteresis` instead (adapts to changes).
+  // When this frame's mean (over the probe's sampled texels) differs from the
+  // history by more than this fraction, the probe blends with
+  // `fast_hysteresis` instead (adapts to lighting changes).
   float change_threshold = 0.25f;
+  // ... and by more than this many standard deviations of the probe's own
+  // frame-to-frame noise. Higher = fewer false alarms, at the cost of
+  // reacting only to larger changes.
+  float change_sigmas = 4.0f;
   float fast_hysteresis = 0.5f;
   // Dilation passes that fill never-sampled texels from sampled neighbours
   // before the map-wide mean fills the rest. Higher = better hole filling,
@@ -30,6 +35,8 @@ struct ProbeMapState {
   DepthMap depth;                    // own mean hit distance (NaN = never hit)
   std::vector<float> depth_squared;  // own mean squared hit distance
   std::vector<float> depth_weight;
+  float noise_variance = 0.0f;  // running mean of (relative frame change)^2 under steady light
+  int noise_frames = 0;
 
   void reset(int texels);
 };

@@ -1,0 +1,174 @@
+#include "probes/probe_field.h"
+
+#include <atomic>
+#include <chrono>
+#include <limits>
+#include <cmath>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "engine/jobs/parallel_for.h"
+#include "engine/math/rng.h"
+#include "engine/math/sampling.h"
+#include "engine/render/surface.h"
+
+namespace transgi::probes {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+std::vector<glm::vec3> spherical_fibonacci(int n) {
+  std::vector<glm::vec3> d(static_cast<std::size_t>(n));
+  const float golden = 0.5f * (1.0f + std::sqrt(5.0f));
+  for (int i = 0; i < n; ++i) {
+    const float z = 1.0f - (2.0f * static_cast<float>(i) + 1.0f) / static_cast<float>(n);
+    const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+    const float phi = engine::math::kTwoPi * std::fmod(static_cast<float>(i) / golden, 1.0f);
+    d[static_cast<std::size_t>(i)] = {r * std::cos(phi), r * std::sin(phi), z};
+  }
+  return d;
+}
+
+// A uniformly random rotation (Shoemake 1992).
+glm::quat random_rotation(engine::math::Pcg32& rng) {
+  const float u1 = rng.next_float(), u2 = engine::math::kTwoPi * rng.next_float(), u3 = engine::math::kTwoPi * rng.next_float();
+  const float a = std::sqrt(1 - u1), b = std::sqrt(u1);
+  return glm::normalize(glm::quat(b * std::cos(u3), a * std::sin(u2), a * std::cos(u2), b * std::sin(u3)));
+}
+}  // namespace
+
+glm::vec3 sh_irradiance(const float* L, const glm::vec3& n) {
+  // Clamped-cosine convolution weights per band: pi, 2pi/3, pi/4, 0, -pi/24.
+  constexpr float kA[5] = {3.14159265f, 2.09439510f, 0.78539816f, 0.0f, -0.13089969f};
+  const auto y = engine::math::sh_eval(n);
+  glm::vec3 e(0.0f);
+  for (int c = 0; c < 3; ++c) {
+    float s = 0;
+    for (int l = 0; l <= 4; ++l)
+      for (int m = -l; m <= l; ++m) {
+        const int k = engine::math::sh_index(l, m);
+        s += kA[l] * L[c * 25 + k] * y[static_cast<std::size_t>(k)];
+      }
+    e[c] = std::max(0.0f, s);
+  }
+  return e;
+}
+
+ProbeField::ProbeField(ProbeFieldSettings s)
+    : settings_(s), projector_(s.map), fibonacci_(spherical_fibonacci(s.rays_per_probe)) {
+  states_.resize(static_cast<std::size_t>(s.grid.count()));
+  for (auto& st : states_) st.reset(s.map.texel_count());
+  sh_.assign(static_cast<std::size_t>(s.grid.count()) * 75, 0.0f);
+}
+
+void ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, float* out) const {
+  const InterpolationResult r = interpolate_probes(settings_.grid, settings_.map, states_, p, n, settings_.interpolation);
+  for (int k = 0; k < 75; ++k) out[k] = 0.0f;
+  for (std::size_t i = 0; i < 8; ++i) {
+    if (r.weights[i] == 0.0f) continue;
+    const float* L = light_sh(r.probes[i]);
+    for (int k = 0; k < 75; ++k) out[k] += r.weights[i] * L[k];
+  }
+}
+
+glm::vec3 ProbeField::irradiance(const glm::vec3& p, const glm::vec3& n) const {
+  float L[75];
+  interpolate(p, n, L);
+  return sh_irradiance(L, n);
+}
+
+ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights) {
+  using namespace engine;
+  ProbeFrameStats stats;
+  const ProbeGrid& grid = settings_.grid;
+  const int probes = grid.count(), M = settings_.rays_per_probe;
+  math::Pcg32 frame_rng = math::make_rng(settings_.seed, 0xF00D, frame_);
+  const glm::quat rotation = random_rotation(frame_rng);
+
+  // 1. Scatter and shade (reads the previous frame's SH for the feedback bounce).
+  auto t0 = Clock::now();
+  std::vector<std::vector<ShadedPoint>> points(static_cast<std::size_t>(probes));
+  std::atomic<std::size_t> hits{0};
+  jobs::parallel_for(0, probes, 1, [&](int b, int e) {
+    for (int q = b; q < e; ++q) {
+      const glm::vec3 origin = grid.position(q);
+      auto& out = points[static_cast<std::size_t>(q)];
+      out.reserve(static_cast<std::size_t>(M));
+      for (int i = 0; i < M; ++i) {
+        math::Pcg32 rng = math::make_rng(settings_.seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
+        const glm::vec3 dir = glm::normalize(rotation * fibonacci_[static_cast<std::size_t>(i)]);
+        ShadedPoint sp;
+        sp.direction = dir;
+        rt::Hit hit;
+        if (!scene.intersect(rt::Ray{origin, dir}, hit)) {
+          sp.distance = std::numeric_limits<float>::infinity();
+          out.push_back(sp);
+          continue;
+        }
+        hits.fetch_add(1, std::memory_order_relaxed);
+        const render::Surface s = render::make_surface(scene, hit, dir);
+        sp.position = s.position;
+        sp.distance = hit.t;
+        const bool emitter = s.emission.r > 0 || s.emission.g > 0 || s.emission.b > 0;
+        const glm::vec3 wo = s.frame.to_local(-dir);
+        if (!emitter && wo.z > 0) {
+          // Direct light by next-event estimation, towards the probe.
+          render::LightSample ls;
+          const float u_sel = rng.next_float();
+          const glm::vec2 u(rng.next_float(), rng.next_float());
+          if (lights.sample(s.position, u_sel, u, ls) && glm::dot(ls.direction, s.geometric_normal) > 0) {
+            const glm::vec3 wi = s.frame.to_local(ls.direction);
+            const glm::vec3 f = wi.z > 0 ? material::brdf_eval(s.brdf, wo, wi) : glm::vec3(0.0f);
+            if (f != glm::vec3(0.0f)) {
+              const glm::vec3 o = rt::offset_ray_origin(s.position, s.geometric_normal);
+              const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
+              if (!scene.occluded(rt::Ray{o, ls.direction, 0.0f, tmax}))
+                sp.radiance += f * wi.z * ls.radiance / (ls.delta ? 1.0f : ls.pdf);
+            }
+          }
+          // Indirect light from last frame's probes (multi-bounce feedback).
+          if (frame_ > 0) {
+            const glm::vec3 diffuse = s.brdf.base_color * (1.0f - s.brdf.metallic);
+            sp.radiance += diffuse * math::kInvPi * irradiance(s.position, s.shading_normal);
+          }
+          if (!std::isfinite(sp.radiance.r + sp.radiance.g + sp.radiance.b)) sp.radiance = glm::vec3(0.0f);
+        }
+        out.push_back(sp);
+      }
+    }
+  });
+  stats.rays = static_cast<std::size_t>(probes) * static_cast<std::size_t>(M);
+  stats.hits = hits.load();
+  stats.scatter_ms = ms_since(t0);
+
+  // 2. Share and rasterize.
+  t0 = Clock::now();
+  for (int q = 0; q < probes; ++q)
+    update_own_depth(states_[static_cast<std::size_t>(q)], settings_.map, points[static_cast<std::size_t>(q)], settings_.accumulation);
+  std::vector<DepthMap> depth(static_cast<std::size_t>(probes));
+  for (int q = 0; q < probes; ++q) depth[static_cast<std::size_t>(q)] = states_[static_cast<std::size_t>(q)].depth;
+  std::vector<FrameSamples> frame;
+  const SharingStats ss = rasterize_shared(grid, settings_.map, points, depth, settings_.sharing, frame);
+  stats.shared_accepted = ss.accepted;
+  stats.shared_rejected = ss.rejected_by_guard;
+  stats.raster_ms = ms_since(t0);
+
+  // 3. Accumulate, fill, project.
+  t0 = Clock::now();
+  jobs::parallel_for(0, probes, 1, [&](int b, int e) {
+    for (int q = b; q < e; ++q) {
+      ProbeMapState& st = states_[static_cast<std::size_t>(q)];
+      accumulate(st, frame[static_cast<std::size_t>(q)], settings_.accumulation);
+      const auto filled = filled_radiance(st, settings_.map, settings_.accumulation.fill_passes);
+      float* out = sh_.data() + static_cast<std::size_t>(q) * 75;
+      projector_.project(filled.data(), out);
+      if (settings_.window) apply_hanning_window(out);
+    }
+  });
+  stats.project_ms = ms_since(t0);
+  ++frame_;
+  return stats;
+}
+
+}  // namespace transgi::probes
