@@ -23,13 +23,17 @@ std::vector<float> random_inputs(std::size_t n) {
   return v;
 }
 
+model::GemmBackend backend_of(const benchmark::State& state) {
+  return state.range(0) == 16 ? model::GemmBackend::OneDnnBf16 : model::GemmBackend::OneDnn;
+}
+
 void BM_DecoderForward(benchmark::State& state) {
   model::Mlp net(model::MlpLayout{});
   net.initialise(1);
   const auto x = random_inputs(static_cast<std::size_t>(kBatch) * 16);
   std::vector<float> y(static_cast<std::size_t>(kBatch) * 75);
   model::MlpWorkspace ws;
-  for (auto _ : state) net.forward(x.data(), kBatch, y.data(), ws, model::GemmBackend::OneDnn);
+  for (auto _ : state) net.forward(x.data(), kBatch, y.data(), ws, backend_of(state));
   state.counters["samples/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * kBatch, benchmark::Counter::kIsRate);
   state.counters["GFLOP/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * kBatch * 88832.0 * 1e-9, benchmark::Counter::kIsRate);
 }
@@ -42,8 +46,8 @@ void BM_DecoderForwardBackward(benchmark::State& state) {
   std::vector<float> y(dy.size()), grad(net.params().size()), dx(x.size());
   model::MlpWorkspace ws;
   for (auto _ : state) {
-    net.forward(x.data(), kBatch, y.data(), ws, model::GemmBackend::OneDnn);
-    net.backward(x.data(), kBatch, dy.data(), ws, grad, dx.data(), model::GemmBackend::OneDnn);
+    net.forward(x.data(), kBatch, y.data(), ws, backend_of(state));
+    net.backward(x.data(), kBatch, dy.data(), ws, grad, dx.data(), backend_of(state));
   }
   // backward ~ 2x forward FLOPs
   state.counters["samples/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * kBatch, benchmark::Counter::kIsRate);
@@ -60,13 +64,16 @@ void BM_TrainerStep(benchmark::State& state) {
   ds.rays = 32;
   const auto data = bake::generate_dataset(a, ds);
   auto m = bake::make_untrained_model(a, 7, model::MlpLayout{}, 1);
-  bake::Trainer trainer(data, a, m, {});
+  bake::TrainSettings ts;
+  ts.backend = backend_of(state);
+  bake::Trainer trainer(data, a, m, ts);
   for (auto _ : state) trainer.step();
   state.counters["samples/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * kBatch, benchmark::Counter::kIsRate);
 }
 }  // namespace
 
-BENCHMARK(BM_DecoderForward)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_DecoderForwardBackward)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_TrainerStep)->Unit(benchmark::kMillisecond);
+// Argument: 32 = f32 sgemm, 16 = bf16 matmul.
+BENCHMARK(BM_DecoderForward)->Arg(32)->Arg(16)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DecoderForwardBackward)->Arg(32)->Arg(16)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TrainerStep)->Arg(32)->Arg(16)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

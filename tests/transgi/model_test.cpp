@@ -36,6 +36,30 @@ TEST(Gemm, OneDnnMatchesTheReferenceForEveryTransposeCombination) {
     }
 }
 
+TEST(Gemm, Bf16MatchesTheReferenceWithinBf16Rounding) {
+  // Each operand is rounded to 8 significant bits (relative error <= 2^-8),
+  // so |C_bf16 - C| <= ~2 * 2^-8 * sum_p |a_ip| |b_pj| (+ f32 accumulation).
+  const int m = 37, n = 29, k = 53;
+  for (bool ta : {false, true})
+    for (bool tb : {false, true}) {
+      const auto a = random_vector(static_cast<std::size_t>(m) * k, 1), b = random_vector(static_cast<std::size_t>(k) * n, 2);
+      auto c_ref = random_vector(static_cast<std::size_t>(m) * n, 3), c_bf = c_ref;
+      const auto c0 = c_ref;
+      const int lda = ta ? m : k, ldb = tb ? k : n;
+      gemm(GemmBackend::Reference, ta, tb, m, n, k, 0.7f, a.data(), lda, b.data(), ldb, 0.5f, c_ref.data(), n);
+      gemm(GemmBackend::OneDnnBf16, ta, tb, m, n, k, 0.7f, a.data(), lda, b.data(), ldb, 0.5f, c_bf.data(), n);
+      for (int i = 0; i < m; ++i)
+        for (int j = 0; j < n; ++j) {
+          double bound = 0;
+          for (int p = 0; p < k; ++p)
+            bound += std::abs((ta ? a[p * lda + i] : a[i * lda + p]) * (tb ? b[j * ldb + p] : b[p * ldb + j]));
+          bound = 0.7 * 2.0 * std::ldexp(bound, -8) + 1e-5;
+          const std::size_t e = static_cast<std::size_t>(i * n + j);
+          ASSERT_NEAR(c_bf[e], c_ref[e], bound) << "ta " << ta << " tb " << tb << " element " << e;
+        }
+    }
+}
+
 TEST(Mlp, ForwardMatchesBetweenBackends) {
   Mlp net(MlpLayout{});
   net.initialise(5);
@@ -46,6 +70,15 @@ TEST(Mlp, ForwardMatchesBetweenBackends) {
   net.forward(x.data(), batch, y_ref.data(), ws, GemmBackend::Reference);
   net.forward(x.data(), batch, y_fast.data(), ws, GemmBackend::OneDnn);
   for (std::size_t i = 0; i < y_ref.size(); ++i) ASSERT_NEAR(y_fast[i], y_ref[i], 1e-4f) << i;
+  // bf16 operands: the outputs agree to about 2 significant digits.
+  std::vector<float> y_bf(y_ref.size());
+  net.forward(x.data(), batch, y_bf.data(), ws, GemmBackend::OneDnnBf16);
+  double err = 0, norm = 0;
+  for (std::size_t i = 0; i < y_ref.size(); ++i) {
+    err += (y_bf[i] - y_ref[i]) * (y_bf[i] - y_ref[i]);
+    norm += y_ref[i] * y_ref[i];
+  }
+  EXPECT_LT(std::sqrt(err / norm), 0.02) << "relative RMS difference of bf16 vs f32 outputs";
   EXPECT_EQ(MlpLayout{}.parameter_count(), 16u * 128 + 128 + 2 * (128 * 128 + 128) + 128 * 75 + 75);
   EXPECT_DOUBLE_EQ(MlpLayout{}.flops_per_sample(), 88832.0) << "the figure quoted in the developers' guide";
 }

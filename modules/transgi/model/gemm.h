@@ -1,17 +1,27 @@
 #pragma once
-// Row-major single-precision GEMM, C = alpha op(A) op(B) + beta C, behind one
-// interface with two backends: a plain reference loop (the oracle) and
-// oneDNN's sgemm (JIT-dispatched to AVX-512 or AVX2 at run time).
+// Row-major GEMM, C = alpha op(A) op(B) + beta C on float arrays, behind one
+// interface with three backends:
+//  - Reference: a plain loop with double accumulation (the test oracle);
+//  - OneDnn: oneDNN's f32 sgemm, JIT-dispatched to AVX-512 or AVX2;
+//  - OneDnnBf16: A and B rounded to bfloat16 and multiplied by oneDNN's
+//    matmul primitive with f32 accumulation (AVX-512 BF16 instructions where
+//    the CPU has them). Half the bytes per operand, ~3 significant digits.
 #include <cstdint>
 
 namespace transgi::model {
 
-enum class GemmBackend { Reference, OneDnn };
+enum class GemmBackend { Reference, OneDnn, OneDnnBf16 };
 
 void gemm(GemmBackend backend, bool trans_a, bool trans_b, std::int64_t m, std::int64_t n, std::int64_t k, float alpha,
           const float* a, std::int64_t lda, const float* b, std::int64_t ldb, float beta, float* c, std::int64_t ldc);
 
-// The fastest backend available on this machine.
+// OneDnn (f32). Measured on the 2-core AVX-512 BF16 machine
+// (docs/benchmarks.md): the bf16 path is slower for these small GEMMs
+// (forward 6.1 vs 4.8 ms at batch 2048) because rounding the operands and
+// the epilogue cost more than the bf16 instructions save. The environment
+// variable TRANSGI_GEMM=f32|bf16|reference overrides the choice.
 GemmBackend default_gemm_backend();
+bool cpu_has_bf16();
+const char* gemm_backend_name(GemmBackend backend);
 
 }  // namespace transgi::model
