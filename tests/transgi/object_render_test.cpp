@@ -33,7 +33,7 @@ struct Furnace {
     const auto light = shading::project_environment(*assets().environment);
     shading::TransferRenderResult r;
     app.jobs().run([&] {
-      r = shading::render_transfer(w.resource<rt::RtScene>(), assets(), m, cam, 24, 24, light, &*assets().environment, source,
+      r = shading::render_transfer(w.resource<rt::RtScene>(), assets(), m, cam, 24, 24, shading::constant_light(light), &*assets().environment, source,
                                   {.spp = 1, .ground_truth_rays = 1024});
     });
     return r;

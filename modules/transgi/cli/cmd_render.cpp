@@ -12,6 +12,7 @@
 #include "engine/scene/gltf_loader.h"
 #include "engine/scene/scene_assets.h"
 #include "model/model_file.h"
+#include "probes/probe_field.h"
 #include "shading/transfer_renderer.h"
 
 namespace transgi::cli {
@@ -30,42 +31,93 @@ ecs::Entity find_camera(ecs::World& world, const std::vector<ecs::Entity>& node_
   throw std::runtime_error("--camera: no camera node named '" + name + "'");
 }
 
-// Object-scale TransGI (paper Fig. 7): the environment projected to SH is
-// the only light; compare with the reference's direct pass.
-int render_transgi_object_scale(const Args& args, app::App& app, ecs::Entity cam, int width, int height,
-                                const std::string& out, double exposure) {
+// TransGI rendering. --lighting environment: the object-scale setting (paper
+// Fig. 7), the environment projected to SH is the only light. --lighting
+// probes: SH light probes with radiance sharing, updated for --frames frames,
+// give the GI; --pass full adds direct light (the path tracer stopped after
+// the first bounce, --direct-spp samples).
+int render_transgi(const Args& args, app::App& app, ecs::Entity cam, int width, int height, const std::string& out,
+                   double exposure, const std::string& pass_name) {
   ecs::World& world = app.world();
   const auto& assets = world.resource<scene::SceneAssets>();
-  if (!assets.environment) throw std::runtime_error("--method transgi needs an environment light in the scene (scenes[0].extras.environment)");
+  const auto& rt_scene = world.resource<rt::RtScene>();
   const std::string model_path = args.str("model");
   const std::string transfer = args.choice("transfer", {"network", "ground-truth"}, "network");
+  const std::string lighting = args.choice("lighting", {"probes", "environment"}, "probes");
   transgi::shading::TransferRenderSettings rs;
   rs.spp = static_cast<int>(args.integer("spp", 1, 4096, 4));
   rs.ground_truth_rays = static_cast<int>(args.integer("gt-rays", 1, 1'000'000, 2048));
   rs.seed = static_cast<std::uint64_t>(args.integer("seed", 0, INT64_MAX, 0));
   const auto model = transgi::model::load_model(model_path);
   if (transfer == "network") transgi::model::validate_model(model, assets, model_path);
-  const auto light = transgi::shading::project_environment(*assets.environment);
   const engine::render::CameraRays camera(world.get<scene::Camera>(cam), world.get<transform::WorldTransform>(cam), width, height);
+  const auto source = transfer == "network" ? transgi::shading::TransferSource::Network : transgi::shading::TransferSource::GroundTruth;
+  const engine::render::LightSet lights(rt_scene, engine::render::gather_punctual_lights(world),
+                                        assets.environment ? &*assets.environment : nullptr);
+
   transgi::shading::TransferRenderResult r;
-  app.jobs().run([&] {
-    r = transgi::shading::render_transfer(world.resource<rt::RtScene>(), assets, model, camera, width, height, light,
-                                         &*assets.environment,
-                                         transfer == "network" ? transgi::shading::TransferSource::Network
-                                                               : transgi::shading::TransferSource::GroundTruth,
-                                         rs);
-  });
-  image::write_exr(out, r.image);
-  if (args.has("png")) image::write_png_srgb(args.str("png"), r.image, static_cast<float>(exposure));
+  std::unique_ptr<transgi::probes::ProbeField> field;
+  transgi::probes::ProbeFrameStats probe_totals;
+  int frames = 0;
+  if (lighting == "environment") {
+    if (!assets.environment) throw std::runtime_error("--lighting environment needs an environment light in the scene (scenes[0].extras.environment)");
+    const auto light = transgi::shading::project_environment(*assets.environment);
+    app.jobs().run([&] {
+      r = transgi::shading::render_transfer(rt_scene, assets, model, camera, width, height,
+                                            transgi::shading::constant_light(light), &*assets.environment, source, rs);
+    });
+  } else {
+    frames = static_cast<int>(args.integer("frames", 1, 100000, 32));
+    const int n = static_cast<int>(args.integer("probe-grid", 2, 64, 8));
+    transgi::probes::ProbeFieldSettings ps;
+    // Probes at the centres of an n^3 partition of the scene bounds.
+    const glm::vec3 lo = rt_scene.bounds_min(), hi = rt_scene.bounds_max(), half_cell = (hi - lo) / (2.0f * static_cast<float>(n));
+    ps.grid = transgi::probes::ProbeGrid{lo + half_cell, hi - half_cell, glm::ivec3(n)};
+    ps.rays_per_probe = static_cast<int>(args.integer("probe-rays", 1, 100000, 100));
+    ps.seed = rs.seed + 1;
+    field = std::make_unique<transgi::probes::ProbeField>(ps);
+    core::ProgressBar bar("probe frames", static_cast<std::uint64_t>(frames));
+    app.jobs().run([&] {
+      for (int f = 0; f < frames; ++f) {
+        const auto st = field->update(rt_scene, lights);
+        probe_totals.scatter_ms += st.scatter_ms;
+        probe_totals.raster_ms += st.raster_ms;
+        probe_totals.project_ms += st.project_ms;
+        bar.update(static_cast<std::uint64_t>(f + 1));
+      }
+    });
+    bar.finish();
+    const auto light_at = [&](const glm::vec3& p, const glm::vec3& nrm, float* o) { field->interpolate(p, nrm, o); };
+    app.jobs().run([&] { r = transgi::shading::render_transfer(rt_scene, assets, model, camera, width, height, light_at, nullptr, source, rs); });
+  }
+
+  image::ImageRGB img = r.image;
+  if (lighting == "probes" && pass_name != "gi") {
+    // Direct light: the reference path tracer stopped after its first bounce.
+    const int direct_spp = static_cast<int>(args.integer("direct-spp", 1, 100000, 16));
+    engine::render::PathTracer direct(rt_scene, lights, camera, width, height,
+                                      engine::render::PathTracerSettings{.max_depth = 1, .seed = rs.seed});
+    app.jobs().run([&] { direct.render(direct_spp); });
+    const image::ImageRGB d = direct.image(engine::render::Pass::Direct);
+    if (pass_name == "direct") img = d;
+    else
+      for (std::size_t i = 0; i < img.size(); ++i) img.pixels[i] += d.pixels[i];
+  }
+  image::write_exr(out, img);
+  if (args.has("png")) image::write_png_srgb(args.str("png"), img, static_cast<float>(exposure));
   if (args.has("coefficient-maps")) {
     const std::string prefix = args.str("coefficient-maps");
     const char* names[3] = {"_sh00.exr", "_sh10.exr", "_sh20.exr"};
     for (int i = 0; i < 3; ++i) image::write_exr(prefix + names[i], r.coefficient_maps[static_cast<std::size_t>(i)]);
   }
-  std::printf("rendered %s (transgi, %s transfer, environment SH light) %dx%d at %d spp: %zu shaded samples\n", out.c_str(),
-              transfer.c_str(), width, height, rs.spp, r.shaded_samples);
+  std::printf("rendered %s (transgi, %s transfer, %s light, %s pass) %dx%d at %d spp: %zu shaded samples\n", out.c_str(),
+              transfer.c_str(), lighting == "probes" ? "probe" : "environment SH", pass_name.c_str(), width, height, rs.spp,
+              r.shaded_samples);
   std::printf("  stage times (ms): G-buffer %.2f, generate network input %.2f, network inference %.2f, SH multiplication %.2f\n",
-              r.timings.gbuffer_ms, r.timings.inputs_ms, r.timings.inference_ms, r.timings.shading_ms);
+              r.timings.gbuffer_ms, r.timings.inputs_ms, r.timings.inference_ms, r.light_ms + r.timings.shading_ms);
+  if (frames > 0)
+    std::printf("  probes: %d frames; per frame (ms): collect shaded points %.2f, probe raster %.2f, SH projection %.2f\n", frames,
+                probe_totals.scatter_ms / frames, probe_totals.raster_ms / frames, probe_totals.project_ms / frames);
   return 0;
 }
 
@@ -74,7 +126,8 @@ int render_transgi_object_scale(const Args& args, app::App& app, ecs::Entity cam
 int run_render(const std::vector<std::string>& argv) {
   const Args args("render", argv,
                   {"scene", "method", "pass", "spp", "width", "height", "out", "camera", "seed", "threads", "png", "exposure",
-                   "model", "transfer", "gt-rays", "coefficient-maps"});
+                   "model", "transfer", "gt-rays", "coefficient-maps", "lighting", "frames", "probe-grid", "probe-rays",
+                   "direct-spp"});
   const std::string scene_path = args.str("scene");
   const std::string method = args.choice("method", {"reference", "transgi"}, "reference");
   const std::string pass_name = args.choice("pass", {"full", "direct", "gi", "all"}, "full");
@@ -97,7 +150,7 @@ int run_render(const std::vector<std::string>& argv) {
   const ecs::Entity cam = find_camera(world, loaded.entities, args.str("camera", std::string()));
   const auto& assets = world.resource<scene::SceneAssets>();
   const auto& rt_scene = world.resource<rt::RtScene>();
-  if (method == "transgi") return render_transgi_object_scale(args, app, cam, width, height, out, exposure);
+  if (method == "transgi") return render_transgi(args, app, cam, width, height, out, exposure, pass_name);
   const engine::render::LightSet lights(rt_scene, engine::render::gather_punctual_lights(world),
                                 assets.environment ? &*assets.environment : nullptr);
   if (lights.empty()) std::fprintf(stderr, "warning: the scene has no lights; the image will be black\n");

@@ -23,6 +23,7 @@ struct Sample {
   std::uint32_t mesh = 0, triangle = 0;
   glm::vec2 bary{0.0f};
   glm::vec3 normal_obj{0.0f}, wo_obj{0.0f}, albedo{0.0f}, background{0.0f};
+  glm::vec3 position{0.0f}, normal_world{0.0f};
 };
 
 constexpr std::array<int, 3> kMapCoefficients = {0, 2, 6};  // (0,0), (1,0), (2,0)
@@ -31,7 +32,7 @@ constexpr std::array<int, 3> kMapCoefficients = {0, 2, 6};  // (0,0), (1,0), (2,
 
 TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                                      const model::TransferModel& model, const engine::render::CameraRays& camera,
-                                     int width, int height, const ShRgb& world_light,
+                                     int width, int height, const LightAt& light_at,
                                      const engine::scene::Environment* background, TransferSource source,
                                      const TransferRenderSettings& s) {
   using namespace engine;
@@ -74,6 +75,8 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
           out.normal_obj = nobj;
           out.wo_obj = wo;
           out.albedo = engine::render::evaluate_material(assets, mesh.triangle_material[hit.primitive], uv).base_color;
+          out.position = ray.origin + hit.t * ray.direction;
+          out.normal_world = glm::normalize(inst.to_world.apply_direction(nobj));
         }
   });
   result.timings.gbuffer_ms = ms_since(t0);
@@ -146,16 +149,30 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
     result.timings.inference_ms = ms_since(t0);
   }
 
-  // 4. SH product with the light in each object's frame.
+  // 4. Light at each sample (world SH), rotated into its object's frame, dotted with the transfer.
   t0 = Clock::now();
-  std::unordered_map<engine::ecs::Entity, ShRgb> object_light;
+  std::unordered_map<engine::ecs::Entity, math::ShRotation> to_object;
   for (std::size_t i : hits)
-    if (!object_light.contains(samples[i].entity))
-      object_light[samples[i].entity] = rotate_to_object(world_light, scene.instance_of(samples[i].entity)->to_world.rotation);
+    if (!to_object.contains(samples[i].entity))
+      to_object.emplace(samples[i].entity,
+                        math::ShRotation(glm::transpose(glm::mat3_cast(scene.instance_of(samples[i].entity)->to_world.rotation))));
+  std::vector<glm::vec3> shaded(n, glm::vec3(0.0f));
+  jobs::parallel_for<std::size_t>(0, hits.size(), 256, [&](std::size_t b, std::size_t e) {
+    float world[75], object[75];
+    for (std::size_t j = b; j < e; ++j) {
+      const Sample& smp = samples[hits[j]];
+      light_at(smp.position, smp.normal_world, world);
+      const math::ShRotation& rot = to_object.at(smp.entity);
+      for (int c = 0; c < 3; ++c) rot.apply(world + c * 25, object + c * 25);
+      ShRgb light;
+      std::copy(object, object + 75, light.begin());
+      shaded[hits[j]] = shade(light, transfer.data() + j * bake::kTransferValues);
+    }
+  });
+  result.light_ms = ms_since(t0);
+  t0 = Clock::now();
   result.image = image::ImageRGB(width, height);
   for (auto& m : result.coefficient_maps) m = image::ImageRGB(width, height);
-  std::vector<glm::vec3> shaded(n, glm::vec3(0.0f));
-  for (std::size_t j = 0; j < hits.size(); ++j) shaded[hits[j]] = shade(object_light.at(samples[hits[j]].entity), transfer.data() + j * bake::kTransferValues);
   std::vector<std::size_t> hit_slot(n, SIZE_MAX);
   for (std::size_t j = 0; j < hits.size(); ++j) hit_slot[hits[j]] = j;
   const float inv = 1.0f / static_cast<float>(s.spp);
@@ -180,6 +197,10 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
   }
   result.timings.shading_ms = ms_since(t0);
   return result;
+}
+
+LightAt constant_light(const ShRgb& world_light) {
+  return [world_light](const glm::vec3&, const glm::vec3&, float* out) { std::copy(world_light.begin(), world_light.end(), out); };
 }
 
 }  // namespace transgi::shading

@@ -4,6 +4,7 @@
 // dotted with SH light rotated into the object's frame. Pixels that see no
 // object show the environment, as in the reference.
 #include <array>
+#include <functional>
 #include <memory>
 #include <unordered_map>
 
@@ -38,12 +39,19 @@ struct TransferRenderResult {
   std::array<engine::image::ImageRGB, 3> coefficient_maps;
   std::size_t shaded_samples = 0;
   TransferRenderTimings timings;
+  double light_ms = 0;  // fetching the SH light per shaded sample (probe interpolation)
 };
+
+// World-space SH light arriving at a shading point (position, normal).
+using LightAt = std::function<void(const glm::vec3& position, const glm::vec3& normal, float* out75)>;
 
 TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                                      const model::TransferModel& model, const engine::render::CameraRays& camera,
-                                     int width, int height, const ShRgb& world_light,
+                                     int width, int height, const LightAt& light_at,
                                      const engine::scene::Environment* background, TransferSource source,
                                      const TransferRenderSettings& settings);
+
+// The same light everywhere (object scale: an environment projected to SH).
+LightAt constant_light(const ShRgb& world_light);
 
 }  // namespace transgi::shading
