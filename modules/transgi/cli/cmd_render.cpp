@@ -48,6 +48,8 @@ int render_transgi(const Args& args, app::App& app, ecs::Entity cam, int width, 
   rs.spp = static_cast<int>(args.integer("spp", 1, 4096, 4));
   rs.ground_truth_rays = static_cast<int>(args.integer("gt-rays", 1, 1'000'000, 2048));
   rs.seed = static_cast<std::uint64_t>(args.integer("seed", 0, INT64_MAX, 0));
+  if (lighting == "environment" && !assets.environment)
+    throw std::runtime_error("--lighting environment needs an environment light in the scene (scenes[0].extras.environment)");
   const auto model = transgi::model::load_model(model_path);
   if (transfer == "network") transgi::model::validate_model(model, assets, model_path);
   const engine::render::CameraRays camera(world.get<scene::Camera>(cam), world.get<transform::WorldTransform>(cam), width, height);
@@ -60,7 +62,6 @@ int render_transgi(const Args& args, app::App& app, ecs::Entity cam, int width, 
   transgi::probes::ProbeFrameStats probe_totals;
   int frames = 0;
   if (lighting == "environment") {
-    if (!assets.environment) throw std::runtime_error("--lighting environment needs an environment light in the scene (scenes[0].extras.environment)");
     const auto light = transgi::shading::project_environment(*assets.environment);
     app.jobs().run([&] {
       r = transgi::shading::render_transfer(rt_scene, assets, model, camera, width, height,

@@ -93,6 +93,18 @@ class Bf16Matmul {
     check(dnnl_engine_create(&engine_, dnnl_cpu, 0), "engine_create");
     check(dnnl_stream_create(&stream_, engine_, dnnl_stream_default_flags), "stream_create");
   }
+  ~Bf16Matmul() {
+    for (auto& [key, e] : cache_) {
+      dnnl_memory_destroy(e.a);
+      dnnl_memory_destroy(e.b);
+      dnnl_memory_destroy(e.c);
+      dnnl_primitive_destroy(e.primitive);
+    }
+    if (stream_) dnnl_stream_destroy(stream_);
+    if (engine_) dnnl_engine_destroy(engine_);
+  }
+  Bf16Matmul(const Bf16Matmul&) = delete;
+  Bf16Matmul& operator=(const Bf16Matmul&) = delete;
   Entry create(const Key& key) {
     const dnnl_dims_t a_dims = {key.m, key.k}, b_dims = {key.k, key.n}, c_dims = {key.m, key.n};
     const dnnl_dims_t a_strides = {key.ta ? 1 : key.k, key.ta ? key.m : 1};
