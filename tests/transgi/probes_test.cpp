@@ -159,18 +159,38 @@ TEST(ProbeMap, HysteresisAdaptsOnlyToChangesBeyondTheNoise) {
   FrameSamples f;
   f.reset(m.texel_count());
   f.count[0] = 1;
+  AccumulationSettings settings;
+  settings.warmup_frames = 0;  // this test is about change detection, not the cold start
   // Steady light with +-10 % noise: slow blending throughout (h = 0.95).
   for (int i = 0; i < 40; ++i) {
     f.sum[0] = glm::vec3(i % 2 ? 1.1f : 0.9f);
     const float before = st.radiance[0].r;
-    accumulate(st, f, {});
+    accumulate(st, f, settings);
     if (i > 0) EXPECT_NEAR(st.radiance[0].r, 0.95f * before + 0.05f * f.sum[0].r, 1e-6f) << "frame " << i;
   }
   // The light goes off: far beyond the noise, so the fast blend (h = 0.5) applies.
   const float before = st.radiance[0].r;
   f.sum[0] = glm::vec3(0.0f);
-  accumulate(st, f, {});
+  accumulate(st, f, settings);
   EXPECT_NEAR(st.radiance[0].r, 0.5f * before, 1e-6f);
+}
+
+TEST(ProbeMap, ColdStartRampsTheHysteresisUp) {
+  const MapLayout m{4, 2};
+  ProbeMapState st;
+  st.reset(m.texel_count());
+  FrameSamples f;
+  f.reset(m.texel_count());
+  f.count[0] = 1;
+  const AccumulationSettings s;  // ramp 0.5 -> 0.95 over 32 frames
+  for (int frame = 0; frame < 40; ++frame) {
+    f.sum[0] = glm::vec3(frame % 2 ? 1.05f : 0.95f);
+    const float before = st.radiance[0].r;
+    accumulate(st, f, s);
+    if (frame == 0) continue;  // the first sample initialises the texel
+    const float h = frame < 32 ? 0.5f + 0.45f * static_cast<float>(frame) / 32.0f : 0.95f;
+    EXPECT_NEAR(st.radiance[0].r, h * before + (1 - h) * f.sum[0].r, 1e-6f) << "frame " << frame;
+  }
 }
 
 // ---- interpolation ---------------------------------------------------------------

@@ -14,6 +14,7 @@ void ProbeMapState::reset(int texels) {
   depth_weight.assign(n, 0.0f);
   noise_variance = 0.0f;
   noise_frames = 0;
+  frames = 0;
 }
 
 namespace {
@@ -45,7 +46,12 @@ void accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSett
       ++st.noise_frames;
     }
   }
-  const float h = changed ? s.fast_hysteresis : s.hysteresis;
+  float h = changed ? s.fast_hysteresis : s.hysteresis;
+  if (st.frames < s.warmup_frames) {
+    const float t = static_cast<float>(st.frames) / static_cast<float>(s.warmup_frames);
+    h = std::min(h, s.fast_hysteresis + (s.hysteresis - s.fast_hysteresis) * t);
+  }
+  ++st.frames;
   for (std::size_t t = 0; t < st.radiance.size(); ++t) {
     if (f.count[t] <= 0) continue;  // nothing new: keep the history
     const glm::vec3 mean = f.sum[t] / f.count[t];

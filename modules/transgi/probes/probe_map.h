@@ -23,6 +23,11 @@ struct AccumulationSettings {
   // reacting only to larger changes.
   float change_sigmas = 4.0f;
   float fast_hysteresis = 0.5f;
+  // Cold start: the hysteresis ramps from `fast_hysteresis` to `hysteresis`
+  // over this many frames, so each bounce of the multi-bounce feedback
+  // propagates within a frame or two instead of ~20. Higher = smoother
+  // start, at the cost of slower convergence.
+  int warmup_frames = 32;
   // Dilation passes that fill never-sampled texels from sampled neighbours
   // before the map-wide mean fills the rest. Higher = better hole filling,
   // at the cost of time.
@@ -37,6 +42,7 @@ struct ProbeMapState {
   std::vector<float> depth_weight;
   float noise_variance = 0.0f;  // running mean of (relative frame change)^2 under steady light
   int noise_frames = 0;
+  int frames = 0;  // frames accumulated since reset
 
   void reset(int texels);
 };
