@@ -35,7 +35,10 @@ void accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSett
       new_sum += luminance(f.sum[t] / f.count[t]);
     }
   bool changed = false;
-  if (old_sum > 0) {
+  // The noise is only measured once the cold start is over: the warm-up's
+  // large frame-to-frame changes are convergence, not noise, and counting
+  // them would hide real lighting changes for hundreds of frames.
+  if (old_sum > 0 && st.frames >= s.warmup_frames) {
     const double rel = (new_sum - old_sum) / std::max(old_sum, 1e-6);
     const bool noise_known = st.noise_frames >= 8;
     changed = noise_known && std::abs(rel) > s.change_threshold && rel * rel > s.change_sigmas * s.change_sigmas * st.noise_variance;
@@ -53,7 +56,13 @@ void accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSett
   }
   ++st.frames;
   for (std::size_t t = 0; t < st.radiance.size(); ++t) {
-    if (f.count[t] <= 0) continue;  // nothing new: keep the history
+    if (f.count[t] <= 0) {
+      // Nothing new: keep the history, unless the lighting just changed, in
+      // which case the history is wrong and the texel is refilled from
+      // fresh neighbours until it is sampled again.
+      if (changed) st.sampled[t] = 0.0f;
+      continue;
+    }
     const glm::vec3 mean = f.sum[t] / f.count[t];
     if (st.sampled[t] == 0.0f) {
       st.radiance[t] = mean;

@@ -17,7 +17,7 @@ struct AccumulationSettings {
   // When this frame's mean (over the probe's sampled texels) differs from the
   // history by more than this fraction, the probe blends with
   // `fast_hysteresis` instead (adapts to lighting changes).
-  float change_threshold = 0.25f;
+  float change_threshold = 0.02f;
   // ... and by more than this many standard deviations of the probe's own
   // frame-to-frame noise. Higher = fewer false alarms, at the cost of
   // reacting only to larger changes.
