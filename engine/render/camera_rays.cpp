@@ -29,6 +29,11 @@ rt::Ray CameraRays::generate(glm::vec2 film) const {
   return r;
 }
 
+rt::Ray CameraRays::generate_filtered(int x, int y, glm::vec2 u, float filter_width) const {
+  const glm::vec2 centre(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
+  return generate(centre + sample_pixel_filter(u, filter_width));
+}
+
 glm::vec2 sample_pixel_filter(glm::vec2 u, float width) {
   // Tabulated inverse CDF of the 1D Blackman-Harris window over [-w/2, w/2].
   static const math::Distribution1D table = [] {

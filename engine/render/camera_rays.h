@@ -11,6 +11,9 @@ struct CameraRays {
   CameraRays(const scene::Camera& camera, const transform::Similarity& to_world, int width, int height);
   // film = pixel coordinates with sub-pixel offset, e.g. (x + 0.5, y + 0.5).
   [[nodiscard]] rt::Ray generate(glm::vec2 film) const;
+  // A ray through pixel (x, y) offset by the pixel filter (see below), from
+  // two uniform numbers u.
+  [[nodiscard]] rt::Ray generate_filtered(int x, int y, glm::vec2 u, float filter_width) const;
   [[nodiscard]] glm::vec3 position() const { return origin_; }
 
  private:

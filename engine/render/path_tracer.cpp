@@ -124,8 +124,8 @@ void PathTracer::render(int spp, const std::function<void(int, int)>& progress) 
           const std::size_t pixel = static_cast<std::size_t>(y) * width_ + x;
           for (int s = first; s < first + batch; ++s) {
             math::Pcg32 rng = math::make_rng(settings_.seed, pixel, static_cast<std::uint64_t>(s));
-            const glm::vec2 jitter = sample_pixel_filter({rng.next_float(), rng.next_float()}, settings_.filter_width);
-            const rt::Ray ray = camera_.generate(glm::vec2(x + 0.5f, y + 0.5f) + jitter);
+            const glm::vec2 u(rng.next_float(), rng.next_float());
+            const rt::Ray ray = camera_.generate_filtered(x, y, u, settings_.filter_width);
             const PathRadiance L = trace(ray, rng);
             if (!finite(L.full) || !finite(L.direct) || !finite(L.gi)) {
               discarded.fetch_add(1, std::memory_order_relaxed);

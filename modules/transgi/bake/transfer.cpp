@@ -36,11 +36,14 @@ MeshTransfer::MeshTransfer(const engine::rt::RtScene& tracer, const engine::scen
 }
 
 SurfacePoint MeshTransfer::sample_point(Pcg32& rng) const {
-  SurfacePoint p;
   std::size_t t = 0;
   (void)triangle_distribution_.sample_continuous(rng.next_float(), nullptr, &t);
-  p.triangle = static_cast<std::uint32_t>(t);
-  const glm::vec2 b = engine::math::sample_uniform_triangle({rng.next_float(), rng.next_float()});
+  return point_at(static_cast<std::uint32_t>(t), engine::math::sample_uniform_triangle({rng.next_float(), rng.next_float()}));
+}
+
+SurfacePoint MeshTransfer::point_at(std::uint32_t t, glm::vec2 b) const {
+  SurfacePoint p;
+  p.triangle = t;
   p.barycentric = b;
   const glm::uvec3 tri = mesh_.triangles[t];
   const float b0 = 1.0f - b.x - b.y;

@@ -56,6 +56,9 @@ class MeshTransfer {
                const engine::scene::SceneAssets& assets, float visibility_distance);
 
   SurfacePoint sample_point(engine::math::Pcg32& rng) const;
+  // The surface point at barycentrics (b1, b2) of a triangle: position,
+  // normals (geometric on the shading normal's side), UV and material.
+  [[nodiscard]] SurfacePoint point_at(std::uint32_t triangle, glm::vec2 barycentric) const;
   // Fills out[j * 75 + c * 25 + k] for each wo[j] (object space, unit, above the surface).
   void estimate(const SurfacePoint& p, std::span<const glm::vec3> wo, int rays, engine::math::Pcg32& rng,
                 std::span<float> out, Proposal proposal = Proposal::BrdfMixture) const;

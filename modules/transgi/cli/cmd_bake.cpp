@@ -94,7 +94,7 @@ int run_bake(const std::vector<std::string>& argv) {
               r.train_seconds, r.train_seconds > 0 ? (r.iterations - r.resumed_from) * double(s.train.batch) / r.train_seconds : 0.0,
               r.resumed_from ? (", resumed at " + std::to_string(r.resumed_from)).c_str() : "", r.rollbacks);
   std::printf("  model:    decoder %.1f KB + latents %.1f KB (%zu welded vertices x %d floats)\n",
-              r.decoder_bytes / 1024.0, r.latent_bytes / 1024.0, r.latent_rows, s.latent_dim);
+              static_cast<double>(r.decoder_bytes) / 1024.0, static_cast<double>(r.latent_bytes) / 1024.0, r.latent_rows, s.latent_dim);
   std::printf("  validation RMSE per SH band l=0..4: %.4f %.4f %.4f %.4f %.4f (all: %.4f)\n", r.validation.rmse[0],
               r.validation.rmse[1], r.validation.rmse[2], r.validation.rmse[3], r.validation.rmse[4], r.validation.total);
   std::printf("  constant predictor:                 %.4f %.4f %.4f %.4f %.4f (all: %.4f)\n", r.constant.rmse[0],

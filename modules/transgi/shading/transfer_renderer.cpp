@@ -49,8 +49,8 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
         for (int si = 0; si < s.spp; ++si) {
           const std::size_t pixel = static_cast<std::size_t>(y) * width + x;
           math::Pcg32 rng = math::make_rng(s.seed, pixel, static_cast<std::uint64_t>(si));
-          const glm::vec2 jitter = engine::render::sample_pixel_filter({rng.next_float(), rng.next_float()}, s.filter_width);
-          const rt::Ray ray = camera.generate(glm::vec2(x + 0.5f, y + 0.5f) + jitter);
+          const glm::vec2 u(rng.next_float(), rng.next_float());
+          const rt::Ray ray = camera.generate_filtered(x, y, u, s.filter_width);
           Sample& out = samples[pixel * static_cast<std::size_t>(s.spp) + static_cast<std::size_t>(si)];
           rt::Hit hit;
           if (!scene.intersect(ray, hit)) {
@@ -127,20 +127,12 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
     jobs::parallel_for<std::size_t>(0, hits.size(), 16, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         const Sample& smp = samples[hits[i]];
-        const scene::MeshAsset& mesh = *assets.meshes[smp.mesh];
-        const glm::uvec3 t = mesh.triangles[smp.triangle];
-        const float b1 = smp.bary.x, b2 = smp.bary.y, b0 = 1 - b1 - b2;
-        bake::SurfacePoint p;
-        p.triangle = smp.triangle;
-        p.barycentric = smp.bary;
-        p.position = b0 * mesh.positions[t.x] + b1 * mesh.positions[t.y] + b2 * mesh.positions[t.z];
-        p.shading_normal = smp.normal_obj;
-        glm::vec3 ng = glm::normalize(glm::cross(mesh.positions[t.y] - mesh.positions[t.x], mesh.positions[t.z] - mesh.positions[t.x]));
-        p.geometric_normal = glm::dot(ng, p.shading_normal) < 0 ? -ng : ng;
-        glm::vec2 uv(0.0f);
-        if (!mesh.uvs.empty()) uv = b0 * mesh.uvs[t.x] + b1 * mesh.uvs[t.y] + b2 * mesh.uvs[t.z];
-        p.uv = uv;
-        p.brdf = engine::render::evaluate_material(assets, mesh.triangle_material[smp.triangle], uv);
+        bake::SurfacePoint p = transfers[smp.mesh]->point_at(smp.triangle, smp.bary);
+        // Seen from the back of a two-sided surface: shade the side facing the viewer.
+        if (glm::dot(p.shading_normal, smp.normal_obj) < 0) {
+          p.shading_normal = -p.shading_normal;
+          p.geometric_normal = -p.geometric_normal;
+        }
         math::Pcg32 rng = math::make_rng(s.seed ^ 0x67ull, hits[i], 0);
         transfers[smp.mesh]->estimate(p, std::span(&smp.wo_obj, 1), s.ground_truth_rays, rng,
                                       std::span(transfer).subspan(i * bake::kTransferValues, bake::kTransferValues));
