@@ -46,7 +46,8 @@ Surface make_surface(const rt::RtScene& scene, const rt::Hit& hit, const glm::ve
   glm::vec3 ns = inst.to_world.apply_direction(b0 * mesh.normals[t.x] + b1 * mesh.normals[t.y] + b2 * mesh.normals[t.z]);
   const float ns_len = glm::length(ns);
   ns = ns_len > 0 ? ns / ns_len : ng;
-  if (glm::dot(ng, incoming_dir) > 0) ng = -ng;  // face the viewer
+  s.back_face = glm::dot(ng, incoming_dir) > 0;
+  if (s.back_face) ng = -ng;  // face the viewer
   if (glm::dot(ns, ng) < 0) ns = -ns;            // shading normal on the same side
   s.geometric_normal = ng;
   s.shading_normal = ns;

@@ -117,7 +117,10 @@ ProbeFieldSettings switch_settings(float hysteresis, bool adaptive) {
   s.map = MapLayout{32, 16};
   s.rays_per_probe = 400;
   s.accumulation.hysteresis = hysteresis;
-  if (!adaptive) s.accumulation.change_threshold = 1e9f;
+  if (!adaptive) {
+    s.accumulation.change_threshold = 1e9f;
+    s.skip.skip_converged = false;  // RTXGI's fixed blend keeps updating every probe
+  }
   return s;
 }
 
@@ -125,6 +128,7 @@ ProbeFieldSettings switch_settings(float hysteresis, bool adaptive) {
 int frames_to_settle(TwoLights& scene, ProbeField& field, const std::vector<float>& settled) {
   scene.app.world().get_mut<scene::PunctualLight>(scene.light_a).enabled = false;
   const auto lights = scene.lights();
+  field.notify_scene_changed(false);  // what the ECS system does when a light changes
   for (int frame = 1; frame <= 400; ++frame) {
     scene.app.jobs().run([&] { field.update(scene.app.world().resource<rt::RtScene>(), lights); });
     bool all = true;

@@ -166,7 +166,9 @@ TEST(ProbeMap, HysteresisAdaptsOnlyToChangesBeyondTheNoise) {
     f.sum[0] = glm::vec3(i % 2 ? 1.1f : 0.9f);
     const float before = st.radiance[0].r;
     accumulate(st, f, settings);
-    if (i > 0) EXPECT_NEAR(st.radiance[0].r, 0.95f * before + 0.05f * f.sum[0].r, 1e-6f) << "frame " << i;
+    if (i > 0) {
+      EXPECT_NEAR(st.radiance[0].r, 0.95f * before + 0.05f * f.sum[0].r, 1e-6f) << "frame " << i;
+    }
   }
   // The light goes off: far beyond the noise, so the fast blend (h = 0.5) applies.
   const float before = st.radiance[0].r;

@@ -14,7 +14,7 @@ float chebyshev_visibility(float mean, float mean_squared, float distance) {
 
 InterpolationResult interpolate_probes(const ProbeGrid& grid, const MapLayout& layout,
                                        const std::vector<ProbeMapState>& states, const glm::vec3& p, const glm::vec3& n,
-                                       const InterpolationSettings& s) {
+                                       const InterpolationSettings& s, std::span<const std::uint8_t> usable) {
   const ProbeGrid::Cage cage = grid.cage(p);
   InterpolationResult r;
   r.probes = cage.probes;
@@ -28,8 +28,9 @@ InterpolationResult interpolate_probes(const ProbeGrid& grid, const MapLayout& l
     const float dist = glm::length(to_probe);
     const glm::vec3 dir = dist > 1e-6f ? to_probe / dist : n;
     // Fallback weight: nearer and more in front of the surface counts more.
-    fallback[i] = std::max(0.05f, 0.5f * (glm::dot(dir, n) + 1.0f)) / (dist * dist + 1e-4f);
-    bool keep = cage.weights[i] > 0;
+    const bool holds_light = usable.empty() || usable[static_cast<std::size_t>(q)] != 0;
+    fallback[i] = holds_light ? std::max(0.05f, 0.5f * (glm::dot(dir, n) + 1.0f)) / (dist * dist + 1e-4f) : 0.0f;
+    bool keep = cage.weights[i] > 0 && holds_light;
     if (keep && s.prune_back_facing && glm::dot(dir, n) < 0) keep = false;
     if (keep && s.prune_occluded) {
       const glm::vec3 from_probe = biased - grid.position(q);
@@ -51,7 +52,7 @@ InterpolationResult interpolate_probes(const ProbeGrid& grid, const MapLayout& l
   r.fallback = true;
   float fsum = 0;
   for (float w : fallback) fsum += w;
-  for (std::size_t i = 0; i < 8; ++i) r.weights[i] = fallback[i] / fsum;
+  for (std::size_t i = 0; i < 8; ++i) r.weights[i] = fsum > 0 ? fallback[i] / fsum : 0.0f;
   return r;
 }
 

@@ -6,6 +6,8 @@
 // When all 8 are pruned, the probes are averaged with distance and cosine
 // weights instead, as the paper says.
 #include <array>
+#include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -34,9 +36,13 @@ struct InterpolationResult {
 };
 
 // states[i] is probe i's accumulated state (its depth moments are read).
+// usable[i] == 0 marks a probe that holds no light (buried in geometry or far
+// from every surface): it gets no weight, in the fallback neither. Empty =
+// every probe is usable. If no probe of the cage is usable, all weights are 0.
 InterpolationResult interpolate_probes(const ProbeGrid& grid, const MapLayout& layout,
                                        const std::vector<ProbeMapState>& states, const glm::vec3& position,
-                                       const glm::vec3& normal, const InterpolationSettings& settings);
+                                       const glm::vec3& normal, const InterpolationSettings& settings,
+                                       std::span<const std::uint8_t> usable = {});
 
 // Chebyshev upper bound on the probability that the probe sees a point at
 // `distance`, from its mean and mean-squared hit distance in that direction.

@@ -59,11 +59,13 @@ ProbeField::ProbeField(ProbeFieldSettings s)
     : settings_(s), projector_(s.map), fibonacci_(spherical_fibonacci(s.rays_per_probe)) {
   states_.resize(static_cast<std::size_t>(s.grid.count()));
   for (auto& st : states_) st.reset(s.map.texel_count());
+  state_.assign(states_.size(), ProbeState::Active);
+  usable_.assign(states_.size(), 1);
   sh_.assign(static_cast<std::size_t>(s.grid.count()) * 75, 0.0f);
 }
 
 void ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, float* out) const {
-  const InterpolationResult r = interpolate_probes(settings_.grid, settings_.map, states_, p, n, settings_.interpolation);
+  const InterpolationResult r = interpolate_probes(settings_.grid, settings_.map, states_, p, n, settings_.interpolation, usable_);
   for (int k = 0; k < 75; ++k) out[k] = 0.0f;
   for (std::size_t i = 0; i < 8; ++i) {
     if (r.weights[i] == 0.0f) continue;
@@ -78,6 +80,15 @@ glm::vec3 ProbeField::irradiance(const glm::vec3& p, const glm::vec3& n) const {
   return sh_irradiance(L, n);
 }
 
+void ProbeField::notify_scene_changed(bool geometry_moved) {
+  for (std::size_t q = 0; q < states_.size(); ++q) {
+    if (state_[q] == ProbeState::Converged) state_[q] = ProbeState::Active;
+    states_[q].stable_frames = 0;
+    if (geometry_moved) states_[q].depth_frames = 0;
+  }
+  if (geometry_moved && settings_.skip.classify) classify_pending_ = true;
+}
+
 ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights) {
   using namespace engine;
   ProbeFrameStats stats;
@@ -85,13 +96,23 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   const int probes = grid.count(), M = settings_.rays_per_probe;
   math::Pcg32 frame_rng = math::make_rng(settings_.seed, 0xF00D, frame_);
   const glm::quat rotation = random_rotation(frame_rng);
+  const bool classify = settings_.skip.classify && classify_pending_;
+  stats.classified = classify;
+  // A classification frame traces every probe, as buried and far probes may
+  // have become useful; otherwise only the active ones do any work.
+  std::vector<std::uint8_t> traced(static_cast<std::size_t>(probes));
+  for (std::size_t q = 0; q < traced.size(); ++q)
+    traced[q] = classify || !settings_.skip.classify || state_[q] == ProbeState::Active;
 
   // 1. Scatter and shade (reads the previous frame's SH for the feedback bounce).
   auto t0 = Clock::now();
   std::vector<std::vector<ShadedPoint>> points(static_cast<std::size_t>(probes));
+  std::vector<int> backfaces(static_cast<std::size_t>(probes), 0);
+  std::vector<float> nearest(static_cast<std::size_t>(probes), std::numeric_limits<float>::infinity());
   std::atomic<std::size_t> hits{0};
   jobs::parallel_for(0, probes, 1, [&](int b, int e) {
     for (int q = b; q < e; ++q) {
+      if (!traced[static_cast<std::size_t>(q)]) continue;
       const glm::vec3 origin = grid.position(q);
       auto& out = points[static_cast<std::size_t>(q)];
       out.reserve(static_cast<std::size_t>(M));
@@ -108,6 +129,8 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
         }
         hits.fetch_add(1, std::memory_order_relaxed);
         const render::Surface s = render::make_surface(scene, hit, dir);
+        backfaces[static_cast<std::size_t>(q)] += s.back_face ? 1 : 0;
+        nearest[static_cast<std::size_t>(q)] = std::min(nearest[static_cast<std::size_t>(q)], hit.t);
         sp.position = s.position;
         sp.distance = hit.t;
         const bool emitter = s.emission.r > 0 || s.emission.g > 0 || s.emission.b > 0;
@@ -138,14 +161,31 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
       }
     }
   });
-  stats.rays = static_cast<std::size_t>(probes) * static_cast<std::size_t>(M);
+  for (std::uint8_t t : traced) stats.traced += t;
+  stats.rays = static_cast<std::size_t>(stats.traced) * static_cast<std::size_t>(M);
   stats.hits = hits.load();
+  if (classify) {
+    const float far = settings_.skip.far_cells * glm::length(grid.spacing());
+    for (std::size_t q = 0; q < state_.size(); ++q) {
+      const bool buried = static_cast<float>(backfaces[q]) > settings_.skip.buried_backface_fraction * static_cast<float>(M);
+      state_[q] = buried ? ProbeState::Buried : nearest[q] > far ? ProbeState::Far : ProbeState::Active;
+      usable_[q] = state_[q] == ProbeState::Active ? 1 : 0;
+      if (!usable_[q]) {
+        // Holds no light; if it becomes active again it starts afresh.
+        states_[q].reset(settings_.map.texel_count());
+        std::fill_n(sh_.data() + q * 75, 75, 0.0f);
+        points[q].clear();
+      }
+    }
+    classify_pending_ = false;
+  }
   stats.scatter_ms = ms_since(t0);
 
   // 2. Share and rasterize.
   t0 = Clock::now();
   for (int q = 0; q < probes; ++q)
-    update_own_depth(states_[static_cast<std::size_t>(q)], settings_.map, points[static_cast<std::size_t>(q)], settings_.accumulation);
+    if (state_[static_cast<std::size_t>(q)] == ProbeState::Active)
+      update_own_depth(states_[static_cast<std::size_t>(q)], settings_.map, points[static_cast<std::size_t>(q)], settings_.accumulation);
   std::vector<DepthMap> depth(static_cast<std::size_t>(probes));
   for (int q = 0; q < probes; ++q) depth[static_cast<std::size_t>(q)] = states_[static_cast<std::size_t>(q)].depth;
   std::vector<FrameSamples> frame;
@@ -158,8 +198,11 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   t0 = Clock::now();
   jobs::parallel_for(0, probes, 1, [&](int b, int e) {
     for (int q = b; q < e; ++q) {
+      if (state_[static_cast<std::size_t>(q)] != ProbeState::Active) continue;
       ProbeMapState& st = states_[static_cast<std::size_t>(q)];
       accumulate(st, frame[static_cast<std::size_t>(q)], settings_.accumulation);
+      if (settings_.skip.skip_converged && st.stable_frames >= settings_.skip.settle_frames)
+        state_[static_cast<std::size_t>(q)] = ProbeState::Converged;
       const auto filled = filled_radiance(st, settings_.map, settings_.accumulation.fill_passes);
       float* out = sh_.data() + static_cast<std::size_t>(q) * 75;
       projector_.project(filled.data(), out);
@@ -167,6 +210,13 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
     }
   });
   stats.project_ms = ms_since(t0);
+  for (std::size_t q = 0; q < state_.size(); ++q) {
+    stats.projected += traced[q] && state_[q] != ProbeState::Buried && state_[q] != ProbeState::Far;
+    stats.active += state_[q] == ProbeState::Active;
+    stats.converged += state_[q] == ProbeState::Converged;
+    stats.buried += state_[q] == ProbeState::Buried;
+    stats.far += state_[q] == ProbeState::Far;
+  }
   ++frame_;
   return stats;
 }

@@ -11,6 +11,12 @@
 //  2. raster: radiance sharing across each probe's 26 neighbours.
 //  3. accumulate over frames (adaptive hysteresis), fill holes, project to
 //     SH (optionally windowed against ringing).
+//
+// Work the scene does not need is skipped (ProbeSkipSettings): probes
+// buried in geometry or far from every surface are classified inactive
+// whenever the geometry moves, and in a static scene a probe that has gone
+// `settle_frames` without a detected change stops updating until the
+// scene changes again (notify_scene_changed).
 #include <cstdint>
 #include <vector>
 
@@ -20,6 +26,34 @@
 #include "probes/probe_map.h"
 
 namespace transgi::probes {
+
+enum class ProbeState : std::uint8_t {
+  Active,     // traced, shared, accumulated and projected every frame
+  Converged,  // static scene, settled: keeps its SH, does no work
+  Buried,     // inside closed geometry: holds no light, does no work
+  Far,        // no surface within a cell diagonal: lights nothing, does no work
+};
+
+struct ProbeSkipSettings {
+  // Classify probes as buried or far whenever the geometry moves (RTXGI's
+  // probe classification). On = less work and no light from inside walls,
+  // at the cost of one frame tracing every probe after each move.
+  bool classify = true;
+  // A probe whose rays hit back faces more often than this is buried.
+  // Higher = fewer probes counted buried, at the cost of more light leaking
+  // from probes that sit inside walls.
+  float buried_backface_fraction = 0.25f;
+  // A probe whose nearest hit is beyond this many cell diagonals is far.
+  // Higher = fewer probes skipped, at the cost of tracing empty space.
+  float far_cells = 1.0f;
+  // Stop updating probes that have settled while the scene is static.
+  // On = less work per frame, at the cost of freezing the last frames' noise.
+  bool skip_converged = true;
+  // Frames after the warm-up without a detected lighting change before a
+  // probe counts as converged. Higher = a better settled estimate before it
+  // freezes, at the cost of more frames of work.
+  int settle_frames = 64;
+};
 
 struct ProbeFieldSettings {
   ProbeGrid grid;
@@ -36,11 +70,17 @@ struct ProbeFieldSettings {
   // (RMSE 0.0237 vs 0.0216 at 128 frames) and lost 5 % of the light
   // (docs/runtime.md).
   bool window = false;
+  ProbeSkipSettings skip;
   std::uint64_t seed = 1;
 };
 
 struct ProbeFrameStats {
   std::size_t rays = 0, hits = 0, shared_accepted = 0, shared_rejected = 0;
+  // Probes that traced rays / were accumulated and projected this frame.
+  int traced = 0, projected = 0;
+  // Probe states after this frame.
+  int active = 0, converged = 0, buried = 0, far = 0;
+  bool classified = false;  // this frame traced every probe to classify them
   double scatter_ms = 0, raster_ms = 0, project_ms = 0;
 };
 
@@ -49,6 +89,11 @@ class ProbeField {
   explicit ProbeField(ProbeFieldSettings settings);
 
   ProbeFrameStats update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights);
+
+  // The scene changed since the last update: converged probes wake up, and
+  // if the geometry moved the probes are classified again and their depth
+  // re-converges quickly.
+  void notify_scene_changed(bool geometry_moved);
 
   // 75 SH coefficients of probe i, [c * 25 + k], world space.
   [[nodiscard]] const float* light_sh(int probe) const { return sh_.data() + static_cast<std::size_t>(probe) * 75; }
@@ -60,11 +105,15 @@ class ProbeField {
   [[nodiscard]] const ProbeFieldSettings& settings() const { return settings_; }
   [[nodiscard]] std::uint64_t frame() const { return frame_; }
   [[nodiscard]] const std::vector<ProbeMapState>& states() const { return states_; }
+  [[nodiscard]] ProbeState state(int probe) const { return state_[static_cast<std::size_t>(probe)]; }
 
  private:
   ProbeFieldSettings settings_;
   MapProjector projector_;
   std::vector<ProbeMapState> states_;
+  std::vector<ProbeState> state_;
+  std::vector<std::uint8_t> usable_;  // 1 unless buried or far (read by interpolation)
+  bool classify_pending_ = true;
   std::vector<float> sh_;  // probes x 75
   std::vector<glm::vec3> fibonacci_;
   std::uint64_t frame_ = 0;

@@ -1,5 +1,6 @@
 #include "probes/probe_map.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -15,13 +16,16 @@ void ProbeMapState::reset(int texels) {
   noise_variance = 0.0f;
   noise_frames = 0;
   frames = 0;
+  stable_frames = 0;
+  depth_frames = 0;
+  drift = 0.0f;
 }
 
 namespace {
 float luminance(const glm::vec3& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
 }  // namespace
 
-void accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSettings& s) {
+bool accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSettings& s) {
   // "The lighting changed" is decided once per probe, from the mean over
   // every texel sampled this frame, and only when the change is far outside
   // the probe's own frame-to-frame noise. A blend weight that depends on the
@@ -34,7 +38,7 @@ void accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSett
       old_sum += luminance(st.radiance[t]);
       new_sum += luminance(f.sum[t] / f.count[t]);
     }
-  bool changed = false;
+  bool changed = false, drifting = false;
   // The noise is only measured once the cold start is over: the warm-up's
   // large frame-to-frame changes are convergence, not noise, and counting
   // them would hide real lighting changes for hundreds of frames.
@@ -48,12 +52,19 @@ void accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSett
       st.noise_variance = static_cast<float>((1 - w) * st.noise_variance + w * rel * rel);
       ++st.noise_frames;
     }
+    // A history still converging (after a change too small to detect, or the
+    // tail of a fast blend) moves the same way frame after frame; noise does
+    // not. The drift is an exponential mean of the signed change, compared
+    // with its own noise (an EMA of weight 0.1 keeps 0.1 / 1.9 of the variance).
+    st.drift = static_cast<float>(0.9 * st.drift + 0.1 * rel);
+    drifting = std::abs(st.drift) > std::max(0.5 * s.change_threshold, 3.0 * std::sqrt(st.noise_variance * 0.1 / 1.9));
   }
   float h = changed ? s.fast_hysteresis : s.hysteresis;
   if (st.frames < s.warmup_frames) {
     const float t = static_cast<float>(st.frames) / static_cast<float>(s.warmup_frames);
     h = std::min(h, s.fast_hysteresis + (s.hysteresis - s.fast_hysteresis) * t);
   }
+  st.stable_frames = (changed || drifting || st.frames < s.warmup_frames) ? 0 : st.stable_frames + 1;
   ++st.frames;
   for (std::size_t t = 0; t < st.radiance.size(); ++t) {
     if (f.count[t] <= 0) {
@@ -71,10 +82,17 @@ void accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSett
     }
     st.radiance[t] = h * st.radiance[t] + (1.0f - h) * mean;
   }
+  return changed;
 }
 
 void update_own_depth(ProbeMapState& st, const MapLayout& layout, const std::vector<ShadedPoint>& own,
                       const AccumulationSettings& s) {
+  // Like the radiance, the depth starts (and restarts after the geometry
+  // moved) with a fast blend, so visibility follows a moved wall in a few
+  // frames rather than ~20 per texel hit.
+  const float ramp = std::min(1.0f, static_cast<float>(st.depth_frames) / static_cast<float>(std::max(1, s.warmup_frames)));
+  const float h = std::min(s.hysteresis, s.fast_hysteresis + (s.hysteresis - s.fast_hysteresis) * ramp);
+  ++st.depth_frames;
   for (const ShadedPoint& p : own) {
     if (!std::isfinite(p.distance)) continue;
     const auto t = static_cast<std::size_t>(layout.texel_of(p.direction));
@@ -83,7 +101,6 @@ void update_own_depth(ProbeMapState& st, const MapLayout& layout, const std::vec
       st.depth_squared[t] = p.distance * p.distance;
       st.depth_weight[t] = 1.0f;
     } else {
-      const float h = s.hysteresis;
       st.depth.mean[t] = h * st.depth.mean[t] + (1 - h) * p.distance;
       st.depth_squared[t] = h * st.depth_squared[t] + (1 - h) * p.distance * p.distance;
     }

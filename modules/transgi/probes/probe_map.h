@@ -43,12 +43,16 @@ struct ProbeMapState {
   float noise_variance = 0.0f;  // running mean of (relative frame change)^2 under steady light
   int noise_frames = 0;
   int frames = 0;  // frames accumulated since reset
+  float drift = 0.0f;     // exponential mean of the signed relative frame change
+  int stable_frames = 0;  // (neither changed nor drifting)
+  int depth_frames = 0;   // frames of own depth since reset or since the geometry last moved  // consecutive frames after the warm-up without a detected change
 
   void reset(int texels);
 };
 
-// Blends this frame's samples into the history.
-void accumulate(ProbeMapState& state, const FrameSamples& frame, const AccumulationSettings& settings);
+// Blends this frame's samples into the history. Returns whether the probe
+// detected a lighting change this frame.
+bool accumulate(ProbeMapState& state, const FrameSamples& frame, const AccumulationSettings& settings);
 // Updates the own-depth moments from this probe's own shaded points.
 void update_own_depth(ProbeMapState& state, const MapLayout& layout, const std::vector<ShadedPoint>& own,
                       const AccumulationSettings& settings);

@@ -1,0 +1,49 @@
+#include "engine/render/light_plugin.h"
+#include "engine/rt/rt_plugin.h"
+#include "engine/transform/transform.h"
+
+namespace engine::render {
+
+namespace {
+
+using namespace engine::schedule;
+using LightView = View<Get<const scene::PunctualLight, const transform::WorldTransform>>;
+
+struct SeenState {
+  std::uint64_t commits = UINT64_MAX;  // RtScene top-level commits at the last rebuild
+  std::uint64_t assets_generation = UINT64_MAX;
+};
+
+void sync_lights(LightView lights, Removed<scene::PunctualLight> removed, Res<rt::RtScene> rt, ResMut<SceneLights> out,
+                 Local<SeenState> seen) {
+  bool lights_changed = !removed.empty();
+  std::vector<PunctualInstance> punctual;
+  lights.each([&](Entity e, const scene::PunctualLight& l, const transform::WorldTransform& w) {
+    if (lights.is_changed<scene::PunctualLight>(e) || lights.is_changed<transform::WorldTransform>(e)) lights_changed = true;
+    if (!l.enabled || l.intensity <= 0) return;
+    punctual.push_back({l, w.translation, glm::normalize(w.apply_direction({0, 0, -1}))});
+  });
+  const scene::SceneAssets* assets = rt->assets();
+  const std::uint64_t generation = assets ? assets->generation : 0;
+  const bool geometry_changed = rt->stats().top_level_commits != seen->commits;
+  const bool assets_changed = generation != seen->assets_generation;
+  if (!lights_changed && !geometry_changed && !assets_changed) return;
+  // Emissive triangles are stored in world space, so moved geometry also
+  // means a rebuilt light set.
+  const scene::Environment* env = assets && assets->environment ? &*assets->environment : nullptr;
+  out->set = LightSet(*rt, std::move(punctual), env);
+  ++out->version;
+  if (geometry_changed || assets_changed) ++out->geometry_version;
+  seen->commits = rt->stats().top_level_commits;
+  seen->assets_generation = generation;
+}
+
+}  // namespace
+
+void LightPlugin::build(app::App& app) {
+  app.add_plugin<rt::RtPlugin>();  // the Embree mirror this sync runs after
+  if (!app.world().has_resource<SceneLights>()) app.world().insert_resource<SceneLights>();
+  app.add_system(Phase::PrepareRender, "render::sync_lights", sync_lights);
+}
+
+}  // namespace engine::render
