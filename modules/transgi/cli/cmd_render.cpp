@@ -13,6 +13,7 @@
 #include "engine/scene/scene_assets.h"
 #include "model/model_file.h"
 #include "probes/probe_field.h"
+#include "runtime/transgi_plugin.h"
 #include "shading/transfer_renderer.h"
 
 namespace transgi::cli {
@@ -29,6 +30,98 @@ ecs::Entity find_camera(ecs::World& world, const std::vector<ecs::Entity>& node_
   }
   if (name.empty()) throw std::runtime_error("the scene has no perspective camera");
   throw std::runtime_error("--camera: no camera node named '" + name + "'");
+}
+
+// --pass all writes OUT (full), OUT_direct.exr and OUT_gi.exr from the same samples.
+std::string sibling(const std::string& path, const std::string& suffix) {
+  const std::filesystem::path p(path);
+  return (p.parent_path() / (p.stem().string() + suffix + p.extension().string())).string();
+}
+
+void print_summary(const std::string& out, const std::string& transfer, const char* light, const std::string& pass,
+                   int width, int height, int spp, std::size_t shaded, std::size_t inferred) {
+  std::printf("rendered %s (transgi, %s transfer, %s light, %s pass) %dx%d at %d spp: %zu shaded samples, %zu inferred\n",
+              out.c_str(), transfer.c_str(), light, pass.c_str(), width, height, spp, shaded, inferred);
+}
+
+std::vector<std::string> split_names(const std::string& list) {
+  std::vector<std::string> names;
+  std::size_t b = 0;
+  while (b <= list.size()) {
+    const std::size_t e = std::min(list.find(',', b), list.size());
+    if (e > b) names.push_back(list.substr(b, e - b));
+    b = e + 1;
+  }
+  return names;
+}
+
+// The game's path: the TransGI plugin in an App, --frames frames of probe
+// updates, the image rendered on the last one.
+transgi::runtime::GiFrame render_with_probes(const Args& args, app::App& app, ecs::Entity cam,
+                                             std::shared_ptr<const transgi::model::TransferModel> model, int width,
+                                             int height, const transgi::shading::TransferRenderSettings& rs,
+                                             bool want_direct) {
+  using namespace transgi;
+  ecs::World& world = app.world();
+  runtime::TransGISettings settings;
+  settings.gbuffer_spp = rs.spp;
+  settings.seed = rs.seed;
+  settings.direct_spp = want_direct ? static_cast<int>(args.integer("direct-spp", 1, 100000, 16)) : 0;
+  settings.probes.rays_per_probe = static_cast<int>(args.integer("probe-rays", 1, 100000, 100));
+  settings.probes.seed = rs.seed + 1;
+  const std::string skip = args.choice("probe-skip", {"on", "off"}, "on");
+  settings.probes.skip.classify = settings.probes.skip.skip_converged = skip == "on";
+  const std::string sharing = args.choice("sharing", {"depth-guard", "paper"}, "depth-guard");
+  settings.probes.sharing.mode = sharing == "paper" ? probes::SharingMode::PaperFaithful : probes::SharingMode::DepthGuard;
+  const int frames = static_cast<int>(args.integer("frames", 1, 100000, 32));
+  const int n = static_cast<int>(args.integer("probe-grid", 1, 64, 8));
+
+  app.add_plugin<runtime::TransGIPlugin>(settings);
+  std::size_t attached = runtime::attach_latent_meshes(world, model);
+  // --no-latent a,b: those nodes keep no latents (they skip inference).
+  for (const std::string& name : split_names(args.str("no-latent", std::string()))) {
+    std::vector<ecs::Entity> matches;
+    world.view<const scene::Name, const runtime::LatentMesh>().each(
+        [&](ecs::Entity e, const scene::Name& nm, const runtime::LatentMesh&) {
+          if (nm.value == name) matches.push_back(e);
+        });
+    if (matches.empty()) throw std::runtime_error("--no-latent: no mesh node named '" + name + "'");
+    for (ecs::Entity e : matches) world.remove<runtime::LatentMesh>(e);
+    attached -= matches.size();
+  }
+  const ecs::Entity volume = world.spawn();
+  world.emplace<runtime::ProbeVolume>(volume, runtime::ProbeVolume{.dims = glm::ivec3(n)});
+
+  auto& frame = world.resource<runtime::GiFrame>();
+  frame.camera = cam;
+  core::ProgressBar bar("probe frames", static_cast<std::uint64_t>(frames));
+  probes::ProbeFrameStats sum;
+  int traced = 0;
+  for (int f = 0; f < frames; ++f) {
+    const bool last = f + 1 == frames;
+    frame.width = last ? width : 0;
+    frame.height = last ? height : 0;
+    app.jobs().run([&] { app.update(); });
+    sum.scatter_ms += frame.probe_stats.scatter_ms;
+    sum.raster_ms += frame.probe_stats.raster_ms;
+    sum.project_ms += frame.probe_stats.project_ms;
+    traced += frame.probe_stats.traced;
+    bar.update(static_cast<std::uint64_t>(f + 1));
+  }
+  bar.finish();
+  const auto& st = frame.probe_stats;
+  std::printf("  %zu of the scene's mesh entities have a LatentMesh; %zu of %zu shaded samples inferred\n", attached,
+              frame.inferred_samples, frame.shaded_samples);
+  std::printf("  probes: %d^3, %d frames, last frame: %d active, %d converged, %d buried, %d far; %.1f probes traced per frame\n",
+              n, frames, st.active, st.converged, st.buried, st.far, static_cast<double>(traced) / frames);
+  const auto& t = frame.times;
+  std::printf("  Table 4 stages (ms): generate network input %.2f (G-buffer %.2f + inputs %.2f), network inference %.2f,\n"
+              "    collect shaded points %.2f, probe raster %.2f (+ accumulate and project %.2f), SH multiplication %.2f;"
+              " direct light %.2f\n",
+              t.gbuffer + t.network_input, t.gbuffer, t.network_input, t.inference, sum.scatter_ms / frames,
+              sum.raster_ms / frames, sum.project_ms / frames, t.sh_multiplication, t.direct);
+  std::printf("  (probe stages are the mean over all %d frames)\n", frames);
+  return frame;
 }
 
 // TransGI rendering. --lighting environment: the object-scale setting (paper
@@ -50,75 +143,45 @@ int render_transgi(const Args& args, app::App& app, ecs::Entity cam, int width, 
   rs.seed = static_cast<std::uint64_t>(args.integer("seed", 0, INT64_MAX, 0));
   if (lighting == "environment" && !assets.environment)
     throw std::runtime_error("--lighting environment needs an environment light in the scene (scenes[0].extras.environment)");
-  const auto model = transgi::model::load_model(model_path);
+  auto model = transgi::model::load_model(model_path);
   if (transfer == "network") transgi::model::validate_model(model, assets, model_path);
   const engine::render::CameraRays camera(world.get<scene::Camera>(cam), world.get<transform::WorldTransform>(cam), width, height);
   const auto source = transfer == "network" ? transgi::shading::TransferSource::Network : transgi::shading::TransferSource::GroundTruth;
-  const engine::render::LightSet lights(rt_scene, engine::render::gather_punctual_lights(world),
-                                        assets.environment ? &*assets.environment : nullptr);
-
   transgi::shading::TransferRenderResult r;
-  std::unique_ptr<transgi::probes::ProbeField> field;
-  transgi::probes::ProbeFrameStats probe_totals;
-  int frames = 0;
+  image::ImageRGB img;
   if (lighting == "environment") {
     const auto light = transgi::shading::project_environment(*assets.environment);
     app.jobs().run([&] {
       r = transgi::shading::render_transfer(rt_scene, assets, model, camera, width, height,
                                             transgi::shading::constant_light(light), &*assets.environment, source, rs);
     });
+    img = r.image;
+    print_summary(out, transfer, "environment SH", pass_name, width, height, rs.spp, r.shaded_samples, r.inferred_samples);
+    std::printf("  stage times (ms): G-buffer %.2f, generate network input %.2f, network inference %.2f, SH multiplication %.2f\n",
+                r.timings.gbuffer_ms, r.timings.inputs_ms, r.timings.inference_ms, r.light_ms + r.timings.shading_ms);
   } else {
-    frames = static_cast<int>(args.integer("frames", 1, 100000, 32));
-    const int n = static_cast<int>(args.integer("probe-grid", 2, 64, 8));
-    transgi::probes::ProbeFieldSettings ps;
-    // Probes at the centres of an n^3 partition of the scene bounds.
-    const glm::vec3 lo = rt_scene.bounds_min(), hi = rt_scene.bounds_max(), half_cell = (hi - lo) / (2.0f * static_cast<float>(n));
-    ps.grid = transgi::probes::ProbeGrid{lo + half_cell, hi - half_cell, glm::ivec3(n)};
-    ps.rays_per_probe = static_cast<int>(args.integer("probe-rays", 1, 100000, 100));
-    ps.seed = rs.seed + 1;
-    field = std::make_unique<transgi::probes::ProbeField>(ps);
-    core::ProgressBar bar("probe frames", static_cast<std::uint64_t>(frames));
-    app.jobs().run([&] {
-      for (int f = 0; f < frames; ++f) {
-        const auto st = field->update(rt_scene, lights);
-        probe_totals.scatter_ms += st.scatter_ms;
-        probe_totals.raster_ms += st.raster_ms;
-        probe_totals.project_ms += st.project_ms;
-        bar.update(static_cast<std::uint64_t>(f + 1));
+    if (transfer != "network") throw std::runtime_error("--transfer ground-truth needs --lighting environment");
+    const auto shared = std::make_shared<const transgi::model::TransferModel>(std::move(model));
+    print_summary(out, transfer, "probe", pass_name, width, height, rs.spp, 0, 0);
+    const auto frame = render_with_probes(args, app, cam, shared, width, height, rs, pass_name != "gi");
+    img = pass_name == "gi" ? frame.gi : pass_name == "direct" ? frame.direct : frame.full;
+    if (pass_name == "all") {
+      image::write_exr(sibling(out, "_direct"), frame.direct);
+      image::write_exr(sibling(out, "_gi"), frame.gi);
+      if (args.has("png")) {
+        image::write_png_srgb(sibling(args.str("png"), "_direct"), frame.direct, static_cast<float>(exposure));
+        image::write_png_srgb(sibling(args.str("png"), "_gi"), frame.gi, static_cast<float>(exposure));
       }
-    });
-    bar.finish();
-    const auto light_at = [&](const glm::vec3& p, const glm::vec3& nrm, float* o) { field->interpolate(p, nrm, o); };
-    app.jobs().run([&] { r = transgi::shading::render_transfer(rt_scene, assets, model, camera, width, height, light_at, nullptr, source, rs); });
-  }
-
-  image::ImageRGB img = r.image;
-  if (lighting == "probes" && pass_name != "gi") {
-    // Direct light: the reference path tracer stopped after its first bounce.
-    const int direct_spp = static_cast<int>(args.integer("direct-spp", 1, 100000, 16));
-    engine::render::PathTracer direct(rt_scene, lights, camera, width, height,
-                                      engine::render::PathTracerSettings{.max_depth = 1, .seed = rs.seed});
-    app.jobs().run([&] { direct.render(direct_spp); });
-    const image::ImageRGB d = direct.image(engine::render::Pass::Direct);
-    if (pass_name == "direct") img = d;
-    else
-      for (std::size_t i = 0; i < img.size(); ++i) img.pixels[i] += d.pixels[i];
+    }
   }
   image::write_exr(out, img);
   if (args.has("png")) image::write_png_srgb(args.str("png"), img, static_cast<float>(exposure));
   if (args.has("coefficient-maps")) {
+    if (lighting != "environment") throw std::runtime_error("--coefficient-maps needs --lighting environment");
     const std::string prefix = args.str("coefficient-maps");
     const char* names[3] = {"_sh00.exr", "_sh10.exr", "_sh20.exr"};
     for (int i = 0; i < 3; ++i) image::write_exr(prefix + names[i], r.coefficient_maps[static_cast<std::size_t>(i)]);
   }
-  std::printf("rendered %s (transgi, %s transfer, %s light, %s pass) %dx%d at %d spp: %zu shaded samples\n", out.c_str(),
-              transfer.c_str(), lighting == "probes" ? "probe" : "environment SH", pass_name.c_str(), width, height, rs.spp,
-              r.shaded_samples);
-  std::printf("  stage times (ms): G-buffer %.2f, generate network input %.2f, network inference %.2f, SH multiplication %.2f\n",
-              r.timings.gbuffer_ms, r.timings.inputs_ms, r.timings.inference_ms, r.light_ms + r.timings.shading_ms);
-  if (frames > 0)
-    std::printf("  probes: %d frames; per frame (ms): collect shaded points %.2f, probe raster %.2f, SH projection %.2f\n", frames,
-                probe_totals.scatter_ms / frames, probe_totals.raster_ms / frames, probe_totals.project_ms / frames);
   return 0;
 }
 
@@ -128,7 +191,7 @@ int run_render(const std::vector<std::string>& argv) {
   const Args args("render", argv,
                   {"scene", "method", "pass", "spp", "width", "height", "out", "camera", "seed", "threads", "png", "exposure",
                    "model", "transfer", "gt-rays", "coefficient-maps", "lighting", "frames", "probe-grid", "probe-rays",
-                   "direct-spp"});
+                   "direct-spp", "probe-skip", "sharing", "no-latent"});
   const std::string scene_path = args.str("scene");
   const std::string method = args.choice("method", {"reference", "transgi"}, "reference");
   const std::string pass_name = args.choice("pass", {"full", "direct", "gi", "all"}, "full");
@@ -165,11 +228,6 @@ int run_render(const std::vector<std::string>& argv) {
   app.jobs().run([&] { tracer.render(spp, [&](int done, int) { bar.update(static_cast<std::uint64_t>(done)); }); });
   bar.finish();
 
-  // --pass all writes OUT (full), OUT_direct.exr and OUT_gi.exr from the same samples.
-  auto sibling = [](const std::string& path, const std::string& suffix) {
-    const std::filesystem::path p(path);
-    return (p.parent_path() / (p.stem().string() + suffix + p.extension().string())).string();
-  };
   const image::ImageRGB img = tracer.image(pass);
   image::write_exr(out, img);
   if (pass_name == "all") {

@@ -26,6 +26,8 @@ struct InterpolationSettings {
   float visibility_threshold = 0.2f;
   bool prune_back_facing = true;
   bool prune_occluded = true;
+
+  bool operator==(const InterpolationSettings&) const = default;
 };
 
 struct InterpolationResult {

@@ -11,6 +11,7 @@
 #include "engine/math/rng.h"
 #include "engine/math/sampling.h"
 #include "engine/render/surface.h"
+#include "shading/sh_light.h"
 
 namespace transgi::probes {
 
@@ -38,22 +39,6 @@ glm::quat random_rotation(engine::math::Pcg32& rng) {
 }
 }  // namespace
 
-glm::vec3 sh_irradiance(const float* L, const glm::vec3& n) {
-  // Clamped-cosine convolution weights per band: pi, 2pi/3, pi/4, 0, -pi/24.
-  constexpr float kA[5] = {3.14159265f, 2.09439510f, 0.78539816f, 0.0f, -0.13089969f};
-  const auto y = engine::math::sh_eval(n);
-  glm::vec3 e(0.0f);
-  for (int c = 0; c < 3; ++c) {
-    float s = 0;
-    for (int l = 0; l <= 4; ++l)
-      for (int m = -l; m <= l; ++m) {
-        const int k = engine::math::sh_index(l, m);
-        s += kA[l] * L[c * 25 + k] * y[static_cast<std::size_t>(k)];
-      }
-    e[c] = std::max(0.0f, s);
-  }
-  return e;
-}
 
 ProbeField::ProbeField(ProbeFieldSettings s)
     : settings_(s), projector_(s.map), fibonacci_(spherical_fibonacci(s.rays_per_probe)) {
@@ -77,7 +62,7 @@ void ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, float* out)
 glm::vec3 ProbeField::irradiance(const glm::vec3& p, const glm::vec3& n) const {
   float L[75];
   interpolate(p, n, L);
-  return sh_irradiance(L, n);
+  return shading::sh_irradiance(L, n);
 }
 
 void ProbeField::notify_scene_changed(bool geometry_moved) {

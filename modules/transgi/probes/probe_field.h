@@ -53,6 +53,8 @@ struct ProbeSkipSettings {
   // probe counts as converged. Higher = a better settled estimate before it
   // freezes, at the cost of more frames of work.
   int settle_frames = 64;
+
+  bool operator==(const ProbeSkipSettings&) const = default;
 };
 
 struct ProbeFieldSettings {
@@ -72,6 +74,8 @@ struct ProbeFieldSettings {
   bool window = false;
   ProbeSkipSettings skip;
   std::uint64_t seed = 1;
+
+  bool operator==(const ProbeFieldSettings&) const = default;
 };
 
 struct ProbeFrameStats {
@@ -118,8 +122,5 @@ class ProbeField {
   std::vector<glm::vec3> fibonacci_;
   std::uint64_t frame_ = 0;
 };
-
-// Irradiance E(n) from radiance SH (Ramamoorthi and Hanrahan 2001).
-glm::vec3 sh_irradiance(const float* radiance_sh, const glm::vec3& normal);
 
 }  // namespace transgi::probes

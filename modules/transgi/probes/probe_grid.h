@@ -11,6 +11,8 @@ struct ProbeGrid {
   glm::vec3 min{0.0f}, max{1.0f};
   glm::ivec3 dims{8};
 
+  bool operator==(const ProbeGrid&) const = default;
+
   [[nodiscard]] int count() const { return dims.x * dims.y * dims.z; }
   [[nodiscard]] int index(glm::ivec3 c) const { return (c.z * dims.y + c.y) * dims.x + c.x; }
   [[nodiscard]] glm::ivec3 coords(int i) const { return {i % dims.x, (i / dims.x) % dims.y, i / (dims.x * dims.y)}; }

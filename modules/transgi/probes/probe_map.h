@@ -32,6 +32,8 @@ struct AccumulationSettings {
   // before the map-wide mean fills the rest. Higher = better hole filling,
   // at the cost of time.
   int fill_passes = 4;
+
+  bool operator==(const AccumulationSettings&) const = default;
 };
 
 struct ProbeMapState {

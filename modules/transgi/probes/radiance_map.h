@@ -20,6 +20,8 @@ struct MapLayout {
   [[nodiscard]] int texel_of(const glm::vec3& unit_dir) const;
   [[nodiscard]] glm::vec3 direction_of(int texel) const;  // texel centre
   [[nodiscard]] double solid_angle(int texel) const;
+
+  bool operator==(const MapLayout&) const = default;
 };
 
 // SH projection of one map: L[c][k] = sum_texels radiance * integral_texel Y_k,

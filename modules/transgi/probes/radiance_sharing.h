@@ -36,6 +36,7 @@ struct SharingSettings {
   // A neighbour's point is rejected beyond own_depth * (1 + relative) + absolute.
   float relative_tolerance = 0.1f;
   float absolute_tolerance = 0.05f;  // world units
+  bool operator==(const SharingSettings&) const = default;
 };
 
 // This frame's samples of one probe's map.

@@ -63,4 +63,21 @@ glm::vec3 shade(const ShRgb& light, const float* t) {
   return out;
 }
 
+glm::vec3 sh_irradiance(const float* L, const glm::vec3& n) {
+  // Clamped-cosine convolution weights per band: pi, 2pi/3, pi/4, 0, -pi/24.
+  constexpr float kA[5] = {3.14159265f, 2.09439510f, 0.78539816f, 0.0f, -0.13089969f};
+  const auto y = engine::math::sh_eval(n);
+  glm::vec3 e(0.0f);
+  for (int c = 0; c < 3; ++c) {
+    float s = 0;
+    for (int l = 0; l <= 4; ++l)
+      for (int m = -l; m <= l; ++m) {
+        const int k = engine::math::sh_index(l, m);
+        s += kA[l] * L[c * 25 + k] * y[static_cast<std::size_t>(k)];
+      }
+    e[c] = std::max(0.0f, s);
+  }
+  return e;
+}
+
 }  // namespace transgi::shading

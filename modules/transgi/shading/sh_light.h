@@ -23,4 +23,8 @@ ShRgb rotate_to_object(const ShRgb& world, const glm::quat& object_rotation);
 // sum_c sum_k light[c][k] * transfer[c][k], per channel.
 glm::vec3 shade(const ShRgb& light, const float* transfer);
 
+// Irradiance E(n) from radiance SH [c * 25 + k] (clamped-cosine
+// convolution, Ramamoorthi and Hanrahan 2001), clamped at zero.
+glm::vec3 sh_irradiance(const float* radiance_sh, const glm::vec3& normal);
+
 }  // namespace transgi::shading

@@ -9,6 +9,7 @@
 #include "engine/jobs/parallel_for.h"
 #include "engine/math/rng.h"
 #include "engine/render/surface.h"
+#include "shading/transfer_inference.h"
 
 namespace transgi::shading {
 
@@ -81,36 +82,33 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
   });
   result.timings.gbuffer_ms = ms_since(t0);
 
-  std::vector<std::size_t> hits;
-  for (std::size_t i = 0; i < n; ++i)
-    if (samples[i].hit) hits.push_back(i);
-  result.shaded_samples = hits.size();
+  // Samples with transfer first (they go through inference), then the rest.
+  std::vector<std::size_t> hits, diffuse_only;
+  {
+    std::unordered_map<engine::ecs::Entity, bool> cache;
+    auto has_transfer = [&](engine::ecs::Entity e) {
+      if (!s.has_transfer) return true;
+      auto [it, inserted] = cache.try_emplace(e, false);
+      if (inserted) it->second = s.has_transfer(e);
+      return it->second;
+    };
+    for (std::size_t i = 0; i < n; ++i)
+      if (samples[i].hit) (has_transfer(samples[i].entity) ? hits : diffuse_only).push_back(i);
+  }
+  result.inferred_samples = hits.size();
+  result.shaded_samples = hits.size() + diffuse_only.size();
   std::vector<float> transfer(hits.size() * bake::kTransferValues, 0.0f);
 
   if (source == TransferSource::Network) {
     // 2. Network inputs, 3. batched inference.
-    t0 = Clock::now();
-    const int in_size = model.decoder.layout().inputs;
-    std::vector<float> inputs(hits.size() * static_cast<std::size_t>(in_size));
-    jobs::parallel_for<std::size_t>(0, hits.size(), 1024, [&](std::size_t b, std::size_t e) {
-      std::vector<float> z(static_cast<std::size_t>(model.latent_dim));
-      for (std::size_t i = b; i < e; ++i) {
-        const Sample& smp = samples[hits[i]];
-        model.meshes[smp.mesh].latents.interpolate(*assets.meshes[smp.mesh], smp.triangle, smp.bary, z.data());
-        model::assemble_input(z.data(), model.latent_dim, smp.albedo, smp.normal_obj, smp.wo_obj,
-                              inputs.data() + i * static_cast<std::size_t>(in_size));
-      }
-    });
-    result.timings.inputs_ms = ms_since(t0);
-    t0 = Clock::now();
-    model::MlpWorkspace ws;
-    constexpr std::size_t kChunk = 8192;
-    for (std::size_t b = 0; b < hits.size(); b += kChunk) {
-      const std::size_t count = std::min(kChunk, hits.size() - b);
-      model.decoder.forward(inputs.data() + b * static_cast<std::size_t>(in_size), static_cast<int>(count),
-                            transfer.data() + b * bake::kTransferValues, ws, model::default_gemm_backend());
+    std::vector<TransferQuery> queries(hits.size());
+    for (std::size_t i = 0; i < hits.size(); ++i) {
+      const Sample& smp = samples[hits[i]];
+      queries[i] = {smp.mesh, smp.triangle, smp.bary, smp.albedo, smp.normal_obj, smp.wo_obj};
     }
-    result.timings.inference_ms = ms_since(t0);
+    const InferenceTimings it = infer_transfer(model, assets, queries, transfer.data());
+    result.timings.inputs_ms = it.inputs_ms;
+    result.timings.inference_ms = it.inference_ms;
   } else {
     // Ground truth: integrate each sample's transfer with the bake's estimator.
     t0 = Clock::now();
@@ -161,6 +159,14 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
       shaded[hits[j]] = shade(light, transfer.data() + j * bake::kTransferValues);
     }
   });
+  jobs::parallel_for<std::size_t>(0, diffuse_only.size(), 256, [&](std::size_t b, std::size_t e) {
+    float world[75];
+    for (std::size_t j = b; j < e; ++j) {
+      const Sample& smp = samples[diffuse_only[j]];
+      light_at(smp.position, smp.normal_world, world);
+      shaded[diffuse_only[j]] = smp.albedo * math::kInvPi * sh_irradiance(world, smp.normal_world);
+    }
+  });
   result.light_ms = ms_since(t0);
   t0 = Clock::now();
   result.image = image::ImageRGB(width, height);
@@ -178,6 +184,7 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
         continue;
       }
       sum += shaded[i];
+      if (hit_slot[i] == SIZE_MAX) continue;  // no transfer (diffuse fallback)
       const float* t = transfer.data() + hit_slot[i] * bake::kTransferValues;
       for (std::size_t m = 0; m < 3; ++m) {
         const int k = kMapCoefficients[m];

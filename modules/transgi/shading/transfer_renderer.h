@@ -23,6 +23,10 @@ enum class TransferSource {
 
 struct TransferRenderSettings {
   int spp = 4;                 // G-buffer samples per pixel (filtered like the reference)
+  // Which entities carry baked transfer (a LatentMesh). Null = every entity.
+  // The others skip inference and are shaded diffusely from the same SH
+  // light: albedo / pi x irradiance.
+  std::function<bool(engine::ecs::Entity)> has_transfer = nullptr;
   int ground_truth_rays = 2048;
   std::uint64_t seed = 0;
   float filter_width = 1.5f;
@@ -38,6 +42,7 @@ struct TransferRenderResult {
   // k = (0,0), (1,0), (2,0), averaged over the pixel's samples (Fig. 10).
   std::array<engine::image::ImageRGB, 3> coefficient_maps;
   std::size_t shaded_samples = 0;
+  std::size_t inferred_samples = 0;  // of which had transfer decoded (the rest: diffuse fallback)
   TransferRenderTimings timings;
   double light_ms = 0;  // fetching the SH light per shaded sample (probe interpolation)
 };

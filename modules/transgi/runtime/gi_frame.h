@@ -1,0 +1,38 @@
+#pragma once
+// The GI renderer's per-frame output and what it cost, read by the game,
+// tools and the CLI after the Render phase.
+#include <cstddef>
+
+#include "engine/ecs/entity.h"
+#include "engine/image/image.h"
+#include "probes/probe_field.h"
+
+namespace transgi::runtime {
+
+// Per-stage times in milliseconds, the rows of the paper's Table 4.
+struct GiStageTimes {
+  double gbuffer = 0;          // primary rays (part of "generate network input" in the paper)
+  double network_input = 0;    // latent interpolation and input assembly
+  double inference = 0;        // network inference
+  double collect_points = 0;   // probe rays + shading of their hits
+  double probe_raster = 0;     // radiance sharing into the probes' maps
+  double probe_projection = 0; // accumulation and SH projection
+  double sh_multiplication = 0;  // probe interpolation, SH rotation and dot product
+  double direct = 0;           // direct light (not TransGI's)
+};
+
+struct GiFrame {
+  // Output size; 0 = update the probes but render no image this frame.
+  int width = 0, height = 0;
+  engine::ecs::Entity camera;  // null = the first camera found
+
+  // Results of the last rendered frame.
+  engine::image::ImageRGB gi, direct, full;
+  GiStageTimes times;
+  std::size_t shaded_samples = 0, inferred_samples = 0;
+  // This frame's probe update (summed over volumes).
+  probes::ProbeFrameStats probe_stats;
+  std::uint64_t probe_frames = 0;
+};
+
+}  // namespace transgi::runtime

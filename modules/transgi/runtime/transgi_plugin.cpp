@@ -1,0 +1,184 @@
+#include "runtime/transgi_plugin.h"
+
+#include <chrono>
+
+#include "engine/render/camera_rays.h"
+#include "engine/render/light_plugin.h"
+#include "engine/render/path_tracer.h"
+#include "engine/rt/rt_scene.h"
+#include "engine/scene/components.h"
+#include "engine/transform/transform.h"
+#include "shading/transfer_renderer.h"
+
+namespace transgi::runtime {
+
+namespace {
+
+using namespace engine;
+using namespace engine::schedule;
+using transform::WorldTransform;
+
+// Probes at the centres of a dims partition of the box, so none sits on the
+// scene's outer walls.
+probes::ProbeGrid grid_in_box(glm::vec3 lo, glm::vec3 hi, glm::ivec3 dims) {
+  const glm::vec3 half_cell = (hi - lo) / (2.0f * glm::vec3(dims));
+  return probes::ProbeGrid{lo + half_cell, hi - half_cell, dims};
+}
+
+struct SeenVersions {
+  std::uint64_t lights = 0, geometry = 0;
+};
+
+void sync_probe_volumes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res<render::SceneLights> lights,
+                        Res<TransGISettings> settings, Local<SeenVersions> seen) {
+  const bool geometry_moved = lights->geometry_version != seen->geometry;
+  const bool lighting_changed = lights->version != seen->lights;
+  volumes.each([&](ProbeVolume& v) {
+    if (v.fits_scene()) {
+      // Fitted once: a later move must not shift every probe (and reset them).
+      v.min = rt->bounds_min();
+      v.max = rt->bounds_max();
+    }
+    probes::ProbeFieldSettings wanted = settings->probes;
+    wanted.grid = grid_in_box(v.min, v.max, glm::max(v.dims, glm::ivec3(1)));
+    if (!v.field || !(v.field->settings() == wanted)) {
+      v.field = std::make_shared<probes::ProbeField>(wanted);
+      return;
+    }
+    if (geometry_moved || lighting_changed) v.field->notify_scene_changed(geometry_moved);
+  });
+  seen->geometry = lights->geometry_version;
+  seen->lights = lights->version;
+}
+
+void add_stats(probes::ProbeFrameStats& sum, const probes::ProbeFrameStats& s) {
+  sum.rays += s.rays;
+  sum.hits += s.hits;
+  sum.shared_accepted += s.shared_accepted;
+  sum.shared_rejected += s.shared_rejected;
+  sum.traced += s.traced;
+  sum.projected += s.projected;
+  sum.active += s.active;
+  sum.converged += s.converged;
+  sum.buried += s.buried;
+  sum.far += s.far;
+  sum.classified = sum.classified || s.classified;
+  sum.scatter_ms += s.scatter_ms;
+  sum.raster_ms += s.raster_ms;
+  sum.project_ms += s.project_ms;
+}
+
+void update_probes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res<render::SceneLights> lights,
+                   ResMut<GiFrame> frame) {
+  probes::ProbeFrameStats total;
+  volumes.each([&](ProbeVolume& v) {
+    if (v.field) add_stats(total, v.field->update(*rt, lights->set));
+  });
+  frame->probe_stats = total;
+  ++frame->probe_frames;
+}
+
+using CameraView = View<Get<const scene::Camera, const WorldTransform>>;
+
+void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Get<const LatentMesh>> latents,
+               Res<rt::RtScene> rt, Res<scene::SceneAssets> assets, Res<render::SceneLights> lights,
+               Res<TransGISettings> settings, ResMut<GiFrame> frame) {
+  if (frame->width <= 0 || frame->height <= 0) return;
+  const scene::Camera* camera = nullptr;
+  const WorldTransform* camera_to_world = nullptr;
+  cameras.each([&](Entity e, const scene::Camera& c, const WorldTransform& w) {
+    if (camera && e != frame->camera) return;
+    if (!camera || e == frame->camera) {
+      camera = &c;
+      camera_to_world = &w;
+    }
+  });
+  if (!camera) throw std::runtime_error("transgi::render_gi: GiFrame asks for an image but the world has no camera");
+
+  // One scene decoder: the model of the first LatentMesh found.
+  std::shared_ptr<const model::TransferModel> model;
+  latents.each([&](const LatentMesh& l) {
+    if (!model) model = l.model;
+  });
+  static const model::TransferModel kNoModel;
+  std::vector<const probes::ProbeField*> fields;
+  volumes.each([&](const ProbeVolume& v) {
+    if (v.field) fields.push_back(v.field.get());
+  });
+
+  shading::TransferRenderSettings rs;
+  rs.spp = settings->gbuffer_spp;
+  rs.seed = settings->seed + frame->probe_frames;
+  rs.has_transfer = [&](Entity e) {
+    const LatentMesh* l = latents.try_read<LatentMesh>(e);
+    return l && model && l->model == model;
+  };
+  // The volume holding the point (the first one, if none does).
+  const shading::LightAt light_at = [&](const glm::vec3& p, const glm::vec3& n, float* out) {
+    if (fields.empty()) {
+      std::fill_n(out, 75, 0.0f);
+      return;
+    }
+    const probes::ProbeField* f = fields.front();
+    for (const probes::ProbeField* c : fields) {
+      const auto& g = c->settings().grid;
+      if (glm::all(glm::greaterThanEqual(p, g.min)) && glm::all(glm::lessThanEqual(p, g.max))) {
+        f = c;
+        break;
+      }
+    }
+    f->interpolate(p, n, out);
+  };
+  const render::CameraRays rays(*camera, *camera_to_world, frame->width, frame->height);
+  const shading::TransferRenderResult r = shading::render_transfer(
+      *rt, *assets, model ? *model : kNoModel, rays, frame->width, frame->height, light_at, nullptr,
+      shading::TransferSource::Network, rs);
+
+  GiStageTimes& t = frame->times;
+  t.gbuffer = r.timings.gbuffer_ms;
+  t.network_input = r.timings.inputs_ms;
+  t.inference = r.timings.inference_ms;
+  t.sh_multiplication = r.light_ms + r.timings.shading_ms;
+  t.collect_points = frame->probe_stats.scatter_ms;
+  t.probe_raster = frame->probe_stats.raster_ms;
+  t.probe_projection = frame->probe_stats.project_ms;
+  frame->shaded_samples = r.shaded_samples;
+  frame->inferred_samples = r.inferred_samples;
+  frame->gi = r.image;
+  frame->full = r.image;
+  if (settings->direct_spp > 0) {
+    const auto t0 = std::chrono::steady_clock::now();
+    render::PathTracer direct(*rt, lights->set, rays, frame->width, frame->height,
+                              render::PathTracerSettings{.max_depth = 1, .seed = rs.seed});
+    direct.render(settings->direct_spp);
+    frame->direct = direct.image(render::Pass::Direct);
+    for (std::size_t i = 0; i < frame->full.size(); ++i) frame->full.pixels[i] += frame->direct.pixels[i];
+    t.direct = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  } else {
+    frame->direct = image::ImageRGB(frame->width, frame->height);
+    t.direct = 0;
+  }
+}
+
+}  // namespace
+
+void TransGIPlugin::build(app::App& app) {
+  app.add_plugin<render::LightPlugin>();  // Embree mirror and light set, which the probes follow
+  ecs::World& w = app.world();
+  if (!w.has_resource<TransGISettings>()) w.insert_resource<TransGISettings>(settings_);
+  if (!w.has_resource<GiFrame>()) w.insert_resource<GiFrame>();
+  app.add_system(Phase::PrepareRender, "transgi::sync_probe_volumes", sync_probe_volumes);
+  app.add_system(Phase::Render, "transgi::update_probes", update_probes);
+  app.add_system(Phase::Render, "transgi::render_gi", render_gi);
+}
+
+std::size_t attach_latent_meshes(ecs::World& world, const std::shared_ptr<const model::TransferModel>& model) {
+  std::vector<std::pair<ecs::Entity, std::uint32_t>> targets;
+  world.view<const scene::MeshInstance>().each([&](ecs::Entity e, const scene::MeshInstance& m) {
+    if (m.mesh < model->meshes.size()) targets.emplace_back(e, m.mesh);
+  });
+  for (const auto& [e, mesh] : targets) world.emplace<LatentMesh>(e, LatentMesh{model, mesh});
+  return targets.size();
+}
+
+}  // namespace transgi::runtime

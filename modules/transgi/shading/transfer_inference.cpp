@@ -1,0 +1,72 @@
+#include "shading/transfer_inference.h"
+
+#include <algorithm>
+#include <chrono>
+#include <vector>
+
+#include "engine/jobs/parallel_for.h"
+
+namespace transgi::shading {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+// Large enough to keep the GEMM efficient, small enough that the activations
+// (width x chunk floats per layer) stay in the last-level cache.
+constexpr std::size_t kChunk = 8192;
+}  // namespace
+
+InferenceTimings infer_transfer(const model::TransferModel& model, const engine::scene::SceneAssets& assets,
+                                std::span<const TransferQuery> queries, float* out) {
+  InferenceTimings t;
+  if (queries.empty()) return t;
+  auto t0 = Clock::now();
+  const int in_size = model.decoder.layout().inputs;
+  std::vector<float> inputs(queries.size() * static_cast<std::size_t>(in_size));
+  engine::jobs::parallel_for<std::size_t>(0, queries.size(), 1024, [&](std::size_t b, std::size_t e) {
+    std::vector<float> z(static_cast<std::size_t>(model.latent_dim));
+    for (std::size_t i = b; i < e; ++i) {
+      const TransferQuery& q = queries[i];
+      model.meshes[q.mesh].latents.interpolate(*assets.meshes[q.mesh], q.triangle, q.barycentric, z.data());
+      model::assemble_input(z.data(), model.latent_dim, q.albedo, q.normal, q.wo,
+                            inputs.data() + i * static_cast<std::size_t>(in_size));
+    }
+  });
+  t.inputs_ms = ms_since(t0);
+  t0 = Clock::now();
+  model::MlpWorkspace ws;
+  const int outputs = model.decoder.layout().outputs;
+  for (std::size_t b = 0; b < queries.size(); b += kChunk) {
+    const std::size_t count = std::min(kChunk, queries.size() - b);
+    model.decoder.forward(inputs.data() + b * static_cast<std::size_t>(in_size), static_cast<int>(count),
+                          out + b * static_cast<std::size_t>(outputs), ws, model::default_gemm_backend());
+  }
+  t.inference_ms = ms_since(t0);
+  return t;
+}
+
+void infer_transfer_reference(const model::TransferModel& model, const engine::scene::SceneAssets& assets,
+                              const TransferQuery& q, float* out75) {
+  const model::MlpLayout& layout = model.decoder.layout();
+  const std::vector<float>& p = model.decoder.params();
+  std::vector<float> z(static_cast<std::size_t>(model.latent_dim));
+  model.meshes[q.mesh].latents.interpolate(*assets.meshes[q.mesh], q.triangle, q.barycentric, z.data());
+  std::vector<float> x(static_cast<std::size_t>(layout.inputs));
+  model::assemble_input(z.data(), model.latent_dim, q.albedo, q.normal, q.wo, x.data());
+  for (int l = 0; l < layout.layer_count(); ++l) {
+    const int n_in = layout.in_of(l), n_out = layout.out_of(l);
+    std::vector<float> y(static_cast<std::size_t>(n_out));
+    for (int o = 0; o < n_out; ++o) {
+      double s = p[layout.bias_offset(l) + static_cast<std::size_t>(o)];
+      for (int i = 0; i < n_in; ++i)
+        s += static_cast<double>(p[layout.weight_offset(l) + static_cast<std::size_t>(o) * n_in + static_cast<std::size_t>(i)]) *
+             x[static_cast<std::size_t>(i)];
+      y[static_cast<std::size_t>(o)] = l < layout.hidden_layers ? std::max(0.0f, static_cast<float>(s)) : static_cast<float>(s);
+    }
+    x = std::move(y);
+  }
+  std::copy(x.begin(), x.end(), out75);
+}
+
+}  // namespace transgi::shading

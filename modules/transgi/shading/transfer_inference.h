@@ -1,0 +1,35 @@
+#pragma once
+// Decoding transfer for shading points: the batched path the renderer uses
+// (inputs assembled in parallel, the decoder run on large batches through the
+// GEMM backend, which is SIMD and multi-threaded), and a plain scalar
+// reference that decodes one point with ordinary loops, to test it against.
+#include <cstdint>
+#include <span>
+
+#include <glm/glm.hpp>
+
+#include "model/transfer_model.h"
+
+namespace transgi::shading {
+
+// One shading point, all in its object's space.
+struct TransferQuery {
+  std::uint32_t mesh = 0, triangle = 0;
+  glm::vec2 barycentric{0.0f};  // Embree's (b1, b2)
+  glm::vec3 albedo{0.0f}, normal{0.0f, 0.0f, 1.0f}, wo{0.0f, 0.0f, 1.0f};
+};
+
+struct InferenceTimings {
+  double inputs_ms = 0, inference_ms = 0;
+};
+
+// out: queries.size() x 75 transfer values ([c * 25 + k] per point).
+InferenceTimings infer_transfer(const model::TransferModel& model, const engine::scene::SceneAssets& assets,
+                                std::span<const TransferQuery> queries, float* out);
+
+// The same for one point: latent interpolation, input assembly and every
+// layer as scalar loops (no GEMM library, no threads).
+void infer_transfer_reference(const model::TransferModel& model, const engine::scene::SceneAssets& assets,
+                              const TransferQuery& query, float* out75);
+
+}  // namespace transgi::shading
