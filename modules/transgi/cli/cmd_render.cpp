@@ -1,3 +1,5 @@
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <filesystem>
 
@@ -94,33 +96,43 @@ transgi::runtime::GiFrame render_with_probes(const Args& args, app::App& app, ec
 
   auto& frame = world.resource<runtime::GiFrame>();
   frame.camera = cam;
+  // The image is rendered on the last --timing-frames frames (once caches
+  // and oneDNN's kernels are warm); stage times are their medians.
+  const int timed = std::min(frames, static_cast<int>(args.integer("timing-frames", 1, 1000, 3)));
   core::ProgressBar bar("probe frames", static_cast<std::uint64_t>(frames));
-  probes::ProbeFrameStats sum;
+  std::vector<std::array<double, 9>> samples;
   int traced = 0;
   for (int f = 0; f < frames; ++f) {
-    const bool last = f + 1 == frames;
-    frame.width = last ? width : 0;
-    frame.height = last ? height : 0;
+    const bool render = f >= frames - timed;
+    frame.width = render ? width : 0;
+    frame.height = render ? height : 0;
     app.jobs().run([&] { app.update(); });
-    sum.scatter_ms += frame.probe_stats.scatter_ms;
-    sum.raster_ms += frame.probe_stats.raster_ms;
-    sum.project_ms += frame.probe_stats.project_ms;
     traced += frame.probe_stats.traced;
+    if (render) {
+      const auto& t = frame.times;
+      samples.push_back({t.gbuffer, t.network_input, t.inference, t.collect_points, t.probe_raster, t.probe_projection,
+                         t.sh_multiplication, t.direct, static_cast<double>(frame.probe_stats.traced)});
+    }
     bar.update(static_cast<std::uint64_t>(f + 1));
   }
   bar.finish();
+  std::array<double, 9> med{};
+  for (std::size_t k = 0; k < med.size(); ++k) {
+    std::vector<double> v;
+    for (const auto& smp : samples) v.push_back(smp[k]);
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    med[k] = v[v.size() / 2];
+  }
   const auto& st = frame.probe_stats;
   std::printf("  %zu of the scene's mesh entities have a LatentMesh; %zu of %zu shaded samples inferred\n", attached,
               frame.inferred_samples, frame.shaded_samples);
   std::printf("  probes: %d^3, %d frames, last frame: %d active, %d converged, %d buried, %d far; %.1f probes traced per frame\n",
               n, frames, st.active, st.converged, st.buried, st.far, static_cast<double>(traced) / frames);
-  const auto& t = frame.times;
-  std::printf("  Table 4 stages (ms): generate network input %.2f (G-buffer %.2f + inputs %.2f), network inference %.2f,\n"
-              "    collect shaded points %.2f, probe raster %.2f (+ accumulate and project %.2f), SH multiplication %.2f;"
-              " direct light %.2f\n",
-              t.gbuffer + t.network_input, t.gbuffer, t.network_input, t.inference, sum.scatter_ms / frames,
-              sum.raster_ms / frames, sum.project_ms / frames, t.sh_multiplication, t.direct);
-  std::printf("  (probe stages are the mean over all %d frames)\n", frames);
+  std::printf("  Table 4 stages, median of the last %d frames (ms): generate network input %.2f (G-buffer %.2f + inputs %.2f),\n"
+              "    network inference %.2f, collect shaded points %.2f, probe raster %.2f (+ accumulate and project %.2f),\n"
+              "    SH multiplication %.2f; direct light %.2f; total %.2f\n",
+              timed, med[0] + med[1], med[0], med[1], med[2], med[3], med[4], med[5], med[6], med[7],
+              med[0] + med[1] + med[2] + med[3] + med[4] + med[5] + med[6] + med[7]);
   return frame;
 }
 
@@ -162,8 +174,8 @@ int render_transgi(const Args& args, app::App& app, ecs::Entity cam, int width, 
   } else {
     if (transfer != "network") throw std::runtime_error("--transfer ground-truth needs --lighting environment");
     const auto shared = std::make_shared<const transgi::model::TransferModel>(std::move(model));
-    print_summary(out, transfer, "probe", pass_name, width, height, rs.spp, 0, 0);
     const auto frame = render_with_probes(args, app, cam, shared, width, height, rs, pass_name != "gi");
+    print_summary(out, transfer, "probe", pass_name, width, height, rs.spp, frame.shaded_samples, frame.inferred_samples);
     img = pass_name == "gi" ? frame.gi : pass_name == "direct" ? frame.direct : frame.full;
     if (pass_name == "all") {
       image::write_exr(sibling(out, "_direct"), frame.direct);
@@ -191,7 +203,7 @@ int run_render(const std::vector<std::string>& argv) {
   const Args args("render", argv,
                   {"scene", "method", "pass", "spp", "width", "height", "out", "camera", "seed", "threads", "png", "exposure",
                    "model", "transfer", "gt-rays", "coefficient-maps", "lighting", "frames", "probe-grid", "probe-rays",
-                   "direct-spp", "probe-skip", "sharing", "no-latent"});
+                   "direct-spp", "probe-skip", "sharing", "no-latent", "timing-frames"});
   const std::string scene_path = args.str("scene");
   const std::string method = args.choice("method", {"reference", "transgi"}, "reference");
   const std::string pass_name = args.choice("pass", {"full", "direct", "gi", "all"}, "full");
