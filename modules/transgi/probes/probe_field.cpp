@@ -10,7 +10,7 @@
 #include "engine/jobs/parallel_for.h"
 #include "engine/math/rng.h"
 #include "engine/math/sampling.h"
-#include "engine/render/surface.h"
+#include "probes/probe_rays.h"
 #include "shading/sh_light.h"
 
 namespace transgi::probes {
@@ -18,25 +18,6 @@ namespace transgi::probes {
 namespace {
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
-
-std::vector<glm::vec3> spherical_fibonacci(int n) {
-  std::vector<glm::vec3> d(static_cast<std::size_t>(n));
-  const float golden = 0.5f * (1.0f + std::sqrt(5.0f));
-  for (int i = 0; i < n; ++i) {
-    const float z = 1.0f - (2.0f * static_cast<float>(i) + 1.0f) / static_cast<float>(n);
-    const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
-    const float phi = engine::math::kTwoPi * std::fmod(static_cast<float>(i) / golden, 1.0f);
-    d[static_cast<std::size_t>(i)] = {r * std::cos(phi), r * std::sin(phi), z};
-  }
-  return d;
-}
-
-// A uniformly random rotation (Shoemake 1992).
-glm::quat random_rotation(engine::math::Pcg32& rng) {
-  const float u1 = rng.next_float(), u2 = engine::math::kTwoPi * rng.next_float(), u3 = engine::math::kTwoPi * rng.next_float();
-  const float a = std::sqrt(1 - u1), b = std::sqrt(u1);
-  return glm::normalize(glm::quat(b * std::cos(u3), a * std::sin(u2), a * std::cos(u2), b * std::sin(u3)));
-}
 }  // namespace
 
 
@@ -104,43 +85,19 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
       for (int i = 0; i < M; ++i) {
         math::Pcg32 rng = math::make_rng(settings_.seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
         const glm::vec3 dir = glm::normalize(rotation * fibonacci_[static_cast<std::size_t>(i)]);
+        const ProbeRayHit h = trace_probe_ray(scene, lights, origin, dir, rng, [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3&) {
+          // Indirect light from last frame's probes (multi-bounce feedback).
+          return frame_ > 0 ? irradiance(p, n) : glm::vec3(0.0f);
+        });
         ShadedPoint sp;
         sp.direction = dir;
-        rt::Hit hit;
-        if (!scene.intersect(rt::Ray{origin, dir}, hit)) {
-          sp.distance = std::numeric_limits<float>::infinity();
-          out.push_back(sp);
-          continue;
-        }
-        hits.fetch_add(1, std::memory_order_relaxed);
-        const render::Surface s = render::make_surface(scene, hit, dir);
-        backfaces[static_cast<std::size_t>(q)] += s.back_face ? 1 : 0;
-        nearest[static_cast<std::size_t>(q)] = std::min(nearest[static_cast<std::size_t>(q)], hit.t);
-        sp.position = s.position;
-        sp.distance = hit.t;
-        const bool emitter = s.emission.r > 0 || s.emission.g > 0 || s.emission.b > 0;
-        const glm::vec3 wo = s.frame.to_local(-dir);
-        if (!emitter && wo.z > 0) {
-          // Direct light by next-event estimation, towards the probe.
-          render::LightSample ls;
-          const float u_sel = rng.next_float();
-          const glm::vec2 u(rng.next_float(), rng.next_float());
-          if (lights.sample(s.position, u_sel, u, ls) && glm::dot(ls.direction, s.geometric_normal) > 0) {
-            const glm::vec3 wi = s.frame.to_local(ls.direction);
-            const glm::vec3 f = wi.z > 0 ? material::brdf_eval(s.brdf, wo, wi) : glm::vec3(0.0f);
-            if (f != glm::vec3(0.0f)) {
-              const glm::vec3 o = rt::offset_ray_origin(s.position, s.geometric_normal);
-              const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
-              if (!scene.occluded(rt::Ray{o, ls.direction, 0.0f, tmax}))
-                sp.radiance += f * wi.z * ls.radiance / (ls.delta ? 1.0f : ls.pdf);
-            }
-          }
-          // Indirect light from last frame's probes (multi-bounce feedback).
-          if (frame_ > 0) {
-            const glm::vec3 diffuse = s.brdf.base_color * (1.0f - s.brdf.metallic);
-            sp.radiance += diffuse * math::kInvPi * irradiance(s.position, s.shading_normal);
-          }
-          if (!std::isfinite(sp.radiance.r + sp.radiance.g + sp.radiance.b)) sp.radiance = glm::vec3(0.0f);
+        sp.distance = h.distance;
+        sp.position = h.position;
+        sp.radiance = h.radiance;
+        if (h.hit) {
+          hits.fetch_add(1, std::memory_order_relaxed);
+          backfaces[static_cast<std::size_t>(q)] += h.back_face ? 1 : 0;
+          nearest[static_cast<std::size_t>(q)] = std::min(nearest[static_cast<std::size_t>(q)], h.distance);
         }
         out.push_back(sp);
       }
