@@ -1,0 +1,246 @@
+#include "ddgi/ddgi_volume.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+#include "engine/jobs/parallel_for.h"
+#include "engine/math/rng.h"
+#include "engine/math/sampling.h"
+#include "probes/probe_rays.h"
+
+namespace transgi::ddgi {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+float max_component(const glm::vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
+
+// RTXGI records missed rays at its default maximum ray distance.
+constexpr float kMissDistance = 1e27f;
+// Backface hits are stored negative and shortened (RTXGI's ProbeTraceRGS).
+constexpr float kBackfaceDistanceScale = -0.2f;
+
+struct RayRecord {
+  glm::vec3 direction;
+  glm::vec3 radiance;
+  float distance;
+};
+
+// Texel-by-texel blend of one probe's irradiance (ProbeBlendingCS with
+// RTXGI_DDGI_BLEND_RADIANCE = 1).
+void blend_irradiance(OctahedralMap<glm::vec3>& map, const std::vector<RayRecord>& rays, const DdgiSettings& s) {
+  const int n = map.interior;
+  const auto max_backfaces = static_cast<int>(static_cast<float>(s.rays_per_probe) * s.random_ray_backface_threshold);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const glm::vec3 texel_dir = texel_direction(x, y, n);
+      glm::vec3 sum(0.0f);
+      float weight_sum = 0.0f;
+      int backfaces = 0;
+      for (const RayRecord& r : rays) {
+        if (r.distance < 0) {
+          if (++backfaces >= max_backfaces) return;  // inside geometry: leave the probe as it was
+          continue;
+        }
+        const float w = std::max(0.0f, glm::dot(texel_dir, r.direction));
+        sum += r.radiance * w;
+        weight_sum += w;
+      }
+      // Dividing by sum(cos) instead of N lowers the variance; the factor
+      // 1/2 (and 2 pi when sampling) turns the cosine-weighted mean
+      // radiance, E / pi, into E / (2 pi).
+      const float epsilon = static_cast<float>(s.rays_per_probe) * 1e-9f;
+      glm::vec3 result = sum / (2.0f * std::max(weight_sum, epsilon));
+      result = glm::pow(result, glm::vec3(1.0f / s.irradiance_gamma));
+      glm::vec3& texel = map.at(x + 1, y + 1);
+      const glm::vec3 previous = texel;
+      float h = s.hysteresis;
+      glm::vec3 delta = result - previous;
+      if (max_component(previous - result) > s.irradiance_threshold) h = std::max(0.0f, h - 0.75f);
+      if (glm::length(delta) > s.brightness_threshold) {
+        result = previous + delta * 0.25f;
+        delta = result - previous;
+      }
+      glm::vec3 lerp_delta = (1.0f - h) * delta;
+      if (max_component(result) < max_component(previous)) {
+        // Darkening steps at least 1/1024 per frame so low-precision
+        // formats (and this one) reach the target.
+        constexpr float kThreshold = 1.0f / 1024.0f;
+        for (int c = 0; c < 3; ++c)
+          lerp_delta[c] = std::min(std::max(kThreshold, std::abs(lerp_delta[c])), std::abs(delta[c])) *
+                          (lerp_delta[c] > 0 ? 1.0f : lerp_delta[c] < 0 ? -1.0f : 0.0f);
+      }
+      texel = previous + lerp_delta;
+    }
+  update_border(map);
+}
+
+void blend_distance(OctahedralMap<glm::vec2>& map, const std::vector<RayRecord>& rays, const DdgiSettings& s,
+                    float max_distance) {
+  const int n = map.interior;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const glm::vec3 texel_dir = texel_direction(x, y, n);
+      glm::vec2 sum(0.0f);
+      float weight_sum = 0.0f;
+      for (const RayRecord& r : rays) {
+        const float w = std::pow(std::max(0.0f, glm::dot(texel_dir, r.direction)), s.distance_exponent);
+        const float d = std::min(std::abs(r.distance), max_distance);
+        sum += w * glm::vec2(d, d * d);
+        weight_sum += w;
+      }
+      if (weight_sum <= 0) continue;
+      // The mean (RTXGI v1.2+ also halves distances here, which biases the
+      // Chebyshev test towards occlusion; the mean is what the test needs).
+      const glm::vec2 result = sum / weight_sum;
+      glm::vec2& texel = map.at(x + 1, y + 1);
+      texel = glm::mix(result, texel, s.hysteresis);
+    }
+  update_border(map);
+}
+
+}  // namespace
+
+DdgiVolume::DdgiVolume(const probes::ProbeGrid& grid, const DdgiSettings& settings)
+    : grid_(grid), settings_(settings), directions_(probes::spherical_fibonacci(settings.rays_per_probe)) {
+  const auto count = static_cast<std::size_t>(grid.count());
+  irradiance_.assign(count, OctahedralMap<glm::vec3>(settings.irradiance_texels, glm::vec3(0.0f)));
+  // Until measured, distances read as "far": nothing is occluded.
+  distance_.assign(count, OctahedralMap<glm::vec2>(settings.distance_texels, glm::vec2(0.0f)));
+  active_.assign(count, 1);
+}
+
+std::size_t DdgiVolume::memory_bytes() const {
+  std::size_t b = 0;
+  for (const auto& m : irradiance_) b += m.texels.size() * sizeof(glm::vec3);
+  for (const auto& m : distance_) b += m.texels.size() * sizeof(glm::vec2);
+  return b;
+}
+
+DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                                  const engine::scene::Environment* sky) {
+  using namespace engine;
+  DdgiFrameStats stats;
+  const int probes = grid_.count(), M = settings_.rays_per_probe;
+  math::Pcg32 frame_rng = math::make_rng(settings_.seed, 0xDD61, frame_);
+  const glm::quat rotation = probes::random_rotation(frame_rng);
+  const float max_distance = 1.5f * glm::length(grid_.spacing());
+  const bool classify_now = settings_.classification && !classified_;
+
+  auto t0 = Clock::now();
+  std::vector<std::vector<RayRecord>> records(static_cast<std::size_t>(probes));
+  std::atomic<std::size_t> rays{0};
+  jobs::parallel_for(0, probes, 1, [&](int b, int e) {
+    for (int q = b; q < e; ++q) {
+      if (!active_[static_cast<std::size_t>(q)]) continue;
+      auto& out = records[static_cast<std::size_t>(q)];
+      out.resize(static_cast<std::size_t>(M));
+      const glm::vec3 origin = grid_.position(q);
+      for (int i = 0; i < M; ++i) {
+        math::Pcg32 rng = math::make_rng(settings_.seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
+        const glm::vec3 dir = glm::normalize(rotation * directions_[static_cast<std::size_t>(i)]);
+        const probes::ProbeRayHit h = probes::trace_probe_ray(
+            scene, lights, origin, dir, rng, [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3& towards_probe) {
+              return frame_ > 0 ? irradiance(p, n, -towards_probe) : glm::vec3(0.0f);
+            });
+        RayRecord& r = out[static_cast<std::size_t>(i)];
+        r.direction = dir;
+        if (!h.hit) {
+          r.radiance = settings_.escaped == EscapedRays::Environment && sky ? sky->radiance(dir) : glm::vec3(0.0f);
+          r.distance = kMissDistance;
+        } else if (h.back_face) {
+          r.radiance = glm::vec3(0.0f);
+          r.distance = kBackfaceDistanceScale * h.distance;
+        } else {
+          r.radiance = h.radiance;
+          r.distance = h.distance;
+        }
+      }
+      rays.fetch_add(static_cast<std::size_t>(M), std::memory_order_relaxed);
+    }
+  });
+  stats.rays = rays.load();
+  stats.trace_ms = ms_since(t0);
+
+  if (classify_now) {
+    for (int q = 0; q < probes; ++q) {
+      int backfaces = 0;
+      for (const RayRecord& r : records[static_cast<std::size_t>(q)]) backfaces += r.distance < 0 ? 1 : 0;
+      active_[static_cast<std::size_t>(q)] = static_cast<float>(backfaces) <= settings_.fixed_ray_backface_threshold * static_cast<float>(M);
+    }
+    classified_ = true;
+  }
+
+  t0 = Clock::now();
+  jobs::parallel_for(0, probes, 1, [&](int b, int e) {
+    for (int q = b; q < e; ++q) {
+      const auto& rec = records[static_cast<std::size_t>(q)];
+      if (rec.empty() || !active_[static_cast<std::size_t>(q)]) continue;
+      blend_irradiance(irradiance_[static_cast<std::size_t>(q)], rec, settings_);
+      blend_distance(distance_[static_cast<std::size_t>(q)], rec, settings_, max_distance);
+    }
+  });
+  stats.blend_ms = ms_since(t0);
+  for (std::uint8_t a : active_) stats.inactive += a ? 0 : 1;
+  ++frame_;
+  return stats;
+}
+
+glm::vec3 DdgiVolume::irradiance(const glm::vec3& position, const glm::vec3& n, const glm::vec3& view_dir) const {
+  const glm::vec3 bias = n * settings_.normal_bias - view_dir * settings_.view_bias;
+  const glm::vec3 biased = position + bias;
+  const glm::vec3 spacing = grid_.spacing();
+  glm::ivec3 base(0);
+  glm::vec3 alpha(0.0f);
+  for (int a = 0; a < 3; ++a) {
+    if (grid_.dims[a] < 2 || spacing[a] <= 0) continue;
+    const float rel = (biased[a] - grid_.min[a]) / spacing[a];
+    base[a] = std::clamp(static_cast<int>(std::floor(rel)), 0, grid_.dims[a] - 1);
+    alpha[a] = std::clamp(rel - static_cast<float>(base[a]), 0.0f, 1.0f);
+  }
+  glm::vec3 sum(0.0f);
+  float weights = 0.0f;
+  for (int i = 0; i < 8; ++i) {
+    const glm::ivec3 offset(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+    const glm::ivec3 c = glm::clamp(base + offset, glm::ivec3(0), grid_.dims - 1);
+    const int q = grid_.index(c);
+    if (!active_[static_cast<std::size_t>(q)]) continue;
+    const glm::vec3 probe = grid_.position(q);
+    const glm::vec3 to_probe = glm::normalize(probe - position);
+    const glm::vec3 biased_to_probe = probe - biased;
+    const float biased_dist = glm::length(biased_to_probe);
+    const glm::vec3 trilinear3 = glm::max(glm::vec3(0.001f), glm::mix(glm::vec3(1.0f) - alpha, alpha, glm::vec3(offset)));
+    const float trilinear = trilinear3.x * trilinear3.y * trilinear3.z;
+    // Wrap shading instead of a hard back-face cut, so small details inside
+    // a room keep some probe with mutual visibility.
+    const float wrap = 0.5f * (glm::dot(to_probe, n) + 1.0f);
+    float w = wrap * wrap + 0.2f;
+    const glm::vec2 moments = biased_dist > 0 ? sample_bilinear(distance_[static_cast<std::size_t>(q)], -biased_to_probe / biased_dist)
+                                              : glm::vec2(0.0f);
+    float chebyshev = 1.0f;
+    if (biased_dist > moments.x) {
+      const float variance = std::abs(moments.x * moments.x - moments.y);
+      const float v = biased_dist - moments.x;
+      chebyshev = variance / (variance + v * v);
+      chebyshev = std::max(chebyshev * chebyshev * chebyshev, 0.0f);
+    }
+    w *= std::max(0.05f, chebyshev);
+    w = std::max(0.000001f, w);
+    constexpr float kCrush = 0.2f;  // perceptually, a little light is a lot: crush tiny weights
+    if (w < kCrush) w *= w * w / (kCrush * kCrush);
+    w *= trilinear;
+    // Undo the tone curve but keep gamma 2, to blend in a perceptual space.
+    const glm::vec3 e = glm::pow(glm::max(sample_bilinear(irradiance_[static_cast<std::size_t>(q)], n), glm::vec3(0.0f)),
+                                 glm::vec3(0.5f * settings_.irradiance_gamma));
+    sum += w * e;
+    weights += w;
+  }
+  if (weights <= 0) return glm::vec3(0.0f);
+  glm::vec3 e = sum / weights;
+  return e * e * engine::math::kTwoPi;
+}
+
+}  // namespace transgi::ddgi

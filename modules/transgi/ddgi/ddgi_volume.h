@@ -1,0 +1,99 @@
+#pragma once
+// The DDGI baseline (Majercik et al. 2019) with the defaults of NVIDIA's
+// RTXGI SDK (DDGIVolume.h, shaders/ddgi/ProbeBlendingCS.hlsl and
+// Irradiance.hlsl). It traces and shades probe rays exactly like TransGI's
+// probes (probes/probe_rays.h) and uses the same grid; what differs is what
+// DDGI is: per-probe octahedral irradiance and distance maps, cosine /
+// power-cosine blending with hysteresis, and Chebyshev + wrap-shading
+// interpolation of irradiance at a shading point.
+#include <cstdint>
+#include <vector>
+
+#include "ddgi/octahedral.h"
+#include "engine/render/light_set.h"
+#include "engine/rt/rt_scene.h"
+#include "engine/scene/environment.h"
+#include "probes/probe_grid.h"
+
+namespace transgi::ddgi {
+
+// What an escaped probe ray records.
+enum class EscapedRays {
+  Zero,         // nothing: probes hold indirect light only, like TransGI's (the GI pass);
+                // the environment is then sampled by next-event estimation at hits
+  Environment,  // the sky's radiance, as RTXGI does; the light set must then leave the sky out
+};
+
+struct DdgiSettings {
+  // Rays per probe per update. Higher = less noise, at the cost of tracing and blending time.
+  int rays_per_probe = 256;
+  // Interior texels per side (a 1-texel border is added: 8x8 and 16x16).
+  // Higher = sharper directional detail, at the cost of memory and blending time.
+  int irradiance_texels = 6;
+  int distance_texels = 14;
+  // Weight of history. Higher = less flicker, at the cost of slower reaction.
+  float hysteresis = 0.97f;
+  // A texel darkening by more than this (in gamma-encoded units) lowers its
+  // hysteresis by 0.75 for the frame.
+  float irradiance_threshold = 0.25f;
+  // A texel changing by more than this moves only a quarter of the way.
+  float brightness_threshold = 0.10f;
+  float irradiance_gamma = 5.0f;
+  // Sharpness of the distance filter (cosine power). Higher = crisper
+  // visibility edges, at the cost of banding.
+  float distance_exponent = 50.0f;
+  // Shading-point offsets before the visibility test (world units). Higher =
+  // fewer self-shadowing artefacts, at the cost of light leaking through thin walls.
+  float normal_bias = 0.1f;
+  float view_bias = 0.1f;
+  // A probe whose rays hit back faces more often than this skips irradiance blending.
+  float random_ray_backface_threshold = 0.1f;
+  // Optional, off as in RTXGI: mark probes inside geometry (more than this
+  // fraction of back-face hits) inactive: they trace nothing and get no weight.
+  bool classification = false;
+  float fixed_ray_backface_threshold = 0.25f;
+  EscapedRays escaped = EscapedRays::Zero;
+  std::uint64_t seed = 1;
+
+  bool operator==(const DdgiSettings&) const = default;
+};
+
+struct DdgiFrameStats {
+  std::size_t rays = 0;
+  int inactive = 0;
+  double trace_ms = 0, blend_ms = 0;
+};
+
+class DdgiVolume {
+ public:
+  DdgiVolume(const probes::ProbeGrid& grid, const DdgiSettings& settings);
+
+  // One update: trace, blend irradiance and distance, update borders.
+  // `sky` is what escaped rays see with EscapedRays::Environment (may be null).
+  DdgiFrameStats update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                        const engine::scene::Environment* sky = nullptr);
+
+  // Irradiance at a surface point with unit normal n, seen along view_dir
+  // (from the eye towards the point), as RTXGI's DDGIGetVolumeIrradiance.
+  [[nodiscard]] glm::vec3 irradiance(const glm::vec3& position, const glm::vec3& normal, const glm::vec3& view_dir) const;
+
+  [[nodiscard]] const probes::ProbeGrid& grid() const { return grid_; }
+  [[nodiscard]] const DdgiSettings& settings() const { return settings_; }
+  [[nodiscard]] const OctahedralMap<glm::vec3>& irradiance_map(int probe) const { return irradiance_[static_cast<std::size_t>(probe)]; }
+  [[nodiscard]] const OctahedralMap<glm::vec2>& distance_map(int probe) const { return distance_[static_cast<std::size_t>(probe)]; }
+  [[nodiscard]] bool active(int probe) const { return active_[static_cast<std::size_t>(probe)] != 0; }
+  [[nodiscard]] std::uint64_t frame() const { return frame_; }
+  [[nodiscard]] std::size_t memory_bytes() const;
+
+ private:
+  probes::ProbeGrid grid_;
+  DdgiSettings settings_;
+  std::vector<glm::vec3> directions_;  // unrotated spherical Fibonacci set
+  std::vector<OctahedralMap<glm::vec3>> irradiance_;  // gamma-encoded E / (2 pi)
+  std::vector<OctahedralMap<glm::vec2>> distance_;    // mean distance, mean squared distance
+  std::vector<std::uint8_t> active_;
+  bool classified_ = false;
+  std::uint64_t frame_ = 0;
+};
+
+}  // namespace transgi::ddgi
