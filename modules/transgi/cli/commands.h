@@ -11,5 +11,7 @@ int run_compare(const std::vector<std::string>& args);
 int run_tonemap(const std::vector<std::string>& args);
 int run_bake(const std::vector<std::string>& args);
 int run_transfer_study(const std::vector<std::string>& args);
+int run_eval(const std::vector<std::string>& args);
+int run_bench_pareto(const std::vector<std::string>& args);
 
 }  // namespace transgi::cli

@@ -20,7 +20,11 @@ void usage() {
                "  tonemap  IN.exr OUT.png [--exposure EV] [--signed SCALE] [--minus B.exr]\n"
                "  bake     --scene S.gltf --out M.tgm [--points N] [--dirs D] [--outgoing K] [--iters I] [--batch B]\n"
                "           [--lr R] [--latent-dim K] [--width W] [--depth L] [--threads T] [--seed S] [--resume] [--keep-dataset]\n"
-               "  transfer-study --scene S.gltf [--points N] [--outgoing K] [--reference-rays R]\n");
+               "  render   --scene S.gltf --method ddgi [--frames F] [--probe-grid N] [--probe-rays M] [--warmup-frames W] ...\n"
+               "  transfer-study --scene S.gltf [--points N] [--outgoing K] [--reference-rays R]\n"
+               "  eval     --scene S.gltf --model M.tgm --out DIR [--width W --height H --spp N --frames F --ddgi-frames F2]\n"
+               "           [--probe-grid N] [--cache DIR]\n"
+               "  bench-pareto --scene S.gltf --model M.tgm --out DIR [--width W --height H --spp N] [--quick]\n");
 }
 }  // namespace
 
@@ -37,6 +41,8 @@ int main(int argc, char** argv) {
     if (command == "tonemap") return transgi::cli::run_tonemap(args);
     if (command == "bake") return transgi::cli::run_bake(args);
     if (command == "transfer-study") return transgi::cli::run_transfer_study(args);
+    if (command == "eval") return transgi::cli::run_eval(args);
+    if (command == "bench-pareto") return transgi::cli::run_bench_pareto(args);
     if (command == "--help" || command == "help") {
       usage();
       return 0;

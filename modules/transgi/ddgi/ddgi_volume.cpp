@@ -31,7 +31,8 @@ struct RayRecord {
 
 // Texel-by-texel blend of one probe's irradiance (ProbeBlendingCS with
 // RTXGI_DDGI_BLEND_RADIANCE = 1).
-void blend_irradiance(OctahedralMap<glm::vec3>& map, const std::vector<RayRecord>& rays, const DdgiSettings& s) {
+void blend_irradiance(OctahedralMap<glm::vec3>& map, const std::vector<RayRecord>& rays, const DdgiSettings& s, float hysteresis,
+                      bool clamp_brightness) {
   const int n = map.interior;
   const auto max_backfaces = static_cast<int>(static_cast<float>(s.rays_per_probe) * s.random_ray_backface_threshold);
   for (int y = 0; y < n; ++y)
@@ -57,10 +58,10 @@ void blend_irradiance(OctahedralMap<glm::vec3>& map, const std::vector<RayRecord
       result = glm::pow(result, glm::vec3(1.0f / s.irradiance_gamma));
       glm::vec3& texel = map.at(x + 1, y + 1);
       const glm::vec3 previous = texel;
-      float h = s.hysteresis;
+      float h = hysteresis;
       glm::vec3 delta = result - previous;
       if (max_component(previous - result) > s.irradiance_threshold) h = std::max(0.0f, h - 0.75f);
-      if (glm::length(delta) > s.brightness_threshold) {
+      if (clamp_brightness && glm::length(delta) > s.brightness_threshold) {
         result = previous + delta * 0.25f;
         delta = result - previous;
       }
@@ -79,7 +80,7 @@ void blend_irradiance(OctahedralMap<glm::vec3>& map, const std::vector<RayRecord
 }
 
 void blend_distance(OctahedralMap<glm::vec2>& map, const std::vector<RayRecord>& rays, const DdgiSettings& s,
-                    float max_distance) {
+                    float max_distance, float hysteresis) {
   const int n = map.interior;
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x) {
@@ -97,7 +98,7 @@ void blend_distance(OctahedralMap<glm::vec2>& map, const std::vector<RayRecord>&
       // Chebyshev test towards occlusion; the mean is what the test needs).
       const glm::vec2 result = sum / weight_sum;
       glm::vec2& texel = map.at(x + 1, y + 1);
-      texel = glm::mix(result, texel, s.hysteresis);
+      texel = glm::mix(result, texel, hysteresis);
     }
   update_border(map);
 }
@@ -175,12 +176,16 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
   }
 
   t0 = Clock::now();
+  const bool warming = frame_ < static_cast<std::uint64_t>(settings_.warmup_frames);
+  const float h = warming ? std::min(settings_.hysteresis, 0.5f + (settings_.hysteresis - 0.5f) * static_cast<float>(frame_) /
+                                                                       static_cast<float>(settings_.warmup_frames))
+                          : settings_.hysteresis;
   jobs::parallel_for(0, probes, 1, [&](int b, int e) {
     for (int q = b; q < e; ++q) {
       const auto& rec = records[static_cast<std::size_t>(q)];
       if (rec.empty() || !active_[static_cast<std::size_t>(q)]) continue;
-      blend_irradiance(irradiance_[static_cast<std::size_t>(q)], rec, settings_);
-      blend_distance(distance_[static_cast<std::size_t>(q)], rec, settings_, max_distance);
+      blend_irradiance(irradiance_[static_cast<std::size_t>(q)], rec, settings_, h, !warming);
+      blend_distance(distance_[static_cast<std::size_t>(q)], rec, settings_, max_distance, h);
     }
   });
   stats.blend_ms = ms_since(t0);

@@ -1,0 +1,56 @@
+#pragma once
+// The DDGI baseline as an opt-in engine plugin, shaped like TransGIPlugin so
+// the two are compared in one engine: a DdgiProbeVolume component, the
+// DdgiSettings resource, and a DdgiFrame with the images and stage times.
+//
+//  PrepareRender  ddgi::sync_volumes: each DdgiProbeVolume has a volume for the
+//                 current settings and bounds (fitted to the scene once).
+//  Render         ddgi::update_volumes: rays traced, irradiance and distance blended.
+//                 ddgi::render: if DdgiFrame has a size, its gi / direct / full
+//                 images and stage times are this frame's.
+#include <memory>
+
+#include "ddgi/ddgi_volume.h"
+#include "engine/app/app.h"
+#include "engine/image/image.h"
+
+namespace transgi::ddgi {
+
+struct DdgiProbeVolume {
+  glm::vec3 min{1.0f}, max{-1.0f};  // min > max: fit to the scene
+  glm::ivec3 dims{8};
+  std::shared_ptr<DdgiVolume> volume = nullptr;  // written by the plugin only
+  [[nodiscard]] bool fits_scene() const { return glm::any(glm::greaterThan(min, max)); }
+};
+
+struct DdgiRenderOptions {
+  int gbuffer_spp = 1;  // higher = antialiased edges, at the cost of that many irradiance lookups
+  int direct_spp = 4;   // higher = less direct-light noise, at the cost of tracing time; 0 = GI only
+  std::uint64_t seed = 0;
+};
+
+struct DdgiStageTimes {
+  double probe_trace = 0, probe_blend = 0, shading = 0, direct = 0;
+};
+
+struct DdgiFrame {
+  int width = 0, height = 0;  // 0 = update the probes only
+  engine::ecs::Entity camera;
+  engine::image::ImageRGB gi, direct, full;
+  DdgiStageTimes times;
+  DdgiFrameStats probe_stats;
+  std::uint64_t frames = 0;
+};
+
+class DdgiPlugin final : public engine::app::Plugin {
+ public:
+  explicit DdgiPlugin(DdgiSettings settings = {}, DdgiRenderOptions options = {}) : settings_(settings), options_(options) {}
+  void build(engine::app::App& app) override;
+  [[nodiscard]] std::string_view name() const override { return "transgi::DdgiPlugin"; }
+
+ private:
+  DdgiSettings settings_;
+  DdgiRenderOptions options_;
+};
+
+}  // namespace transgi::ddgi

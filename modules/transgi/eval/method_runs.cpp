@@ -1,0 +1,169 @@
+#include "eval/method_runs.h"
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+
+#include "engine/core/progress.h"
+#include "engine/rt/rt_plugin.h"
+#include "engine/scene/components.h"
+#include "engine/scene/gltf_loader.h"
+
+namespace transgi::eval {
+
+namespace {
+
+using namespace engine;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// Per-stage samples of the timed frames -> named medians.
+std::vector<Stage> medians(const std::vector<std::string>& names, const std::vector<std::vector<double>>& samples) {
+  std::vector<Stage> out;
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    std::vector<double> v;
+    for (const auto& s : samples) v.push_back(s[k]);
+    out.push_back({names[k], median(v)});
+  }
+  return out;
+}
+
+double median_total(const std::vector<std::vector<double>>& samples, std::size_t stages_without_direct) {
+  std::vector<double> totals;
+  for (const auto& s : samples) {
+    double t = 0;
+    for (std::size_t k = 0; k < stages_without_direct; ++k) t += s[k];
+    totals.push_back(t);
+  }
+  return median(totals);
+}
+
+}  // namespace
+
+LoadedScene load_scene(const std::string& path, const std::string& camera_name, int threads) {
+  LoadedScene s;
+  s.app = std::make_unique<app::App>(app::AppOptions{.jobs = {.threads = threads}});
+  s.app->add_plugin<rt::RtPlugin>();
+  const auto loaded = scene::load_gltf(s.app->world(), path);
+  for (const auto& w : loaded.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  s.entities = loaded.entities;
+  s.app->update();
+  ecs::World& world = s.app->world();
+  bool found = false;
+  for (ecs::Entity e : loaded.entities) {
+    if (!world.has<scene::Camera>(e)) continue;
+    if (camera_name.empty() || world.get<scene::Name>(e).value == camera_name) {
+      s.camera = e;
+      found = true;
+      break;
+    }
+  }
+  if (!found) {
+    if (camera_name.empty()) throw std::runtime_error(path + ": the scene has no perspective camera");
+    throw std::runtime_error("--camera: no camera node named '" + camera_name + "' in " + path);
+  }
+  return s;
+}
+
+MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::TransferModel>& model, int width, int height,
+                      const TransgiRunOptions& o) {
+  ecs::World& world = scene.app->world();
+  scene.app->add_plugin<runtime::TransGIPlugin>(o.settings);
+  runtime::attach_latent_meshes(world, model);
+  for (const std::string& name : o.no_latent) {
+    std::vector<ecs::Entity> matches;
+    world.view<const scene::Name, const runtime::LatentMesh>().each(
+        [&](ecs::Entity e, const scene::Name& nm, const runtime::LatentMesh&) {
+          if (nm.value == name) matches.push_back(e);
+        });
+    if (matches.empty()) throw std::runtime_error("--no-latent: no mesh node named '" + name + "'");
+    for (ecs::Entity e : matches) world.remove<runtime::LatentMesh>(e);
+  }
+  const ecs::Entity volume = world.spawn();
+  world.emplace<runtime::ProbeVolume>(volume, runtime::ProbeVolume{.dims = glm::ivec3(o.probe_grid)});
+
+  auto& frame = world.resource<runtime::GiFrame>();
+  frame.camera = scene.camera;
+  const int timed = std::clamp(o.timing_frames, 1, o.frames);
+  core::ProgressBar bar("TransGI probe frames", static_cast<std::uint64_t>(o.frames), o.progress);
+  std::vector<std::vector<double>> samples;
+  int traced = 0;
+  for (int f = 0; f < o.frames; ++f) {
+    const bool render = f >= o.frames - timed;
+    frame.width = render ? width : 0;
+    frame.height = render ? height : 0;
+    scene.app->jobs().run([&] { scene.app->update(); });
+    traced += frame.probe_stats.traced;
+    if (render) {
+      const auto& t = frame.times;
+      samples.push_back({t.gbuffer + t.network_input, t.inference, t.collect_points, t.probe_raster, t.probe_projection,
+                         t.sh_multiplication, t.direct});
+    }
+    bar.update(static_cast<std::uint64_t>(f + 1));
+  }
+  bar.finish();
+  MethodRun r;
+  r.gi = frame.gi;
+  r.direct = frame.direct;
+  r.full = frame.full;
+  r.shaded_samples = frame.shaded_samples;
+  r.inferred_samples = frame.inferred_samples;
+  r.stages = medians({"generate network input", "network inference", "collect shaded points", "probe raster",
+                      "probe accumulation + SH projection", "SH multiplication", "direct light"},
+                     samples);
+  r.frame_ms = median_total(samples, 6);
+  world.view<const runtime::ProbeVolume>().each([&](const runtime::ProbeVolume& v) {
+    if (!v.field) return;
+    const auto& s = v.field->settings();
+    // Radiance, sample flags, depth moments per texel; 75 SH floats per probe.
+    const std::size_t per_probe = static_cast<std::size_t>(s.map.texel_count()) * (sizeof(glm::vec3) + 4 * sizeof(float)) + 75 * sizeof(float);
+    r.probe_bytes += per_probe * static_cast<std::size_t>(s.grid.count());
+  });
+  const auto& st = frame.probe_stats;
+  char line[256];
+  std::snprintf(line, sizeof(line), "%d^3 probes, %d frames; last frame %d active, %d converged, %d buried, %d far; %.1f traced per frame",
+                o.probe_grid, o.frames, st.active, st.converged, st.buried, st.far, static_cast<double>(traced) / o.frames);
+  r.probe_summary = line;
+  return r;
+}
+
+MethodRun run_ddgi(LoadedScene& scene, int width, int height, const DdgiRunOptions& o) {
+  ecs::World& world = scene.app->world();
+  scene.app->add_plugin<ddgi::DdgiPlugin>(o.settings, o.render);
+  const ecs::Entity volume = world.spawn();
+  world.emplace<ddgi::DdgiProbeVolume>(volume, ddgi::DdgiProbeVolume{.dims = glm::ivec3(o.probe_grid)});
+  auto& frame = world.resource<ddgi::DdgiFrame>();
+  frame.camera = scene.camera;
+  const int timed = std::clamp(o.timing_frames, 1, o.frames);
+  core::ProgressBar bar("DDGI probe updates", static_cast<std::uint64_t>(o.frames), o.progress);
+  std::vector<std::vector<double>> samples;
+  for (int f = 0; f < o.frames; ++f) {
+    const bool render = f >= o.frames - timed;
+    frame.width = render ? width : 0;
+    frame.height = render ? height : 0;
+    scene.app->jobs().run([&] { scene.app->update(); });
+    if (render) samples.push_back({frame.times.probe_trace, frame.times.probe_blend, frame.times.shading, frame.times.direct});
+    bar.update(static_cast<std::uint64_t>(f + 1));
+  }
+  bar.finish();
+  MethodRun r;
+  r.gi = frame.gi;
+  r.direct = frame.direct;
+  r.full = frame.full;
+  r.stages = medians({"probe update: trace and shade rays", "probe update: blend", "probe interpolation (render)", "direct light"}, samples);
+  r.frame_ms = median_total(samples, 3);
+  world.view<const ddgi::DdgiProbeVolume>().each([&](const ddgi::DdgiProbeVolume& v) {
+    if (v.volume) r.probe_bytes += v.volume->memory_bytes();
+  });
+  char line[160];
+  std::snprintf(line, sizeof(line), "%d^3 probes, %d rays, %d updates, %d inactive", o.probe_grid, o.settings.rays_per_probe,
+                o.frames, frame.probe_stats.inactive);
+  r.probe_summary = line;
+  return r;
+}
+
+}  // namespace transgi::eval
