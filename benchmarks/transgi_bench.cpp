@@ -4,9 +4,13 @@
 // spent outside the GEMMs is visible (docs/bake.md).
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <vector>
 
 #include "bake/trainer.h"
+#include "ddgi/ddgi_volume.h"
+#include "engine/jobs/job_system.h"
+#include "shading/transfer_inference.h"
 #include "engine/math/rng.h"
 #include "engine/scene/procedural.h"
 #include "model/mlp.h"
@@ -70,8 +74,54 @@ void BM_TrainerStep(benchmark::State& state) {
   for (auto _ : state) trainer.step();
   state.counters["samples/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * kBatch, benchmark::Counter::kIsRate);
 }
+// Per-pixel transfer: the batched path the renderer uses (arg 1) against the
+// scalar reference it is tested against (arg 0), on 8192 queries.
+void BM_InferTransfer(benchmark::State& state) {
+  engine::scene::SceneAssets a;
+  a.generation = engine::scene::next_scene_generation();
+  a.meshes = {std::make_shared<engine::scene::MeshAsset>(engine::scene::make_uv_sphere(1, 64, 32))};
+  a.materials.resize(1);
+  auto m = bake::make_untrained_model(a, 7, model::MlpLayout{}, 1);
+  engine::math::Pcg32 rng(3, 4);
+  std::vector<shading::TransferQuery> q(8192);
+  for (auto& x : q) {
+    x.triangle = static_cast<std::uint32_t>(rng.next_float() * 1000.0f);
+    x.barycentric = {0.3f, 0.3f};
+    x.albedo = glm::vec3(0.5f);
+    x.normal = {0, 0, 1};
+    x.wo = glm::normalize(glm::vec3(0.2f, 0.1f, 1));
+  }
+  std::vector<float> out(q.size() * 75);
+  engine::jobs::JobSystem jobs({.threads = 0});
+  for (auto _ : state) {
+    if (state.range(0) == 1) {
+      jobs.run([&] { shading::infer_transfer(m, a, q, out.data()); });
+    } else {
+      for (std::size_t i = 0; i < q.size(); ++i) shading::infer_transfer_reference(m, a, q[i], out.data() + i * 75);
+    }
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.counters["pixels/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * q.size(), benchmark::Counter::kIsRate);
+}
+
+// DDGI's distance lobe: repeated squaring (arg 1) against std::pow (arg 0).
+void BM_PowerCosine(benchmark::State& state) {
+  std::vector<float> c(4096);
+  engine::math::Pcg32 rng(5, 6);
+  for (float& x : c) x = rng.next_float();
+  for (auto _ : state) {
+    float sum = 0;
+    if (state.range(0) == 1)
+      for (float x : c) sum += ddgi::power_cosine(x, 50.0f);
+    else
+      for (float x : c) sum += std::pow(x, 50.0f);
+    benchmark::DoNotOptimize(sum);
+  }
+}
 }  // namespace
 
+BENCHMARK(BM_InferTransfer)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PowerCosine)->Arg(0)->Arg(1);
 // Argument: 32 = f32 sgemm, 16 = bf16 matmul.
 BENCHMARK(BM_DecoderForward)->Arg(32)->Arg(16)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DecoderForwardBackward)->Arg(32)->Arg(16)->Unit(benchmark::kMillisecond);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,27 @@ double rmse_clamped(const ImageRGB& a, const ImageRGB& b) {
       sum += d * d;
     }
   return std::sqrt(sum / (3.0 * static_cast<double>(a.size())));
+}
+
+double top_error_share(const ImageRGB& a, const ImageRGB& b, double fraction) {
+  check_sizes(a, b);
+  std::vector<double> err(a.size());
+  double total = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    double s = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double d = clamp01(a.pixels[i][c]) - clamp01(b.pixels[i][c]);
+      s += d * d;
+    }
+    err[i] = s;
+    total += s;
+  }
+  if (total <= 0) return 0;
+  const auto k = static_cast<std::size_t>(std::ceil(std::clamp(fraction, 0.0, 1.0) * static_cast<double>(err.size())));
+  std::partial_sort(err.begin(), err.begin() + static_cast<std::ptrdiff_t>(k), err.end(), std::greater<>());
+  double top = 0;
+  for (std::size_t i = 0; i < k; ++i) top += err[i];
+  return top / total;
 }
 
 double l1_clamped(const ImageRGB& a, const ImageRGB& b) {

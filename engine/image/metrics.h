@@ -19,6 +19,9 @@ inline constexpr double kRelMseEpsilon = 1e-2;
 // Throws ImageError if the sizes differ or an image is smaller than the SSIM window.
 ErrorMetrics compare_images(const ImageRGB& a, const ImageRGB& b);
 double rmse_clamped(const ImageRGB& a, const ImageRGB& b);
+// The share of the clamped squared error held by the `fraction` of pixels
+// with the largest errors (0.01 = the worst 1 %): how concentrated the error is.
+double top_error_share(const ImageRGB& a, const ImageRGB& b, double fraction);
 double l1_clamped(const ImageRGB& a, const ImageRGB& b);
 // Wang et al. 2004: 11x11 Gaussian window (sigma 1.5), K1 0.01, K2 0.03,
 // L = 1, on Rec.709 luminance; mean over the 'valid' windows (no padding).

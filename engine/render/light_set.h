@@ -57,6 +57,7 @@ class LightSet {
   [[nodiscard]] const scene::Environment* environment() const { return env_; }
   [[nodiscard]] std::size_t emissive_triangle_count() const { return triangles_.size(); }
   [[nodiscard]] std::size_t punctual_count() const { return punctual_.size(); }
+  [[nodiscard]] const std::vector<PunctualInstance>& punctual_lights() const { return punctual_; }
   [[nodiscard]] bool empty() const { return groups_ == 0; }
 
  private:

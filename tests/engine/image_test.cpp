@@ -228,3 +228,14 @@ TEST(Metrics, HeatmapScalesToThe99thPercentile) {
   EXPECT_EQ(h.pixels[0], 0);                  // zero error is black
   EXPECT_EQ(h.pixels[99 * 3 + 2], 255);       // the largest error saturates to white
 }
+
+TEST(Metrics, TopErrorShareIsTheWorstPixelsShareOfTheSquaredError) {
+  // 100 pixels: 99 off by 0.1 in every channel, one off by 0.5: squared
+  // errors 99 x 0.03 and 1 x 0.75, so the worst 1 % holds 0.75 / 3.72.
+  engine::image::ImageRGB a(10, 10), b(10, 10);
+  for (auto& p : b.pixels) p = glm::vec3(0.1f);
+  b.pixels[37] = glm::vec3(0.5f);
+  EXPECT_NEAR(engine::image::top_error_share(a, b, 0.01), 0.75 / 3.72, 1e-6);
+  EXPECT_NEAR(engine::image::top_error_share(a, b, 1.0), 1.0, 1e-12);
+  EXPECT_EQ(engine::image::top_error_share(a, a, 0.5), 0.0) << "no error, no share";
+}

@@ -57,7 +57,7 @@ int run_bench_pareto(const std::vector<std::string>& argv) {
                   {"scene", "model", "out", "width", "height", "spp", "frames", "ddgi-frames", "ddgi-warmup", "timing-frames",
                    "camera", "threads", "cache", "seed", "grids", "rays", "maps", "widths", "depths", "latents", "ddgi-grids",
                    "default-grid", "default-rays", "default-map", "bake-iters", "bake-points", "bake-dirs"},
-                  {"no-network"});
+                  {"no-network", "report-only"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const std::filesystem::path out = args.str("out");
   const int width = static_cast<int>(args.integer("width", 16, 8192, 160));
@@ -82,6 +82,15 @@ int run_bench_pareto(const std::vector<std::string>& argv) {
   data.rays = static_cast<int>(args.integer("bake-dirs", 1, 1'000'000, data.rays));
   const int bake_iters = static_cast<int>(args.integer("bake-iters", 1, 100'000'000, 5000));
 
+  if (args.has("report-only")) {
+    // Re-render the plot and tables from an earlier run's pareto.csv.
+    auto points = eval::read_pareto_csv(out / "pareto.csv");
+    eval::mark_pareto_front(points);
+    eval::write_pareto_plot(out / "pareto.svg", "GI error against frame time: " + scene_path, points);
+    eval::write_ablation_markdown(out / "ablation.md", "# Run time against error: " + scene_path + "\n\n(re-rendered from pareto.csv)\n\n![](pareto.svg)", points);
+    std::printf("re-rendered %s/pareto.svg and ablation.md from pareto.csv\n", out.string().c_str());
+    return 0;
+  }
   auto base_model = model::load_model(model_path);
   eval::LoadedScene ref_scene = eval::load_scene(scene_path, camera, threads);
   const auto& assets = ref_scene.app->world().resource<scene::SceneAssets>();

@@ -8,7 +8,7 @@
 namespace transgi::cli {
 
 int run_compare(const std::vector<std::string>& argv) {
-  const Args args("compare", argv, {"heatmap", "heatmap-max"});
+  const Args args("compare", argv, {"heatmap", "heatmap-max", "top-error"});
   if (args.positional().size() != 2) throw UsageError("compare: expected two EXR files: A.exr B.exr (B is the reference)");
   const auto a = engine::image::read_exr(args.positional()[0]);
   const auto b = engine::image::read_exr(args.positional()[1]);
@@ -23,7 +23,13 @@ int run_compare(const std::vector<std::string>& argv) {
     engine::image::write_png(args.str("heatmap"), heat);
     std::fprintf(stderr, "heat map: black = 0, white = %.4g mean absolute error (clamped linear RGB)\n", used);
   }
-  std::printf("{\"rmse\": %.8g, \"l1\": %.8g, \"ssim\": %.8g, \"relmse\": %.8g}\n", m.rmse, m.l1, m.ssim, m.relmse);
+  if (args.has("top-error")) {
+    const double f = args.number("top-error", 0.0, 100.0) / 100.0;
+    std::printf("{\"rmse\": %.8g, \"l1\": %.8g, \"ssim\": %.8g, \"relmse\": %.8g, \"top_error_share\": %.6g}\n", m.rmse, m.l1,
+                m.ssim, m.relmse, engine::image::top_error_share(a, b, f));
+  } else {
+    std::printf("{\"rmse\": %.8g, \"l1\": %.8g, \"ssim\": %.8g, \"relmse\": %.8g}\n", m.rmse, m.l1, m.ssim, m.relmse);
+  }
   return 0;
 }
 

@@ -23,6 +23,8 @@ struct ParetoPoint {
 void mark_pareto_front(std::vector<ParetoPoint>& points);
 
 void write_pareto_csv(const std::filesystem::path& path, const std::vector<ParetoPoint>& points);
+// Reads what write_pareto_csv wrote (to re-render the plot and tables).
+std::vector<ParetoPoint> read_pareto_csv(const std::filesystem::path& path);
 void write_pareto_plot(const std::filesystem::path& path, const std::string& title, const std::vector<ParetoPoint>& points);
 // Our ablation rows (time change against the default, SSIM, RMSE) beside
 // the paper's Living Room rows (its Tables 6 and 7).

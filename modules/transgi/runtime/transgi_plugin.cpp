@@ -87,8 +87,7 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
   const scene::Camera* camera = nullptr;
   const WorldTransform* camera_to_world = nullptr;
   cameras.each([&](Entity e, const scene::Camera& c, const WorldTransform& w) {
-    if (camera && e != frame->camera) return;
-    if (!camera || e == frame->camera) {
+    if (!camera || e == frame->camera) {  // the requested camera, else the first
       camera = &c;
       camera_to_world = &w;
     }
