@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "bake/trainer.h"
-#include "ddgi/ddgi_volume.h"
 #include "engine/jobs/job_system.h"
 #include "shading/transfer_inference.h"
 #include "engine/math/rng.h"
@@ -104,24 +103,9 @@ void BM_InferTransfer(benchmark::State& state) {
   state.counters["pixels/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * q.size(), benchmark::Counter::kIsRate);
 }
 
-// DDGI's distance lobe: repeated squaring (arg 1) against std::pow (arg 0).
-void BM_PowerCosine(benchmark::State& state) {
-  std::vector<float> c(4096);
-  engine::math::Pcg32 rng(5, 6);
-  for (float& x : c) x = rng.next_float();
-  for (auto _ : state) {
-    float sum = 0;
-    if (state.range(0) == 1)
-      for (float x : c) sum += ddgi::power_cosine(x, 50.0f);
-    else
-      for (float x : c) sum += std::pow(x, 50.0f);
-    benchmark::DoNotOptimize(sum);
-  }
-}
 }  // namespace
 
 BENCHMARK(BM_InferTransfer)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_PowerCosine)->Arg(0)->Arg(1);
 // Argument: 32 = f32 sgemm, 16 = bf16 matmul.
 BENCHMARK(BM_DecoderForward)->Arg(32)->Arg(16)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DecoderForwardBackward)->Arg(32)->Arg(16)->Unit(benchmark::kMillisecond);

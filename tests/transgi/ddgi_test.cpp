@@ -112,11 +112,3 @@ TEST(Ddgi, FurnaceConvergesToTheAnalyticIrradiance) {
     EXPECT_NEAR(e.r, e.g, 1e-4) << "grey";
   }
 }
-
-TEST(Ddgi, PowerCosineMatchesStdPow) {
-  for (float e : {1.0f, 2.0f, 7.0f, 50.0f, 64.0f, 2.5f, 80.0f})
-    for (float c = -0.5f; c <= 1.0f; c += 0.0137f) {
-      const float expected = c <= 0 ? 0.0f : std::pow(c, e);
-      EXPECT_NEAR(power_cosine(c, e), expected, 2e-6f * (1.0f + expected)) << "c " << c << " exponent " << e;
-    }
-}

@@ -88,7 +88,7 @@ void blend_distance(OctahedralMap<glm::vec2>& map, const std::vector<RayRecord>&
       glm::vec2 sum(0.0f);
       float weight_sum = 0.0f;
       for (const RayRecord& r : rays) {
-        const float w = power_cosine(glm::dot(texel_dir, r.direction), s.distance_exponent);
+        const float w = std::pow(std::max(0.0f, glm::dot(texel_dir, r.direction)), s.distance_exponent);
         const float d = std::min(std::abs(r.distance), max_distance);
         sum += w * glm::vec2(d, d * d);
         weight_sum += w;
@@ -104,18 +104,6 @@ void blend_distance(OctahedralMap<glm::vec2>& map, const std::vector<RayRecord>&
 }
 
 }  // namespace
-
-float power_cosine(float c, float e) {
-  if (c <= 0) return 0.0f;
-  const auto n = static_cast<unsigned>(e);
-  if (static_cast<float>(n) != e || n > 64) return std::pow(c, e);
-  float result = 1.0f, base = c;
-  for (unsigned k = n; k; k >>= 1) {
-    if (k & 1) result *= base;
-    base *= base;
-  }
-  return result;
-}
 
 DdgiVolume::DdgiVolume(const probes::ProbeGrid& grid, const DdgiSettings& settings)
     : grid_(grid), settings_(settings), directions_(probes::spherical_fibonacci(settings.rays_per_probe)) {

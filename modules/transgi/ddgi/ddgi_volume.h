@@ -71,11 +71,6 @@ struct DdgiFrameStats {
   double trace_ms = 0, blend_ms = 0;
 };
 
-// max(0, c)^e, the distance filter's lobe. For whole exponents up to 64
-// (RTXGI's 50) by repeated squaring, ~20x faster than std::pow here; the
-// reference is std::pow (tests/transgi/ddgi_test.cpp compares them).
-float power_cosine(float c, float e);
-
 class DdgiVolume {
  public:
   DdgiVolume(const probes::ProbeGrid& grid, const DdgiSettings& settings);
