@@ -112,3 +112,31 @@ TEST(Ddgi, FurnaceConvergesToTheAnalyticIrradiance) {
     EXPECT_NEAR(e.r, e.g, 1e-4) << "grey";
   }
 }
+
+// Optional classification (off by default, as in RTXGI): a probe inside a
+// closed box sees only back faces and becomes inactive; an outside one stays.
+TEST(Ddgi, ClassificationDisablesAProbeInsideGeometry) {
+  scene::SceneAssets a;
+  a.generation = scene::next_scene_generation();
+  a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_box(glm::vec3(0.5f)))};
+  a.materials.resize(1);
+  app::App app(app::AppOptions{.jobs = {.threads = 2}});
+  app.world().insert_resource<scene::SceneAssets>(std::move(a));
+  app.add_plugin<rt::RtPlugin>();
+  const ecs::Entity e = app.world().spawn();
+  app.world().emplace<transform::Transform>(e);
+  app.world().emplace<scene::MeshInstance>(e, scene::MeshInstance{0});
+  app.update();
+  DdgiSettings settings;
+  settings.classification = true;
+  // Probe 0 at the box's centre, probe 1 outside it.
+  DdgiVolume volume(transgi::probes::ProbeGrid{{0, 0, 0}, {2, 0, 0}, {2, 1, 1}}, settings);
+  const render::LightSet no_lights;
+  app.jobs().run([&] { volume.update(app.world().resource<rt::RtScene>(), no_lights); });
+  EXPECT_FALSE(volume.active(0)) << "the probe inside the box";
+  EXPECT_TRUE(volume.active(1)) << "the probe outside";
+  DdgiSettings off;
+  DdgiVolume unclassified(transgi::probes::ProbeGrid{{0, 0, 0}, {2, 0, 0}, {2, 1, 1}}, off);
+  app.jobs().run([&] { unclassified.update(app.world().resource<rt::RtScene>(), no_lights); });
+  EXPECT_TRUE(unclassified.active(0)) << "classification is off by default";
+}
