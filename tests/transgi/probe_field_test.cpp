@@ -13,32 +13,10 @@
 #include "engine/rt/rt_plugin.h"
 #include "engine/scene/procedural.h"
 #include "probes/probe_field.h"
+#include "floor_under_sky.h"
 
 using namespace transgi::probes;
 using namespace engine;
-
-namespace {
-struct FloorUnderSky {
-  app::App app{app::AppOptions{.jobs = {.threads = 2}}};
-  explicit FloorUnderSky(float albedo) {
-    scene::SceneAssets a;
-    a.generation = scene::next_scene_generation();
-    a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({100, 100}))};
-    material::Material m;
-    m.base_color_factor = glm::vec4(albedo, albedo, albedo, 1);
-    m.metallic_factor = 0;
-    m.specular_factor = 0;
-    a.materials = {m};
-    a.environment = scene::uniform_environment(glm::vec3(1.0f));
-    app.world().insert_resource<scene::SceneAssets>(std::move(a));
-    app.add_plugin<rt::RtPlugin>();
-    const ecs::Entity e = app.world().spawn();
-    app.world().emplace<transform::Transform>(e);
-    app.world().emplace<scene::MeshInstance>(e, scene::MeshInstance{0});
-    app.update();
-  }
-};
-}  // namespace
 
 TEST(ProbeField, ProbesAboveALitFloorConvergeToTheAnalyticSh) {
   const float a = 0.5f;

@@ -79,4 +79,10 @@ std::string Args::choice(const std::string& name, const std::vector<std::string>
   fail(name, "expected one of " + list + ", got '" + v + "'");
 }
 
+std::string command_line(const std::string& command, const std::vector<std::string>& argv) {
+  std::string s = "transgi " + command;
+  for (const auto& a : argv) s += " " + a;
+  return s;
+}
+
 }  // namespace transgi::cli

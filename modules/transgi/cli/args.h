@@ -40,4 +40,7 @@ class Args {
   std::vector<std::string> positional_;
 };
 
+// "transgi <command> <args...>", for reports that record how they were made.
+std::string command_line(const std::string& command, const std::vector<std::string>& argv);
+
 }  // namespace transgi::cli

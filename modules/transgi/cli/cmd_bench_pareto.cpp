@@ -40,12 +40,6 @@ std::vector<int> int_list(const Args& args, const std::string& name, const std::
   return out;
 }
 
-std::string joined(const std::vector<std::string>& argv) {
-  std::string s = "transgi bench-pareto";
-  for (const auto& a : argv) s += " " + a;
-  return s;
-}
-
 }  // namespace
 
 // transgi bench-pareto: frame time against GI error for TransGI (one factor
@@ -203,7 +197,7 @@ int run_bench_pareto(const std::vector<std::string>& argv) {
   std::ostringstream header;
   header << "# Run time against error: " << scene_path << "\n\n" << width << "x" << height << ", GI pass, reference " << ref.spp
          << " spp. TransGI: " << frames << " probe frames (no converged-probe skip), DDGI: " << ddgi_frames
-         << " updates; frame times are medians of the last " << timing << " frames.\n\nCommand: `" << joined(argv) << "`\n\n![](pareto.svg)";
+         << " updates; frame times are medians of the last " << timing << " frames.\n\nCommand: `" << command_line("bench-pareto", argv) << "`\n\n![](pareto.svg)";
   eval::write_ablation_markdown(out / "ablation.md", header.str(), points);
   std::printf("Pareto front:");
   for (const auto& p : points)

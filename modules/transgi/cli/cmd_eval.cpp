@@ -29,12 +29,6 @@ void write_image(const std::filesystem::path& dir, const std::string& name, cons
   image::write_png_srgb(dir / (name + ".png"), img);
 }
 
-std::string joined(const std::vector<std::string>& argv) {
-  std::string s = "transgi eval";
-  for (const auto& a : argv) s += " " + a;
-  return s;
-}
-
 }  // namespace
 
 // transgi eval: the reference, TransGI and DDGI on one scene, in two setups
@@ -82,7 +76,7 @@ int run_eval(const std::vector<std::string>& argv) {
 
   eval::EvalReport report;
   report.scene = scene_path;
-  report.command = joined(argv);
+  report.command = command_line("eval", argv);
   report.width = width;
   report.height = height;
   report.reference_spp = ref.spp;

@@ -3,21 +3,11 @@
 #include <cstdio>
 #include <sstream>
 
-#include "engine/io/atomic_file.h"
+#include "eval/text_output.h"
 
 namespace transgi::eval {
 
 namespace {
-
-void write_text(const std::filesystem::path& path, const std::string& text) {
-  engine::io::write_file_atomically(path, std::as_bytes(std::span(text.data(), text.size())));
-}
-
-std::string fmt(const char* f, double v) {
-  char b[64];
-  std::snprintf(b, sizeof(b), f, v);
-  return b;
-}
 
 std::string json_string(const std::string& s) {
   std::string o = "\"";

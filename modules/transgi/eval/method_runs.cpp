@@ -42,6 +42,28 @@ double median_total(const std::vector<std::vector<double>>& samples, std::size_t
   return median(totals);
 }
 
+// Runs `frames` App frames; the frame's image is requested (frame.width /
+// height set) on the last `timed` ones, after each of which `sample` collects
+// that frame's stage times. `after_frame` sees every frame.
+template <class Frame, class Sample, class AfterFrame>
+std::vector<std::vector<double>> run_frames(LoadedScene& scene, Frame& frame, int width, int height, int frames, int timed,
+                                            const std::string& label, bool progress, Sample&& sample, AfterFrame&& after_frame) {
+  timed = std::clamp(timed, 1, frames);
+  core::ProgressBar bar(label, static_cast<std::uint64_t>(frames), progress);
+  std::vector<std::vector<double>> samples;
+  for (int f = 0; f < frames; ++f) {
+    const bool render = f >= frames - timed;
+    frame.width = render ? width : 0;
+    frame.height = render ? height : 0;
+    scene.app->jobs().run([&] { scene.app->update(); });
+    after_frame();
+    if (render) samples.push_back(sample());
+    bar.update(static_cast<std::uint64_t>(f + 1));
+  }
+  bar.finish();
+  return samples;
+}
+
 }  // namespace
 
 LoadedScene load_scene(const std::string& path, const std::string& camera_name, int threads) {
@@ -88,24 +110,15 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
 
   auto& frame = world.resource<runtime::GiFrame>();
   frame.camera = scene.camera;
-  const int timed = std::clamp(o.timing_frames, 1, o.frames);
-  core::ProgressBar bar("TransGI probe frames", static_cast<std::uint64_t>(o.frames), o.progress);
-  std::vector<std::vector<double>> samples;
   int traced = 0;
-  for (int f = 0; f < o.frames; ++f) {
-    const bool render = f >= o.frames - timed;
-    frame.width = render ? width : 0;
-    frame.height = render ? height : 0;
-    scene.app->jobs().run([&] { scene.app->update(); });
-    traced += frame.probe_stats.traced;
-    if (render) {
-      const auto& t = frame.times;
-      samples.push_back({t.gbuffer + t.network_input, t.inference, t.collect_points, t.probe_raster, t.probe_projection,
-                         t.sh_multiplication, t.direct});
-    }
-    bar.update(static_cast<std::uint64_t>(f + 1));
-  }
-  bar.finish();
+  const auto samples = run_frames(
+      scene, frame, width, height, o.frames, o.timing_frames, "TransGI probe frames", o.progress,
+      [&] {
+        const auto& t = frame.times;
+        return std::vector<double>{t.gbuffer + t.network_input, t.inference, t.collect_points, t.probe_raster,
+                                   t.probe_projection, t.sh_multiplication, t.direct};
+      },
+      [&] { traced += frame.probe_stats.traced; });
   MethodRun r;
   r.gi = frame.gi;
   r.direct = frame.direct;
@@ -138,18 +151,10 @@ MethodRun run_ddgi(LoadedScene& scene, int width, int height, const DdgiRunOptio
   world.emplace<ddgi::DdgiProbeVolume>(volume, ddgi::DdgiProbeVolume{.dims = glm::ivec3(o.probe_grid)});
   auto& frame = world.resource<ddgi::DdgiFrame>();
   frame.camera = scene.camera;
-  const int timed = std::clamp(o.timing_frames, 1, o.frames);
-  core::ProgressBar bar("DDGI probe updates", static_cast<std::uint64_t>(o.frames), o.progress);
-  std::vector<std::vector<double>> samples;
-  for (int f = 0; f < o.frames; ++f) {
-    const bool render = f >= o.frames - timed;
-    frame.width = render ? width : 0;
-    frame.height = render ? height : 0;
-    scene.app->jobs().run([&] { scene.app->update(); });
-    if (render) samples.push_back({frame.times.probe_trace, frame.times.probe_blend, frame.times.shading, frame.times.direct});
-    bar.update(static_cast<std::uint64_t>(f + 1));
-  }
-  bar.finish();
+  const auto samples = run_frames(
+      scene, frame, width, height, o.frames, o.timing_frames, "DDGI probe updates", o.progress,
+      [&] { return std::vector<double>{frame.times.probe_trace, frame.times.probe_blend, frame.times.shading, frame.times.direct}; },
+      [] {});
   MethodRun r;
   r.gi = frame.gi;
   r.direct = frame.direct;

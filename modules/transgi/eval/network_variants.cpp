@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "bake/trainer.h"
+#include "engine/core/fnv1a.h"
 #include "engine/core/progress.h"
 #include "eval/scene_fingerprint.h"
 #include "model/model_file.h"
@@ -14,12 +15,13 @@ NetworkVariantBaker::NetworkVariantBaker(const engine::scene::SceneAssets& asset
     : assets_(assets), fingerprint_(scene_fingerprint), data_settings_(data), iterations_(iterations), cache_dir_(std::move(cache_dir)) {}
 
 std::shared_ptr<const model::TransferModel> NetworkVariantBaker::get(const NetworkVariant& v) {
-  std::uint64_t key = fingerprint_;
-  for (std::uint64_t x : {static_cast<std::uint64_t>(v.latent_dim), static_cast<std::uint64_t>(v.width), static_cast<std::uint64_t>(v.depth),
-                          static_cast<std::uint64_t>(iterations_), static_cast<std::uint64_t>(data_settings_.points),
-                          static_cast<std::uint64_t>(data_settings_.rays), data_settings_.seed})
-    key = (key ^ x) * 1099511628211ull;
-  const auto path = cache_dir_ / ("network-" + hex64(key) + ".tgm");
+  engine::core::Fnv1a key;
+  for (std::uint64_t x : {fingerprint_, static_cast<std::uint64_t>(v.latent_dim), static_cast<std::uint64_t>(v.width),
+                          static_cast<std::uint64_t>(v.depth), static_cast<std::uint64_t>(iterations_),
+                          static_cast<std::uint64_t>(data_settings_.points), static_cast<std::uint64_t>(data_settings_.rays),
+                          data_settings_.seed})
+    key.value(x);
+  const auto path = cache_dir_ / ("network-" + hex64(key.h) + ".tgm");
   if (std::filesystem::exists(path)) {
     try {
       auto m = model::load_model(path);

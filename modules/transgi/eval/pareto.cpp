@@ -8,19 +8,11 @@
 #include <sstream>
 
 #include "engine/image/svg_plot.h"
-#include "engine/io/atomic_file.h"
+#include "eval/text_output.h"
 
 namespace transgi::eval {
 
 namespace {
-void write_text(const std::filesystem::path& path, const std::string& text) {
-  engine::io::write_file_atomically(path, std::as_bytes(std::span(text.data(), text.size())));
-}
-std::string fmt(const char* f, double v) {
-  char b[64];
-  std::snprintf(b, sizeof(b), f, v);
-  return b;
-}
 
 // The paper's Living Room ablations: (variant as we name it, time change ms, SSIM).
 struct PaperRow {

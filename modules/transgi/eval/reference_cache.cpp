@@ -4,6 +4,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "engine/core/fnv1a.h"
 #include "engine/core/progress.h"
 #include "engine/image/exr.h"
 #include "engine/io/atomic_file.h"
@@ -40,10 +41,11 @@ render::LightSet scene_lights(LoadedScene& scene) {
 ReferenceImages reference_images(LoadedScene& scene, int width, int height, int spp, std::uint64_t seed,
                                  const std::filesystem::path& cache_dir, bool progress) {
   ReferenceImages r;
-  std::uint64_t key = scene_fingerprint(scene.app->world()) ^ (kReferenceVersion * 0x9E3779B97F4A7C15ull);
-  for (std::uint64_t v : {static_cast<std::uint64_t>(width), static_cast<std::uint64_t>(height), static_cast<std::uint64_t>(spp), seed})
-    key = (key ^ v) * 1099511628211ull;
-  r.key = hex64(key);
+  core::Fnv1a key;
+  for (std::uint64_t v : {scene_fingerprint(scene.app->world()), kReferenceVersion, static_cast<std::uint64_t>(width),
+                          static_cast<std::uint64_t>(height), static_cast<std::uint64_t>(spp), seed})
+    key.value(v);
+  r.key = hex64(key.h);
   const auto path = [&](const char* pass) { return cache_dir / ("reference-" + r.key + "_" + pass + ".exr"); };
   const auto meta = cache_dir / ("reference-" + r.key + ".txt");
   if (std::filesystem::exists(meta)) {

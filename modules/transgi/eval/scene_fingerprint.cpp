@@ -1,8 +1,8 @@
 #include "eval/scene_fingerprint.h"
 
 #include <cstdio>
-#include <cstring>
 
+#include "engine/core/fnv1a.h"
 #include "engine/scene/components.h"
 #include "engine/scene/scene_assets.h"
 #include "engine/transform/transform.h"
@@ -10,27 +10,10 @@
 
 namespace transgi::eval {
 
-namespace {
-struct Fnv {
-  std::uint64_t h = 1469598103934665603ull;
-  void bytes(const void* p, std::size_t n) {
-    const auto* b = static_cast<const unsigned char*>(p);
-    for (std::size_t i = 0; i < n; ++i) {
-      h ^= b[i];
-      h *= 1099511628211ull;
-    }
-  }
-  template <class T>
-  void value(const T& v) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    bytes(&v, sizeof(T));
-  }
-};
-}  // namespace
 
 std::uint64_t scene_fingerprint(engine::ecs::World& world) {
   using namespace engine;
-  Fnv f;
+  core::Fnv1a f;
   const auto& assets = world.resource<scene::SceneAssets>();
   for (std::uint32_t m = 0; m < assets.meshes.size(); ++m) f.value(model::mesh_content_hash(assets, m));
   if (assets.environment) {

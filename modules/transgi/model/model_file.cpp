@@ -6,6 +6,7 @@
 #include <span>
 
 #include "engine/io/atomic_file.h"
+#include "engine/core/fnv1a.h"
 
 namespace transgi::model {
 
@@ -16,9 +17,9 @@ constexpr std::size_t kHeaderBytes = 24;
 constexpr std::uint64_t kMaxPayload = 4ull << 30;
 
 std::uint64_t fnv1a(const std::byte* p, std::size_t n) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (std::size_t i = 0; i < n; ++i) h = (h ^ static_cast<std::uint8_t>(p[i])) * 1099511628211ull;
-  return h;
+  engine::core::Fnv1a f;
+  f.bytes(p, n);
+  return f.h;
 }
 
 struct Writer {

@@ -2,6 +2,8 @@
 
 #include <set>
 
+#include "engine/core/fnv1a.h"
+
 namespace transgi::model {
 
 std::size_t TransferModel::latent_bytes() const {
@@ -25,25 +27,7 @@ void assemble_input(const float* latent, int latent_dim, const glm::vec3& albedo
   rest[8] = wo.z;
 }
 
-namespace {
-struct Fnv1a {
-  std::uint64_t h = 1469598103934665603ull;
-  void bytes(const void* p, std::size_t n) {
-    const auto* c = static_cast<const unsigned char*>(p);
-    for (std::size_t i = 0; i < n; ++i) h = (h ^ c[i]) * 1099511628211ull;
-  }
-  template <class T>
-  void vec(const std::vector<T>& v) {
-    const std::uint64_t n = v.size();
-    bytes(&n, sizeof(n));
-    bytes(v.data(), v.size() * sizeof(T));
-  }
-  template <class T>
-  void value(const T& v) {
-    bytes(&v, sizeof(T));
-  }
-};
-}  // namespace
+using engine::core::Fnv1a;
 
 std::uint64_t mesh_content_hash(const engine::scene::SceneAssets& assets, std::uint32_t mesh_index) {
   const engine::scene::MeshAsset& mesh = *assets.meshes[mesh_index];

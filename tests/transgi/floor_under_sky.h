@@ -1,0 +1,29 @@
+#pragma once
+// A large Lambertian floor (albedo a, no specular) under a uniform sky of
+// radiance 1: probes above it have an analytic answer (probe_field_test.cpp,
+// ddgi_test.cpp).
+#include "engine/app/app.h"
+#include "engine/rt/rt_plugin.h"
+#include "engine/scene/procedural.h"
+
+struct FloorUnderSky {
+  engine::app::App app{engine::app::AppOptions{.jobs = {.threads = 2}}};
+  explicit FloorUnderSky(float albedo) {
+    using namespace engine;
+    scene::SceneAssets a;
+    a.generation = scene::next_scene_generation();
+    a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({100, 100}))};
+    material::Material m;
+    m.base_color_factor = glm::vec4(albedo, albedo, albedo, 1);
+    m.metallic_factor = 0;
+    m.specular_factor = 0;
+    a.materials = {m};
+    a.environment = scene::uniform_environment(glm::vec3(1.0f));
+    app.world().insert_resource<scene::SceneAssets>(std::move(a));
+    app.add_plugin<rt::RtPlugin>();
+    const ecs::Entity e = app.world().spawn();
+    app.world().emplace<transform::Transform>(e);
+    app.world().emplace<scene::MeshInstance>(e, scene::MeshInstance{0});
+    app.update();
+  }
+};
