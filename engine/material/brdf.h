@@ -44,6 +44,11 @@ struct BrdfSample {
   bool specular_lobe = false;
 };
 
+// Reflectance of the diffuse lobe alone (base colour of the non-metal part).
+// What irradiance-only lighting can reflect: probe feedback bounces, DDGI, and
+// TransGI's fallback for objects without latents.
+inline glm::vec3 diffuse_albedo(const BrdfParams& p) { return p.base_color * (1.0f - p.metallic); }
+
 // f(wo, wi). Zero when either direction is below the surface.
 glm::vec3 brdf_eval(const BrdfParams& p, const glm::vec3& wo, const glm::vec3& wi);
 // Density with which brdf_sample() produces wi.

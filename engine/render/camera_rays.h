@@ -1,6 +1,9 @@
 #pragma once
 // Pinhole camera rays from a scene::Camera and its WorldTransform. Pixel
 // (0, 0) is the top-left; the camera looks down its local -Z with +Y up.
+#include <optional>
+
+#include "engine/ecs/entity.h"
 #include "engine/rt/ray.h"
 #include "engine/scene/components.h"
 #include "engine/transform/transform.h"
@@ -22,6 +25,23 @@ struct CameraRays {
   float tan_half_y_, tan_half_x_;
   int width_, height_;
 };
+
+// Rays of the camera entity `requested` when it is in `cameras` (a view of
+// const Camera and const WorldTransform), else of the first camera there;
+// nullopt when the world has none. What every renderer system asks for.
+template <class CameraView>
+std::optional<CameraRays> camera_rays_for(const CameraView& cameras, ecs::Entity requested, int width, int height) {
+  const scene::Camera* camera = nullptr;
+  const transform::WorldTransform* to_world = nullptr;
+  cameras.each([&](ecs::Entity e, const scene::Camera& c, const transform::WorldTransform& w) {
+    if (!camera || e == requested) {
+      camera = &c;
+      to_world = &w;
+    }
+  });
+  if (!camera) return std::nullopt;
+  return CameraRays(*camera, *to_world, width, height);
+}
 
 // Samples a pixel-filter offset (separable Blackman-Harris, sampled by its
 // tabulated inverse CDF, so the estimate converges to the filtered image

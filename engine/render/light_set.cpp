@@ -146,12 +146,16 @@ float LightSet::pdf_environment(const glm::vec3& dir) const {
   return env_ ? group_probability() * env_->pdf(dir) : 0.0f;
 }
 
+std::optional<PunctualInstance> punctual_instance(const scene::PunctualLight& l, const transform::Similarity& w) {
+  if (!l.enabled || l.intensity <= 0) return std::nullopt;
+  return PunctualInstance{l, w.translation, glm::normalize(w.apply_direction({0, 0, -1}))};
+}
+
 std::vector<PunctualInstance> gather_punctual_lights(ecs::World& world) {
   std::vector<PunctualInstance> out;
   world.view<const scene::PunctualLight, const transform::WorldTransform>().each(
       [&](const scene::PunctualLight& l, const transform::WorldTransform& w) {
-        if (!l.enabled || l.intensity <= 0) return;
-        out.push_back({l, w.translation, glm::normalize(w.apply_direction({0, 0, -1}))});
+        if (auto p = punctual_instance(l, w)) out.push_back(*p);
       });
   return out;
 }

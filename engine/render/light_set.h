@@ -72,6 +72,10 @@ class LightSet {
   int groups_ = 0;
 };
 
+// A punctual light placed by its world transform; nullopt when it is off
+// (disabled or zero intensity).
+std::optional<PunctualInstance> punctual_instance(const scene::PunctualLight& light, const transform::Similarity& to_world);
+
 // Collects the world's enabled punctual lights.
 std::vector<PunctualInstance> gather_punctual_lights(ecs::World& world);
 

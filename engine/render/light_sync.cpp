@@ -20,8 +20,7 @@ void sync_lights(LightView lights, Removed<scene::PunctualLight> removed, Res<rt
   std::vector<PunctualInstance> punctual;
   lights.each([&](Entity e, const scene::PunctualLight& l, const transform::WorldTransform& w) {
     if (lights.is_changed<scene::PunctualLight>(e) || lights.is_changed<transform::WorldTransform>(e)) lights_changed = true;
-    if (!l.enabled || l.intensity <= 0) return;
-    punctual.push_back({l, w.translation, glm::normalize(w.apply_direction({0, 0, -1}))});
+    if (auto p = render::punctual_instance(l, w)) punctual.push_back(*p);
   });
   const scene::SceneAssets* assets = rt->assets();
   const std::uint64_t generation = assets ? assets->generation : 0;

@@ -153,4 +153,11 @@ image::ImageRGB PathTracer::image(Pass pass) const {
   return out;
 }
 
+image::ImageRGB render_direct_light(const rt::RtScene& scene, const LightSet& lights, const CameraRays& camera, int width,
+                                    int height, int spp, std::uint64_t seed) {
+  PathTracer direct(scene, lights, camera, width, height, PathTracerSettings{.max_depth = 1, .seed = seed});
+  direct.render(spp);
+  return direct.image(Pass::Direct);
+}
+
 }  // namespace engine::render

@@ -48,6 +48,13 @@ struct PathTracerStats {
   double seconds = 0.0;
 };
 
+class PathTracer;
+
+// The direct pass alone (paths end after their first bounce) at `spp`
+// samples per pixel: what real-time GI methods add to their indirect light.
+image::ImageRGB render_direct_light(const rt::RtScene& scene, const LightSet& lights, const CameraRays& camera, int width,
+                                    int height, int spp, std::uint64_t seed);
+
 class PathTracer {
  public:
   PathTracer(const rt::RtScene& scene, const LightSet& lights, CameraRays camera, int width, int height,

@@ -128,7 +128,7 @@ TEST(RadianceSharing, DepthGuardStopsALeakThroughAWall) {
   for (auto& s : states) s.reset(m.texel_count());
   update_own_depth(states[0], m, pts[0], {});
   update_own_depth(states[1], m, pts[1], {});
-  const std::vector<DepthMap> depth = {states[0].depth, states[1].depth};
+  const std::vector<const DepthMap*> depth = {&states[0].depth, &states[1].depth};
   const int t = m.texel_of({1, 0, 0});
 
   std::vector<FrameSamples> guarded, faithful;

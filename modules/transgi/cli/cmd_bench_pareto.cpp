@@ -2,7 +2,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <map>
+#include <set>
 #include <sstream>
 
 #include "cli/args.h"
@@ -179,16 +179,16 @@ int run_bench_pareto(const std::vector<std::string>& argv) {
   (void)eval::path_traced_gi(ref_scene, width, height, 4, seed + 7, &seconds);
   const double ms_per_spp = seconds * 1000.0 / 4.0;
   std::printf("path tracer: %.2f ms per sample per pixel at %dx%d; at equal time:\n", ms_per_spp, width, height);
-  std::map<int, eval::ParetoPoint> by_spp;
-  for (const auto& p : std::vector<eval::ParetoPoint>(points)) {
+  std::set<int> done;
+  const std::vector<eval::ParetoPoint> timed = points;  // score() appends to points
+  for (const auto& p : timed) {
     const int n = std::max(1, static_cast<int>(std::lround(p.frame_ms / ms_per_spp)));
-    if (by_spp.contains(n)) continue;
+    if (!done.insert(n).second) continue;
     double t = 0;
     const image::ImageRGB gi = eval::path_traced_gi(ref_scene, width, height, n, seed + 11, &t);
     eval::ParetoPoint q{"path tracer (equal time)", std::to_string(n) + " spp", "", t * 1000.0};
     q.spp = n;
     score(q, gi);
-    by_spp.emplace(n, q);
   }
 
   eval::mark_pareto_front(points);

@@ -23,10 +23,7 @@ void sync_volumes(View<Get<DdgiProbeVolume>> volumes, Res<rt::RtScene> rt, Res<D
       v.min = rt->bounds_min();
       v.max = rt->bounds_max();
     }
-    // Probes at the centres of a dims partition, as TransGI's volumes.
-    const glm::ivec3 dims = glm::max(v.dims, glm::ivec3(1));
-    const glm::vec3 half_cell = (v.max - v.min) / (2.0f * glm::vec3(dims));
-    const probes::ProbeGrid grid{v.min + half_cell, v.max - half_cell, dims};
+    const probes::ProbeGrid grid = probes::ProbeGrid::centred_in(v.min, v.max, v.dims);
     if (!v.volume || !(v.volume->grid() == grid) || !(v.volume->settings() == *settings))
       v.volume = std::make_shared<DdgiVolume>(grid, *settings);
   });
@@ -68,37 +65,24 @@ void update_volumes(View<Get<DdgiProbeVolume>> volumes, Res<rt::RtScene> rt, Res
 void render_frame(View<Get<const scene::Camera, const transform::WorldTransform>> cameras, View<Get<const DdgiProbeVolume>> volumes,
                   Res<rt::RtScene> rt, Res<render::SceneLights> lights, Res<DdgiRenderOptions> options, ResMut<DdgiFrame> frame) {
   if (frame->width <= 0 || frame->height <= 0) return;
-  const scene::Camera* camera = nullptr;
-  const transform::WorldTransform* to_world = nullptr;
-  cameras.each([&](Entity e, const scene::Camera& c, const transform::WorldTransform& w) {
-    if (!camera || e == frame->camera) {
-      camera = &c;
-      to_world = &w;
-    }
-  });
-  if (!camera) throw std::runtime_error("ddgi::render: DdgiFrame asks for an image but the world has no camera");
+  const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
+  if (!rays) throw std::runtime_error("ddgi::render: DdgiFrame asks for an image but the world has no camera");
   const DdgiVolume* volume = nullptr;
   volumes.each([&](const DdgiProbeVolume& v) {
     if (!volume && v.volume) volume = v.volume.get();
   });
   if (!volume) throw std::runtime_error("ddgi::render: no DdgiProbeVolume in the world");
-  const render::CameraRays rays(*camera, *to_world, frame->width, frame->height);
   const std::uint64_t seed = options->seed + frame->frames;
   auto t0 = Clock::now();
-  frame->gi = render_ddgi_gi(*rt, *volume, rays, frame->width, frame->height, {.spp = options->gbuffer_spp, .seed = seed});
+  frame->gi = render_ddgi_gi(*rt, *volume, *rays, frame->width, frame->height, {.spp = options->gbuffer_spp, .seed = seed});
   frame->times.shading = ms_since(t0);
+  t0 = Clock::now();
+  frame->direct = options->direct_spp > 0 ? render::render_direct_light(*rt, lights->set, *rays, frame->width, frame->height,
+                                                                        options->direct_spp, seed)
+                                          : image::ImageRGB(frame->width, frame->height);
+  frame->times.direct = options->direct_spp > 0 ? ms_since(t0) : 0.0;
   frame->full = frame->gi;
-  frame->direct = image::ImageRGB(frame->width, frame->height);
-  frame->times.direct = 0;
-  if (options->direct_spp > 0) {
-    t0 = Clock::now();
-    render::PathTracer direct(*rt, lights->set, rays, frame->width, frame->height,
-                              render::PathTracerSettings{.max_depth = 1, .seed = seed});
-    direct.render(options->direct_spp);
-    frame->direct = direct.image(render::Pass::Direct);
-    for (std::size_t i = 0; i < frame->full.size(); ++i) frame->full.pixels[i] += frame->direct.pixels[i];
-    frame->times.direct = ms_since(t0);
-  }
+  for (std::size_t i = 0; i < frame->full.size(); ++i) frame->full.pixels[i] += frame->direct.pixels[i];
 }
 
 }  // namespace

@@ -4,7 +4,6 @@
 #include "engine/math/rng.h"
 #include "engine/math/sampling.h"
 #include "engine/render/surface.h"
-#include "probes/probe_rays.h"
 
 namespace transgi::ddgi {
 
@@ -25,7 +24,7 @@ engine::image::ImageRGB render_ddgi_gi(const engine::rt::RtScene& scene, const D
           rt::Hit hit;
           if (!scene.intersect(ray, hit)) continue;
           const render::Surface surf = render::make_surface(scene, hit, ray.direction);
-          sum += probes::feedback_albedo(surf.brdf) * math::kInvPi * volume.irradiance(surf.position, surf.shading_normal, ray.direction);
+          sum += material::diffuse_albedo(surf.brdf) * math::kInvPi * volume.irradiance(surf.position, surf.shading_normal, ray.direction);
         }
         img.pixels[pixel] = sum / static_cast<float>(s.spp);
       }

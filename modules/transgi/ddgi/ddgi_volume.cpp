@@ -34,18 +34,19 @@ struct RayRecord {
 void blend_irradiance(OctahedralMap<glm::vec3>& map, const std::vector<RayRecord>& rays, const DdgiSettings& s, float hysteresis,
                       bool clamp_brightness) {
   const int n = map.interior;
+  // RTXGI counts back-face rays in every texel's thread; the count is the
+  // probe's, so count once: a probe at or past the limit (inside geometry)
+  // keeps its irradiance as it was.
   const auto max_backfaces = static_cast<int>(static_cast<float>(s.rays_per_probe) * s.random_ray_backface_threshold);
+  const auto backfaces = std::count_if(rays.begin(), rays.end(), [](const RayRecord& r) { return r.distance < 0; });
+  if (backfaces > 0 && backfaces >= max_backfaces) return;
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x) {
       const glm::vec3 texel_dir = texel_direction(x, y, n);
       glm::vec3 sum(0.0f);
       float weight_sum = 0.0f;
-      int backfaces = 0;
       for (const RayRecord& r : rays) {
-        if (r.distance < 0) {
-          if (++backfaces >= max_backfaces) return;  // inside geometry: leave the probe as it was
-          continue;
-        }
+        if (r.distance < 0) continue;  // back-face hits carry no radiance
         const float w = std::max(0.0f, glm::dot(texel_dir, r.direction));
         sum += r.radiance * w;
         weight_sum += w;

@@ -130,11 +130,7 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
                      samples);
   r.frame_ms = median_total(samples, 6);
   world.view<const runtime::ProbeVolume>().each([&](const runtime::ProbeVolume& v) {
-    if (!v.field) return;
-    const auto& s = v.field->settings();
-    // Radiance, sample flags, depth moments per texel; 75 SH floats per probe.
-    const std::size_t per_probe = static_cast<std::size_t>(s.map.texel_count()) * (sizeof(glm::vec3) + 4 * sizeof(float)) + 75 * sizeof(float);
-    r.probe_bytes += per_probe * static_cast<std::size_t>(s.grid.count());
+    if (v.field) r.probe_bytes += v.field->memory_bytes();
   });
   const auto& st = frame.probe_stats;
   char line[256];

@@ -57,7 +57,6 @@ ReferenceImages reference_images(LoadedScene& scene, int width, int height, int 
       in >> r.spp >> r.seconds;
       if (r.full.width == width && r.full.height == height && r.spp == spp) {
         r.from_cache = true;
-        r.seconds_per_spp = r.seconds / spp;
         return r;
       }
     } catch (const std::exception& e) {
@@ -75,7 +74,6 @@ ReferenceImages reference_images(LoadedScene& scene, int width, int height, int 
   r.gi = tracer.image(render::Pass::Gi);
   r.spp = spp;
   r.seconds = tracer.stats().seconds;
-  r.seconds_per_spp = r.seconds / spp;
   std::filesystem::create_directories(cache_dir);
   image::write_exr(path("full"), r.full);
   image::write_exr(path("direct"), r.direct);

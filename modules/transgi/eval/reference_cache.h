@@ -15,7 +15,6 @@ struct ReferenceImages {
   engine::image::ImageRGB full, direct, gi;
   int spp = 0;
   double seconds = 0;        // render time when it was made
-  double seconds_per_spp = 0;
   bool from_cache = false;
   std::string key;
 };

@@ -46,6 +46,14 @@ glm::vec3 ProbeField::irradiance(const glm::vec3& p, const glm::vec3& n) const {
   return shading::sh_irradiance(L, n);
 }
 
+std::size_t ProbeField::memory_bytes() const {
+  std::size_t b = sh_.size() * sizeof(float);
+  for (const ProbeMapState& st : states_)
+    b += st.radiance.size() * sizeof(glm::vec3) +
+         (st.sampled.size() + st.depth.mean.size() + st.depth_squared.size() + st.depth_weight.size()) * sizeof(float);
+  return b;
+}
+
 void ProbeField::notify_scene_changed(bool geometry_moved) {
   for (std::size_t q = 0; q < states_.size(); ++q) {
     if (state_[q] == ProbeState::Converged) state_[q] = ProbeState::Active;
@@ -128,8 +136,8 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   for (int q = 0; q < probes; ++q)
     if (state_[static_cast<std::size_t>(q)] == ProbeState::Active)
       update_own_depth(states_[static_cast<std::size_t>(q)], settings_.map, points[static_cast<std::size_t>(q)], settings_.accumulation);
-  std::vector<DepthMap> depth(static_cast<std::size_t>(probes));
-  for (int q = 0; q < probes; ++q) depth[static_cast<std::size_t>(q)] = states_[static_cast<std::size_t>(q)].depth;
+  std::vector<const DepthMap*> depth(static_cast<std::size_t>(probes));
+  for (int q = 0; q < probes; ++q) depth[static_cast<std::size_t>(q)] = &states_[static_cast<std::size_t>(q)].depth;
   std::vector<FrameSamples> frame;
   const SharingStats ss = rasterize_shared(grid, settings_.map, points, depth, settings_.sharing, frame);
   stats.shared_accepted = ss.accepted;
@@ -153,7 +161,6 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   });
   stats.project_ms = ms_since(t0);
   for (std::size_t q = 0; q < state_.size(); ++q) {
-    stats.projected += traced[q] && state_[q] != ProbeState::Buried && state_[q] != ProbeState::Far;
     stats.active += state_[q] == ProbeState::Active;
     stats.converged += state_[q] == ProbeState::Converged;
     stats.buried += state_[q] == ProbeState::Buried;

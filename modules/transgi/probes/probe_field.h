@@ -80,12 +80,29 @@ struct ProbeFieldSettings {
 
 struct ProbeFrameStats {
   std::size_t rays = 0, hits = 0, shared_accepted = 0, shared_rejected = 0;
-  // Probes that traced rays / were accumulated and projected this frame.
-  int traced = 0, projected = 0;
+  int traced = 0;  // probes that traced rays this frame
   // Probe states after this frame.
   int active = 0, converged = 0, buried = 0, far = 0;
   bool classified = false;  // this frame traced every probe to classify them
   double scatter_ms = 0, raster_ms = 0, project_ms = 0;
+
+  // Sums over volumes (counts and times add; `classified` if any was).
+  ProbeFrameStats& operator+=(const ProbeFrameStats& o) {
+    rays += o.rays;
+    hits += o.hits;
+    shared_accepted += o.shared_accepted;
+    shared_rejected += o.shared_rejected;
+    traced += o.traced;
+    active += o.active;
+    converged += o.converged;
+    buried += o.buried;
+    far += o.far;
+    classified = classified || o.classified;
+    scatter_ms += o.scatter_ms;
+    raster_ms += o.raster_ms;
+    project_ms += o.project_ms;
+    return *this;
+  }
 };
 
 class ProbeField {
@@ -110,6 +127,8 @@ class ProbeField {
   [[nodiscard]] std::uint64_t frame() const { return frame_; }
   [[nodiscard]] const std::vector<ProbeMapState>& states() const { return states_; }
   [[nodiscard]] ProbeState state(int probe) const { return state_[static_cast<std::size_t>(probe)]; }
+  // Bytes held by the probes' maps, depth moments and SH.
+  [[nodiscard]] std::size_t memory_bytes() const;
 
  private:
   ProbeFieldSettings settings_;

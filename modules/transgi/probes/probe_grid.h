@@ -13,6 +13,14 @@ struct ProbeGrid {
 
   bool operator==(const ProbeGrid&) const = default;
 
+  // Probes at the centres of a dims partition of the box [lo, hi], so none
+  // sits on the box's faces (a room's walls). Used by both probe plugins.
+  static ProbeGrid centred_in(glm::vec3 lo, glm::vec3 hi, glm::ivec3 dims) {
+    dims = glm::max(dims, glm::ivec3(1));
+    const glm::vec3 half_cell = (hi - lo) / (2.0f * glm::vec3(dims));
+    return ProbeGrid{lo + half_cell, hi - half_cell, dims};
+  }
+
   [[nodiscard]] int count() const { return dims.x * dims.y * dims.z; }
   [[nodiscard]] int index(glm::ivec3 c) const { return (c.z * dims.y + c.y) * dims.x + c.x; }
   [[nodiscard]] glm::ivec3 coords(int i) const { return {i % dims.x, (i / dims.x) % dims.y, i / (dims.x * dims.y)}; }

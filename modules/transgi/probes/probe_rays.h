@@ -28,10 +28,6 @@ struct ProbeRayHit {
   glm::vec3 radiance{0.0f};  // leaving the hit towards the probe
 };
 
-// Diffuse reflectance used for the multi-bounce feedback (probes carry
-// irradiance, so only the diffuse lobe can reflect it).
-inline glm::vec3 feedback_albedo(const engine::material::BrdfParams& b) { return b.base_color * (1.0f - b.metallic); }
-
 // Traces one probe ray. At a hit that is not an emitter and faces the ray,
 // the radiance is direct light by one next-event-estimation sample (MIS-free:
 // delta and area lights alike are sampled, never hit) plus the diffuse
@@ -65,7 +61,7 @@ ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::rend
       if (!scene.occluded(rt::Ray{o, ls.direction, 0.0f, tmax})) r.radiance += f * wi.z * ls.radiance / (ls.delta ? 1.0f : ls.pdf);
     }
   }
-  r.radiance += feedback_albedo(s.brdf) * math::kInvPi * feedback(s.position, s.shading_normal, -dir);
+  r.radiance += material::diffuse_albedo(s.brdf) * math::kInvPi * feedback(s.position, s.shading_normal, -dir);
   if (!std::isfinite(r.radiance.r + r.radiance.g + r.radiance.b)) r.radiance = glm::vec3(0.0f);
   return r;
 }

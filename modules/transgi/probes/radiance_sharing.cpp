@@ -8,7 +8,7 @@
 namespace transgi::probes {
 
 SharingStats rasterize_shared(const ProbeGrid& grid, const MapLayout& layout,
-                              const std::vector<std::vector<ShadedPoint>>& points, const std::vector<DepthMap>& own_depth,
+                              const std::vector<std::vector<ShadedPoint>>& points, const std::vector<const DepthMap*>& own_depth,
                               const SharingSettings& s, std::vector<FrameSamples>& out) {
   const int n = grid.count();
   out.resize(static_cast<std::size_t>(n));
@@ -19,7 +19,7 @@ SharingStats rasterize_shared(const ProbeGrid& grid, const MapLayout& layout,
       FrameSamples& fs = out[static_cast<std::size_t>(p)];
       fs.reset(layout.texel_count());
       const glm::vec3 origin = grid.position(p);
-      const DepthMap* depth = own_depth.empty() ? nullptr : &own_depth[static_cast<std::size_t>(p)];
+      const DepthMap* depth = own_depth.empty() ? nullptr : own_depth[static_cast<std::size_t>(p)];
       grid.for_each_neighbour(p, [&](int q) {
         for (const ShadedPoint& pt : points[static_cast<std::size_t>(q)]) {
           if (!std::isfinite(pt.distance)) {

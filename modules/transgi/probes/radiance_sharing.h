@@ -59,10 +59,11 @@ struct SharingStats {
   std::size_t accepted = 0, rejected_by_guard = 0;
 };
 
-// points[q] are probe q's shaded points this frame. out[p] receives probe
-// p's frame samples. Escaped rays add a zero sample to their own probe only.
+// points[q] are probe q's shaded points this frame; own_depth[q] points to
+// probe q's depth (read, not copied: the maps are large). out[p] receives
+// probe p's frame samples. Escaped rays add a zero sample to their own probe only.
 SharingStats rasterize_shared(const ProbeGrid& grid, const MapLayout& layout,
-                              const std::vector<std::vector<ShadedPoint>>& points, const std::vector<DepthMap>& own_depth,
+                              const std::vector<std::vector<ShadedPoint>>& points, const std::vector<const DepthMap*>& own_depth,
                               const SharingSettings& settings, std::vector<FrameSamples>& out);
 
 }  // namespace transgi::probes

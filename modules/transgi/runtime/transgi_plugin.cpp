@@ -18,13 +18,6 @@ using namespace engine;
 using namespace engine::schedule;
 using transform::WorldTransform;
 
-// Probes at the centres of a dims partition of the box, so none sits on the
-// scene's outer walls.
-probes::ProbeGrid grid_in_box(glm::vec3 lo, glm::vec3 hi, glm::ivec3 dims) {
-  const glm::vec3 half_cell = (hi - lo) / (2.0f * glm::vec3(dims));
-  return probes::ProbeGrid{lo + half_cell, hi - half_cell, dims};
-}
-
 struct SeenVersions {
   std::uint64_t lights = 0, geometry = 0;
 };
@@ -40,7 +33,7 @@ void sync_probe_volumes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res
       v.max = rt->bounds_max();
     }
     probes::ProbeFieldSettings wanted = settings->probes;
-    wanted.grid = grid_in_box(v.min, v.max, glm::max(v.dims, glm::ivec3(1)));
+    wanted.grid = probes::ProbeGrid::centred_in(v.min, v.max, v.dims);
     if (!v.field || !(v.field->settings() == wanted)) {
       v.field = std::make_shared<probes::ProbeField>(wanted);
       return;
@@ -51,28 +44,11 @@ void sync_probe_volumes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res
   seen->lights = lights->version;
 }
 
-void add_stats(probes::ProbeFrameStats& sum, const probes::ProbeFrameStats& s) {
-  sum.rays += s.rays;
-  sum.hits += s.hits;
-  sum.shared_accepted += s.shared_accepted;
-  sum.shared_rejected += s.shared_rejected;
-  sum.traced += s.traced;
-  sum.projected += s.projected;
-  sum.active += s.active;
-  sum.converged += s.converged;
-  sum.buried += s.buried;
-  sum.far += s.far;
-  sum.classified = sum.classified || s.classified;
-  sum.scatter_ms += s.scatter_ms;
-  sum.raster_ms += s.raster_ms;
-  sum.project_ms += s.project_ms;
-}
-
 void update_probes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res<render::SceneLights> lights,
                    ResMut<GiFrame> frame) {
   probes::ProbeFrameStats total;
   volumes.each([&](ProbeVolume& v) {
-    if (v.field) add_stats(total, v.field->update(*rt, lights->set));
+    if (v.field) total += v.field->update(*rt, lights->set);
   });
   frame->probe_stats = total;
   ++frame->probe_frames;
@@ -84,15 +60,8 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
                Res<rt::RtScene> rt, Res<scene::SceneAssets> assets, Res<render::SceneLights> lights,
                Res<TransGISettings> settings, ResMut<GiFrame> frame) {
   if (frame->width <= 0 || frame->height <= 0) return;
-  const scene::Camera* camera = nullptr;
-  const WorldTransform* camera_to_world = nullptr;
-  cameras.each([&](Entity e, const scene::Camera& c, const WorldTransform& w) {
-    if (!camera || e == frame->camera) {  // the requested camera, else the first
-      camera = &c;
-      camera_to_world = &w;
-    }
-  });
-  if (!camera) throw std::runtime_error("transgi::render_gi: GiFrame asks for an image but the world has no camera");
+  const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
+  if (!rays) throw std::runtime_error("transgi::render_gi: GiFrame asks for an image but the world has no camera");
 
   // One scene decoder: the model of the first LatentMesh found.
   std::shared_ptr<const model::TransferModel> model;
@@ -128,9 +97,8 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
     }
     f->interpolate(p, n, out);
   };
-  const render::CameraRays rays(*camera, *camera_to_world, frame->width, frame->height);
   const shading::TransferRenderResult r = shading::render_transfer(
-      *rt, *assets, model ? *model : kNoModel, rays, frame->width, frame->height, light_at, nullptr,
+      *rt, *assets, model ? *model : kNoModel, *rays, frame->width, frame->height, light_at, nullptr,
       shading::TransferSource::Network, rs);
 
   GiStageTimes& t = frame->times;
@@ -144,19 +112,13 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
   frame->shaded_samples = r.shaded_samples;
   frame->inferred_samples = r.inferred_samples;
   frame->gi = r.image;
-  frame->full = r.image;
-  if (settings->direct_spp > 0) {
-    const auto t0 = std::chrono::steady_clock::now();
-    render::PathTracer direct(*rt, lights->set, rays, frame->width, frame->height,
-                              render::PathTracerSettings{.max_depth = 1, .seed = rs.seed});
-    direct.render(settings->direct_spp);
-    frame->direct = direct.image(render::Pass::Direct);
-    for (std::size_t i = 0; i < frame->full.size(); ++i) frame->full.pixels[i] += frame->direct.pixels[i];
-    t.direct = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  } else {
-    frame->direct = image::ImageRGB(frame->width, frame->height);
-    t.direct = 0;
-  }
+  const auto t0 = std::chrono::steady_clock::now();
+  frame->direct = settings->direct_spp > 0 ? render::render_direct_light(*rt, lights->set, *rays, frame->width, frame->height,
+                                                                         settings->direct_spp, rs.seed)
+                                           : image::ImageRGB(frame->width, frame->height);
+  t.direct = settings->direct_spp > 0 ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() : 0.0;
+  frame->full = frame->gi;
+  for (std::size_t i = 0; i < frame->full.size(); ++i) frame->full.pixels[i] += frame->direct.pixels[i];
 }
 
 }  // namespace

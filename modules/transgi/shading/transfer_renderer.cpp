@@ -23,7 +23,7 @@ struct Sample {
   engine::ecs::Entity entity;
   std::uint32_t mesh = 0, triangle = 0;
   glm::vec2 bary{0.0f};
-  glm::vec3 normal_obj{0.0f}, wo_obj{0.0f}, albedo{0.0f}, background{0.0f};
+  glm::vec3 normal_obj{0.0f}, wo_obj{0.0f}, albedo{0.0f}, diffuse{0.0f}, background{0.0f};
   glm::vec3 position{0.0f}, normal_world{0.0f};
 };
 
@@ -75,7 +75,9 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
           out.bary = hit.barycentric;
           out.normal_obj = nobj;
           out.wo_obj = wo;
-          out.albedo = engine::render::evaluate_material(assets, mesh.triangle_material[hit.primitive], uv).base_color;
+          const material::BrdfParams brdf = engine::render::evaluate_material(assets, mesh.triangle_material[hit.primitive], uv);
+          out.albedo = brdf.base_color;  // the network's input
+          out.diffuse = material::diffuse_albedo(brdf);
           out.position = ray.origin + hit.t * ray.direction;
           out.normal_world = glm::normalize(inst.to_world.apply_direction(nobj));
         }
@@ -164,7 +166,7 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
     for (std::size_t j = b; j < e; ++j) {
       const Sample& smp = samples[diffuse_only[j]];
       light_at(smp.position, smp.normal_world, world);
-      shaded[diffuse_only[j]] = smp.albedo * math::kInvPi * sh_irradiance(world, smp.normal_world);
+      shaded[diffuse_only[j]] = smp.diffuse * math::kInvPi * sh_irradiance(world, smp.normal_world);
     }
   });
   result.light_ms = ms_since(t0);

@@ -25,7 +25,7 @@ struct TransferRenderSettings {
   int spp = 4;                 // G-buffer samples per pixel (filtered like the reference)
   // Which entities carry baked transfer (a LatentMesh). Null = every entity.
   // The others skip inference and are shaded diffusely from the same SH
-  // light: albedo / pi x irradiance.
+  // light: diffuse albedo / pi x irradiance.
   std::function<bool(engine::ecs::Entity)> has_transfer = nullptr;
   int ground_truth_rays = 2048;
   std::uint64_t seed = 0;
