@@ -9,7 +9,9 @@
 
 #include "bake/trainer.h"
 #include "engine/jobs/job_system.h"
+#include "shading/fused_decoder.h"
 #include "shading/transfer_inference.h"
+#include <immintrin.h>
 #include "engine/math/rng.h"
 #include "engine/scene/procedural.h"
 #include "model/mlp.h"
@@ -103,8 +105,91 @@ void BM_InferTransfer(benchmark::State& state) {
   state.counters["pixels/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * q.size(), benchmark::Counter::kIsRate);
 }
 
+// The machine's bf16 peak, measured here so every ratio is against the same
+// clock and load: 24 independent vdpbf16ps chains on registers (enough to
+// cover latency at two issues per cycle), 64 FLOP each.
+__attribute__((target("avx512f,avx512bf16"))) double bf16_peak_loop(std::int64_t reps) {
+  __m512 acc[24];
+  for (int i = 0; i < 24; ++i) acc[i] = _mm512_set1_ps(static_cast<float>(i));
+  const __m512bh a = (__m512bh)_mm512_set1_epi32(0x3f803f80), b = (__m512bh)_mm512_set1_epi32(0x00010001);
+  __m512bh a_opaque = a;
+  for (std::int64_t r = 0; r < reps; ++r) {
+    asm volatile("" : "+v"(a_opaque));  // keeps the compiler from folding the chains
+#pragma GCC unroll 24
+    for (int i = 0; i < 24; ++i) acc[i] = _mm512_dpbf16_ps(acc[i], a_opaque, b);
+  }
+  __m512 s = acc[0];
+  for (int i = 1; i < 24; ++i) s = _mm512_add_ps(s, acc[i]);
+  return static_cast<double>(_mm512_reduce_add_ps(s));
+}
+
+void BM_Bf16Peak(benchmark::State& state) {
+  if (!shading::cpu_supports(shading::FusedIsa::Avx512Bf16)) {
+    state.SkipWithError("no AVX-512 BF16 on this CPU");
+    return;
+  }
+  constexpr std::int64_t kReps = 1 << 20;
+  for (auto _ : state) benchmark::DoNotOptimize(bf16_peak_loop(kReps));
+  state.counters["GFLOP/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * kReps * 24 * 64 * 1e-9, benchmark::Counter::kIsRate);
+}
+
+// One frame's GI pixels at half of 640x360.
+constexpr int kFramePixels = 320 * 180;
+
+struct FusedBatch {
+  model::Mlp net{model::MlpLayout{}};
+  std::vector<float> inputs, light;
+  FusedBatch() {
+    net.initialise(1);
+    inputs = random_inputs(static_cast<std::size_t>(kFramePixels) * 16);
+    light = random_inputs(static_cast<std::size_t>(kFramePixels) * 75);
+  }
+};
+
+// The fused kernel on a frame's pixels, tile after tile on each benchmark
+// thread (arg: 2 = avx512bf16, 1 = avx2, 0 = scalar). GFLOP/s counts the
+// network's 88,832 FLOP per pixel.
+void BM_FusedShade(benchmark::State& state) {
+  const auto isa = static_cast<shading::FusedIsa>(state.range(0));
+  if (!shading::cpu_supports(isa)) {
+    state.SkipWithError("backend not supported by this CPU");
+    return;
+  }
+  static const FusedBatch batch;
+  const shading::FusedDecoder decoder(batch.net, isa);
+  const int pixels = isa == shading::FusedIsa::Scalar ? kFramePixels / 64 : kFramePixels;
+  std::vector<float> rgb(static_cast<std::size_t>(pixels) * 3);
+  for (auto _ : state) {
+    for (int b = 0; b < pixels; b += shading::kFusedTile)
+      decoder.shade_tile(batch.inputs.data() + static_cast<std::size_t>(b) * 16, batch.light.data() + static_cast<std::size_t>(b) * 75,
+                         std::min(shading::kFusedTile, pixels - b), rgb.data() + static_cast<std::size_t>(b) * 3);
+    benchmark::DoNotOptimize(rgb.data());
+  }
+  state.counters["GFLOP/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * pixels * 88832.0 * 1e-9, benchmark::Counter::kIsRate);
+}
+
+// oneDNN's bf16 matmul chain (one primitive per layer, bias and ReLU between
+// them, 8192-row chunks as the batched renderer runs it) on the same pixels;
+// the 75 outputs go to memory and the light dot is not even included.
+void BM_OneDnnBf16Chain(benchmark::State& state) {
+  static const FusedBatch batch;
+  std::vector<float> y(static_cast<std::size_t>(kFramePixels) * 75);
+  model::MlpWorkspace ws;
+  for (auto _ : state) {
+    for (int b = 0; b < kFramePixels; b += 8192)
+      batch.net.forward(batch.inputs.data() + static_cast<std::size_t>(b) * 16, std::min(8192, kFramePixels - b),
+                        y.data() + static_cast<std::size_t>(b) * 75, ws, model::GemmBackend::OneDnnBf16);
+    benchmark::DoNotOptimize(y.data());
+  }
+  state.counters["GFLOP/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * kFramePixels * 88832.0 * 1e-9, benchmark::Counter::kIsRate);
+}
+
 }  // namespace
 
+BENCHMARK(BM_Bf16Peak)->Threads(1)->Threads(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FusedShade)->Arg(2)->Arg(1)->Arg(0)->Threads(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FusedShade)->Arg(2)->Threads(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_OneDnnBf16Chain)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_InferTransfer)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 // Argument: 32 = f32 sgemm, 16 = bf16 matmul.
 BENCHMARK(BM_DecoderForward)->Arg(32)->Arg(16)->Unit(benchmark::kMillisecond);

@@ -15,6 +15,7 @@ double ms_since(Clock::time_point t) { return std::chrono::duration<double, std:
 // Large enough to keep the GEMM efficient, small enough that the activations
 // (width x chunk floats per layer) stay in the last-level cache.
 constexpr std::size_t kChunk = 8192;
+static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "shade_tile writes RGB triples into glm::vec3 arrays");
 }  // namespace
 
 InferenceTimings infer_transfer(const model::TransferModel& model, const engine::scene::SceneAssets& assets,
@@ -44,6 +45,26 @@ InferenceTimings infer_transfer(const model::TransferModel& model, const engine:
   }
   t.inference_ms = ms_since(t0);
   return t;
+}
+
+void shade_transfer_fused(const FusedDecoder& decoder, const model::TransferModel& model,
+                          const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
+                          const float* light, glm::vec3* out) {
+  const int in_size = decoder.layout().inputs;
+  const std::size_t tiles = (queries.size() + kFusedTile - 1) / kFusedTile;
+  engine::jobs::parallel_for<std::size_t>(0, tiles, 4, [&](std::size_t tb, std::size_t te) {
+    std::vector<float> inputs(static_cast<std::size_t>(kFusedTile) * static_cast<std::size_t>(in_size));
+    std::vector<float> z(static_cast<std::size_t>(model.latent_dim));
+    for (std::size_t tile = tb; tile < te; ++tile) {
+      const std::size_t b = tile * kFusedTile, e = std::min(b + kFusedTile, queries.size());
+      for (std::size_t i = b; i < e; ++i) {
+        const TransferQuery& q = queries[i];
+        model.meshes[q.mesh].latents.interpolate(*assets.meshes[q.mesh], q.triangle, q.barycentric, z.data());
+        model::assemble_input(z.data(), model.latent_dim, q.albedo, q.normal, q.wo, inputs.data() + (i - b) * static_cast<std::size_t>(in_size));
+      }
+      decoder.shade_tile(inputs.data(), light + b * 75, static_cast<int>(e - b), &out[b].x);
+    }
+  });
 }
 
 void infer_transfer_reference(const model::TransferModel& model, const engine::scene::SceneAssets& assets,

@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "model/transfer_model.h"
+#include "shading/fused_decoder.h"
 
 namespace transgi::shading {
 
@@ -26,6 +27,15 @@ struct InferenceTimings {
 // out: queries.size() x 75 transfer values ([c * 25 + k] per point).
 InferenceTimings infer_transfer(const model::TransferModel& model, const engine::scene::SceneAssets& assets,
                                 std::span<const TransferQuery> queries, float* out);
+
+// The fused path (issue 10): per tile of kFusedTile queries, gathers and
+// interpolates the latents, builds the inputs and runs decoder.shade_tile,
+// which dots the decoded transfer with each query's object-space SH light
+// (light: queries.size() x 75) without storing it. Tiles run in parallel on
+// the job system. out: one RGB radiance per query.
+void shade_transfer_fused(const FusedDecoder& decoder, const model::TransferModel& model,
+                          const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
+                          const float* light, glm::vec3* out);
 
 // The same for one point: latent interpolation, input assembly and every
 // layer as scalar loops (no GEMM library, no threads).
