@@ -30,12 +30,14 @@ ProbeField::ProbeField(ProbeFieldSettings s)
   sh_.assign(static_cast<std::size_t>(s.grid.count()) * 75, 0.0f);
 }
 
-void ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, float* out) const {
+void ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, float* out) const { interpolate(p, n, sh_.data(), out); }
+
+void ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float* probe_sh, float* out) const {
   const InterpolationResult r = interpolate_probes(settings_.grid, settings_.map, states_, p, n, settings_.interpolation, usable_);
   for (int k = 0; k < 75; ++k) out[k] = 0.0f;
   for (std::size_t i = 0; i < 8; ++i) {
     if (r.weights[i] == 0.0f) continue;
-    const float* L = light_sh(r.probes[i]);
+    const float* L = probe_sh + static_cast<std::size_t>(r.probes[i]) * 75;
     for (int k = 0; k < 75; ++k) out[k] += r.weights[i] * L[k];
   }
 }

@@ -120,6 +120,12 @@ class ProbeField {
   [[nodiscard]] const float* light_sh(int probe) const { return sh_.data() + static_cast<std::size_t>(probe) * 75; }
   // Interpolated SH light at a surface point (pruned trilinear).
   void interpolate(const glm::vec3& position, const glm::vec3& normal, float* out75) const;
+  // The same weights applied to another copy of the probes' SH (probes x 75,
+  // e.g. rotated into an object's frame: interpolation is linear, so rotating
+  // the probes once equals rotating every interpolated result).
+  void interpolate(const glm::vec3& position, const glm::vec3& normal, const float* probe_sh, float* out75) const;
+  // All probes' SH, probes x 75, world space.
+  [[nodiscard]] const std::vector<float>& light_sh_all() const { return sh_; }
   // Irradiance from the interpolated SH (clamped-cosine convolution).
   [[nodiscard]] glm::vec3 irradiance(const glm::vec3& position, const glm::vec3& normal) const;
 

@@ -6,6 +6,7 @@
 #include "engine/ecs/entity.h"
 #include "engine/image/image.h"
 #include "probes/probe_field.h"
+#include "shading/realtime_gi.h"
 
 namespace transgi::runtime {
 
@@ -19,6 +20,7 @@ struct GiStageTimes {
   double probe_projection = 0; // accumulation and SH projection
   double sh_multiplication = 0;  // probe interpolation, SH rotation and dot product
   double direct = 0;           // direct light (not TransGI's)
+  double upsample = 0;         // real-time path: choosing decoded pixels and upsampling (0 on the quality path)
 };
 
 struct GiFrame {
@@ -33,6 +35,8 @@ struct GiFrame {
   // This frame's probe update (summed over volumes).
   probes::ProbeFrameStats probe_stats;
   std::uint64_t probe_frames = 0;
+  // Real-time path only: decoded pixels, rotations and their times.
+  shading::RealtimeGiStats realtime;
 };
 
 }  // namespace transgi::runtime

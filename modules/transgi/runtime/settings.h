@@ -4,10 +4,23 @@
 #include <cstdint>
 
 #include "probes/probe_field.h"
+#include "shading/realtime_gi.h"
 
 namespace transgi::runtime {
 
+// Which path renders the GI image.
+enum class GiPath {
+  // Every pixel decoded from gbuffer_spp filtered samples, batched oneDNN
+  // inference, SH light rotated per pixel: the paper's setting, used by eval.
+  Quality,
+  // Pixel-centre G-buffer, GI decoded at realtime.resolution_scale plus
+  // edge pixels and upsampled, the fused decoder, SH rotated once per object.
+  Realtime,
+};
+
 struct TransGISettings {
+  GiPath gi_path = GiPath::Quality;
+  shading::RealtimeGiSettings realtime;  // read when gi_path is Realtime
   // Probe rays, map size, sharing, accumulation, interpolation and skips
   // (see ProbeFieldSettings and the structs it holds; its `grid` is ignored:
   // each ProbeVolume gives its own).
@@ -21,5 +34,10 @@ struct TransGISettings {
   int direct_spp = 4;
   std::uint64_t seed = 0;
 };
+
+// The settings a game runs with: the real-time GI path.
+TransGISettings realtime_preset();
+// The paper's setting, what eval measures.
+TransGISettings quality_preset();
 
 }  // namespace transgi::runtime

@@ -8,6 +8,7 @@
 #include "engine/rt/rt_scene.h"
 #include "engine/scene/components.h"
 #include "engine/transform/transform.h"
+#include "shading/realtime_gi.h"
 #include "shading/transfer_renderer.h"
 
 namespace transgi::runtime {
@@ -56,9 +57,56 @@ void update_probes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res<rend
 
 using CameraView = View<Get<const scene::Camera, const WorldTransform>>;
 
+// The decoder packed for the fused kernel, repacked only when the model changes.
+struct PackedDecoder {
+  std::shared_ptr<const model::TransferModel> model;
+  std::unique_ptr<shading::FusedDecoder> decoder;
+};
+
+// Realtime path: returns the GI image and fills the frame's stage times.
+image::ImageRGB render_gi_realtime(const CameraView& cameras, const std::shared_ptr<const model::TransferModel>& model,
+                                   const std::function<bool(Entity)>& has_transfer,
+                                   std::span<const probes::ProbeField* const> fields, const rt::RtScene& rt,
+                                   const scene::SceneAssets& assets, const TransGISettings& settings, PackedDecoder& packed,
+                                   GiFrame& frame) {
+  const auto rays = render::camera_rays_for(cameras, frame.camera, frame.width, frame.height);
+  if (model && packed.model != model) {
+    packed.decoder = std::make_unique<shading::FusedDecoder>(model->decoder);
+    packed.model = model;
+  }
+  auto t0 = std::chrono::steady_clock::now();
+  const shading::GBuffer g = shading::trace_gbuffer(rt, assets, *rays, frame.width, frame.height);
+  frame.times.gbuffer = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  shading::RealtimeGiStats st;
+  image::ImageRGB gi = shading::shade_gi_realtime(g, rt, assets, model.get(), model ? packed.decoder.get() : nullptr,
+                                                  has_transfer, fields, settings.realtime, &st);
+  GiStageTimes& t = frame.times;
+  t.network_input = 0;  // inside the fused kernel, counted as inference
+  t.inference = st.inference_ms;
+  t.sh_multiplication = st.rotate_ms + st.light_ms;
+  t.upsample = st.upsample_ms;
+  frame.shaded_samples = st.grid_samples + st.edge_samples;
+  frame.inferred_samples = st.inferred;
+  frame.realtime = st;
+  return gi;
+}
+
+// direct = the light set's direct light; full = gi + direct.
+void add_direct_light(const rt::RtScene& rt, const render::LightSet& lights, const render::CameraRays& rays,
+                      const TransGISettings& settings, std::uint64_t seed, GiFrame& frame) {
+  const auto t0 = std::chrono::steady_clock::now();
+  frame.direct = settings.direct_spp > 0
+                     ? render::render_direct_light(rt, lights, rays, frame.width, frame.height, settings.direct_spp, seed)
+                     : image::ImageRGB(frame.width, frame.height);
+  frame.times.direct =
+      settings.direct_spp > 0 ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() : 0.0;
+  frame.full = frame.gi;
+  for (std::size_t i = 0; i < frame.full.size(); ++i) frame.full.pixels[i] += frame.direct.pixels[i];
+}
+
 void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Get<const LatentMesh>> latents,
                Res<rt::RtScene> rt, Res<scene::SceneAssets> assets, Res<render::SceneLights> lights,
-               Res<TransGISettings> settings, ResMut<GiFrame> frame) {
+               Res<TransGISettings> settings, ResMut<GiFrame> frame, Local<PackedDecoder> packed) {
   if (frame->width <= 0 || frame->height <= 0) return;
   const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
   if (!rays) throw std::runtime_error("transgi::render_gi: GiFrame asks for an image but the world has no camera");
@@ -81,6 +129,14 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
     const LatentMesh* l = latents.try_read<LatentMesh>(e);
     return l && model && l->model == model;
   };
+  if (settings->gi_path == GiPath::Realtime) {
+    frame->gi = render_gi_realtime(cameras, model, rs.has_transfer, fields, *rt, *assets, *settings, *packed, *frame);
+    frame->times.collect_points = frame->probe_stats.scatter_ms;
+    frame->times.probe_raster = frame->probe_stats.raster_ms;
+    frame->times.probe_projection = frame->probe_stats.project_ms;
+    add_direct_light(*rt, lights->set, *rays, *settings, rs.seed, *frame);
+    return;
+  }
   // The volume holding the point (the first one, if none does).
   const shading::LightAt light_at = [&](const glm::vec3& p, const glm::vec3& n, float* out) {
     if (fields.empty()) {
@@ -112,16 +168,19 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
   frame->shaded_samples = r.shaded_samples;
   frame->inferred_samples = r.inferred_samples;
   frame->gi = r.image;
-  const auto t0 = std::chrono::steady_clock::now();
-  frame->direct = settings->direct_spp > 0 ? render::render_direct_light(*rt, lights->set, *rays, frame->width, frame->height,
-                                                                         settings->direct_spp, rs.seed)
-                                           : image::ImageRGB(frame->width, frame->height);
-  t.direct = settings->direct_spp > 0 ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() : 0.0;
-  frame->full = frame->gi;
-  for (std::size_t i = 0; i < frame->full.size(); ++i) frame->full.pixels[i] += frame->direct.pixels[i];
+  add_direct_light(*rt, lights->set, *rays, *settings, rs.seed, *frame);
 }
 
 }  // namespace
+
+TransGISettings realtime_preset() {
+  TransGISettings s;
+  s.gi_path = GiPath::Realtime;
+  s.gbuffer_spp = 1;
+  return s;
+}
+
+TransGISettings quality_preset() { return TransGISettings{}; }
 
 void TransGIPlugin::build(app::App& app) {
   app.add_plugin<render::LightPlugin>();  // Embree mirror and light set, which the probes follow

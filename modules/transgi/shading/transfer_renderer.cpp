@@ -9,6 +9,7 @@
 #include "engine/jobs/parallel_for.h"
 #include "engine/math/rng.h"
 #include "engine/render/surface.h"
+#include "shading/gbuffer.h"
 #include "shading/transfer_inference.h"
 
 namespace transgi::shading {
@@ -18,14 +19,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
-struct Sample {
-  bool hit = false;
-  engine::ecs::Entity entity;
-  std::uint32_t mesh = 0, triangle = 0;
-  glm::vec2 bary{0.0f};
-  glm::vec3 normal_obj{0.0f}, wo_obj{0.0f}, albedo{0.0f}, diffuse{0.0f}, background{0.0f};
-  glm::vec3 position{0.0f}, normal_world{0.0f};
-};
+using Sample = GSample;
 
 constexpr std::array<int, 3> kMapCoefficients = {0, 2, 6};  // (0,0), (1,0), (2,0)
 
@@ -53,33 +47,7 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
           const glm::vec2 u(rng.next_float(), rng.next_float());
           const rt::Ray ray = camera.generate_filtered(x, y, u, s.filter_width);
           Sample& out = samples[pixel * static_cast<std::size_t>(s.spp) + static_cast<std::size_t>(si)];
-          rt::Hit hit;
-          if (!scene.intersect(ray, hit)) {
-            if (background) out.background = background->radiance(ray.direction);
-            continue;
-          }
-          const rt::InstanceRecord& inst = *scene.instance_of(hit.entity);
-          const scene::MeshAsset& mesh = *assets.meshes[hit.mesh];
-          const glm::uvec3 t = mesh.triangles[hit.primitive];
-          const float b1 = hit.barycentric.x, b2 = hit.barycentric.y, b0 = 1 - b1 - b2;
-          glm::vec3 nobj = glm::normalize(b0 * mesh.normals[t.x] + b1 * mesh.normals[t.y] + b2 * mesh.normals[t.z]);
-          const glm::quat inv = glm::conjugate(inst.to_world.rotation);
-          const glm::vec3 wo = glm::normalize(inv * -ray.direction);
-          if (glm::dot(nobj, wo) < 0) nobj = -nobj;  // seen from the back of a two-sided surface
-          glm::vec2 uv(0.0f);
-          if (!mesh.uvs.empty()) uv = b0 * mesh.uvs[t.x] + b1 * mesh.uvs[t.y] + b2 * mesh.uvs[t.z];
-          out.hit = true;
-          out.entity = hit.entity;
-          out.mesh = hit.mesh;
-          out.triangle = hit.primitive;
-          out.bary = hit.barycentric;
-          out.normal_obj = nobj;
-          out.wo_obj = wo;
-          const material::BrdfParams brdf = engine::render::evaluate_material(assets, mesh.triangle_material[hit.primitive], uv);
-          out.albedo = brdf.base_color;  // the network's input
-          out.diffuse = material::diffuse_albedo(brdf);
-          out.position = ray.origin + hit.t * ray.direction;
-          out.normal_world = glm::normalize(inst.to_world.apply_direction(nobj));
+          out = trace_gsample(scene, assets, ray, background);
         }
   });
   result.timings.gbuffer_ms = ms_since(t0);

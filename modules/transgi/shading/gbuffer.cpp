@@ -1,0 +1,44 @@
+#include "shading/gbuffer.h"
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "engine/render/surface.h"
+
+namespace transgi::shading {
+
+GSample trace_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
+                      const engine::rt::Ray& ray, const engine::scene::Environment* background) {
+  using namespace engine;
+  GSample out;
+  rt::Hit hit;
+  if (!scene.intersect(ray, hit)) {
+    if (background) out.background = background->radiance(ray.direction);
+    return out;
+  }
+  const rt::InstanceRecord& inst = *scene.instance_of(hit.entity);
+  const scene::MeshAsset& mesh = *assets.meshes[hit.mesh];
+  const glm::uvec3 t = mesh.triangles[hit.primitive];
+  const float b1 = hit.barycentric.x, b2 = hit.barycentric.y, b0 = 1 - b1 - b2;
+  glm::vec3 nobj = glm::normalize(b0 * mesh.normals[t.x] + b1 * mesh.normals[t.y] + b2 * mesh.normals[t.z]);
+  const glm::quat inv = glm::conjugate(inst.to_world.rotation);
+  const glm::vec3 wo = glm::normalize(inv * -ray.direction);
+  if (glm::dot(nobj, wo) < 0) nobj = -nobj;  // seen from the back of a two-sided surface
+  glm::vec2 uv(0.0f);
+  if (!mesh.uvs.empty()) uv = b0 * mesh.uvs[t.x] + b1 * mesh.uvs[t.y] + b2 * mesh.uvs[t.z];
+  out.hit = true;
+  out.entity = hit.entity;
+  out.mesh = hit.mesh;
+  out.triangle = hit.primitive;
+  out.bary = hit.barycentric;
+  out.normal_obj = nobj;
+  out.wo_obj = wo;
+  const material::BrdfParams brdf = render::evaluate_material(assets, mesh.triangle_material[hit.primitive], uv);
+  out.albedo = brdf.base_color;  // the network's input
+  out.diffuse = material::diffuse_albedo(brdf);
+  out.position = ray.origin + hit.t * ray.direction;
+  out.normal_world = glm::normalize(inst.to_world.apply_direction(nobj));
+  out.depth = hit.t;
+  return out;
+}
+
+}  // namespace transgi::shading

@@ -1,0 +1,27 @@
+#pragma once
+// One G-buffer sample: what a camera ray hit, in the terms the transfer
+// shading needs (object-space normal and view for the network, world-space
+// position and normal for the probes, depth for edge-aware upsampling).
+// Shared by the batched transfer renderer and the real-time GI path.
+#include "engine/rt/rt_scene.h"
+#include "engine/scene/environment.h"
+
+namespace transgi::shading {
+
+struct GSample {
+  bool hit = false;
+  engine::ecs::Entity entity;
+  std::uint32_t mesh = 0, triangle = 0;
+  glm::vec2 bary{0.0f};
+  glm::vec3 normal_obj{0.0f}, wo_obj{0.0f}, albedo{0.0f}, diffuse{0.0f}, background{0.0f};
+  glm::vec3 position{0.0f}, normal_world{0.0f};
+  float depth = 0.0f;  // distance along the camera ray
+};
+
+// Traces `ray` and fills the sample; a miss records the background's
+// radiance (none if background is null). Normals face the viewer (surfaces
+// are two-sided).
+GSample trace_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
+                      const engine::rt::Ray& ray, const engine::scene::Environment* background);
+
+}  // namespace transgi::shading

@@ -1,0 +1,273 @@
+#include "shading/realtime_gi.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <unordered_map>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "engine/jobs/parallel_for.h"
+#include "engine/math/sampling.h"
+#include "shading/sh_light.h"
+#include "shading/transfer_inference.h"
+
+namespace transgi::shading {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+constexpr std::size_t kNone = SIZE_MAX;
+
+// The cell grid and, for each output pixel, the grid samples that stand for it.
+struct Upsampling {
+  int grid_w = 0, grid_h = 0;
+  std::vector<std::size_t> cell_pixel;  // per cell: the pixel it decodes
+  struct Taps {
+    std::array<std::size_t, 4> cell{kNone, kNone, kNone, kNone};
+    std::array<float, 4> weight{};
+    bool own = false;  // no cell represents it: decoded on its own
+  };
+  std::vector<Taps> taps;  // per pixel
+};
+
+float similarity(const GSample& p, const GSample& q, const RealtimeGiSettings& s) {
+  if (!q.hit) return 0.0f;
+  if (!s.edge_aware) return 1.0f;
+  const float dz = (q.depth - p.depth) / (s.depth_tolerance * std::max(p.depth, 1e-6f));
+  const float depth = std::max(0.0f, 1.0f - dz * dz);  // zero beyond the tolerance: silhouettes cut hard
+  float n = std::max(0.0f, glm::dot(p.normal_world, q.normal_world)), normal = 1.0f;
+  for (int e = s.normal_power; e > 0; e >>= 1, n *= n)  // n^power by squaring
+    if (e & 1) normal *= n;
+  return depth * normal;
+}
+
+Upsampling plan_upsampling(const GBuffer& g, const RealtimeGiSettings& s) {
+  Upsampling u;
+  const float scale = std::clamp(s.resolution_scale, 1e-3f, 1.0f);
+  u.grid_w = std::max(1, static_cast<int>(std::lround(static_cast<float>(g.width) * scale)));
+  u.grid_h = std::max(1, static_cast<int>(std::lround(static_cast<float>(g.height) * scale)));
+  const float sx = static_cast<float>(g.width) / static_cast<float>(u.grid_w);
+  const float sy = static_cast<float>(g.height) / static_cast<float>(u.grid_h);
+  u.cell_pixel.resize(static_cast<std::size_t>(u.grid_w) * u.grid_h);
+  for (int j = 0; j < u.grid_h; ++j)
+    for (int i = 0; i < u.grid_w; ++i) {
+      const int x = std::min(g.width - 1, static_cast<int>((static_cast<float>(i) + 0.5f) * sx));
+      const int y = std::min(g.height - 1, static_cast<int>((static_cast<float>(j) + 0.5f) * sy));
+      u.cell_pixel[static_cast<std::size_t>(j) * u.grid_w + i] = static_cast<std::size_t>(y) * g.width + x;
+    }
+  u.taps.resize(g.samples.size());
+  engine::jobs::parallel_for(0, g.height, 8, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < g.width; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
+        const GSample& sp = g.samples[p];
+        if (!sp.hit) continue;
+        Upsampling::Taps& t = u.taps[p];
+        // Position in cell coordinates, cell centres at integers.
+        const float fx = (static_cast<float>(x) + 0.5f) / sx - 0.5f, fy = (static_cast<float>(y) + 0.5f) / sy - 0.5f;
+        const int i0 = static_cast<int>(std::floor(fx)), j0 = static_cast<int>(std::floor(fy));
+        const float tx = fx - static_cast<float>(i0), ty = fy - static_cast<float>(j0);
+        float total = 0;
+        for (int k = 0; k < 4; ++k) {
+          const int i = std::clamp(i0 + (k & 1), 0, u.grid_w - 1), j = std::clamp(j0 + (k >> 1), 0, u.grid_h - 1);
+          const float bilinear = ((k & 1) ? tx : 1 - tx) * ((k >> 1) ? ty : 1 - ty);
+          const std::size_t cell = static_cast<std::size_t>(j) * u.grid_w + i;
+          const float w = bilinear * similarity(sp, g.samples[u.cell_pixel[cell]], s);
+          t.cell[static_cast<std::size_t>(k)] = cell;
+          t.weight[static_cast<std::size_t>(k)] = w;
+          total += w;
+        }
+        if (total < s.min_weight) {
+          t.own = true;
+        } else {
+          for (float& w : t.weight) w /= total;
+        }
+      }
+  });
+  return u;
+}
+
+const probes::ProbeField* field_at(std::span<const probes::ProbeField* const> fields, const glm::vec3& p) {
+  for (const probes::ProbeField* f : fields) {
+    const auto& grid = f->settings().grid;
+    if (glm::all(glm::greaterThanEqual(p, grid.min)) && glm::all(glm::lessThanEqual(p, grid.max))) return f;
+  }
+  return fields.front();
+}
+
+// Probe SH rotated into object frames, one copy per distinct rotation and
+// field; identity rotations read the field's own SH.
+class RotatedProbes {
+ public:
+  RotatedProbes(std::span<const probes::ProbeField* const> fields) : fields_(fields) {}
+
+  // Index of the rotation of `q` (object to world), or -1 for identity.
+  int add(const glm::quat& q) {
+    if (std::abs(std::abs(q.w) - 1.0f) < 1e-7f) return -1;
+    const std::array<float, 4> key{q.x, q.y, q.z, q.w};
+    auto [it, inserted] = index_.try_emplace(key, static_cast<int>(rotations_.size()));
+    if (inserted) rotations_.push_back(q);
+    return it->second;
+  }
+  void rotate_all() {
+    copies_.assign(rotations_.size() * fields_.size(), {});
+    engine::jobs::parallel_for<std::size_t>(0, copies_.size(), 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t c = b; c < e; ++c) {
+        const std::size_t r = c / fields_.size(), f = c % fields_.size();
+        const engine::math::ShRotation rot(glm::transpose(glm::mat3_cast(rotations_[r])));
+        const std::vector<float>& src = fields_[f]->light_sh_all();
+        std::vector<float>& dst = copies_[c];
+        dst.resize(src.size());
+        for (std::size_t probe = 0; probe < src.size() / 75; ++probe)
+          for (std::size_t ch = 0; ch < 3; ++ch) rot.apply(src.data() + probe * 75 + ch * 25, dst.data() + probe * 75 + ch * 25);
+      }
+    });
+  }
+  // The SH array of field f as seen in rotation r's frame.
+  [[nodiscard]] const float* sh(int r, const probes::ProbeField* f) const {
+    if (r < 0) return f->light_sh_all().data();
+    for (std::size_t i = 0; i < fields_.size(); ++i)
+      if (fields_[i] == f) return copies_[static_cast<std::size_t>(r) * fields_.size() + i].data();
+    return nullptr;
+  }
+  [[nodiscard]] std::size_t count() const { return rotations_.size(); }
+
+ private:
+  std::span<const probes::ProbeField* const> fields_;
+  std::map<std::array<float, 4>, int> index_;
+  std::vector<glm::quat> rotations_;
+  std::vector<std::vector<float>> copies_;
+};
+
+}  // namespace
+
+GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
+                      const engine::render::CameraRays& camera, int width, int height) {
+  GBuffer g;
+  g.width = width;
+  g.height = height;
+  g.samples.resize(static_cast<std::size_t>(width) * height);
+  engine::jobs::parallel_for(0, height, 4, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < width; ++x)
+        g.samples[static_cast<std::size_t>(y) * width + x] =
+            trace_gsample(scene, assets, camera.generate({static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f}), nullptr);
+  });
+  return g;
+}
+
+engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
+                                          const engine::scene::SceneAssets& assets, const model::TransferModel* model,
+                                          const FusedDecoder* decoder,
+                                          const std::function<bool(engine::ecs::Entity)>& has_transfer,
+                                          std::span<const probes::ProbeField* const> fields,
+                                          const RealtimeGiSettings& settings, RealtimeGiStats* stats_out) {
+  RealtimeGiStats stats;
+  engine::image::ImageRGB image(g.width, g.height);
+  if (fields.empty() || g.samples.empty()) {
+    if (stats_out) *stats_out = stats;
+    return image;
+  }
+  auto t0 = Clock::now();
+  const Upsampling up = plan_upsampling(g, settings);
+
+  // The pixels to decode: grid cells that hit, then pixels on their own.
+  std::vector<std::size_t> decode;
+  std::vector<std::size_t> slot_of_pixel(g.samples.size(), kNone);
+  auto want = [&](std::size_t p) {
+    if (slot_of_pixel[p] != kNone || !g.samples[p].hit) return;
+    slot_of_pixel[p] = decode.size();
+    decode.push_back(p);
+  };
+  for (std::size_t p : up.cell_pixel) want(p);
+  stats.grid_samples = decode.size();
+  for (std::size_t p = 0; p < g.samples.size(); ++p)
+    if (up.taps[p].own) want(p);
+  stats.edge_samples = decode.size() - stats.grid_samples;
+  double plan_ms = ms_since(t0);
+
+  // Split into network and diffuse samples; one rotation per moved object.
+  t0 = Clock::now();
+  std::vector<std::size_t> net, diffuse;  // indices into decode
+  std::vector<int> rotation_of;           // per net sample
+  RotatedProbes rotated(fields);
+  {
+    std::unordered_map<engine::ecs::Entity, std::pair<bool, int>> per_entity;
+    for (std::size_t i = 0; i < decode.size(); ++i) {
+      const GSample& s = g.samples[decode[i]];
+      auto [it, inserted] = per_entity.try_emplace(s.entity, false, -1);
+      if (inserted) {
+        it->second.first = model && decoder && (!has_transfer || has_transfer(s.entity));
+        if (it->second.first) it->second.second = rotated.add(scene.instance_of(s.entity)->to_world.rotation);
+      }
+      if (it->second.first) {
+        net.push_back(i);
+        rotation_of.push_back(it->second.second);
+      } else {
+        diffuse.push_back(i);
+      }
+    }
+  }
+  rotated.rotate_all();
+  stats.rotations = rotated.count();
+  stats.rotate_ms = ms_since(t0);
+
+  // Light per decoded sample: object-space SH for the network, irradiance
+  // for the diffuse fallback.
+  t0 = Clock::now();
+  std::vector<glm::vec3> value(decode.size(), glm::vec3(0.0f));
+  std::vector<float> light(net.size() * 75);
+  std::vector<TransferQuery> queries(net.size());
+  engine::jobs::parallel_for<std::size_t>(0, net.size(), 256, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      const GSample& s = g.samples[decode[net[k]]];
+      const probes::ProbeField* f = field_at(fields, s.position);
+      f->interpolate(s.position, s.normal_world, rotated.sh(rotation_of[k], f), light.data() + k * 75);
+      queries[k] = {s.mesh, s.triangle, s.bary, s.albedo, s.normal_obj, s.wo_obj};
+    }
+  });
+  engine::jobs::parallel_for<std::size_t>(0, diffuse.size(), 256, [&](std::size_t b, std::size_t e) {
+    float world[75];
+    for (std::size_t k = b; k < e; ++k) {
+      const GSample& s = g.samples[decode[diffuse[k]]];
+      field_at(fields, s.position)->interpolate(s.position, s.normal_world, world);
+      value[diffuse[k]] = s.diffuse * engine::math::kInvPi * sh_irradiance(world, s.normal_world);
+    }
+  });
+  stats.light_ms = ms_since(t0);
+
+  t0 = Clock::now();
+  if (!net.empty()) {
+    std::vector<glm::vec3> shaded(net.size());
+    shade_transfer_fused(*decoder, *model, assets, queries, light.data(), shaded.data());
+    for (std::size_t k = 0; k < net.size(); ++k) value[net[k]] = shaded[k];
+  }
+  stats.inference_ms = ms_since(t0);
+  stats.inferred = net.size();
+  stats.diffuse = diffuse.size();
+
+  t0 = Clock::now();
+  engine::jobs::parallel_for<std::size_t>(0, g.samples.size(), 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t p = b; p < e; ++p) {
+      if (!g.samples[p].hit) continue;
+      const Upsampling::Taps& t = up.taps[p];
+      if (t.own) {
+        image.pixels[p] = value[slot_of_pixel[p]];
+        continue;
+      }
+      glm::vec3 sum(0.0f);
+      for (std::size_t k = 0; k < 4; ++k)
+        if (t.weight[k] > 0) sum += t.weight[k] * value[slot_of_pixel[up.cell_pixel[t.cell[k]]]];
+      image.pixels[p] = sum;
+    }
+  });
+  stats.upsample_ms = plan_ms + ms_since(t0);
+  if (stats_out) *stats_out = stats;
+  return image;
+}
+
+}  // namespace transgi::shading

@@ -1,0 +1,80 @@
+#pragma once
+// The real-time GI path (issue 10, items 2-4):
+//  1. a G-buffer of one ray through each pixel centre (deterministic);
+//  2. GI decoded for a subset of pixels: one per cell of a grid at
+//     `resolution_scale` of the output, plus every pixel that no cell sample
+//     represents (silhouettes, thin objects), so GI never bleeds across
+//     edges;
+//  3. the probes' SH rotated into each moved object's frame once per frame
+//     (interpolation is linear, so this equals rotating every pixel's light),
+//     then per pixel: probe interpolation and the fused decoder + SH dot;
+//  4. a joint bilateral upsample (bilinear x depth x normal weights) to the
+//     output resolution.
+// The reference for it is render_transfer (every pixel decoded, per-pixel
+// rotation, batched inference); tests compare the two.
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "engine/image/image.h"
+#include "engine/render/camera_rays.h"
+#include "model/transfer_model.h"
+#include "probes/probe_field.h"
+#include "shading/fused_decoder.h"
+#include "shading/gbuffer.h"
+
+namespace transgi::shading {
+
+struct RealtimeGiSettings {
+  // GI is decoded on a grid this fraction of the output size per axis.
+  // Higher = finer GI detail inside surfaces, at the cost of inference time
+  // (quadratic in it). 1 = every pixel decoded.
+  float resolution_scale = 0.5f;
+  // Depth similarity: a grid sample's weight is max(0, 1 - (dz / (tol z))^2),
+  // zero past tol of the pixel's depth. Higher = smoother GI across depth
+  // steps, at the cost of bleeding across silhouettes.
+  float depth_tolerance = 0.05f;
+  // Normal similarity: weight x max(0, n . n_sample)^power. Higher = sharper
+  // GI at creases, at the cost of more pixels decoded on their own.
+  int normal_power = 8;
+  // A pixel whose grid samples weigh less than this in total (of 1) is
+  // decoded on its own. Lower = fewer extra decodes, at the cost of GI taken
+  // from barely similar samples.
+  float min_weight = 0.05f;
+  // Off = plain bilinear upsampling (only to show what the guidance prevents).
+  bool edge_aware = true;
+
+  bool operator==(const RealtimeGiSettings&) const = default;
+};
+
+struct GBuffer {
+  int width = 0, height = 0;
+  std::vector<GSample> samples;  // row-major, pixel (0, 0) top-left
+};
+
+// One ray through each pixel centre, in parallel over rows.
+GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
+                      const engine::render::CameraRays& camera, int width, int height);
+
+struct RealtimeGiStats {
+  double rotate_ms = 0;     // probe SH into moved objects' frames
+  double light_ms = 0;      // probe interpolation per decoded pixel
+  double inference_ms = 0;  // latent gather, inputs, fused decoder + SH dot
+  double upsample_ms = 0;   // choosing samples, joint bilateral upsampling
+  std::size_t grid_samples = 0, edge_samples = 0;  // decoded: on the grid, on their own
+  std::size_t inferred = 0, diffuse = 0;           // of those: through the network, diffuse fallback
+  std::size_t rotations = 0;                        // distinct object rotations this frame
+};
+
+// The GI image (output size = g's) from the probes of `fields` (a point
+// takes the first field whose grid holds it, else the first). Entities for
+// which has_transfer is false, or all of them if model is null, are shaded
+// diffusely: albedo / pi x irradiance.
+engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
+                                          const engine::scene::SceneAssets& assets, const model::TransferModel* model,
+                                          const FusedDecoder* decoder,
+                                          const std::function<bool(engine::ecs::Entity)>& has_transfer,
+                                          std::span<const probes::ProbeField* const> fields,
+                                          const RealtimeGiSettings& settings, RealtimeGiStats* stats = nullptr);
+
+}  // namespace transgi::shading
