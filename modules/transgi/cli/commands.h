@@ -13,5 +13,6 @@ int run_bake(const std::vector<std::string>& args);
 int run_transfer_study(const std::vector<std::string>& args);
 int run_eval(const std::vector<std::string>& args);
 int run_bench_pareto(const std::vector<std::string>& args);
+int run_bench_frame(const std::vector<std::string>& args);
 
 }  // namespace transgi::cli

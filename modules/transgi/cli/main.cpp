@@ -24,7 +24,8 @@ void usage() {
                "  transfer-study --scene S.gltf [--points N] [--outgoing K] [--reference-rays R]\n"
                "  eval     --scene S.gltf --model M.tgm --out DIR [--width W --height H --spp N --frames F --ddgi-frames F2]\n"
                "           [--probe-grid N] [--cache DIR]\n"
-               "  bench-pareto --scene S.gltf --model M.tgm --out DIR [--width W --height H --spp N] [--quick]\n");
+               "  bench-pareto --scene S.gltf --model M.tgm --out DIR [--width W --height H --spp N] [--quick]\n"
+               "  bench-frame --scene S.gltf --model M.tgm [--width W --height H --frames N --warmup W --preset realtime|quality --csv F]\n");
 }
 }  // namespace
 
@@ -43,6 +44,7 @@ int main(int argc, char** argv) {
     if (command == "transfer-study") return transgi::cli::run_transfer_study(args);
     if (command == "eval") return transgi::cli::run_eval(args);
     if (command == "bench-pareto") return transgi::cli::run_bench_pareto(args);
+    if (command == "bench-frame") return transgi::cli::run_bench_frame(args);
     if (command == "--help" || command == "help") {
       usage();
       return 0;

@@ -1,5 +1,6 @@
 #include "probes/probe_field.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <limits>
@@ -62,7 +63,27 @@ void ProbeField::notify_scene_changed(bool geometry_moved) {
     states_[q].stable_frames = 0;
     if (geometry_moved) states_[q].depth_frames = 0;
   }
-  if (geometry_moved && settings_.skip.classify) classify_pending_ = true;
+  if (geometry_moved && settings_.skip.classify) {
+    if (settings_.update_budget > 0 && !classify_pending_)
+      std::fill(needs_classify_.begin(), needs_classify_.end(), std::uint8_t{1});
+    else
+      classify_pending_ = true;
+  }
+}
+
+void ProbeField::select_within_budget(std::vector<std::uint8_t>& traced) const {
+  // Candidates: active probes and those queued for classification; the
+  // stalest first, ties broken by a rotating offset (round-robin).
+  const std::size_t n = traced.size();
+  std::vector<std::pair<std::uint64_t, std::size_t>> order;  // (-staleness, rotated index)
+  for (std::size_t q = 0; q < n; ++q) {
+    const bool candidate = state_[q] == ProbeState::Active || needs_classify_[q];
+    traced[q] = 0;
+    if (candidate) order.emplace_back(last_traced_[q], (q + n - frame_ * static_cast<std::size_t>(settings_.update_budget) % n) % n);
+  }
+  const std::size_t k = std::min(order.size(), static_cast<std::size_t>(settings_.update_budget));
+  std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(k), order.end());
+  for (std::size_t i = 0; i < k; ++i) traced[(order[i].second + frame_ * static_cast<std::size_t>(settings_.update_budget)) % n] = 1;
 }
 
 ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights) {
@@ -79,6 +100,10 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   std::vector<std::uint8_t> traced(static_cast<std::size_t>(probes));
   for (std::size_t q = 0; q < traced.size(); ++q)
     traced[q] = classify || !settings_.skip.classify || state_[q] == ProbeState::Active;
+  last_traced_.resize(static_cast<std::size_t>(probes), 0);
+  needs_classify_.resize(static_cast<std::size_t>(probes), 0);
+  const bool budgeted = settings_.update_budget > 0 && !classify;
+  if (budgeted) select_within_budget(traced);
 
   // 1. Scatter and shade (reads the previous frame's SH for the feedback bounce).
   auto t0 = Clock::now();
@@ -116,9 +141,13 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   for (std::uint8_t t : traced) stats.traced += t;
   stats.rays = static_cast<std::size_t>(stats.traced) * static_cast<std::size_t>(M);
   stats.hits = hits.load();
-  if (classify) {
+  if (classify || budgeted) {
     const float far = settings_.skip.far_cells * glm::length(grid.spacing());
     for (std::size_t q = 0; q < state_.size(); ++q) {
+      if (traced[q]) last_traced_[q] = frame_;
+      // Budgeted frames classify only the probes queued for it.
+      if (!classify && !(traced[q] && needs_classify_[q])) continue;
+      needs_classify_[q] = 0;
       const bool buried = static_cast<float>(backfaces[q]) > settings_.skip.buried_backface_fraction * static_cast<float>(M);
       state_[q] = buried ? ProbeState::Buried : nearest[q] > far ? ProbeState::Far : ProbeState::Active;
       usable_[q] = state_[q] == ProbeState::Active ? 1 : 0;
@@ -135,8 +164,12 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
 
   // 2. Share and rasterize.
   t0 = Clock::now();
+  // Untraced probes (outside the budget) keep their state this frame.
+  auto updates = [&](int q) {
+    return state_[static_cast<std::size_t>(q)] == ProbeState::Active && (!budgeted || traced[static_cast<std::size_t>(q)]);
+  };
   for (int q = 0; q < probes; ++q)
-    if (state_[static_cast<std::size_t>(q)] == ProbeState::Active)
+    if (updates(q))
       update_own_depth(states_[static_cast<std::size_t>(q)], settings_.map, points[static_cast<std::size_t>(q)], settings_.accumulation);
   std::vector<const DepthMap*> depth(static_cast<std::size_t>(probes));
   for (int q = 0; q < probes; ++q) depth[static_cast<std::size_t>(q)] = &states_[static_cast<std::size_t>(q)].depth;
@@ -150,7 +183,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   t0 = Clock::now();
   jobs::parallel_for(0, probes, 1, [&](int b, int e) {
     for (int q = b; q < e; ++q) {
-      if (state_[static_cast<std::size_t>(q)] != ProbeState::Active) continue;
+      if (!updates(q)) continue;
       ProbeMapState& st = states_[static_cast<std::size_t>(q)];
       accumulate(st, frame[static_cast<std::size_t>(q)], settings_.accumulation);
       if (settings_.skip.skip_converged && st.stable_frames >= settings_.skip.settle_frames)

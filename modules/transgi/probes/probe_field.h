@@ -73,6 +73,12 @@ struct ProbeFieldSettings {
   // (docs/runtime.md).
   bool window = false;
   ProbeSkipSettings skip;
+  // Probes updated per frame; 0 = every active probe. The stalest go first
+  // (round-robin); after geometry moves, buried and far probes rejoin the
+  // queue to be classified again from their own rays. Lower = a shorter
+  // frame, at the cost of each probe refreshing only every active/budget
+  // frames, so lighting responds that many times slower.
+  int update_budget = 0;
   std::uint64_t seed = 1;
 
   bool operator==(const ProbeFieldSettings&) const = default;
@@ -137,12 +143,19 @@ class ProbeField {
   [[nodiscard]] std::size_t memory_bytes() const;
 
  private:
+  // Marks the probes this frame's budget updates (update_budget > 0).
+  void select_within_budget(std::vector<std::uint8_t>& traced) const;
+
   ProbeFieldSettings settings_;
   MapProjector projector_;
   std::vector<ProbeMapState> states_;
   std::vector<ProbeState> state_;
   std::vector<std::uint8_t> usable_;  // 1 unless buried or far (read by interpolation)
   bool classify_pending_ = true;
+  // Budgeted updates: the frame each probe last traced, and which probes
+  // must be classified again when next traced.
+  std::vector<std::uint64_t> last_traced_;
+  std::vector<std::uint8_t> needs_classify_;
   std::vector<float> sh_;  // probes x 75
   std::vector<glm::vec3> fibonacci_;
   std::uint64_t frame_ = 0;

@@ -177,6 +177,7 @@ TransGISettings realtime_preset() {
   TransGISettings s;
   s.gi_path = GiPath::Realtime;
   s.gbuffer_spp = 1;
+  s.probes.update_budget = 128;  // a quarter of the 8^3 grid per frame
   return s;
 }
 
