@@ -5,6 +5,8 @@
 // test can fail.
 #include <gtest/gtest.h>
 
+#include "lambert.h"
+
 #include <cmath>
 #include <cstdio>
 
@@ -19,14 +21,6 @@ using namespace transgi;
 using namespace engine;
 
 namespace {
-
-material::Material lambert(glm::vec3 albedo) {
-  material::Material m;
-  m.base_color_factor = glm::vec4(albedo, 1);
-  m.metallic_factor = 0;
-  m.specular_factor = 0;
-  return m;
-}
 
 // A saturated orange box in front of a blue wall, on a grey floor, under a
 // uniform sky: every silhouette separates two colours, so GI that bleeds

@@ -3,6 +3,8 @@
 // moved object's GI converging to the path tracer's GI of the moved scene.
 #include <gtest/gtest.h>
 
+#include "lambert.h"
+
 #include <cmath>
 #include <cstdio>
 
@@ -26,15 +28,6 @@ using namespace transgi;
 using namespace engine;
 
 namespace {
-
-material::Material lambert(glm::vec3 albedo) {
-  material::Material m;
-  m.base_color_factor = glm::vec4(albedo, 1);
-  m.metallic_factor = 0;
-  m.roughness_factor = 1;
-  m.specular_factor = 0;
-  return m;
-}
 
 // A grey floor with an orange cube on it, lit by a low sun (no sky): all GI
 // is light bounced between the two.
