@@ -1,6 +1,7 @@
 #include "probes/probe_field.h"
 
 #include <algorithm>
+#include <tuple>
 #include <atomic>
 #include <chrono>
 #include <limits>
@@ -74,16 +75,15 @@ void ProbeField::notify_scene_changed(bool geometry_moved) {
 void ProbeField::select_within_budget(std::vector<std::uint8_t>& traced) const {
   // Candidates: active probes and those queued for classification; the
   // stalest first, ties broken by a rotating offset (round-robin).
-  const std::size_t n = traced.size();
-  std::vector<std::pair<std::uint64_t, std::size_t>> order;  // (-staleness, rotated index)
+  const std::size_t n = traced.size(), offset = frame_ * static_cast<std::size_t>(settings_.update_budget) % n;
+  std::vector<std::tuple<std::uint64_t, std::size_t, std::size_t>> order;  // (last traced, turn, probe)
   for (std::size_t q = 0; q < n; ++q) {
-    const bool candidate = state_[q] == ProbeState::Active || needs_classify_[q];
     traced[q] = 0;
-    if (candidate) order.emplace_back(last_traced_[q], (q + n - frame_ * static_cast<std::size_t>(settings_.update_budget) % n) % n);
+    if (state_[q] == ProbeState::Active || needs_classify_[q]) order.emplace_back(last_traced_[q], (q + n - offset) % n, q);
   }
   const std::size_t k = std::min(order.size(), static_cast<std::size_t>(settings_.update_budget));
   std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(k), order.end());
-  for (std::size_t i = 0; i < k; ++i) traced[(order[i].second + frame_ * static_cast<std::size_t>(settings_.update_budget)) % n] = 1;
+  for (std::size_t i = 0; i < k; ++i) traced[std::get<2>(order[i])] = 1;
 }
 
 ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights) {

@@ -64,18 +64,17 @@ struct PackedDecoder {
 };
 
 // Realtime path: returns the GI image and fills the frame's stage times.
-image::ImageRGB render_gi_realtime(const CameraView& cameras, const std::shared_ptr<const model::TransferModel>& model,
+image::ImageRGB render_gi_realtime(const render::CameraRays& rays, const std::shared_ptr<const model::TransferModel>& model,
                                    const std::function<bool(Entity)>& has_transfer,
                                    std::span<const probes::ProbeField* const> fields, const rt::RtScene& rt,
                                    const scene::SceneAssets& assets, const TransGISettings& settings, PackedDecoder& packed,
                                    GiFrame& frame) {
-  const auto rays = render::camera_rays_for(cameras, frame.camera, frame.width, frame.height);
   if (model && packed.model != model) {
     packed.decoder = std::make_unique<shading::FusedDecoder>(model->decoder);
     packed.model = model;
   }
   auto t0 = std::chrono::steady_clock::now();
-  const shading::GBuffer g = shading::trace_gbuffer(rt, assets, *rays, frame.width, frame.height);
+  const shading::GBuffer g = shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height);
   frame.times.gbuffer = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   shading::RealtimeGiStats st;
   image::ImageRGB gi = shading::shade_gi_realtime(g, rt, assets, model.get(), model ? packed.decoder.get() : nullptr,
@@ -130,7 +129,7 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
     return l && model && l->model == model;
   };
   if (settings->gi_path == GiPath::Realtime) {
-    frame->gi = render_gi_realtime(cameras, model, rs.has_transfer, fields, *rt, *assets, *settings, *packed, *frame);
+    frame->gi = render_gi_realtime(*rays, model, rs.has_transfer, fields, *rt, *assets, *settings, *packed, *frame);
     frame->times.collect_points = frame->probe_stats.scatter_ms;
     frame->times.probe_raster = frame->probe_stats.raster_ms;
     frame->times.probe_projection = frame->probe_stats.project_ms;
