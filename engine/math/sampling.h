@@ -60,6 +60,12 @@ inline glm::vec3 sample_uniform_hemisphere(glm::vec2 u) {
   const float phi = kTwoPi * u.y;
   return {r * std::cos(phi), r * std::sin(phi), z};
 }
+// Uniform direction in the cone of half-angle r around +z.
+inline glm::vec3 sample_uniform_cone(glm::vec2 u, float cos_r) {
+  const float z = 1.0f - u.x * (1.0f - cos_r), s = std::sqrt(std::max(0.0f, 1.0f - z * z)), phi = kTwoPi * u.y;
+  return {s * std::cos(phi), s * std::sin(phi), z};
+}
+
 inline constexpr float kUniformHemispherePdf = 1.0f / (2.0f * kPi);
 
 // Uniform point on a triangle as barycentrics (b1, b2); b0 = 1 - b1 - b2.

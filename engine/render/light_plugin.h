@@ -11,10 +11,25 @@
 
 namespace engine::render {
 
+// How the light set is built. What a renderer that wants the sun as a
+// directional light (the real-time paths) asks for.
+struct LightSettings {
+  // On = a sun found in the environment map is shaded as a directional light
+  // of the disk's size (one shadow ray, no noise from finding it by chance),
+  // at the cost of the disk's own shape (it becomes a uniform cone). Off =
+  // the map lights as it is (the reference path tracer's default).
+  bool split_sun = false;
+  scene::SunExtractionSettings extraction;
+};
+
 struct SceneLights {
   LightSet set;
   std::uint64_t version = 0;           // lighting changed (lights, emitters, environment)
   std::uint64_t geometry_version = 0;  // the ray-traced geometry changed
+  // The sun split of the current environment, computed once per map (a
+  // moving object rebuilds the set every frame; the map does not change).
+  std::shared_ptr<const scene::SunSplit> sun_split;
+  const scene::Environment* sun_split_of = nullptr;
 };
 
 class LightPlugin final : public app::Plugin {

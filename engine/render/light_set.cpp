@@ -26,8 +26,21 @@ float spot_falloff(const scene::PunctualLight& l, float cos_angle) {
 }
 }  // namespace
 
-LightSet::LightSet(const rt::RtScene& scene, std::vector<PunctualInstance> punctual, const scene::Environment* env)
+LightSet::LightSet(const rt::RtScene& scene, std::vector<PunctualInstance> punctual, const scene::Environment* env,
+                   std::shared_ptr<const scene::SunSplit> sun_split)
     : punctual_(std::move(punctual)), env_(env && env->valid() ? env : nullptr) {
+  background_ = env_;
+  if (env_ && sun_split && sun_split->sun) {
+    const scene::ExtractedSun& sun = *sun_split->sun;
+    scene::PunctualLight light;
+    light.type = scene::PunctualLight::Type::Directional;
+    light.color = sun.irradiance;
+    light.intensity = 1.0f;
+    split_sun_index_ = static_cast<int>(punctual_.size());
+    punctual_.push_back(PunctualInstance{light, glm::vec3(0.0f), -sun.direction, sun.angular_radius});
+    sun_split_ = std::move(sun_split);
+    env_ = &sun_split_->residual;
+  }
   std::vector<float> power;
   assets_ = scene.assets();
   if (const scene::SceneAssets* assets = assets_) {
@@ -102,31 +115,42 @@ bool LightSet::sample(const glm::vec3& p, float u_select, glm::vec2 u, LightSamp
     return true;
   }
   if (!punctual_.empty()) {
-    const std::size_t i = std::min(punctual_.size() - 1, static_cast<std::size_t>(u.x * static_cast<float>(punctual_.size())));
-    const PunctualInstance& l = punctual_[i];
-    const float select = pg / static_cast<float>(punctual_.size());
-    const glm::vec3 power = l.light.color * l.light.intensity / select;
-    out.delta = true;
-    out.pdf = 0;
-    if (l.light.type == scene::PunctualLight::Type::Directional) {
-      out.direction = -l.direction;
-      out.distance = std::numeric_limits<float>::infinity();
-      out.radiance = power;
-      return true;
-    }
-    glm::vec3 d = l.position - p;
-    const float dist2 = glm::dot(d, d);
-    if (!(dist2 > 0)) return false;
-    const float dist = std::sqrt(dist2);
-    d /= dist;
-    float atten = range_window(dist, l.light.range) / dist2;
-    if (l.light.type == scene::PunctualLight::Type::Spot) atten *= spot_falloff(l.light, glm::dot(l.direction, -d));
-    out.direction = d;
-    out.distance = dist;
-    out.radiance = power * atten;
-    return atten > 0;
+    const float n = static_cast<float>(punctual_.size());
+    const std::size_t i = std::min(punctual_.size() - 1, static_cast<std::size_t>(u.x * n));
+    // The rest of u.x after selection places the point on a sun's disk.
+    const float ux = std::clamp(u.x * n - static_cast<float>(i), 0.0f, 0.99999994f);
+    if (!sample_punctual(i, p, {ux, u.y}, out)) return false;
+    out.radiance /= pg / n;
+    return true;
   }
   return false;
+}
+
+bool LightSet::sample_punctual(std::size_t i, const glm::vec3& p, glm::vec2 u, LightSample& out) const {
+  if (i >= punctual_.size()) return false;
+  const PunctualInstance& l = punctual_[i];
+  const glm::vec3 power = l.light.color * l.light.intensity;
+  out.delta = true;
+  out.pdf = 0;
+  if (l.light.type == scene::PunctualLight::Type::Directional) {
+    out.direction = -l.direction;
+    if (l.angular_radius > 0)  // a direction uniform over the disk
+      out.direction = math::Frame::from_normal(-l.direction).to_world(math::sample_uniform_cone(u, std::cos(l.angular_radius)));
+    out.distance = std::numeric_limits<float>::infinity();
+    out.radiance = power;
+    return true;
+  }
+  glm::vec3 d = l.position - p;
+  const float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0)) return false;
+  const float dist = std::sqrt(dist2);
+  d /= dist;
+  float atten = range_window(dist, l.light.range) / dist2;
+  if (l.light.type == scene::PunctualLight::Type::Spot) atten *= spot_falloff(l.light, glm::dot(l.direction, -d));
+  out.direction = d;
+  out.distance = dist;
+  out.radiance = power * atten;
+  return atten > 0;
 }
 
 float LightSet::pdf_area_light(ecs::Entity entity, std::uint32_t primitive, const glm::vec3& dir, float dist,

@@ -7,6 +7,7 @@
 // present (environment, area lights, punctual lights), then a triangle by
 // emitted power, a punctual light uniformly, or a direction from the
 // environment's own importance distribution.
+#include <memory>
 #include <optional>
 #include <unordered_map>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "engine/math/distribution.h"
 #include "engine/rt/rt_scene.h"
 #include "engine/scene/components.h"
+#include "engine/scene/sun_extraction.h"
 
 namespace engine::render {
 
@@ -30,6 +32,10 @@ struct PunctualInstance {
   scene::PunctualLight light;
   glm::vec3 position;
   glm::vec3 direction;  // the way the light shines (its local -Z in world space)
+  // Directional only: half-angle of the source's disk (a sun split out of
+  // the environment); 0 = a delta light. Samples spread over the disk, so
+  // shadows get the penumbra the disk gives.
+  float angular_radius = 0.0f;
 };
 
 struct LightSample {
@@ -43,8 +49,11 @@ struct LightSample {
 class LightSet {
  public:
   LightSet() = default;
-  // env may be null. Punctual lights come from the world.
-  LightSet(const rt::RtScene& scene, std::vector<PunctualInstance> punctual, const scene::Environment* env);
+  // env may be null. Punctual lights come from the world. With a sun split
+  // of env, the split's sun becomes one more directional light and the
+  // residual map replaces env for lighting (env stays the background).
+  LightSet(const rt::RtScene& scene, std::vector<PunctualInstance> punctual, const scene::Environment* env,
+           std::shared_ptr<const scene::SunSplit> sun_split = nullptr);
 
   // Samples one light as seen from point p (u3: selection, u: position/direction).
   bool sample(const glm::vec3& p, float u_select, glm::vec2 u, LightSample& out) const;
@@ -53,8 +62,17 @@ class LightSet {
   [[nodiscard]] float pdf_area_light(ecs::Entity entity, std::uint32_t primitive, const glm::vec3& dir, float dist,
                                      const glm::vec3& light_normal) const;
   [[nodiscard]] float pdf_environment(const glm::vec3& dir) const;
+  // Punctual light i as seen from p, not divided by any selection
+  // probability (renderers that shade every light once). u picks a point
+  // on a sun's disk; delta lights ignore it.
+  bool sample_punctual(std::size_t i, const glm::vec3& p, glm::vec2 u, LightSample& out) const;
 
+  // The environment that lights the scene (the residual when the sun is split out).
   [[nodiscard]] const scene::Environment* environment() const { return env_; }
+  // The environment as the camera sees it (with its sun disk).
+  [[nodiscard]] const scene::Environment* background() const { return background_; }
+  // The sun taken out of the environment, as a punctual light (index into punctual_lights()), or -1.
+  [[nodiscard]] int split_sun_index() const { return split_sun_index_; }
   [[nodiscard]] std::size_t emissive_triangle_count() const { return triangles_.size(); }
   [[nodiscard]] std::size_t punctual_count() const { return punctual_.size(); }
   [[nodiscard]] const std::vector<PunctualInstance>& punctual_lights() const { return punctual_; }
@@ -69,6 +87,9 @@ class LightSet {
   std::vector<PunctualInstance> punctual_;
   const scene::SceneAssets* assets_ = nullptr;
   const scene::Environment* env_ = nullptr;
+  const scene::Environment* background_ = nullptr;
+  std::shared_ptr<const scene::SunSplit> sun_split_;  // owns the residual env_ points to
+  int split_sun_index_ = -1;
   int groups_ = 0;
 };
 

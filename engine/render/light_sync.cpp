@@ -12,11 +12,12 @@ using LightView = View<Get<const scene::PunctualLight, const transform::WorldTra
 struct SeenState {
   std::uint64_t commits = UINT64_MAX;  // RtScene top-level commits at the last rebuild
   std::uint64_t assets_generation = UINT64_MAX;
+  bool split_sun = false;
 };
 
-void sync_lights(LightView lights, Removed<scene::PunctualLight> removed, Res<rt::RtScene> rt, ResMut<SceneLights> out,
-                 Local<SeenState> seen) {
-  bool lights_changed = !removed.empty();
+void sync_lights(LightView lights, Removed<scene::PunctualLight> removed, Res<rt::RtScene> rt, Res<LightSettings> settings,
+                 ResMut<SceneLights> out, Local<SeenState> seen) {
+  bool lights_changed = !removed.empty() || settings->split_sun != seen->split_sun;
   std::vector<PunctualInstance> punctual;
   lights.each([&](Entity e, const scene::PunctualLight& l, const transform::WorldTransform& w) {
     if (lights.is_changed<scene::PunctualLight>(e) || lights.is_changed<transform::WorldTransform>(e)) lights_changed = true;
@@ -30,11 +31,19 @@ void sync_lights(LightView lights, Removed<scene::PunctualLight> removed, Res<rt
   // Emissive triangles are stored in world space, so moved geometry also
   // means a rebuilt light set.
   const scene::Environment* env = assets && assets->environment ? &*assets->environment : nullptr;
-  out->set = LightSet(*rt, std::move(punctual), env);
+  if (!settings->split_sun || !env) {
+    out->sun_split.reset();
+    out->sun_split_of = nullptr;
+  } else if (out->sun_split_of != env || assets_changed || !out->sun_split) {
+    out->sun_split = std::make_shared<const scene::SunSplit>(scene::split_sun(*env, settings->extraction));
+    out->sun_split_of = env;
+  }
+  out->set = LightSet(*rt, std::move(punctual), env, out->sun_split);
   ++out->version;
   if (geometry_changed || assets_changed) ++out->geometry_version;
   seen->commits = rt->stats().top_level_commits;
   seen->assets_generation = generation;
+  seen->split_sun = settings->split_sun;
 }
 
 }  // namespace
@@ -42,6 +51,7 @@ void sync_lights(LightView lights, Removed<scene::PunctualLight> removed, Res<rt
 void LightPlugin::build(app::App& app) {
   app.add_plugin<rt::RtPlugin>();  // the Embree mirror this sync runs after
   if (!app.world().has_resource<SceneLights>()) app.world().insert_resource<SceneLights>();
+  if (!app.world().has_resource<LightSettings>()) app.world().insert_resource<LightSettings>();
   app.add_system(Phase::PrepareRender, "render::sync_lights", sync_lights);
 }
 

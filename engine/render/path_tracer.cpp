@@ -51,8 +51,10 @@ PathRadiance PathTracer::trace(rt::Ray ray, math::Pcg32& rng) const {
   for (int depth = 0;; ++depth) {
     rt::Hit hit;
     if (!scene_.intersect(ray, hit)) {
-      if (env) {
-        const glm::vec3 le = env->radiance(ray.direction);
+      // The camera sees the background (with its sun disk, if the light set
+      // split the sun out); bounces see the environment that lights.
+      if (const scene::Environment* seen = depth == 0 ? lights_.background() : env) {
+        const glm::vec3 le = seen->radiance(ray.direction);
         const float w = depth == 0 ? 1.0f : math::power_heuristic(prev_bsdf_pdf, lights_.pdf_environment(ray.direction));
         add(beta * le * w, depth);
       }

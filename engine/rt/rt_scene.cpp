@@ -260,6 +260,74 @@ bool RtScene::occluded(const Ray& ray) const {
   return r.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
 }
 
+namespace {
+template <class Packet>
+void fill16(Packet& out, const Ray* rays, int n, int* valid, std::atomic<std::uint64_t>& rejected) {
+  // Inactive lanes repeat an active ray: Embree 3.13.5's packet traversal
+  // was seen to loop forever on a packet whose inactive lanes held a far-off
+  // default ray (tests/engine/rt_test.cpp keeps packets honest).
+  Ray filler{};
+  for (int i = 0; i < n; ++i)
+    if (valid_ray(rays[i])) {
+      filler = rays[i];
+      break;
+    }
+  for (int i = 0; i < 16; ++i) {
+    const bool ok = i < n && valid_ray(rays[i]);
+    if (i < n && !ok) rejected.fetch_add(1, std::memory_order_relaxed);
+    valid[i] = ok ? -1 : 0;
+    const Ray r = ok ? rays[i] : filler;
+    out.org_x[i] = r.origin.x;
+    out.org_y[i] = r.origin.y;
+    out.org_z[i] = r.origin.z;
+    out.dir_x[i] = r.direction.x;
+    out.dir_y[i] = r.direction.y;
+    out.dir_z[i] = r.direction.z;
+    out.tnear[i] = r.tmin;
+    out.tfar[i] = r.tmax;
+    out.time[i] = 0.0f;
+    out.mask[i] = 0xffffffffu;
+    out.id[i] = static_cast<unsigned>(i);
+    out.flags[i] = 0;
+  }
+}
+}  // namespace
+
+void RtScene::intersect16(const Ray* rays, int n, Hit* hits, bool* found) const {
+  alignas(64) int valid[16];
+  alignas(64) RTCRayHit16 rh;
+  fill16(rh.ray, rays, std::min(n, 16), valid, rejected_);
+  for (int i = 0; i < 16; ++i) {
+    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+  }
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  rtcIntersect16(valid, impl_->top, &ctx, &rh);
+  for (int i = 0; i < std::min(n, 16); ++i) {
+    found[i] = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+    if (!found[i]) continue;
+    const InstanceRecord& inst = instances_[rh.hit.instID[0][i]];
+    hits[i].entity = inst.entity;
+    hits[i].mesh = inst.mesh;
+    hits[i].primitive = rh.hit.primID[i];
+    hits[i].barycentric = {rh.hit.u[i], rh.hit.v[i]};
+    hits[i].t = rh.ray.tfar[i];
+  }
+}
+
+void RtScene::occluded16(const Ray* rays, int n, bool* blocked) const {
+  alignas(64) int valid[16];
+  alignas(64) RTCRay16 r;
+  fill16(r, rays, std::min(n, 16), valid, rejected_);
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  rtcOccluded16(valid, impl_->top, &ctx, &r);
+  for (int i = 0; i < std::min(n, 16); ++i) blocked[i] = valid[i] && r.tfar[i] < 0.0f;
+}
+
 const InstanceRecord* RtScene::instance(std::uint32_t id) const {
   return id < instances_.size() && instances_[id].active ? &instances_[id] : nullptr;
 }

@@ -58,6 +58,12 @@ class RtScene {
   // Queries.
   bool intersect(const Ray& ray, Hit& hit) const;
   bool occluded(const Ray& ray) const;
+  // Packets of up to 16 rays (Embree's 16-wide queries). Same answers as the
+  // single-ray queries; coherent rays (a tile of camera rays, shadow rays to
+  // one light) traverse together and run several times faster. Invalid rays
+  // are counted as rejected and report no hit / not occluded.
+  void intersect16(const Ray* rays, int n, Hit* hits, bool* found) const;
+  void occluded16(const Ray* rays, int n, bool* blocked) const;
 
   [[nodiscard]] const InstanceRecord* instance(std::uint32_t id) const;
   // Calls fn(const InstanceRecord&) for every live instance, in id order.

@@ -3,6 +3,7 @@
 #include <limits>
 
 #include "engine/app/app.h"
+#include "engine/math/rng.h"
 #include "engine/rt/rt_plugin.h"
 #include "engine/scene/components.h"
 #include "engine/scene/scene_assets.h"
@@ -154,4 +155,48 @@ TEST(RtScene, OffsetOriginEscapesTheSurface) {
   Hit h;
   EXPECT_FALSE(f.rt().intersect(Ray{o, {0.3f, 0.1f, 1.0f}}, h)) << "a ray leaving the surface must not re-hit it";
   EXPECT_GT(o.z, p.z);
+}
+
+TEST(RtScene, PacketsAnswerAsSingleRays) {
+  // The 16-wide queries are a fast path; the single-ray queries are their
+  // reference. Rays of every kind: hits on two quads (one masked half), misses,
+  // short tmax, a NaN ray and a short last packet.
+  RtFixture f(/*masked=*/true);
+  const Entity a = f.spawn_quad({0, 0, 0});
+  const Entity b = f.spawn_quad({0.3f, 0.1f, -1.0f});
+  f.app.world().get_mut<scene::MeshInstance>(b).mesh = 0;
+  f.app.update();
+  math::Pcg32 rng(3, 9);
+  std::vector<Ray> rays;
+  for (int i = 0; i < 16 * 20 + 5; ++i) {
+    Ray r{{rng.next_float() * 2 - 1, rng.next_float() * 2 - 1, 3}, {0.2f * (rng.next_float() - 0.5f), 0.2f * (rng.next_float() - 0.5f), -1}};
+    if (i % 7 == 0) r.tmax = 3.5f;  // stops between the quads
+    if (i == 37) r.origin.x = std::numeric_limits<float>::quiet_NaN();
+    rays.push_back(r);
+  }
+  int hits = 0, blocked_count = 0;
+  for (std::size_t p = 0; p < rays.size(); p += 16) {
+    const int n = static_cast<int>(std::min<std::size_t>(16, rays.size() - p));
+    Hit packet[16];
+    bool found[16], blocked[16];
+    f.rt().intersect16(rays.data() + p, n, packet, found);
+    f.rt().occluded16(rays.data() + p, n, blocked);
+    for (int i = 0; i < n; ++i) {
+      Hit single;
+      const bool want = f.rt().intersect(rays[p + i], single);
+      ASSERT_EQ(found[i], want) << "ray " << p + i;
+      EXPECT_EQ(blocked[i], f.rt().occluded(rays[p + i])) << "ray " << p + i;
+      if (!want) continue;
+      ++hits;
+      blocked_count += blocked[i];
+      EXPECT_EQ(packet[i].entity, single.entity) << "ray " << p + i;
+      EXPECT_EQ(packet[i].primitive, single.primitive) << "ray " << p + i;
+      EXPECT_NEAR(packet[i].t, single.t, 1e-5f * single.t) << "ray " << p + i;
+      EXPECT_NEAR(packet[i].barycentric.x, single.barycentric.x, 1e-5f) << "ray " << p + i;
+    }
+  }
+  EXPECT_GT(hits, 50) << "the rays must exercise hits";
+  EXPECT_GT(static_cast<int>(rays.size()) - hits, 50) << "and misses";
+  EXPECT_EQ(f.rt().rejected_rays(), 4u) << "the NaN ray, counted by each of the four queries";
+  (void)a;
 }

@@ -191,3 +191,25 @@ TEST(FusedDecoder, UnsupportedLayoutFallsBackToScalar) {
   EXPECT_LE(compare(d, mlp, b, 10).relative_rms, 1e-5);
   EXPECT_THROW(shading::FusedDecoder(random_mlp({.outputs = 27}, 1)), std::invalid_argument);
 }
+
+// The second light rides on the same decoded transfer: each of the two
+// outputs must equal a one-light call with that light (same backend, same
+// rounding, so exactly), for tile tails too.
+TEST(FusedDecoder, SecondLightEqualsASeparateCall) {
+  for (FusedIsa isa : {FusedIsa::Scalar, FusedIsa::Avx2, FusedIsa::Avx512Bf16}) {
+    if (!shading::cpu_supports(isa)) continue;
+    const model::Mlp mlp = random_mlp({}, 8);
+    const shading::FusedDecoder d(mlp, isa);
+    for (int n : {1, 17, 64}) {
+      const Batch a = random_batch(n, mlp.layout().inputs, 21), b = random_batch(n, mlp.layout().inputs, 22);
+      std::vector<float> one_a(static_cast<std::size_t>(n) * 3), one_b(one_a.size()), two_a(one_a.size()), two_b(one_a.size());
+      d.shade_tile(a.inputs.data(), a.light.data(), n, one_a.data());
+      d.shade_tile(a.inputs.data(), b.light.data(), n, one_b.data());
+      d.shade_tile(a.inputs.data(), a.light.data(), n, two_a.data(), b.light.data(), two_b.data());
+      for (std::size_t i = 0; i < one_a.size(); ++i) {
+        ASSERT_EQ(two_a[i], one_a[i]) << shading::fused_isa_name(isa) << " n " << n << " value " << i << " (first light)";
+        ASSERT_EQ(two_b[i], one_b[i]) << shading::fused_isa_name(isa) << " n " << n << " value " << i << " (second light)";
+      }
+    }
+  }
+}

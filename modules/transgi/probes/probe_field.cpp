@@ -12,7 +12,9 @@
 #include "engine/jobs/parallel_for.h"
 #include "engine/math/rng.h"
 #include "engine/math/sampling.h"
+#include "engine/math/sh.h"
 #include "probes/probe_rays.h"
+#include "probes/radiance_map.h"
 #include "shading/sh_light.h"
 
 namespace transgi::probes {
@@ -30,6 +32,9 @@ ProbeField::ProbeField(ProbeFieldSettings s)
   state_.assign(states_.size(), ProbeState::Active);
   usable_.assign(states_.size(), 1);
   sh_.assign(static_cast<std::size_t>(s.grid.count()) * 75, 0.0f);
+  direct_mean_.assign(sh_.size(), 0.0f);
+  direct_sh_.assign(sh_.size(), 0.0f);
+  direct_frames_.assign(states_.size(), 0);
 }
 
 void ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, float* out) const { interpolate(p, n, sh_.data(), out); }
@@ -44,6 +49,18 @@ void ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float
   }
 }
 
+void ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float* sh_a, float* out_a, const float* sh_b,
+                             float* out_b) const {
+  const InterpolationResult r = interpolate_probes(settings_.grid, settings_.map, states_, p, n, settings_.interpolation, usable_);
+  for (int k = 0; k < 75; ++k) out_a[k] = out_b[k] = 0.0f;
+  for (std::size_t i = 0; i < 8; ++i) {
+    if (r.weights[i] == 0.0f) continue;
+    const std::size_t at = static_cast<std::size_t>(r.probes[i]) * 75;
+    for (int k = 0; k < 75; ++k) out_a[k] += r.weights[i] * sh_a[at + k];
+    for (int k = 0; k < 75; ++k) out_b[k] += r.weights[i] * sh_b[at + k];
+  }
+}
+
 glm::vec3 ProbeField::irradiance(const glm::vec3& p, const glm::vec3& n) const {
   float L[75];
   interpolate(p, n, L);
@@ -51,7 +68,8 @@ glm::vec3 ProbeField::irradiance(const glm::vec3& p, const glm::vec3& n) const {
 }
 
 std::size_t ProbeField::memory_bytes() const {
-  std::size_t b = sh_.size() * sizeof(float);
+  std::size_t b = (sh_.size() + direct_mean_.size() + direct_sh_.size()) * sizeof(float) +
+                  direct_frames_.size() * sizeof(std::uint32_t);
   for (const ProbeMapState& st : states_)
     b += st.radiance.size() * sizeof(glm::vec3) +
          (st.sampled.size() + st.depth.mean.size() + st.depth_squared.size() + st.depth_weight.size()) * sizeof(float);
@@ -63,6 +81,8 @@ void ProbeField::notify_scene_changed(bool geometry_moved) {
     if (state_[q] == ProbeState::Converged) state_[q] = ProbeState::Active;
     states_[q].stable_frames = 0;
     if (geometry_moved) states_[q].depth_frames = 0;
+    // The direct light may have changed: keep a short history so the mean follows.
+    direct_frames_[q] = std::min<std::uint32_t>(direct_frames_[q], 4);
   }
   if (geometry_moved && settings_.skip.classify) {
     if (settings_.update_budget > 0 && !classify_pending_)
@@ -111,9 +131,11 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   std::vector<int> backfaces(static_cast<std::size_t>(probes), 0);
   std::vector<float> nearest(static_cast<std::size_t>(probes), std::numeric_limits<float>::infinity());
   std::atomic<std::size_t> hits{0};
+  std::vector<float> direct_frame(static_cast<std::size_t>(probes) * 75, 0.0f);
   jobs::parallel_for(0, probes, 1, [&](int b, int e) {
     for (int q = b; q < e; ++q) {
       if (!traced[static_cast<std::size_t>(q)]) continue;
+      float* direct = direct_frame.data() + static_cast<std::size_t>(q) * 75;
       const glm::vec3 origin = grid.position(q);
       auto& out = points[static_cast<std::size_t>(q)];
       out.reserve(static_cast<std::size_t>(M));
@@ -124,6 +146,13 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
           // Indirect light from last frame's probes (multi-bounce feedback).
           return frame_ > 0 ? irradiance(p, n) : glm::vec3(0.0f);
         });
+        if (h.emitted != glm::vec3(0.0f)) {
+          // Monte Carlo projection over a near-uniform set: 4 pi / M per ray.
+          const math::ShBasis y = math::sh_eval(dir);
+          const glm::vec3 e4 = h.emitted * (4.0f * math::kPi / static_cast<float>(M));
+          for (int c = 0; c < 3; ++c)
+            for (int k = 0; k < 25; ++k) direct[c * 25 + k] += e4[c] * y[static_cast<std::size_t>(k)];
+        }
         ShadedPoint sp;
         sp.direction = dir;
         sp.distance = h.distance;
@@ -155,6 +184,9 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
         // Holds no light; if it becomes active again it starts afresh.
         states_[q].reset(settings_.map.texel_count());
         std::fill_n(sh_.data() + q * 75, 75, 0.0f);
+        std::fill_n(direct_mean_.data() + q * 75, 75, 0.0f);
+        std::fill_n(direct_sh_.data() + q * 75, 75, 0.0f);
+        direct_frames_[q] = 0;
         points[q].clear();
       }
     }
@@ -188,6 +220,13 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
       accumulate(st, frame[static_cast<std::size_t>(q)], settings_.accumulation);
       if (settings_.skip.skip_converged && st.stable_frames >= settings_.skip.settle_frames)
         state_[static_cast<std::size_t>(q)] = ProbeState::Converged;
+      const std::size_t at = static_cast<std::size_t>(q) * 75;
+      const std::uint32_t frames = direct_frames_[static_cast<std::size_t>(q)] =
+          std::min<std::uint32_t>(direct_frames_[static_cast<std::size_t>(q)] + 1, static_cast<std::uint32_t>(std::max(1, settings_.direct_history)));
+      for (int k = 0; k < 75; ++k)
+        direct_mean_[at + k] += (direct_frame[at + k] - direct_mean_[at + k]) / static_cast<float>(frames);
+      std::copy_n(direct_mean_.data() + at, 75, direct_sh_.data() + at);
+      if (settings_.direct_window) apply_hanning_window(direct_sh_.data() + at);
       const auto filled = filled_radiance(st, settings_.map, settings_.accumulation.fill_passes);
       float* out = sh_.data() + static_cast<std::size_t>(q) * 75;
       projector_.project(filled.data(), out);

@@ -7,7 +7,11 @@
 //     the LightSet) plus indirect light from the previous frame's probes
 //     (their interpolated irradiance times the diffuse albedo, as DDGI does).
 //     Rays that hit an emitter or escape record zero: the probes hold
-//     indirect light only.
+//     indirect light only. What those rays saw (the environment, residual
+//     if the sun is split out, and emitters) is projected to a second SH per
+//     probe, the direct sky and emitter light (a running mean over
+//     `direct_history` frames): the real-time path's direct light from
+//     everything but punctual lights and the sun.
 //  2. raster: radiance sharing across each probe's 26 neighbours.
 //  3. accumulate over frames (adaptive hysteresis), fill holes, project to
 //     SH (optionally windowed against ringing).
@@ -79,6 +83,13 @@ struct ProbeFieldSettings {
   // frame, at the cost of each probe refreshing only every active/budget
   // frames, so lighting responds that many times slower.
   int update_budget = 0;
+  // Frames the direct sky and emitter SH averages over (a running mean,
+  // restarted short when the scene changes). Higher = less noise from M rays
+  // a frame, at the cost of a slower response to a changed sky or lamp.
+  int direct_history = 64;
+  // Hanning window on the direct sky and emitter SH. On = no ringing around
+  // small bright emitters, at the cost of a blurrier sky.
+  bool direct_window = true;
   std::uint64_t seed = 1;
 
   bool operator==(const ProbeFieldSettings&) const = default;
@@ -126,6 +137,12 @@ class ProbeField {
   [[nodiscard]] const float* light_sh(int probe) const { return sh_.data() + static_cast<std::size_t>(probe) * 75; }
   // Interpolated SH light at a surface point (pruned trilinear).
   void interpolate(const glm::vec3& position, const glm::vec3& normal, float* out75) const;
+  // One set of weights applied to two probe SH arrays (the indirect and the
+  // direct light, possibly rotated): half the cost of two calls.
+  void interpolate(const glm::vec3& position, const glm::vec3& normal, const float* sh_a, float* out_a, const float* sh_b,
+                   float* out_b) const;
+  // The direct sky and emitter light of every probe, probes x 75, world space.
+  [[nodiscard]] const std::vector<float>& direct_sh_all() const { return direct_sh_; }
   // The same weights applied to another copy of the probes' SH (probes x 75,
   // e.g. rotated into an object's frame: interpolation is linear, so rotating
   // the probes once equals rotating every interpolated result).
@@ -157,6 +174,8 @@ class ProbeField {
   std::vector<std::uint64_t> last_traced_;
   std::vector<std::uint8_t> needs_classify_;
   std::vector<float> sh_;  // probes x 75
+  std::vector<float> direct_mean_, direct_sh_;  // probes x 75: running mean, and that windowed
+  std::vector<std::uint32_t> direct_frames_;    // frames in each probe's running mean
   std::vector<glm::vec3> fibonacci_;
   std::uint64_t frame_ = 0;
 };

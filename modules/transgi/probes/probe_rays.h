@@ -26,6 +26,10 @@ struct ProbeRayHit {
   float distance = std::numeric_limits<float>::infinity();
   glm::vec3 position{0.0f};
   glm::vec3 radiance{0.0f};  // leaving the hit towards the probe
+  // Light arriving straight from an emitter or the (residual) environment:
+  // not part of `radiance`, which is indirect light only; the probes keep it
+  // apart as the real-time path's direct sky and emitter light.
+  glm::vec3 emitted{0.0f};
 };
 
 // Traces one probe ray. At a hit that is not an emitter and faces the ray,
@@ -40,8 +44,14 @@ ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::rend
   using namespace engine;
   ProbeRayHit r;
   rt::Hit hit;
-  if (!scene.intersect(rt::Ray{origin, dir}, hit)) return r;
+  if (!scene.intersect(rt::Ray{origin, dir}, hit)) {
+    if (const scene::Environment* env = lights.environment()) r.emitted = env->radiance(dir);
+    if (!std::isfinite(r.emitted.r + r.emitted.g + r.emitted.b)) r.emitted = glm::vec3(0.0f);
+    return r;
+  }
   const render::Surface s = render::make_surface(scene, hit, dir);
+  r.emitted = s.emission;
+  if (!std::isfinite(r.emitted.r + r.emitted.g + r.emitted.b)) r.emitted = glm::vec3(0.0f);
   r.hit = true;
   r.back_face = s.back_face;
   r.distance = hit.t;

@@ -6,6 +6,7 @@
 #include "engine/ecs/entity.h"
 #include "engine/image/image.h"
 #include "probes/probe_field.h"
+#include "shading/realtime_direct.h"
 #include "shading/realtime_gi.h"
 
 namespace transgi::runtime {
@@ -37,6 +38,8 @@ struct GiFrame {
   std::uint64_t probe_frames = 0;
   // Real-time path only: decoded pixels, rotations and their times.
   shading::RealtimeGiStats realtime;
+  // Deterministic direct light only: its shadow rays.
+  shading::RealtimeDirectStats direct_stats;
 };
 
 }  // namespace transgi::runtime

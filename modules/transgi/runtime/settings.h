@@ -18,6 +18,19 @@ enum class GiPath {
   Realtime,
 };
 
+// How the direct light is rendered.
+enum class DirectLight {
+  // direct_spp next-event-estimation samples per pixel over every light,
+  // seeded per frame: the reference's estimator, noisy at a few samples.
+  Stochastic,
+  // Realtime path only (the quality path uses Stochastic): the sun split
+  // out of the environment and every punctual light with one shadow ray per
+  // pixel; the residual sky and emissive meshes from the probes' direct SH
+  // through the transfer. No seed, no noise; costs one packet shadow ray
+  // per light per pixel.
+  Deterministic,
+};
+
 struct TransGISettings {
   GiPath gi_path = GiPath::Quality;
   shading::RealtimeGiSettings realtime;  // read when gi_path is Realtime
@@ -32,6 +45,7 @@ struct TransGISettings {
   // area lights and environment). Higher = less direct-light noise, at the
   // cost of tracing time. 0 = GI only.
   int direct_spp = 4;
+  DirectLight direct_light = DirectLight::Stochastic;
   std::uint64_t seed = 0;
 };
 

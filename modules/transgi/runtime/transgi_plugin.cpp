@@ -8,6 +8,7 @@
 #include "engine/rt/rt_scene.h"
 #include "engine/scene/components.h"
 #include "engine/transform/transform.h"
+#include "shading/realtime_direct.h"
 #include "shading/realtime_gi.h"
 #include "shading/transfer_renderer.h"
 
@@ -45,6 +46,18 @@ void sync_probe_volumes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res
   seen->lights = lights->version;
 }
 
+bool deterministic_direct(const TransGISettings& s) {
+  return s.gi_path == GiPath::Realtime && s.direct_light == DirectLight::Deterministic;
+}
+
+// The light set splits the sun out of the sky when the direct light is
+// deterministic (it shades the sun with one shadow ray); the probes then
+// carry the residual sky.
+void request_light_settings(Res<TransGISettings> settings, ResMut<render::LightSettings> lights) {
+  const bool split = deterministic_direct(*settings);
+  if (lights->split_sun != split) lights->split_sun = split;
+}
+
 void update_probes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res<render::SceneLights> lights,
                    ResMut<GiFrame> frame) {
   probes::ProbeFrameStats total;
@@ -63,12 +76,11 @@ struct PackedDecoder {
   std::unique_ptr<shading::FusedDecoder> decoder;
 };
 
-// Realtime path: returns the GI image and fills the frame's stage times.
-image::ImageRGB render_gi_realtime(const render::CameraRays& rays, const std::shared_ptr<const model::TransferModel>& model,
-                                   const std::function<bool(Entity)>& has_transfer,
-                                   std::span<const probes::ProbeField* const> fields, const rt::RtScene& rt,
-                                   const scene::SceneAssets& assets, const TransGISettings& settings, PackedDecoder& packed,
-                                   GiFrame& frame) {
+// Realtime path: fills the frame's gi, direct and full images and its stage times.
+void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const model::TransferModel>& model,
+                     const std::function<bool(Entity)>& has_transfer, std::span<const probes::ProbeField* const> fields,
+                     const rt::RtScene& rt, const scene::SceneAssets& assets, const render::LightSet& lights,
+                     const TransGISettings& settings, std::uint64_t seed, PackedDecoder& packed, GiFrame& frame) {
   if (model && packed.model != model) {
     packed.decoder = std::make_unique<shading::FusedDecoder>(model->decoder);
     packed.model = model;
@@ -76,9 +88,11 @@ image::ImageRGB render_gi_realtime(const render::CameraRays& rays, const std::sh
   auto t0 = std::chrono::steady_clock::now();
   const shading::GBuffer g = shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height);
   frame.times.gbuffer = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  const bool deterministic = deterministic_direct(settings);
   shading::RealtimeGiStats st;
-  image::ImageRGB gi = shading::shade_gi_realtime(g, rt, assets, model.get(), model ? packed.decoder.get() : nullptr,
-                                                  has_transfer, fields, settings.realtime, &st);
+  image::ImageRGB probe_direct;
+  frame.gi = shading::shade_gi_realtime(g, rt, assets, model.get(), model ? packed.decoder.get() : nullptr, has_transfer, fields,
+                                        settings.realtime, &st, deterministic ? &probe_direct : nullptr);
   GiStageTimes& t = frame.times;
   t.network_input = 0;  // inside the fused kernel, counted as inference
   t.inference = st.inference_ms;
@@ -87,18 +101,17 @@ image::ImageRGB render_gi_realtime(const render::CameraRays& rays, const std::sh
   frame.shaded_samples = st.grid_samples + st.edge_samples;
   frame.inferred_samples = st.inferred;
   frame.realtime = st;
-  return gi;
-}
 
-// direct = the light set's direct light; full = gi + direct.
-void add_direct_light(const rt::RtScene& rt, const render::LightSet& lights, const render::CameraRays& rays,
-                      const TransGISettings& settings, std::uint64_t seed, GiFrame& frame) {
-  const auto t0 = std::chrono::steady_clock::now();
-  frame.direct = settings.direct_spp > 0
-                     ? render::render_direct_light(rt, lights, rays, frame.width, frame.height, settings.direct_spp, seed)
-                     : image::ImageRGB(frame.width, frame.height);
-  frame.times.direct =
-      settings.direct_spp > 0 ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() : 0.0;
+  t0 = std::chrono::steady_clock::now();
+  if (deterministic) {
+    frame.direct = shading::shade_direct_realtime(g, rt, lights, rays, &frame.direct_stats);
+    for (std::size_t i = 0; i < frame.direct.size(); ++i) frame.direct.pixels[i] += probe_direct.pixels[i];
+  } else {
+    frame.direct = settings.direct_spp > 0
+                       ? render::render_direct_light(rt, lights, rays, frame.width, frame.height, settings.direct_spp, seed)
+                       : image::ImageRGB(frame.width, frame.height);
+  }
+  t.direct = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   frame.full = frame.gi;
   for (std::size_t i = 0; i < frame.full.size(); ++i) frame.full.pixels[i] += frame.direct.pixels[i];
 }
@@ -129,11 +142,10 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
     return l && model && l->model == model;
   };
   if (settings->gi_path == GiPath::Realtime) {
-    frame->gi = render_gi_realtime(*rays, model, rs.has_transfer, fields, *rt, *assets, *settings, *packed, *frame);
+    render_realtime(*rays, model, rs.has_transfer, fields, *rt, *assets, lights->set, *settings, rs.seed, *packed, *frame);
     frame->times.collect_points = frame->probe_stats.scatter_ms;
     frame->times.probe_raster = frame->probe_stats.raster_ms;
     frame->times.probe_projection = frame->probe_stats.project_ms;
-    add_direct_light(*rt, lights->set, *rays, *settings, rs.seed, *frame);
     return;
   }
   // The volume holding the point (the first one, if none does).
@@ -167,7 +179,13 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
   frame->shaded_samples = r.shaded_samples;
   frame->inferred_samples = r.inferred_samples;
   frame->gi = r.image;
-  add_direct_light(*rt, lights->set, *rays, *settings, rs.seed, *frame);
+  const auto t0 = std::chrono::steady_clock::now();
+  frame->direct = settings->direct_spp > 0 ? render::render_direct_light(*rt, lights->set, *rays, frame->width, frame->height,
+                                                                         settings->direct_spp, rs.seed)
+                                           : image::ImageRGB(frame->width, frame->height);
+  t.direct = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  frame->full = frame->gi;
+  for (std::size_t i = 0; i < frame->full.size(); ++i) frame->full.pixels[i] += frame->direct.pixels[i];
 }
 
 }  // namespace
@@ -177,6 +195,7 @@ TransGISettings realtime_preset() {
   s.gi_path = GiPath::Realtime;
   s.gbuffer_spp = 1;
   s.probes.update_budget = 128;  // a quarter of the 8^3 grid per frame
+  s.direct_light = DirectLight::Deterministic;
   return s;
 }
 
@@ -187,6 +206,7 @@ void TransGIPlugin::build(app::App& app) {
   ecs::World& w = app.world();
   if (!w.has_resource<TransGISettings>()) w.insert_resource<TransGISettings>(settings_);
   if (!w.has_resource<GiFrame>()) w.insert_resource<GiFrame>();
+  app.add_system(Phase::PostUpdate, "transgi::request_light_settings", request_light_settings);
   app.add_system(Phase::PrepareRender, "transgi::sync_probe_volumes", sync_probe_volumes);
   app.add_system(Phase::Render, "transgi::update_probes", update_probes);
   app.add_system(Phase::Render, "transgi::render_gi", render_gi);

@@ -114,12 +114,14 @@ FusedDecoder::FusedDecoder(const model::Mlp& mlp, FusedIsa isa) : layout_(mlp.la
   for (int l = 0; l < layout_.layer_count(); ++l) layers_.push_back(pack_layer(mlp, l, lane, group, avx512 && l > 0));
 }
 
-void FusedDecoder::shade_tile(const float* inputs, const float* light, int n, float* rgb) const {
+void FusedDecoder::shade_tile(const float* inputs, const float* light, int n, float* rgb, const float* light2,
+                              float* rgb2) const {
+  if (!light2 || !rgb2) light2 = nullptr, rgb2 = nullptr;
   if (n <= 0) return;
   if (n > kFusedTile) throw std::invalid_argument("FusedDecoder::shade_tile: more than kFusedTile points");
   switch (isa_) {
-    case FusedIsa::Avx512Bf16: detail::shade_tile_avx512bf16(layers_, layout_.inputs, inputs, light, n, rgb); return;
-    case FusedIsa::Avx2: detail::shade_tile_avx2(layers_, layout_.inputs, inputs, light, n, rgb); return;
+    case FusedIsa::Avx512Bf16: detail::shade_tile_avx512bf16(layers_, layout_.inputs, inputs, light, n, rgb, light2, rgb2); return;
+    case FusedIsa::Avx2: detail::shade_tile_avx2(layers_, layout_.inputs, inputs, light, n, rgb, light2, rgb2); return;
     case FusedIsa::Scalar: break;
   }
   // Plain fp32 loops, one point at a time.
@@ -138,11 +140,13 @@ void FusedDecoder::shade_tile(const float* inputs, const float* light, int n, fl
       }
       x.swap(y);
     }
-    const float* li = light + static_cast<std::size_t>(i) * 75;
-    for (int c = 0; c < 3; ++c) {
-      float s = 0;
-      for (int k = 0; k < 25; ++k) s += x[static_cast<std::size_t>(c * 25 + k)] * li[c * 25 + k];
-      rgb[i * 3 + c] = s;
+    for (int which = 0; which < (light2 ? 2 : 1); ++which) {
+      const float* li = (which ? light2 : light) + static_cast<std::size_t>(i) * 75;
+      for (int c = 0; c < 3; ++c) {
+        float s = 0;
+        for (int k = 0; k < 25; ++k) s += x[static_cast<std::size_t>(c * 25 + k)] * li[c * 25 + k];
+        (which ? rgb2 : rgb)[i * 3 + c] = s;
+      }
     }
   }
 }

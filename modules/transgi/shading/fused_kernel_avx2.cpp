@@ -19,7 +19,9 @@ constexpr int kRows = 2;
 struct Tile {
   alignas(32) float act[2][kFusedTile * kMaxWidth];  // act[0] also holds the inputs
   alignas(32) float light[kFusedTile * kLightPadded];
-  float rgb[kFusedTile * 3];
+  alignas(32) float light2[kFusedTile * kLightPadded];
+  float rgb[kFusedTile * 3], rgb2[kFusedTile * 3];
+  bool two_lights = false;
 };
 
 TRANSGI_AVX2 inline void dot_light(__m256 y, const float* light, int o, float* rgb) {
@@ -59,6 +61,7 @@ TRANSGI_AVX2 void layer_group(const PackedLayer& L, int o0, Tile& t, int src, in
         const int o = o0 + j * kLanes;
         if (output) {
           dot_light(acc[p][j], t.light + (r0 + p) * kLightPadded, o, t.rgb + (r0 + p) * 3);
+          if (t.two_lights) dot_light(acc[p][j], t.light2 + (r0 + p) * kLightPadded, o, t.rgb2 + (r0 + p) * 3);
         } else {
           const __m256 v = L.relu ? _mm256_max_ps(acc[p][j], _mm256_setzero_ps()) : acc[p][j];
           _mm256_storeu_ps(t.act[1 - src] + (r0 + p) * kMaxWidth + o, v);
@@ -81,26 +84,32 @@ TRANSGI_AVX2 void run_layer(const PackedLayer& L, Tile& t, int src, int rows, bo
 }  // namespace
 
 TRANSGI_AVX2 void shade_tile_avx2(const std::vector<PackedLayer>& layers, int inputs, const float* x, const float* light,
-                                  int n, float* rgb) {
+                                  int n, float* rgb, const float* light2, float* rgb2) {
   thread_local Tile t;
+  t.two_lights = light2 && rgb2;
   const int rows = (n + kRows - 1) / kRows * kRows;
   // Rows are independent: the padding rows past n are zeroed only so that
   // they compute finite values, which are dropped at the end.
   std::fill_n(t.rgb, rows * 3, 0.0f);
+  std::fill_n(t.rgb2, rows * 3, 0.0f);
   for (int i = 0; i < rows; ++i) {
     float* in = t.act[0] + i * kMaxWidth;
     float* l = t.light + i * kLightPadded;
+    float* l2 = t.light2 + i * kLightPadded;
     if (i < n) {
       std::copy_n(x + static_cast<std::size_t>(i) * inputs, inputs, in);
       std::copy_n(light + static_cast<std::size_t>(i) * 75, 75, l);
+      if (t.two_lights) std::copy_n(light2 + static_cast<std::size_t>(i) * 75, 75, l2);
     } else {
       std::fill_n(in, inputs, 0.0f);
     }
     std::fill(l + (i < n ? 75 : 0), l + kLightPadded, 0.0f);
+    if (t.two_lights) std::fill(l2 + (i < n ? 75 : 0), l2 + kLightPadded, 0.0f);
   }
   int src = 0;
   for (std::size_t l = 0; l < layers.size(); ++l, src = 1 - src) run_layer(layers[l], t, src, rows, l + 1 == layers.size());
   std::copy_n(t.rgb, n * 3, rgb);
+  if (t.two_lights) std::copy_n(t.rgb2, n * 3, rgb2);
 }
 
 }  // namespace transgi::shading::detail

@@ -31,8 +31,10 @@ constexpr int kRowMultiple = 16;  // every kRowsFor divides it
 struct Tile {
   alignas(64) float input[kFusedTile * kMaxInputs];
   alignas(64) float light[kFusedTile * kLightPadded];
+  alignas(64) float light2[kFusedTile * kLightPadded];
   alignas(64) std::uint16_t act[2][kFusedTile * kMaxWidth];
-  float rgb[kFusedTile * 3];
+  float rgb[kFusedTile * 3], rgb2[kFusedTile * 3];
+  bool two_lights = false;
 };
 
 TRANSGI_AVX512BF16 inline __m512bh broadcast_pair(const std::uint16_t* p) {
@@ -120,10 +122,12 @@ TRANSGI_AVX512BF16 void bf16_layer_group(const PackedLayer& L, int o0, Tile& t, 
 #pragma GCC unroll 16
       for (int j = 0; j < NB; ++j) {
         const int o = o0 + j * kLanes;
-        if constexpr (kOutput)
+        if constexpr (kOutput) {
           dot_light(acc[p][j], t.light + (r0 + p) * kLightPadded, o, t.rgb + (r0 + p) * 3);
-        else
+          if (t.two_lights) dot_light(acc[p][j], t.light2 + (r0 + p) * kLightPadded, o, t.rgb2 + (r0 + p) * 3);
+        } else {
           store_bf16(t.act[1 - src] + (r0 + p) * kMaxWidth + o, acc[p][j], L.relu);
+        }
       }
   }
 }
@@ -162,17 +166,24 @@ struct OutputLayer {
 }  // namespace
 
 TRANSGI_AVX512BF16 void shade_tile_avx512bf16(const std::vector<PackedLayer>& layers, int inputs, const float* x,
-                                              const float* light, int n, float* rgb) {
+                                              const float* light, int n, float* rgb, const float* light2, float* rgb2) {
   thread_local Tile t;
+  t.two_lights = light2 && rgb2;
   const int rows = (n + kRowMultiple - 1) / kRowMultiple * kRowMultiple;
   // Rows are independent: the padding rows past n are zeroed only so that
   // they compute finite values, which are dropped at the end.
   std::fill(t.input + n * kMaxInputs, t.input + rows * kMaxInputs, 0.0f);
   std::fill_n(t.rgb, rows * 3, 0.0f);
+  std::fill_n(t.rgb2, rows * 3, 0.0f);
   for (int i = 0; i < rows; ++i) {
     float* l = t.light + i * kLightPadded;
     if (i < n) std::copy_n(light + static_cast<std::size_t>(i) * 75, 75, l);
     std::fill(l + (i < n ? 75 : 0), l + kLightPadded, 0.0f);
+    if (t.two_lights) {
+      float* l2 = t.light2 + i * kLightPadded;
+      if (i < n) std::copy_n(light2 + static_cast<std::size_t>(i) * 75, 75, l2);
+      std::fill(l2 + (i < n ? 75 : 0), l2 + kLightPadded, 0.0f);
+    }
     if (i < n) std::copy_n(x + static_cast<std::size_t>(i) * inputs, inputs, t.input + i * kMaxInputs);
   }
   for_each_group<FirstLayer>(layers.front(), t, rows);
@@ -180,6 +191,7 @@ TRANSGI_AVX512BF16 void shade_tile_avx512bf16(const std::vector<PackedLayer>& la
   for (std::size_t l = 1; l + 1 < layers.size(); ++l, src = 1 - src) for_each_group<HiddenLayer>(layers[l], t, src, rows);
   for_each_group<OutputLayer>(layers.back(), t, src, rows);
   std::copy_n(t.rgb, n * 3, rgb);
+  if (t.two_lights) std::copy_n(t.rgb2, n * 3, rgb2);
 }
 
 }  // namespace transgi::shading::detail

@@ -15,9 +15,10 @@ inline constexpr int kLightPadded = 80;  // 75 SH values, padded to whole vector
 inline constexpr int kGroupAvx512 = 64;
 inline constexpr int kGroupAvx2 = 32;
 
+// light2 / rgb2 may be null (one light).
 void shade_tile_avx512bf16(const std::vector<PackedLayer>& layers, int inputs, const float* x, const float* light, int n,
-                           float* rgb);
+                           float* rgb, const float* light2, float* rgb2);
 void shade_tile_avx2(const std::vector<PackedLayer>& layers, int inputs, const float* x, const float* light, int n,
-                     float* rgb);
+                     float* rgb, const float* light2, float* rgb2);
 
 }  // namespace transgi::shading::detail

@@ -8,13 +8,20 @@ namespace transgi::shading {
 
 GSample trace_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                       const engine::rt::Ray& ray, const engine::scene::Environment* background) {
+  engine::rt::Hit hit;
+  const bool found = scene.intersect(ray, hit);
+  return make_gsample(scene, assets, ray, found ? &hit : nullptr, background);
+}
+
+GSample make_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
+                     const engine::rt::Ray& ray, const engine::rt::Hit* found, const engine::scene::Environment* background) {
   using namespace engine;
   GSample out;
-  rt::Hit hit;
-  if (!scene.intersect(ray, hit)) {
+  if (!found) {
     if (background) out.background = background->radiance(ray.direction);
     return out;
   }
+  const rt::Hit& hit = *found;
   const rt::InstanceRecord& inst = *scene.instance_of(hit.entity);
   const scene::MeshAsset& mesh = *assets.meshes[hit.mesh];
   const glm::uvec3 t = mesh.triangles[hit.primitive];
@@ -32,11 +39,17 @@ GSample trace_gsample(const engine::rt::RtScene& scene, const engine::scene::Sce
   out.bary = hit.barycentric;
   out.normal_obj = nobj;
   out.wo_obj = wo;
-  const material::BrdfParams brdf = render::evaluate_material(assets, mesh.triangle_material[hit.primitive], uv);
-  out.albedo = brdf.base_color;  // the network's input
-  out.diffuse = material::diffuse_albedo(brdf);
+  const std::uint32_t material = mesh.triangle_material[hit.primitive];
+  out.brdf = render::evaluate_material(assets, material, uv);
+  out.albedo = out.brdf.base_color;  // the network's input
+  out.diffuse = material::diffuse_albedo(out.brdf);
+  out.emission = render::evaluate_emission(assets, material, uv);
   out.position = ray.origin + hit.t * ray.direction;
   out.normal_world = glm::normalize(inst.to_world.apply_direction(nobj));
+  out.wo_world = glm::normalize(-ray.direction);
+  glm::vec3 ng = glm::cross(mesh.positions[t.y] - mesh.positions[t.x], mesh.positions[t.z] - mesh.positions[t.x]);
+  ng = glm::length(ng) > 0 ? glm::normalize(inst.to_world.apply_direction(glm::normalize(ng))) : out.normal_world;
+  out.geometric_normal = glm::dot(ng, out.wo_world) < 0 ? -ng : ng;
   out.depth = hit.t;
   return out;
 }

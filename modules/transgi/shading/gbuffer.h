@@ -3,6 +3,7 @@
 // shading needs (object-space normal and view for the network, world-space
 // position and normal for the probes, depth for edge-aware upsampling).
 // Shared by the batched transfer renderer and the real-time GI path.
+#include "engine/material/brdf.h"
 #include "engine/rt/rt_scene.h"
 #include "engine/scene/environment.h"
 
@@ -15,6 +16,11 @@ struct GSample {
   glm::vec2 bary{0.0f};
   glm::vec3 normal_obj{0.0f}, wo_obj{0.0f}, albedo{0.0f}, diffuse{0.0f}, background{0.0f};
   glm::vec3 position{0.0f}, normal_world{0.0f};
+  // For direct light: the full material, what the surface emits, the world
+  // geometric normal facing the viewer (shadow-ray offsets) and the unit
+  // direction back to the camera.
+  engine::material::BrdfParams brdf;
+  glm::vec3 emission{0.0f}, geometric_normal{0.0f}, wo_world{0.0f};
   float depth = 0.0f;  // distance along the camera ray
 };
 
@@ -23,5 +29,9 @@ struct GSample {
 // are two-sided).
 GSample trace_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                       const engine::rt::Ray& ray, const engine::scene::Environment* background);
+// The sample for a hit found elsewhere (a packet query); `hit` may be null
+// for a miss.
+GSample make_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
+                     const engine::rt::Ray& ray, const engine::rt::Hit* hit, const engine::scene::Environment* background);
 
 }  // namespace transgi::shading

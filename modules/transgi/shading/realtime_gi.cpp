@@ -114,12 +114,12 @@ class RotatedProbes {
     return it->second;
   }
   void rotate_all() {
-    copies_.assign(rotations_.size() * fields_.size(), {});
+    copies_.assign(rotations_.size() * fields_.size() * 2, {});
     engine::jobs::parallel_for<std::size_t>(0, copies_.size(), 1, [&](std::size_t b, std::size_t e) {
       for (std::size_t c = b; c < e; ++c) {
-        const std::size_t r = c / fields_.size(), f = c % fields_.size();
+        const std::size_t r = c / (2 * fields_.size()), f = c / 2 % fields_.size();
         const engine::math::ShRotation rot(glm::transpose(glm::mat3_cast(rotations_[r])));
-        const std::vector<float>& src = fields_[f]->light_sh_all();
+        const std::vector<float>& src = c % 2 ? fields_[f]->direct_sh_all() : fields_[f]->light_sh_all();
         std::vector<float>& dst = copies_[c];
         dst.resize(src.size());
         for (std::size_t probe = 0; probe < src.size() / 75; ++probe)
@@ -127,11 +127,12 @@ class RotatedProbes {
       }
     });
   }
-  // The SH array of field f as seen in rotation r's frame.
-  [[nodiscard]] const float* sh(int r, const probes::ProbeField* f) const {
-    if (r < 0) return f->light_sh_all().data();
+  // The indirect (direct = false) or direct SH array of field f as seen in
+  // rotation r's frame.
+  [[nodiscard]] const float* sh(int r, const probes::ProbeField* f, bool direct = false) const {
+    if (r < 0) return (direct ? f->direct_sh_all() : f->light_sh_all()).data();
     for (std::size_t i = 0; i < fields_.size(); ++i)
-      if (fields_[i] == f) return copies_[static_cast<std::size_t>(r) * fields_.size() + i].data();
+      if (fields_[i] == f) return copies_[(static_cast<std::size_t>(r) * fields_.size() + i) * 2 + (direct ? 1 : 0)].data();
     return nullptr;
   }
   [[nodiscard]] std::size_t count() const { return rotations_.size(); }
@@ -151,11 +152,25 @@ GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::Sce
   g.width = width;
   g.height = height;
   g.samples.resize(static_cast<std::size_t>(width) * height);
-  engine::jobs::parallel_for(0, height, 4, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < width; ++x)
-        g.samples[static_cast<std::size_t>(y) * width + x] =
-            trace_gsample(scene, assets, camera.generate({static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f}), nullptr);
+  // 4x4 pixel tiles as one Embree packet: neighbouring camera rays share
+  // their traversal.
+  const int tiles_x = (width + 3) / 4, tiles_y = (height + 3) / 4;
+  engine::jobs::parallel_for(0, tiles_x * tiles_y, 16, [&](int t0, int t1) {
+    engine::rt::Ray rays[16];
+    engine::rt::Hit hits[16];
+    bool found[16];
+    std::size_t pixel[16];
+    for (int t = t0; t < t1; ++t) {
+      const int tx = t % tiles_x * 4, ty = t / tiles_x * 4;
+      int n = 0;
+      for (int y = ty; y < std::min(ty + 4, height); ++y)
+        for (int x = tx; x < std::min(tx + 4, width); ++x, ++n) {
+          rays[n] = camera.generate({static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f});
+          pixel[n] = static_cast<std::size_t>(y) * width + x;
+        }
+      scene.intersect16(rays, n, hits, found);
+      for (int i = 0; i < n; ++i) g.samples[pixel[i]] = make_gsample(scene, assets, rays[i], found[i] ? &hits[i] : nullptr, nullptr);
+    }
   });
   return g;
 }
@@ -165,9 +180,11 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
                                           const FusedDecoder* decoder,
                                           const std::function<bool(engine::ecs::Entity)>& has_transfer,
                                           std::span<const probes::ProbeField* const> fields,
-                                          const RealtimeGiSettings& settings, RealtimeGiStats* stats_out) {
+                                          const RealtimeGiSettings& settings, RealtimeGiStats* stats_out,
+                                          engine::image::ImageRGB* direct_out) {
   RealtimeGiStats stats;
   engine::image::ImageRGB image(g.width, g.height);
+  if (direct_out) *direct_out = engine::image::ImageRGB(g.width, g.height);
   if (fields.empty() || g.samples.empty()) {
     if (stats_out) *stats_out = stats;
     return image;
@@ -217,52 +234,70 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   stats.rotate_ms = ms_since(t0);
 
   // Light per decoded sample: object-space SH for the network, irradiance
-  // for the diffuse fallback.
+  // for the diffuse fallback; the probes' indirect light and, if asked, their
+  // direct sky and emitter light, with one set of interpolation weights.
   t0 = Clock::now();
-  std::vector<glm::vec3> value(decode.size(), glm::vec3(0.0f));
-  std::vector<float> light(net.size() * 75);
+  const bool with_direct = direct_out != nullptr;
+  std::vector<glm::vec3> value(decode.size(), glm::vec3(0.0f)), value_direct(with_direct ? decode.size() : 0, glm::vec3(0.0f));
+  std::vector<float> light(net.size() * 75), light_direct(with_direct ? net.size() * 75 : 0);
   std::vector<TransferQuery> queries(net.size());
   engine::jobs::parallel_for<std::size_t>(0, net.size(), 256, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       const GSample& s = g.samples[decode[net[k]]];
       const probes::ProbeField* f = field_at(fields, s.position);
-      f->interpolate(s.position, s.normal_world, rotated.sh(rotation_of[k], f), light.data() + k * 75);
+      if (with_direct)
+        f->interpolate(s.position, s.normal_world, rotated.sh(rotation_of[k], f), light.data() + k * 75,
+                       rotated.sh(rotation_of[k], f, true), light_direct.data() + k * 75);
+      else
+        f->interpolate(s.position, s.normal_world, rotated.sh(rotation_of[k], f), light.data() + k * 75);
       queries[k] = {s.mesh, s.triangle, s.bary, s.albedo, s.normal_obj, s.wo_obj};
     }
   });
   engine::jobs::parallel_for<std::size_t>(0, diffuse.size(), 256, [&](std::size_t b, std::size_t e) {
-    float world[75];
+    float world[75], world_direct[75];
     for (std::size_t k = b; k < e; ++k) {
       const GSample& s = g.samples[decode[diffuse[k]]];
-      field_at(fields, s.position)->interpolate(s.position, s.normal_world, world);
+      const probes::ProbeField* f = field_at(fields, s.position);
+      f->interpolate(s.position, s.normal_world, f->light_sh_all().data(), world, f->direct_sh_all().data(), world_direct);
       value[diffuse[k]] = s.diffuse * engine::math::kInvPi * sh_irradiance(world, s.normal_world);
+      if (with_direct) value_direct[diffuse[k]] = s.diffuse * engine::math::kInvPi * sh_irradiance(world_direct, s.normal_world);
     }
   });
   stats.light_ms = ms_since(t0);
 
   t0 = Clock::now();
   if (!net.empty()) {
-    std::vector<glm::vec3> shaded(net.size());
-    shade_transfer_fused(*decoder, *model, assets, queries, light.data(), shaded.data());
+    std::vector<glm::vec3> shaded(net.size()), shaded_direct(with_direct ? net.size() : 0);
+    shade_transfer_fused(*decoder, *model, assets, queries, light.data(), shaded.data(),
+                         with_direct ? light_direct.data() : nullptr, with_direct ? shaded_direct.data() : nullptr);
     for (std::size_t k = 0; k < net.size(); ++k) value[net[k]] = shaded[k];
+    if (with_direct)
+      for (std::size_t k = 0; k < net.size(); ++k) value_direct[net[k]] = shaded_direct[k];
   }
   stats.inference_ms = ms_since(t0);
   stats.inferred = net.size();
   stats.diffuse = diffuse.size();
 
   t0 = Clock::now();
+  if (with_direct) *direct_out = engine::image::ImageRGB(g.width, g.height);
   engine::jobs::parallel_for<std::size_t>(0, g.samples.size(), 4096, [&](std::size_t b, std::size_t e) {
     for (std::size_t p = b; p < e; ++p) {
       if (!g.samples[p].hit) continue;
       const Upsampling::Taps& t = up.taps[p];
       if (t.own) {
         image.pixels[p] = value[slot_of_pixel[p]];
+        if (with_direct) direct_out->pixels[p] = value_direct[slot_of_pixel[p]];
         continue;
       }
-      glm::vec3 sum(0.0f);
-      for (std::size_t k = 0; k < 4; ++k)
-        if (t.weight[k] > 0) sum += t.weight[k] * value[slot_of_pixel[up.cell_pixel[t.cell[k]]]];
+      glm::vec3 sum(0.0f), sum_direct(0.0f);
+      for (std::size_t k = 0; k < 4; ++k) {
+        if (!(t.weight[k] > 0)) continue;
+        const std::size_t slot = slot_of_pixel[up.cell_pixel[t.cell[k]]];
+        sum += t.weight[k] * value[slot];
+        if (with_direct) sum_direct += t.weight[k] * value_direct[slot];
+      }
       image.pixels[p] = sum;
+      if (with_direct) direct_out->pixels[p] = sum_direct;
     }
   });
   stats.upsample_ms = plan_ms + ms_since(t0);

@@ -69,12 +69,16 @@ struct RealtimeGiStats {
 // The GI image (output size = g's) from the probes of `fields` (a point
 // takes the first field whose grid holds it, else the first). Entities for
 // which has_transfer is false, or all of them if model is null, are shaded
-// diffusely: albedo / pi x irradiance.
+// diffusely: albedo / pi x irradiance. With direct_out, the probes' direct
+// sky and emitter light goes through the same transfer (or irradiance) and
+// upsampling into it: the real-time direct light from everything but
+// punctual lights and the split sun (see realtime_direct.h).
 engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
                                           const engine::scene::SceneAssets& assets, const model::TransferModel* model,
                                           const FusedDecoder* decoder,
                                           const std::function<bool(engine::ecs::Entity)>& has_transfer,
                                           std::span<const probes::ProbeField* const> fields,
-                                          const RealtimeGiSettings& settings, RealtimeGiStats* stats = nullptr);
+                                          const RealtimeGiSettings& settings, RealtimeGiStats* stats = nullptr,
+                                          engine::image::ImageRGB* direct_out = nullptr);
 
 }  // namespace transgi::shading

@@ -49,7 +49,7 @@ InferenceTimings infer_transfer(const model::TransferModel& model, const engine:
 
 void shade_transfer_fused(const FusedDecoder& decoder, const model::TransferModel& model,
                           const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
-                          const float* light, glm::vec3* out) {
+                          const float* light, glm::vec3* out, const float* light2, glm::vec3* out2) {
   const int in_size = decoder.layout().inputs;
   const std::size_t tiles = (queries.size() + kFusedTile - 1) / kFusedTile;
   engine::jobs::parallel_for<std::size_t>(0, tiles, 4, [&](std::size_t tb, std::size_t te) {
@@ -62,7 +62,8 @@ void shade_transfer_fused(const FusedDecoder& decoder, const model::TransferMode
         model.meshes[q.mesh].latents.interpolate(*assets.meshes[q.mesh], q.triangle, q.barycentric, z.data());
         model::assemble_input(z.data(), model.latent_dim, q.albedo, q.normal, q.wo, inputs.data() + (i - b) * static_cast<std::size_t>(in_size));
       }
-      decoder.shade_tile(inputs.data(), light + b * 75, static_cast<int>(e - b), &out[b].x);
+      decoder.shade_tile(inputs.data(), light + b * 75, static_cast<int>(e - b), &out[b].x,
+                         light2 && out2 ? light2 + b * 75 : nullptr, light2 && out2 ? &out2[b].x : nullptr);
     }
   });
 }

@@ -32,10 +32,11 @@ InferenceTimings infer_transfer(const model::TransferModel& model, const engine:
 // interpolates the latents, builds the inputs and runs decoder.shade_tile,
 // which dots the decoded transfer with each query's object-space SH light
 // (light: queries.size() x 75) without storing it. Tiles run in parallel on
-// the job system. out: one RGB radiance per query.
+// the job system. out: one RGB radiance per query. With light2 and out2,
+// the same transfer is also dotted with a second light into out2.
 void shade_transfer_fused(const FusedDecoder& decoder, const model::TransferModel& model,
                           const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
-                          const float* light, glm::vec3* out);
+                          const float* light, glm::vec3* out, const float* light2 = nullptr, glm::vec3* out2 = nullptr);
 
 // The same for one point: latent interpolation, input assembly and every
 // layer as scalar loops (no GEMM library, no threads).

@@ -1,0 +1,86 @@
+#include "shading/realtime_direct.h"
+
+#include <atomic>
+#include <cmath>
+
+#include "engine/jobs/parallel_for.h"
+#include "engine/math/sampling.h"
+
+namespace transgi::shading {
+
+glm::vec2 disk_pattern(int x, int y) {
+  // Index in the 8x8 block in bit-reversed order, so neighbouring pixels
+  // take far-apart points of the sequence.
+  const unsigned i = static_cast<unsigned>((x & 7) | ((y & 7) << 3));
+  unsigned r = 0;
+  for (int b = 0; b < 6; ++b) r |= ((i >> b) & 1u) << (5 - b);
+  const float a1 = 0.7548776662f, a2 = 0.5698402910f;  // R2: 1 / plastic number, its square
+  const float k = static_cast<float>(r);
+  return {std::fmod(0.5f + a1 * k, 1.0f), std::fmod(0.5f + a2 * k, 1.0f)};
+}
+
+engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
+                                              const engine::render::LightSet& lights,
+                                              const engine::render::CameraRays& camera, RealtimeDirectStats* stats) {
+  using namespace engine;
+  image::ImageRGB out(g.width, g.height);
+  const std::size_t n_lights = lights.punctual_count();
+  const scene::Environment* background = lights.background();
+  std::atomic<std::size_t> rays_traced{0};
+  const int tiles_x = (g.width + 3) / 4, tiles_y = (g.height + 3) / 4;
+  jobs::parallel_for(0, tiles_x * tiles_y, 16, [&](int t0, int t1) {
+    rt::Ray rays[16];
+    bool blocked[16];
+    std::size_t pixel[16];
+    glm::vec3 contribution[16];
+    std::size_t traced = 0;
+    for (int t = t0; t < t1; ++t) {
+      const int tx = t % tiles_x * 4, ty = t / tiles_x * 4;
+      // Emission and background first.
+      for (int y = ty; y < std::min(ty + 4, g.height); ++y)
+        for (int x = tx; x < std::min(tx + 4, g.width); ++x) {
+          const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
+          const GSample& s = g.samples[p];
+          if (s.hit)
+            out.pixels[p] = s.emission;
+          else if (background)
+            out.pixels[p] = background->radiance(camera.generate({static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f}).direction);
+        }
+      for (std::size_t l = 0; l < n_lights; ++l) {
+        int n = 0;
+        for (int y = ty; y < std::min(ty + 4, g.height); ++y)
+          for (int x = tx; x < std::min(tx + 4, g.width); ++x) {
+            const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
+            const GSample& s = g.samples[p];
+            if (!s.hit) continue;
+            render::LightSample ls;
+            if (!lights.sample_punctual(l, s.position, disk_pattern(x, y), ls)) continue;
+            if (glm::dot(ls.direction, s.geometric_normal) <= 0) continue;
+            const math::Frame frame = math::Frame::from_normal(s.normal_world);
+            const glm::vec3 wo = frame.to_local(s.wo_world), wi = frame.to_local(ls.direction);
+            if (wo.z <= 0 || wi.z <= 0) continue;
+            const glm::vec3 c = material::brdf_eval(s.brdf, wo, wi) * wi.z * ls.radiance;
+            if (!(c.r > 0 || c.g > 0 || c.b > 0)) continue;
+            const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
+            rays[n] = rt::Ray{rt::offset_ray_origin(s.position, s.geometric_normal), ls.direction, 0.0f, tmax};
+            pixel[n] = p;
+            contribution[n] = c;
+            ++n;
+          }
+        if (n == 0) continue;
+        scene.occluded16(rays, n, blocked);
+        traced += static_cast<std::size_t>(n);
+        for (int i = 0; i < n; ++i)
+          if (!blocked[i]) out.pixels[pixel[i]] += contribution[i];
+      }
+    }
+    rays_traced.fetch_add(traced, std::memory_order_relaxed);
+  });
+  if (stats) {
+    stats->shadow_rays = rays_traced.load();
+    stats->lights = n_lights;
+  }
+  return out;
+}
+
+}  // namespace transgi::shading

@@ -1,0 +1,34 @@
+#pragma once
+// Deterministic real-time direct light (issue 10, item 6), from the G-buffer:
+//  - emission the camera sees, and the background (with its sun disk) where
+//    camera rays escape;
+//  - every punctual light, the sun split out of the environment included,
+//    with one shadow ray per light per pixel, traced as 4x4-pixel Embree
+//    packets. A sun with a disk takes its direction per pixel from a fixed
+//    8x8 pattern over the disk (no seed, no frame index), so its penumbra is
+//    a stable dither, not noise.
+// The rest of the direct light, the residual sky and emissive meshes, comes
+// from the probes' direct SH through the transfer (shade_gi_realtime's
+// direct_out). The reference is the path tracer's direct pass.
+#include "engine/image/image.h"
+#include "engine/render/camera_rays.h"
+#include "engine/render/light_set.h"
+#include "shading/realtime_gi.h"
+
+namespace transgi::shading {
+
+struct RealtimeDirectStats {
+  std::size_t shadow_rays = 0;
+  std::size_t lights = 0;  // punctual lights shaded (the split sun included)
+};
+
+engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
+                                              const engine::render::LightSet& lights,
+                                              const engine::render::CameraRays& camera,
+                                              RealtimeDirectStats* stats = nullptr);
+
+// The fixed point on [0, 1)^2 that pixel (x, y) uses for disk lights: an
+// R2 low-discrepancy sequence over each 8x8 block.
+glm::vec2 disk_pattern(int x, int y);
+
+}  // namespace transgi::shading
