@@ -69,7 +69,7 @@ ecs::Entity pick_moving_object(ecs::World& world, const std::string& name) {
 int run_bench_frame(const std::vector<std::string>& argv) {
   const Args args("bench-frame", argv,
                   {"scene", "model", "width", "height", "frames", "warmup", "preset", "csv", "object", "threads", "camera",
-                   "direct-spp", "gi-scale", "probe-budget"});
+                   "direct-spp", "gi-scale", "probe-budget", "direct"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const int width = static_cast<int>(args.integer("width", 16, 8192, 640));
   const int height = static_cast<int>(args.integer("height", 16, 8192, 360));
@@ -87,6 +87,10 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   settings.direct_spp = static_cast<int>(args.integer("direct-spp", 0, 100000, settings.direct_spp));
   settings.realtime.resolution_scale = static_cast<float>(args.number("gi-scale", 0.05, 1.0, settings.realtime.resolution_scale));
   settings.probes.update_budget = static_cast<int>(args.integer("probe-budget", 0, 1 << 20, settings.probes.update_budget));
+  if (args.has("direct"))
+    settings.direct_light = args.choice("direct", {"deterministic", "stochastic"}, "stochastic") == "deterministic"
+                                ? runtime::DirectLight::Deterministic
+                                : runtime::DirectLight::Stochastic;
   scene.app->add_plugin<runtime::TransGIPlugin>(settings);
   runtime::attach_latent_meshes(world, std::make_shared<const model::TransferModel>(std::move(model)));
   world.emplace<runtime::ProbeVolume>(world.spawn(), runtime::ProbeVolume{});

@@ -117,6 +117,10 @@ int render_transgi(const Args& args, eval::LoadedScene& scene, int width, int he
                                                                                        : runtime::quality_preset();
   t.settings.realtime.resolution_scale = static_cast<float>(args.number("gi-scale", 0.05, 1.0, t.settings.realtime.resolution_scale));
   t.settings.probes.update_budget = static_cast<int>(args.integer("probe-budget", 0, 1 << 20, t.settings.probes.update_budget));
+  if (args.has("direct"))
+    t.settings.direct_light = args.choice("direct", {"deterministic", "stochastic"}, "stochastic") == "deterministic"
+                                  ? runtime::DirectLight::Deterministic
+                                  : runtime::DirectLight::Stochastic;
   t.settings.gbuffer_spp = static_cast<int>(args.integer("spp", 1, 4096, 1));
   t.settings.seed = static_cast<std::uint64_t>(args.integer("seed", 0, INT64_MAX, 0));
   t.settings.direct_spp = o.pass == "gi" ? 0 : static_cast<int>(args.integer("direct-spp", 1, 100000, 16));
@@ -198,7 +202,7 @@ int run_render(const std::vector<std::string>& argv) {
   const Args args("render", argv,
                   {"scene", "method", "pass", "spp", "width", "height", "out", "camera", "seed", "threads", "png", "exposure",
                    "model", "transfer", "gt-rays", "coefficient-maps", "lighting", "frames", "probe-grid", "probe-rays",
-                   "direct-spp", "probe-skip", "sharing", "no-latent", "timing-frames", "map-width", "hysteresis", "irradiance-gamma", "warmup-frames", "brightness-threshold", "preset", "gi-scale", "probe-budget"});
+                   "direct-spp", "probe-skip", "sharing", "no-latent", "timing-frames", "map-width", "hysteresis", "irradiance-gamma", "warmup-frames", "brightness-threshold", "preset", "gi-scale", "probe-budget", "direct"});
   const std::string scene_path = args.str("scene");
   const std::string method = args.choice("method", {"reference", "transgi", "ddgi"}, "reference");
   Outputs o;

@@ -14,7 +14,7 @@ void usage() {
                "  render   --scene S.gltf --method reference --pass full|direct|gi|all --spp N --width W --height H\n"
                "           --out F.exr [--camera NAME] [--seed K] [--threads T] [--png F.png] [--exposure EV]\n"
                "  render   --scene S.gltf --method transgi --model M.tgm [--lighting probes|environment] [--frames F]\n"
-               "           [--pass gi|direct|full] [--probe-grid N] [--probe-rays M] [--direct-spp N]\n"
+               "           [--pass gi|direct|full] [--probe-grid N] [--probe-rays M] [--direct-spp N] [--direct deterministic|stochastic]\n"
                "           [--transfer network|ground-truth] [--gt-rays N] [--coefficient-maps PREFIX] ...\n"
                "  compare  A.exr B.exr [--heatmap out.png] [--heatmap-max E]\n"
                "  tonemap  IN.exr OUT.png [--exposure EV] [--signed SCALE] [--minus B.exr]\n"

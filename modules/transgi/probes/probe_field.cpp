@@ -111,8 +111,9 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   ProbeFrameStats stats;
   const ProbeGrid& grid = settings_.grid;
   const int probes = grid.count(), M = settings_.rays_per_probe;
-  math::Pcg32 frame_rng = math::make_rng(settings_.seed, 0xF00D, frame_);
-  const glm::quat rotation = random_rotation(frame_rng);
+  const std::uint64_t seed = settings_.fixed_pattern ? 0x5EEDu : settings_.seed;
+  math::Pcg32 frame_rng = math::make_rng(seed, 0xF00D, frame_);
+  const glm::quat rotation = settings_.fixed_pattern ? low_discrepancy_rotation(frame_) : random_rotation(frame_rng);
   const bool classify = settings_.skip.classify && classify_pending_;
   stats.classified = classify;
   // A classification frame traces every probe, as buried and far probes may
@@ -140,7 +141,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
       auto& out = points[static_cast<std::size_t>(q)];
       out.reserve(static_cast<std::size_t>(M));
       for (int i = 0; i < M; ++i) {
-        math::Pcg32 rng = math::make_rng(settings_.seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
+        math::Pcg32 rng = math::make_rng(seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
         const glm::vec3 dir = glm::normalize(rotation * fibonacci_[static_cast<std::size_t>(i)]);
         const ProbeRayHit h = trace_probe_ray(scene, lights, origin, dir, rng, [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3&) {
           // Indirect light from last frame's probes (multi-bounce feedback).

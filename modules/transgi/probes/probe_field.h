@@ -90,6 +90,13 @@ struct ProbeFieldSettings {
   // Hanning window on the direct sky and emitter SH. On = no ringing around
   // small bright emitters, at the cost of a blurrier sky.
   bool direct_window = true;
+  // Fixed patterns instead of seeded randomness: ray sets rotate by a Halton
+  // sequence of rotations and hit sampling ignores `seed`, so the probes
+  // (and a real-time image) are a function of the scene and the frame count
+  // alone. On = no seed-to-seed difference and evenly spread rotations, at
+  // the cost of estimates that are not independent across seeds (eval's
+  // seed studies use off).
+  bool fixed_pattern = false;
   std::uint64_t seed = 1;
 
   bool operator==(const ProbeFieldSettings&) const = default;

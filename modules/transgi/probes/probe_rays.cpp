@@ -18,10 +18,28 @@ std::vector<glm::vec3> spherical_fibonacci(int n) {
   return d;
 }
 
-glm::quat random_rotation(engine::math::Pcg32& rng) {
-  const float u1 = rng.next_float(), u2 = engine::math::kTwoPi * rng.next_float(), u3 = engine::math::kTwoPi * rng.next_float();
+namespace {
+// Shoemake's uniform rotation from a point of the unit cube.
+glm::quat rotation_from_cube(float u1, float v2, float v3) {
+  const float u2 = engine::math::kTwoPi * v2, u3 = engine::math::kTwoPi * v3;
   const float a = std::sqrt(1 - u1), b = std::sqrt(u1);
   return glm::normalize(glm::quat(b * std::cos(u3), a * std::sin(u2), a * std::cos(u2), b * std::sin(u3)));
+}
+
+float radical_inverse(std::uint64_t i, std::uint64_t base) {
+  double inv = 1.0 / static_cast<double>(base), f = inv, r = 0;
+  for (; i > 0; i /= base, f *= inv) r += static_cast<double>(i % base) * f;
+  return static_cast<float>(r);
+}
+}  // namespace
+
+glm::quat random_rotation(engine::math::Pcg32& rng) {
+  const float u1 = rng.next_float(), u2 = rng.next_float(), u3 = rng.next_float();
+  return rotation_from_cube(u1, u2, u3);
+}
+
+glm::quat low_discrepancy_rotation(std::uint64_t index) {
+  return rotation_from_cube(radical_inverse(index + 1, 2), radical_inverse(index + 1, 3), radical_inverse(index + 1, 5));
 }
 
 }  // namespace transgi::probes

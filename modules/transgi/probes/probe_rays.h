@@ -19,6 +19,9 @@ namespace transgi::probes {
 std::vector<glm::vec3> spherical_fibonacci(int n);
 // A uniformly random rotation (Shoemake 1992), new every frame.
 glm::quat random_rotation(engine::math::Pcg32& rng);
+// The index-th rotation of a Halton (2, 3, 5) sequence through Shoemake's
+// map: rotations that cover SO(3) evenly frame after frame, with no seed.
+glm::quat low_discrepancy_rotation(std::uint64_t index);
 
 struct ProbeRayHit {
   bool hit = false;
