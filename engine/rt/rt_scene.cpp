@@ -323,7 +323,7 @@ void RtScene::occluded16(const Ray* rays, int n, bool* blocked) const {
   fill16(r, rays, std::min(n, 16), valid, rejected_);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
   rtcOccluded16(valid, impl_->top, &ctx, &r);
   for (int i = 0; i < std::min(n, 16); ++i) blocked[i] = valid[i] && r.tfar[i] < 0.0f;
 }

@@ -70,10 +70,12 @@ void update_probes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res<rend
 
 using CameraView = View<Get<const scene::Camera, const WorldTransform>>;
 
-// The decoder packed for the fused kernel, repacked only when the model changes.
+// The decoder packed for the fused kernel, repacked only when the model
+// changes, and the G-buffer storage kept from frame to frame.
 struct PackedDecoder {
   std::shared_ptr<const model::TransferModel> model;
   std::unique_ptr<shading::FusedDecoder> decoder;
+  shading::GBuffer gbuffer;
 };
 
 // Realtime path: fills the frame's gi, direct and full images and its stage times.
@@ -86,7 +88,8 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
     packed.model = model;
   }
   auto t0 = std::chrono::steady_clock::now();
-  const shading::GBuffer g = shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height);
+  shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, packed.gbuffer);
+  const shading::GBuffer& g = packed.gbuffer;
   frame.times.gbuffer = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const bool deterministic = deterministic_direct(settings);
   shading::RealtimeGiStats st;

@@ -149,6 +149,12 @@ class RotatedProbes {
 GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                       const engine::render::CameraRays& camera, int width, int height) {
   GBuffer g;
+  trace_gbuffer(scene, assets, camera, width, height, g);
+  return g;
+}
+
+void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
+                   const engine::render::CameraRays& camera, int width, int height, GBuffer& g) {
   g.width = width;
   g.height = height;
   g.samples.resize(static_cast<std::size_t>(width) * height);
@@ -172,7 +178,6 @@ GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::Sce
       for (int i = 0; i < n; ++i) g.samples[pixel[i]] = make_gsample(scene, assets, rays[i], found[i] ? &hits[i] : nullptr, nullptr);
     }
   });
-  return g;
 }
 
 engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::RtScene& scene,

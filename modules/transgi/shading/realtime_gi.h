@@ -55,6 +55,10 @@ struct GBuffer {
 // One ray through each pixel centre, in parallel over rows.
 GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                       const engine::render::CameraRays& camera, int width, int height);
+// The same into `g`, reusing its storage (a frame loop keeps one G-buffer:
+// 230,400 samples are tens of MB to fault in afresh every frame).
+void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
+                   const engine::render::CameraRays& camera, int width, int height, GBuffer& g);
 
 struct RealtimeGiStats {
   double rotate_ms = 0;     // probe SH into moved objects' frames
