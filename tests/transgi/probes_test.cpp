@@ -4,6 +4,7 @@
 // stopping a leak through a wall, and unsampled texels never read as black.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -22,6 +23,35 @@ TEST(RadianceMap, SolidAnglesSumToTheSphereAndTexelsRoundTrip) {
     ASSERT_EQ(m.texel_of(m.direction_of(t)), t) << "texel " << t;
   }
   EXPECT_NEAR(total, 4 * engine::math::kPi, 1e-9);
+}
+
+TEST(RadianceMap, FastTexelLookupMatchesTheReferenceAwayFromBorders) {
+  // texel_of uses polynomial atan2/acos; texel_of_reference the library
+  // ones. They may disagree only for directions within 1e-4 rad of a texel
+  // border; the polynomials themselves stay within 2e-5 rad.
+  const MapLayout m;
+  engine::math::Pcg32 rng(5, 3);
+  int disagree = 0, near_border = 0;
+  double worst_atan = 0, worst_acos = 0;
+  const int n = 200000;
+  for (int i = 0; i < n; ++i) {
+    glm::vec3 d = engine::math::sample_uniform_sphere({rng.next_float(), rng.next_float()});
+    if (i < 16) d = glm::vec3(i & 1 ? -1.0f : 1.0f, 0, 0) * (i < 8 ? 1.0f : 0.0f) + glm::vec3(0, i >= 8 ? (i & 1 ? -1.0f : 1.0f) : 0.0f, 0);
+    // Modulo 2 pi: at the branch cut +pi and -pi are the same angle (and texel).
+    worst_atan = std::max(worst_atan, std::abs(std::remainder(static_cast<double>(fast_atan2(d.x, -d.z)) - std::atan2(d.x, -d.z), 2 * M_PI)));
+    worst_acos = std::max(worst_acos, static_cast<double>(std::abs(fast_acos(d.y) - std::acos(std::clamp(d.y, -1.0f, 1.0f)))));
+    const int fast = m.texel_of(d), ref = m.texel_of_reference(d);
+    if (fast == ref) continue;
+    ++disagree;
+    const float u = (std::atan2(d.x, -d.z) / engine::math::kTwoPi + 1.0f) * m.width, v = std::acos(d.y) / engine::math::kPi * m.height;
+    const float du = std::abs(u - std::round(u)) * engine::math::kTwoPi / m.width, dv = std::abs(v - std::round(v)) * engine::math::kPi / m.height;
+    near_border += std::min(du, dv) < 1e-4f;
+  }
+  EXPECT_LT(worst_atan, 2e-5) << "polynomial atan2 error";
+  EXPECT_LT(worst_acos, 2e-5) << "polynomial acos error";
+  EXPECT_EQ(disagree, near_border) << "every disagreement must be within 1e-4 rad of a border; " << disagree << " of " << n
+                                   << " differ, " << near_border << " of them at a border";
+  EXPECT_LT(disagree, n / 1000);
 }
 
 TEST(RadianceMap, ConstantMapProjectsToBandZeroOnly) {

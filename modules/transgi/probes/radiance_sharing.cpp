@@ -9,13 +9,15 @@ namespace transgi::probes {
 
 SharingStats rasterize_shared(const ProbeGrid& grid, const MapLayout& layout,
                               const std::vector<std::vector<ShadedPoint>>& points, const std::vector<const DepthMap*>& own_depth,
-                              const SharingSettings& s, std::vector<FrameSamples>& out) {
+                              const SharingSettings& s, std::vector<FrameSamples>& out,
+                              std::span<const std::uint8_t> targets) {
   const int n = grid.count();
   out.resize(static_cast<std::size_t>(n));
   std::atomic<std::size_t> accepted{0}, rejected{0};
   engine::jobs::parallel_for(0, n, 8, [&](int b, int e) {
     std::size_t acc = 0, rej = 0;
     for (int p = b; p < e; ++p) {
+      if (!targets.empty() && !targets[static_cast<std::size_t>(p)]) continue;
       FrameSamples& fs = out[static_cast<std::size_t>(p)];
       fs.reset(layout.texel_count());
       const glm::vec3 origin = grid.position(p);

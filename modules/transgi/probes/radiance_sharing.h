@@ -13,6 +13,8 @@
 // hit first. With the depth guard on, such a point is rejected when its
 // distance exceeds the target's own mean hit distance in that texel by more
 // than the tolerance. SharingMode::PaperFaithful keeps every point (ablation).
+#include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -62,8 +64,11 @@ struct SharingStats {
 // points[q] are probe q's shaded points this frame; own_depth[q] points to
 // probe q's depth (read, not copied: the maps are large). out[p] receives
 // probe p's frame samples. Escaped rays add a zero sample to their own probe only.
+// targets[p] == 0 skips probe p (left empty: a budgeted frame does not update
+// it); empty targets = every probe.
 SharingStats rasterize_shared(const ProbeGrid& grid, const MapLayout& layout,
                               const std::vector<std::vector<ShadedPoint>>& points, const std::vector<const DepthMap*>& own_depth,
-                              const SharingSettings& settings, std::vector<FrameSamples>& out);
+                              const SharingSettings& settings, std::vector<FrameSamples>& out,
+                              std::span<const std::uint8_t> targets = {});
 
 }  // namespace transgi::probes

@@ -76,6 +76,7 @@ struct PackedDecoder {
   std::shared_ptr<const model::TransferModel> model;
   std::unique_ptr<shading::FusedDecoder> decoder;
   shading::GBuffer gbuffer;
+  shading::RealtimeGiScratch scratch;
 };
 
 // Realtime path: fills the frame's gi, direct and full images and its stage times.
@@ -95,7 +96,7 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   shading::RealtimeGiStats st;
   image::ImageRGB probe_direct;
   frame.gi = shading::shade_gi_realtime(g, rt, assets, model.get(), model ? packed.decoder.get() : nullptr, has_transfer, fields,
-                                        settings.realtime, &st, deterministic ? &probe_direct : nullptr);
+                                        settings.realtime, &st, deterministic ? &probe_direct : nullptr, &packed.scratch);
   GiStageTimes& t = frame.times;
   t.network_input = 0;  // inside the fused kernel, counted as inference
   t.inference = st.inference_ms;

@@ -34,6 +34,22 @@ struct Upsampling {
   std::vector<Taps> taps;  // per pixel
 };
 
+}  // namespace
+
+struct RealtimeGiScratch::Impl {
+  Upsampling up;
+  std::vector<std::size_t> decode, slot_of_pixel;
+  std::vector<glm::vec3> value, value_direct, shaded, shaded_direct;
+  std::vector<float> light, light_direct;
+  std::vector<TransferQuery> queries;
+};
+RealtimeGiScratch::RealtimeGiScratch() : impl(std::make_unique<Impl>()) {}
+RealtimeGiScratch::~RealtimeGiScratch() = default;
+RealtimeGiScratch::RealtimeGiScratch(RealtimeGiScratch&&) noexcept = default;
+RealtimeGiScratch& RealtimeGiScratch::operator=(RealtimeGiScratch&&) noexcept = default;
+
+namespace {
+
 float similarity(const GSample& p, const GSample& q, const RealtimeGiSettings& s) {
   if (!q.hit) return 0.0f;
   if (!s.edge_aware) return 1.0f;
@@ -45,8 +61,7 @@ float similarity(const GSample& p, const GSample& q, const RealtimeGiSettings& s
   return depth * normal;
 }
 
-Upsampling plan_upsampling(const GBuffer& g, const RealtimeGiSettings& s) {
-  Upsampling u;
+void plan_upsampling(const GBuffer& g, const RealtimeGiSettings& s, Upsampling& u) {
   const float scale = std::clamp(s.resolution_scale, 1e-3f, 1.0f);
   u.grid_w = std::max(1, static_cast<int>(std::lround(static_cast<float>(g.width) * scale)));
   u.grid_h = std::max(1, static_cast<int>(std::lround(static_cast<float>(g.height) * scale)));
@@ -65,8 +80,9 @@ Upsampling plan_upsampling(const GBuffer& g, const RealtimeGiSettings& s) {
       for (int x = 0; x < g.width; ++x) {
         const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
         const GSample& sp = g.samples[p];
-        if (!sp.hit) continue;
         Upsampling::Taps& t = u.taps[p];
+        t = Upsampling::Taps{};  // storage is reused across frames
+        if (!sp.hit) continue;
         // Position in cell coordinates, cell centres at integers.
         const float fx = (static_cast<float>(x) + 0.5f) / sx - 0.5f, fy = (static_cast<float>(y) + 0.5f) / sy - 0.5f;
         const int i0 = static_cast<int>(std::floor(fx)), j0 = static_cast<int>(std::floor(fy));
@@ -88,7 +104,6 @@ Upsampling plan_upsampling(const GBuffer& g, const RealtimeGiSettings& s) {
         }
       }
   });
-  return u;
 }
 
 const probes::ProbeField* field_at(std::span<const probes::ProbeField* const> fields, const glm::vec3& p) {
@@ -186,7 +201,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
                                           const std::function<bool(engine::ecs::Entity)>& has_transfer,
                                           std::span<const probes::ProbeField* const> fields,
                                           const RealtimeGiSettings& settings, RealtimeGiStats* stats_out,
-                                          engine::image::ImageRGB* direct_out) {
+                                          engine::image::ImageRGB* direct_out, RealtimeGiScratch* scratch) {
   RealtimeGiStats stats;
   engine::image::ImageRGB image(g.width, g.height);
   if (direct_out) *direct_out = engine::image::ImageRGB(g.width, g.height);
@@ -195,11 +210,16 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     return image;
   }
   auto t0 = Clock::now();
-  const Upsampling up = plan_upsampling(g, settings);
+  RealtimeGiScratch local;
+  RealtimeGiScratch::Impl& sc = *(scratch ? scratch : &local)->impl;
+  plan_upsampling(g, settings, sc.up);
+  const Upsampling& up = sc.up;
 
   // The pixels to decode: grid cells that hit, then pixels on their own.
-  std::vector<std::size_t> decode;
-  std::vector<std::size_t> slot_of_pixel(g.samples.size(), kNone);
+  std::vector<std::size_t>& decode = sc.decode;
+  decode.clear();
+  std::vector<std::size_t>& slot_of_pixel = sc.slot_of_pixel;
+  slot_of_pixel.assign(g.samples.size(), kNone);
   auto want = [&](std::size_t p) {
     if (slot_of_pixel[p] != kNone || !g.samples[p].hit) return;
     slot_of_pixel[p] = decode.size();
@@ -243,9 +263,17 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   // direct sky and emitter light, with one set of interpolation weights.
   t0 = Clock::now();
   const bool with_direct = direct_out != nullptr;
-  std::vector<glm::vec3> value(decode.size(), glm::vec3(0.0f)), value_direct(with_direct ? decode.size() : 0, glm::vec3(0.0f));
-  std::vector<float> light(net.size() * 75), light_direct(with_direct ? net.size() * 75 : 0);
-  std::vector<TransferQuery> queries(net.size());
+  // Every entry below is written before it is read: resize, never refill.
+  std::vector<glm::vec3>& value = sc.value;
+  std::vector<glm::vec3>& value_direct = sc.value_direct;
+  std::vector<float>& light = sc.light;
+  std::vector<float>& light_direct = sc.light_direct;
+  std::vector<TransferQuery>& queries = sc.queries;
+  value.resize(decode.size());
+  value_direct.resize(with_direct ? decode.size() : 0);
+  light.resize(net.size() * 75);
+  light_direct.resize(with_direct ? net.size() * 75 : 0);
+  queries.resize(net.size());
   engine::jobs::parallel_for<std::size_t>(0, net.size(), 256, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       const GSample& s = g.samples[decode[net[k]]];
@@ -272,7 +300,10 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
 
   t0 = Clock::now();
   if (!net.empty()) {
-    std::vector<glm::vec3> shaded(net.size()), shaded_direct(with_direct ? net.size() : 0);
+    std::vector<glm::vec3>& shaded = sc.shaded;
+    std::vector<glm::vec3>& shaded_direct = sc.shaded_direct;
+    shaded.resize(net.size());
+    shaded_direct.resize(with_direct ? net.size() : 0);
     shade_transfer_fused(*decoder, *model, assets, queries, light.data(), shaded.data(),
                          with_direct ? light_direct.data() : nullptr, with_direct ? shaded_direct.data() : nullptr);
     for (std::size_t k = 0; k < net.size(); ++k) value[net[k]] = shaded[k];

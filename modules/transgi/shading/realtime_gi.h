@@ -13,6 +13,7 @@
 // The reference for it is render_transfer (every pixel decoded, per-pixel
 // rotation, batched inference); tests compare the two.
 #include <functional>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -60,6 +61,17 @@ GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::Sce
 void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                    const engine::render::CameraRays& camera, int width, int height, GBuffer& g);
 
+// Buffers the real-time path keeps from frame to frame: at 640x360 they are
+// tens of MB that would otherwise be faulted in and zeroed every frame.
+struct RealtimeGiScratch {
+  struct Impl;
+  std::unique_ptr<Impl> impl;
+  RealtimeGiScratch();
+  ~RealtimeGiScratch();
+  RealtimeGiScratch(RealtimeGiScratch&&) noexcept;
+  RealtimeGiScratch& operator=(RealtimeGiScratch&&) noexcept;
+};
+
 struct RealtimeGiStats {
   double rotate_ms = 0;     // probe SH into moved objects' frames
   double light_ms = 0;      // probe interpolation per decoded pixel
@@ -83,6 +95,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
                                           const std::function<bool(engine::ecs::Entity)>& has_transfer,
                                           std::span<const probes::ProbeField* const> fields,
                                           const RealtimeGiSettings& settings, RealtimeGiStats* stats = nullptr,
-                                          engine::image::ImageRGB* direct_out = nullptr);
+                                          engine::image::ImageRGB* direct_out = nullptr,
+                                          RealtimeGiScratch* scratch = nullptr);
 
 }  // namespace transgi::shading
