@@ -111,9 +111,12 @@ std::vector<glm::vec3> filled_radiance(const ProbeMapState& st, const MapLayout&
   std::vector<glm::vec3> r = st.radiance;
   std::vector<float> known = st.sampled;
   const int w = layout.width, h = layout.height;
+  // Each pass fills the holes next to known texels from the state before the
+  // pass (a Jacobi step): fills are collected, then applied, so only the
+  // holes are touched instead of copying both maps every pass.
+  std::vector<std::pair<std::size_t, glm::vec3>> fills;
   for (int pass = 0; pass < passes; ++pass) {
-    std::vector<glm::vec3> next = r;
-    std::vector<float> next_known = known;
+    fills.clear();
     bool any_missing = false;
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
@@ -132,15 +135,15 @@ std::vector<glm::vec3> filled_radiance(const ProbeMapState& st, const MapLayout&
               ++n;
             }
           }
-        if (n > 0) {
-          next[t] = sum / static_cast<float>(n);
-          next_known[t] = 1.0f;
-        } else {
+        if (n > 0)
+          fills.emplace_back(t, sum / static_cast<float>(n));
+        else
           any_missing = true;
-        }
       }
-    r.swap(next);
-    known.swap(next_known);
+    for (const auto& [t, value] : fills) {
+      r[t] = value;
+      known[t] = 1.0f;
+    }
     if (!any_missing) return r;
   }
   // What dilation could not reach gets the mean of everything known.

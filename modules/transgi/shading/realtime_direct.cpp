@@ -1,6 +1,8 @@
 #include "shading/realtime_direct.h"
 
+#include <array>
 #include <atomic>
+#include <vector>
 #include <cmath>
 
 #include "engine/jobs/parallel_for.h"
@@ -27,6 +29,15 @@ engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt
   const std::size_t n_lights = lights.punctual_count();
   const scene::Environment* background = lights.background();
   std::atomic<std::size_t> rays_traced{0};
+  // A directional light's sample does not depend on the point: its 64
+  // pattern directions are computed once per frame, not per pixel.
+  std::vector<std::array<render::LightSample, 64>> directional(n_lights);
+  std::vector<std::uint8_t> is_directional(n_lights, 0);
+  for (std::size_t l = 0; l < n_lights; ++l) {
+    if (lights.punctual_lights()[l].light.type != scene::PunctualLight::Type::Directional) continue;
+    is_directional[l] = 1;
+    for (int i = 0; i < 64; ++i) lights.sample_punctual(l, glm::vec3(0.0f), disk_pattern(i & 7, i >> 3), directional[l][static_cast<std::size_t>(i)]);
+  }
   const int tiles_x = (g.width + 3) / 4, tiles_y = (g.height + 3) / 4;
   jobs::parallel_for(0, tiles_x * tiles_y, 16, [&](int t0, int t1) {
     rt::Ray rays[16];
@@ -54,7 +65,10 @@ engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt
             const GSample& s = g.samples[p];
             if (!s.hit) continue;
             render::LightSample ls;
-            if (!lights.sample_punctual(l, s.position, disk_pattern(x, y), ls)) continue;
+            if (is_directional[l])
+              ls = directional[l][static_cast<std::size_t>((x & 7) | ((y & 7) << 3))];
+            else if (!lights.sample_punctual(l, s.position, disk_pattern(x, y), ls))
+              continue;
             if (glm::dot(ls.direction, s.geometric_normal) <= 0) continue;
             const math::Frame frame = math::Frame::from_normal(s.normal_world);
             const glm::vec3 wo = frame.to_local(s.wo_world), wi = frame.to_local(ls.direction);
