@@ -52,10 +52,9 @@ SpecularAlbedo integrate(float mu, float alpha) {
   return {static_cast<float>(a / n), static_cast<float>(b / n)};
 }
 
-const Tables& tables() {
-  static Tables t;
-  static std::once_flag once;
-  std::call_once(once, [] {
+Tables build_tables() {
+  Tables t;
+  {
     for (int j = 0; j < kAlphaSize; ++j) {
       for (int i = 0; i < kMuSize; ++i)
         t.directional[static_cast<std::size_t>(j * kMuSize + i)] = integrate(mu_at(i), alpha_at(j));
@@ -71,7 +70,15 @@ const Tables& tables() {
       }
       t.average[static_cast<std::size_t>(j)] = {static_cast<float>(avg_a), static_cast<float>(avg_b)};
     }
-  });
+  }
+  return t;
+}
+
+// Built on first use. A function-local static costs one guard load per call;
+// std::call_once cost about 1 % of a real-time frame (one call per BRDF
+// evaluation).
+const Tables& tables() {
+  static const Tables t = build_tables();
   return t;
 }
 
