@@ -1,5 +1,7 @@
 #include "eval/method_runs.h"
 
+#include "engine/render/light_plugin.h"
+
 #include <algorithm>
 #include <array>
 #include <cstdio>
@@ -137,6 +139,17 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
   std::snprintf(line, sizeof(line), "%d^3 probes, %d frames; last frame %d active, %d converged, %d buried, %d far; %.1f traced per frame",
                 o.probe_grid, o.frames, st.active, st.converged, st.buried, st.far, static_cast<double>(traced) / o.frames);
   r.probe_summary = line;
+  // Say when the sun was taken out of the sky: a user comparing direct
+  // light should know it is a directional light now.
+  const auto& lights = world.resource<render::SceneLights>();
+  if (lights.sun_split && lights.sun_split->sun) {
+    const scene::ExtractedSun& sun = *lights.sun_split->sun;
+    std::snprintf(line, sizeof(line), "; sun split out of the sky: direction (%.3f, %.3f, %.3f), %.1f deg radius, irradiance (%.3g, %.3g, %.3g) W/m^2",
+                  static_cast<double>(sun.direction.x), static_cast<double>(sun.direction.y), static_cast<double>(sun.direction.z),
+                  static_cast<double>(glm::degrees(sun.angular_radius)), static_cast<double>(sun.irradiance.r),
+                  static_cast<double>(sun.irradiance.g), static_cast<double>(sun.irradiance.b));
+    r.probe_summary += line;
+  }
   return r;
 }
 
