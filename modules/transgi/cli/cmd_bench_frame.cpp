@@ -12,6 +12,11 @@
 #include "cli/args.h"
 #include "cli/commands.h"
 #include "engine/core/progress.h"
+#include "engine/image/exr.h"
+#include "engine/render/camera_rays.h"
+#include "engine/render/light_plugin.h"
+#include "engine/render/path_tracer.h"
+#include "engine/rt/rt_scene.h"
 #include "engine/scene/components.h"
 #include "engine/transform/transform.h"
 #include "eval/machine_peak.h"
@@ -69,7 +74,7 @@ ecs::Entity pick_moving_object(ecs::World& world, const std::string& name) {
 int run_bench_frame(const std::vector<std::string>& argv) {
   const Args args("bench-frame", argv,
                   {"scene", "model", "width", "height", "frames", "warmup", "preset", "csv", "object", "threads", "camera",
-                   "direct-spp", "gi-scale", "probe-budget", "direct"});
+                   "direct-spp", "gi-scale", "probe-budget", "direct", "gi-out", "reference-out", "reference-spp"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const int width = static_cast<int>(args.integer("width", 16, 8192, 640));
   const int height = static_cast<int>(args.integer("height", 16, 8192, 360));
@@ -156,6 +161,30 @@ int run_bench_frame(const std::vector<std::string>& argv) {
               frame.realtime.grid_samples + frame.realtime.edge_samples, frame.realtime.grid_samples,
               frame.realtime.edge_samples, frame.realtime.rotations, frame.probe_stats.traced);
   if (!csv.empty()) std::printf("per-frame CSV: %s\n", csv.c_str());
+  std::printf("direct light, last frame: %zu shadow rays to %zu punctual lights\n", frame.direct_stats.shadow_rays,
+              frame.direct_stats.lights);
+
+  // Accuracy with the object moving: the last frame's GI, and the path
+  // tracer's GI pass of the scene exactly as it stands after that frame.
+  if (args.has("gi-out")) {
+    image::write_exr(args.str("gi-out"), frame.gi);
+    std::printf("GI of the last frame: %s\n", args.str("gi-out").c_str());
+  }
+  if (args.has("reference-out")) {
+    const int spp = static_cast<int>(args.integer("reference-spp", 1, 1 << 20, 1024));
+    const auto& assets = world.resource<scene::SceneAssets>();
+    // The map as it is (no sun split): the reference's own estimator.
+    const render::LightSet lights(world.resource<rt::RtScene>(), render::gather_punctual_lights(world),
+                                  assets.environment ? &*assets.environment : nullptr);
+    const render::CameraRays rays(world.get<scene::Camera>(scene.camera), world.get<transform::WorldTransform>(scene.camera),
+                                  width, height);
+    render::PathTracer pt(world.resource<rt::RtScene>(), lights, rays, width, height, render::PathTracerSettings{.seed = 1});
+    core::ProgressBar ref_bar("reference", static_cast<std::uint64_t>(spp), true);
+    scene.app->jobs().run([&] { pt.render(spp, [&](int done, int) { ref_bar.update(static_cast<std::uint64_t>(done)); }); });
+    ref_bar.finish();
+    image::write_exr(args.str("reference-out"), pt.image(render::Pass::Gi));
+    std::printf("reference GI pass of the moved scene (%d spp): %s\n", spp, args.str("reference-out").c_str());
+  }
   return 0;
 }
 
