@@ -54,6 +54,28 @@ TEST(RadianceMap, FastTexelLookupMatchesTheReferenceAwayFromBorders) {
   EXPECT_LT(disagree, n / 1000);
 }
 
+TEST(RadianceMap, VectorisedProjectionKeepsBandZeroExactOnARandomMap) {
+  // Band 0's texel integral is Y00 x the texel's solid angle exactly, so for
+  // any map out[0] = Y00 x sum(L x omega): the float row sums of the
+  // vectorised projection must hold that to float rounding (the old scalar
+  // loop summed in double).
+  const MapLayout m;
+  const MapProjector proj(m);
+  engine::math::Pcg32 rng(11, 4);
+  std::vector<glm::vec3> L(static_cast<std::size_t>(m.texel_count()));
+  double want[3] = {0, 0, 0};
+  const double y00 = 0.5 / std::sqrt(M_PI);
+  for (int t = 0; t < m.texel_count(); ++t) {
+    const float s = rng.next_float() < 0.1f ? 50.0f : 1.0f;  // a few bright texels, as a window gives
+    L[static_cast<std::size_t>(t)] = s * glm::vec3(rng.next_float(), rng.next_float(), rng.next_float());
+    for (int c = 0; c < 3; ++c) want[c] += y00 * L[static_cast<std::size_t>(t)][c] * m.solid_angle(t);
+  }
+  float out[75];
+  proj.project(L.data(), out);
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(out[c * 25], want[c], 2e-5 * want[c]) << "channel " << c << ": expected " << want[c] << ", got " << out[c * 25];
+}
+
 TEST(RadianceMap, ConstantMapProjectsToBandZeroOnly) {
   const MapLayout m;
   const MapProjector proj(m);
