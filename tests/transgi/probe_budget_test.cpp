@@ -57,3 +57,45 @@ TEST(ProbeBudget, ZeroBudgetUpdatesEveryActiveProbe) {
     for (int f = 0; f < 3; ++f) EXPECT_EQ(field.update(rt, lights).traced, 32);
   });
 }
+
+TEST(ProbeBudget, AChangedRegionIsUpdatedFirst) {
+  // 32 probes, budget 5: round-robin alone reaches a probe every 6-7
+  // frames. A change at one corner probe marks the 8 probes within a cell of
+  // it: the next two frames must trace exactly those, before any other.
+  FloorUnderSky s(0.5f);
+  const auto& assets = s.app.world().resource<scene::SceneAssets>();
+  const auto& rt = s.app.world().resource<rt::RtScene>();
+  const render::LightSet lights(rt, {}, &*assets.environment);
+  ProbeFieldSettings settings;
+  settings.grid = ProbeGrid{{-1, 0.5f, -1}, {1, 1.0f, 1}, {4, 2, 4}};
+  settings.map = MapLayout{32, 16};
+  settings.skip.skip_converged = false;
+  settings.update_budget = 5;
+  ProbeField field(settings);
+  const ProbeGrid& g = settings.grid;
+  auto near_corner = [&](int q) {
+    const glm::ivec3 c(q % 4, q / 4 % 2, q / 8);
+    return c.x >= 2 && c.z >= 2;  // within one cell of (3, *, 3); y spans both layers
+  };
+  s.app.jobs().run([&] {
+    for (int f = 0; f < 13; ++f) field.update(rt, lights);
+    const glm::vec3 p = g.position(g.index({3, 1, 3}));
+    field.notify_region_changed(p - glm::vec3(0.01f), p + glm::vec3(0.01f));
+    const std::uint64_t first = field.frame();
+    field.update(rt, lights);
+    field.update(rt, lights);
+    int traced_near = 0;
+    for (int q = 0; q < g.count(); ++q) {
+      const bool traced = field.last_traced(q) >= first;
+      if (near_corner(q)) {
+        EXPECT_TRUE(traced) << "probe " << q << " lies within a cell of the change and was not traced in 2 frames";
+        traced_near += traced;
+      } else if (traced) {
+        // 8 urgent probes, 10 budget slots: 2 go to the stalest others.
+        EXPECT_LT(field.last_traced(q), first + 2) << "probe " << q;
+      }
+    }
+    EXPECT_EQ(traced_near, 8);
+    // The first frame spends its whole budget on the region.
+  });
+}

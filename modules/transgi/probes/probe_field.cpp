@@ -103,18 +103,32 @@ void ProbeField::notify_scene_changed(bool geometry_moved) {
   }
 }
 
+void ProbeField::notify_region_changed(const glm::vec3& lo, const glm::vec3& hi) {
+  const ProbeGrid& grid = settings_.grid;
+  const glm::vec3 margin = grid.spacing();
+  urgent_.resize(states_.size(), 0);
+  for (int q = 0; q < grid.count(); ++q) {
+    const glm::vec3 p = grid.position(q);
+    if (glm::all(glm::greaterThanEqual(p, lo - margin)) && glm::all(glm::lessThanEqual(p, hi + margin)))
+      urgent_[static_cast<std::size_t>(q)] = 1;
+  }
+}
+
 void ProbeField::select_within_budget(std::vector<std::uint8_t>& traced) const {
-  // Candidates: active probes and those queued for classification; the
-  // stalest first, ties broken by a rotating offset (round-robin).
+  // Candidates: active probes and those queued for classification; those in
+  // a changed region first, then the stalest, ties broken by a rotating
+  // offset (round-robin).
   const std::size_t n = traced.size(), offset = frame_ * static_cast<std::size_t>(settings_.update_budget) % n;
-  std::vector<std::tuple<std::uint64_t, std::size_t, std::size_t>> order;  // (last traced, turn, probe)
+  std::vector<std::tuple<int, std::uint64_t, std::size_t, std::size_t>> order;  // (not urgent, last traced, turn, probe)
   for (std::size_t q = 0; q < n; ++q) {
     traced[q] = 0;
-    if (state_[q] == ProbeState::Active || needs_classify_[q]) order.emplace_back(last_traced_[q], (q + n - offset) % n, q);
+    const int not_urgent = q < urgent_.size() && urgent_[q] ? 0 : 1;
+    if (state_[q] == ProbeState::Active || needs_classify_[q])
+      order.emplace_back(not_urgent, last_traced_[q], (q + n - offset) % n, q);
   }
   const std::size_t k = std::min(order.size(), static_cast<std::size_t>(settings_.update_budget));
   std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(k), order.end());
-  for (std::size_t i = 0; i < k; ++i) traced[std::get<2>(order[i])] = 1;
+  for (std::size_t i = 0; i < k; ++i) traced[std::get<3>(order[i])] = 1;
 }
 
 ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights) {
@@ -185,7 +199,10 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   if (classify || budgeted) {
     const float far = settings_.skip.far_cells * glm::length(grid.spacing());
     for (std::size_t q = 0; q < state_.size(); ++q) {
-      if (traced[q]) last_traced_[q] = frame_;
+      if (traced[q]) {
+        last_traced_[q] = frame_;
+        if (q < urgent_.size()) urgent_[q] = 0;
+      }
       // Budgeted frames classify only the probes queued for it.
       if (!classify && !(traced[q] && needs_classify_[q])) continue;
       needs_classify_[q] = 0;

@@ -139,6 +139,10 @@ class ProbeField {
   // if the geometry moved the probes are classified again and their depth
   // re-converges quickly.
   void notify_scene_changed(bool geometry_moved);
+  // What changed lies in [min, max] (a moved object's old and new bounds):
+  // with a budget, the probes within one cell of it are updated before any
+  // other, so a moving object re-lights its neighbourhood first.
+  void notify_region_changed(const glm::vec3& min, const glm::vec3& max);
 
   // 75 SH coefficients of probe i, [c * 25 + k], world space.
   [[nodiscard]] const float* light_sh(int probe) const { return sh_.data() + static_cast<std::size_t>(probe) * 75; }
@@ -163,6 +167,10 @@ class ProbeField {
   [[nodiscard]] std::uint64_t frame() const { return frame_; }
   [[nodiscard]] const std::vector<ProbeMapState>& states() const { return states_; }
   [[nodiscard]] ProbeState state(int probe) const { return state_[static_cast<std::size_t>(probe)]; }
+  // The frame probe last traced rays (budgeted fields; 0 before it ever did).
+  [[nodiscard]] std::uint64_t last_traced(int probe) const {
+    return static_cast<std::size_t>(probe) < last_traced_.size() ? last_traced_[static_cast<std::size_t>(probe)] : 0;
+  }
   // Bytes held by the probes' maps, depth moments and SH.
   [[nodiscard]] std::size_t memory_bytes() const;
 
@@ -180,6 +188,7 @@ class ProbeField {
   // must be classified again when next traced.
   std::vector<std::uint64_t> last_traced_;
   std::vector<std::uint8_t> needs_classify_;
+  std::vector<std::uint8_t> urgent_;  // in a changed region, not yet traced since
   std::vector<float> sh_;  // probes x 75
   std::vector<float> direct_mean_, direct_sh_;  // probes x 75: running mean, and that windowed
   std::vector<std::uint32_t> direct_frames_;    // frames in each probe's running mean

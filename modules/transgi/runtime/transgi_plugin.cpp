@@ -1,6 +1,8 @@
 #include "runtime/transgi_plugin.h"
 
 #include <chrono>
+#include <limits>
+#include <unordered_map>
 
 #include "engine/render/camera_rays.h"
 #include "engine/render/light_plugin.h"
@@ -22,12 +24,45 @@ using transform::WorldTransform;
 
 struct SeenVersions {
   std::uint64_t lights = 0, geometry = 0;
+  // World bounds of every instance at the last sync, to find what moved.
+  std::unordered_map<Entity, std::pair<glm::vec3, glm::vec3>> bounds;
 };
+
+// The regions that changed since the last call: for every instance that
+// moved, appeared or went away, the union of its old and new world bounds.
+std::vector<std::pair<glm::vec3, glm::vec3>> changed_regions(const rt::RtScene& rt, SeenVersions& seen) {
+  std::vector<std::pair<glm::vec3, glm::vec3>> changed;
+  const scene::SceneAssets* assets = rt.assets();
+  if (!assets) return changed;
+  std::unordered_map<Entity, std::pair<glm::vec3, glm::vec3>> now;
+  rt.for_each_instance([&](const rt::InstanceRecord& inst) {
+    const scene::MeshAsset& mesh = *assets->meshes[inst.mesh];
+    glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-std::numeric_limits<float>::infinity());
+    for (int c = 0; c < 8; ++c) {
+      const glm::vec3 corner((c & 1) ? mesh.bounds_max.x : mesh.bounds_min.x, (c & 2) ? mesh.bounds_max.y : mesh.bounds_min.y,
+                             (c & 4) ? mesh.bounds_max.z : mesh.bounds_min.z);
+      const glm::vec3 w = inst.to_world.apply_point(corner);
+      lo = glm::min(lo, w);
+      hi = glm::max(hi, w);
+    }
+    now.emplace(inst.entity, std::make_pair(lo, hi));
+    auto it = seen.bounds.find(inst.entity);
+    if (it == seen.bounds.end())
+      changed.emplace_back(lo, hi);
+    else if (it->second.first != lo || it->second.second != hi)
+      changed.emplace_back(glm::min(lo, it->second.first), glm::max(hi, it->second.second));
+  });
+  for (const auto& [e, box] : seen.bounds)
+    if (!now.contains(e)) changed.push_back(box);
+  seen.bounds = std::move(now);
+  return changed;
+}
 
 void sync_probe_volumes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res<render::SceneLights> lights,
                         Res<TransGISettings> settings, Local<SeenVersions> seen) {
   const bool geometry_moved = lights->geometry_version != seen->geometry;
   const bool lighting_changed = lights->version != seen->lights;
+  const auto regions = geometry_moved ? changed_regions(*rt, *seen) : std::vector<std::pair<glm::vec3, glm::vec3>>{};
   volumes.each([&](ProbeVolume& v) {
     if (v.fits_scene()) {
       // Fitted once: a later move must not shift every probe (and reset them).
@@ -41,6 +76,7 @@ void sync_probe_volumes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res
       return;
     }
     if (geometry_moved || lighting_changed) v.field->notify_scene_changed(geometry_moved);
+    for (const auto& [lo, hi] : regions) v.field->notify_region_changed(lo, hi);
   });
   seen->geometry = lights->geometry_version;
   seen->lights = lights->version;
