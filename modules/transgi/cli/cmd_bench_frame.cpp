@@ -74,7 +74,7 @@ ecs::Entity pick_moving_object(ecs::World& world, const std::string& name) {
 int run_bench_frame(const std::vector<std::string>& argv) {
   const Args args("bench-frame", argv,
                   {"scene", "model", "width", "height", "frames", "warmup", "preset", "csv", "object", "threads", "camera",
-                   "direct-spp", "gi-scale", "probe-budget", "direct", "gi-out", "reference-out", "reference-spp"});
+                   "direct-spp", "gi-scale", "probe-budget", "direct", "gi-out", "reference-out", "reference-spp", "map-width"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const int width = static_cast<int>(args.integer("width", 16, 8192, 640));
   const int height = static_cast<int>(args.integer("height", 16, 8192, 360));
@@ -92,6 +92,8 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   settings.direct_spp = static_cast<int>(args.integer("direct-spp", 0, 100000, settings.direct_spp));
   settings.realtime.resolution_scale = static_cast<float>(args.number("gi-scale", 0.05, 1.0, settings.realtime.resolution_scale));
   settings.probes.update_budget = static_cast<int>(args.integer("probe-budget", 0, 1 << 20, settings.probes.update_budget));
+  settings.probes.map.width = static_cast<int>(args.integer("map-width", 4, 4096, settings.probes.map.width));
+  settings.probes.map.height = std::max(2, settings.probes.map.width / 2);
   if (args.has("direct"))
     settings.direct_light = args.choice("direct", {"deterministic", "stochastic"}, "stochastic") == "deterministic"
                                 ? runtime::DirectLight::Deterministic

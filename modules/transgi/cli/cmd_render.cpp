@@ -126,7 +126,7 @@ int render_transgi(const Args& args, eval::LoadedScene& scene, int width, int he
   t.settings.direct_spp = o.pass == "gi" ? 0 : static_cast<int>(args.integer("direct-spp", 1, 100000, 16));
   t.settings.probes.rays_per_probe = static_cast<int>(args.integer("probe-rays", 1, 100000, 100));
   t.settings.probes.seed = t.settings.seed + 1;
-  t.settings.probes.map.width = static_cast<int>(args.integer("map-width", 4, 4096, 100));
+  t.settings.probes.map.width = static_cast<int>(args.integer("map-width", 4, 4096, t.settings.probes.map.width));
   t.settings.probes.map.height = std::max(2, t.settings.probes.map.width / 2);
   const bool skip = args.choice("probe-skip", {"on", "off"}, "on") == "on";
   t.settings.probes.skip.classify = t.settings.probes.skip.skip_converged = skip;

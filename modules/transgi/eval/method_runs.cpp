@@ -139,6 +139,8 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
   std::snprintf(line, sizeof(line), "%d^3 probes, %d frames; last frame %d active, %d converged, %d buried, %d far; %.1f traced per frame",
                 o.probe_grid, o.frames, st.active, st.converged, st.buried, st.far, static_cast<double>(traced) / o.frames);
   r.probe_summary = line;
+  std::snprintf(line, sizeof(line), "; probe state %.1f MB", static_cast<double>(r.probe_bytes) / (1024.0 * 1024.0));
+  r.probe_summary += line;
   // Say when the sun was taken out of the sky: a user comparing direct
   // light should know it is a directional light now.
   const auto& lights = world.resource<render::SceneLights>();
