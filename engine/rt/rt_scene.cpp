@@ -263,9 +263,11 @@ bool RtScene::occluded(const Ray& ray) const {
 namespace {
 template <class Packet>
 void fill16(Packet& out, const Ray* rays, int n, int* valid, std::atomic<std::uint64_t>& rejected) {
-  // Inactive lanes repeat an active ray: Embree 3.13.5's packet traversal
-  // was seen to loop forever on a packet whose inactive lanes held a far-off
-  // default ray (tests/engine/rt_test.cpp keeps packets honest).
+  // Inactive lanes repeat an active ray, so their (ignored) data is a
+  // well-formed ray near the others. Suspected at first of causing a hang,
+  // it was not the cause (that was the coherent kernel, see intersect16); kept
+  // because it costs nothing. tests/engine/rt_test.cpp keeps packets equal to
+  // single rays.
   Ray filler{};
   for (int i = 0; i < n; ++i)
     if (valid_ray(rays[i])) {
@@ -303,7 +305,11 @@ void RtScene::intersect16(const Ray* rays, int n, Hit* hits, bool* found) const 
   }
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  // Not the coherent kernel: Embree 3.13.5's coherent packet traversal
+  // looped forever on one shadow packet of the sample level (occluded16);
+  // camera rays never hit it, but a hang is worse than the 1 ms (of 10) the
+  // coherent kernel saved on the level's G-buffer.
+  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
   rtcIntersect16(valid, impl_->top, &ctx, &rh);
   for (int i = 0; i < std::min(n, 16); ++i) {
     found[i] = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
