@@ -88,6 +88,20 @@ struct RtScene::Impl {
 RtScene::RtScene() : impl_(std::make_unique<Impl>()) {}
 RtScene::~RtScene() = default;
 
+namespace {
+WorldBounds world_bounds(const scene::MeshAsset& m, const transform::Similarity& to_world) {
+  WorldBounds b{glm::vec3(std::numeric_limits<float>::infinity()), glm::vec3(-std::numeric_limits<float>::infinity())};
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec3 corner((c & 1) ? m.bounds_max.x : m.bounds_min.x, (c & 2) ? m.bounds_max.y : m.bounds_min.y,
+                           (c & 4) ? m.bounds_max.z : m.bounds_min.z);
+    const glm::vec3 w = to_world.apply_point(corner);
+    b.min = glm::min(b.min, w);
+    b.max = glm::max(b.max, w);
+  }
+  return b;
+}
+}  // namespace
+
 void RtScene::set_assets(const scene::SceneAssets* assets) {
   if (assets == assets_ && (!assets || assets->generation == generation_)) return;
   // A new asset set invalidates every instance and mesh scene.
@@ -143,12 +157,16 @@ void RtScene::upsert_instance(ecs::Entity e, std::uint32_t mesh, const transform
   }
 
   const glm::mat4 matrix = to_world.matrix();
+  const WorldBounds bounds = world_bounds(*assets_->meshes[mesh], to_world);
   auto it = entity_to_id_.find(e);
   if (it != entity_to_id_.end() && instances_[it->second].mesh == mesh) {
     RTCGeometry inst = rtcGetGeometry(impl_->top, it->second);
     rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &matrix[0][0]);
     rtcCommitGeometry(inst);
-    instances_[it->second].to_world = to_world;
+    InstanceRecord& r = instances_[it->second];
+    changed_pending_.push_back({glm::min(r.bounds.min, bounds.min), glm::max(r.bounds.max, bounds.max)});
+    r.to_world = to_world;
+    r.bounds = bounds;
     ++stats_.instances_moved;
     dirty_ = true;
     return;
@@ -171,7 +189,8 @@ void RtScene::upsert_instance(ecs::Entity e, std::uint32_t mesh, const transform
   rtcReleaseGeometry(inst);
   check_embree("adding an instance");
   if (id >= instances_.size()) instances_.resize(id + 1);
-  instances_[id] = InstanceRecord{e, mesh, to_world, true};
+  instances_[id] = InstanceRecord{e, mesh, to_world, true, bounds};
+  changed_pending_.push_back(bounds);
   entity_to_id_[e] = id;
   ++stats_.instances_added;
   dirty_ = true;
@@ -182,6 +201,7 @@ void RtScene::remove_instance(ecs::Entity e) {
   if (it == entity_to_id_.end()) return;
   rtcDetachGeometry(impl_->top, it->second);
   instances_[it->second].active = false;
+  changed_pending_.push_back(instances_[it->second].bounds);
   impl_->free_ids.push_back(it->second);
   entity_to_id_.erase(it);
   ++stats_.instances_removed;
@@ -194,6 +214,8 @@ void RtScene::commit() {
   check_embree("committing the top-level scene");
   ++stats_.top_level_commits;
   dirty_ = false;
+  changed_at_commit_ = std::move(changed_pending_);
+  changed_pending_.clear();
   RTCBounds b;
   rtcGetSceneBounds(impl_->top, &b);
   if (entity_to_id_.empty()) {

@@ -25,11 +25,17 @@ class RtError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// An axis-aligned box in world space.
+struct WorldBounds {
+  glm::vec3 min{0.0f}, max{0.0f};
+};
+
 struct InstanceRecord {
   ecs::Entity entity;
   std::uint32_t mesh = 0;
   transform::Similarity to_world;
   bool active = false;
+  WorldBounds bounds;  // the mesh's bounds carried to world space
 };
 
 struct RtStats {
@@ -77,6 +83,11 @@ class RtScene {
   [[nodiscard]] const RtStats& stats() const { return stats_; }
   [[nodiscard]] std::uint64_t rejected_rays() const { return rejected_.load(std::memory_order_relaxed); }
   [[nodiscard]] bool empty() const { return entity_to_id_.empty(); }
+  // Where the geometry changed in the last commit that had changes: for
+  // each instance moved, added or removed, its old and new bounds merged.
+  // Read it when top_level_commits moved (caches that follow geometry,
+  // such as light probes, re-light those regions first).
+  [[nodiscard]] const std::vector<WorldBounds>& changed_at_last_commit() const { return changed_at_commit_; }
   // World-space bounds of all instances (valid after commit()).
   [[nodiscard]] glm::vec3 bounds_min() const { return bounds_min_; }
   [[nodiscard]] glm::vec3 bounds_max() const { return bounds_max_; }
@@ -91,6 +102,7 @@ class RtScene {
   RtStats stats_;
   bool dirty_ = false;
   glm::vec3 bounds_min_{0.0f}, bounds_max_{0.0f};
+  std::vector<WorldBounds> changed_pending_, changed_at_commit_;
   mutable std::atomic<std::uint64_t> rejected_{0};
 };
 

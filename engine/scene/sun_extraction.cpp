@@ -19,8 +19,7 @@ float pixel_solid_angle(int y, int w, int h) {
 
 SunSplit split_sun(const Environment& env, const SunExtractionSettings& settings) {
   const image::ImageRGB& img = env.image();
-  const glm::mat4 matrix(glm::mat3(env.to_world({1, 0, 0}), env.to_world({0, 1, 0}), env.to_world({0, 0, 1})));
-  SunSplit out{std::nullopt, Environment(img, env.strength(), matrix)};
+  SunSplit out{std::nullopt, env};  // no sun: the residual is the map itself (copied, not rebuilt)
   const int w = img.width, h = img.height;
   if (w < 3 || h < 3 || !(env.strength() > 0)) return out;
 
@@ -101,6 +100,7 @@ SunSplit split_sun(const Environment& env, const SunExtractionSettings& settings
   // Cone of equal solid angle: omega = 2 pi (1 - cos r).
   sun.angular_radius = std::acos(std::clamp(1.0f - sun.solid_angle / math::kTwoPi, -1.0f, 1.0f));
   out.sun = sun;
+  const glm::mat4 matrix(glm::mat3(env.to_world({1, 0, 0}), env.to_world({0, 1, 0}), env.to_world({0, 0, 1})));
   out.residual = Environment(std::move(residual), env.strength(), matrix);
   return out;
 }

@@ -200,3 +200,30 @@ TEST(RtScene, PacketsAnswerAsSingleRays) {
   EXPECT_EQ(f.rt().rejected_rays(), 4u) << "the NaN ray, counted by each of the four queries";
   (void)a;
 }
+
+TEST(RtScene, ReportsWhereTheLastCommitChangedTheGeometry) {
+  RtFixture f;
+  const Entity a = f.spawn_quad({0, 0, 0});
+  f.app.update();
+  // Added: the unit quad at the origin, flat in z.
+  ASSERT_EQ(f.rt().changed_at_last_commit().size(), 1u);
+  EXPECT_EQ(f.rt().changed_at_last_commit()[0].min, glm::vec3(-0.5f, -0.5f, 0.0f));
+  EXPECT_EQ(f.rt().changed_at_last_commit()[0].max, glm::vec3(0.5f, 0.5f, 0.0f));
+  // Moved by (3, 0, 1): old and new bounds merged.
+  f.app.world().get_mut<transform::Transform>(a).translation = {3, 0, 1};
+  f.app.update();
+  ASSERT_EQ(f.rt().changed_at_last_commit().size(), 1u);
+  EXPECT_EQ(f.rt().changed_at_last_commit()[0].min, glm::vec3(-0.5f, -0.5f, 0.0f));
+  EXPECT_EQ(f.rt().changed_at_last_commit()[0].max, glm::vec3(3.5f, 0.5f, 1.0f));
+  EXPECT_EQ(f.rt().instance_of(a)->bounds.min, glm::vec3(2.5f, -0.5f, 1.0f));
+  // A static frame commits nothing: the list still describes the last commit.
+  const std::size_t commits = f.rt().stats().top_level_commits;
+  f.app.update();
+  EXPECT_EQ(f.rt().stats().top_level_commits, commits);
+  // Removed: its last bounds.
+  f.app.world().despawn(a);
+  f.app.update();
+  ASSERT_EQ(f.rt().changed_at_last_commit().size(), 1u);
+  EXPECT_EQ(f.rt().changed_at_last_commit()[0].max, glm::vec3(3.5f, 0.5f, 1.0f));
+  EXPECT_EQ(f.rt().changed_at_last_commit()[0].min, glm::vec3(2.5f, -0.5f, 1.0f));
+}

@@ -12,15 +12,31 @@
 using namespace transgi::probes;
 using namespace engine;
 
+namespace {
+// The floor under a uniform sky with 32 probes above it (4x2x4, none far
+// from the floor), small maps: the setting every budget test starts from.
+struct BudgetFloor {
+  FloorUnderSky scene;
+  render::LightSet lights;
+  explicit BudgetFloor(float albedo)
+      : scene(albedo), lights(rt(), {}, &*scene.app.world().resource<scene::SceneAssets>().environment) {}
+  const rt::RtScene& rt() { return scene.app.world().resource<rt::RtScene>(); }
+  static ProbeFieldSettings settings() {
+    ProbeFieldSettings s;
+    s.grid = ProbeGrid{{-1, 0.5f, -1}, {1, 1.0f, 1}, {4, 2, 4}};
+    s.map = MapLayout{32, 16};
+    return s;
+  }
+};
+}  // namespace
+
 TEST(ProbeBudget, TracesAtMostTheBudgetAndRefreshesEveryProbeInTurn) {
   const float a = 0.5f;
-  FloorUnderSky s(a);
-  const auto& assets = s.app.world().resource<scene::SceneAssets>();
-  const auto& rt = s.app.world().resource<rt::RtScene>();
-  const render::LightSet lights(rt, {}, &*assets.environment);
-  ProbeFieldSettings settings;
-  settings.grid = ProbeGrid{{-1, 0.5f, -1}, {1, 1.0f, 1}, {4, 2, 4}};  // 32 probes, none far from the floor
-  settings.map = MapLayout{32, 16};
+  BudgetFloor floor(a);
+  FloorUnderSky& s = floor.scene;
+  const auto& rt = floor.rt();
+  const render::LightSet& lights = floor.lights;
+  ProbeFieldSettings settings = floor.settings();
   settings.skip.skip_converged = false;
   settings.update_budget = 5;
   ProbeField field(settings);
@@ -45,13 +61,11 @@ TEST(ProbeBudget, TracesAtMostTheBudgetAndRefreshesEveryProbeInTurn) {
 }
 
 TEST(ProbeBudget, ZeroBudgetUpdatesEveryActiveProbe) {
-  FloorUnderSky s(0.5f);
-  const auto& assets = s.app.world().resource<scene::SceneAssets>();
-  const auto& rt = s.app.world().resource<rt::RtScene>();
-  const render::LightSet lights(rt, {}, &*assets.environment);
-  ProbeFieldSettings settings;
-  settings.grid = ProbeGrid{{-1, 0.5f, -1}, {1, 1.0f, 1}, {4, 2, 4}};
-  settings.map = MapLayout{32, 16};
+  BudgetFloor floor(0.5f);
+  FloorUnderSky& s = floor.scene;
+  const auto& rt = floor.rt();
+  const render::LightSet& lights = floor.lights;
+  ProbeFieldSettings settings = floor.settings();
   ProbeField field(settings);
   s.app.jobs().run([&] {
     for (int f = 0; f < 3; ++f) EXPECT_EQ(field.update(rt, lights).traced, 32);
@@ -62,13 +76,11 @@ TEST(ProbeBudget, AChangedRegionIsUpdatedFirst) {
   // 32 probes, budget 5: round-robin alone reaches a probe every 6-7
   // frames. A change at one corner probe marks the 8 probes within a cell of
   // it: the next two frames must trace exactly those, before any other.
-  FloorUnderSky s(0.5f);
-  const auto& assets = s.app.world().resource<scene::SceneAssets>();
-  const auto& rt = s.app.world().resource<rt::RtScene>();
-  const render::LightSet lights(rt, {}, &*assets.environment);
-  ProbeFieldSettings settings;
-  settings.grid = ProbeGrid{{-1, 0.5f, -1}, {1, 1.0f, 1}, {4, 2, 4}};
-  settings.map = MapLayout{32, 16};
+  BudgetFloor floor(0.5f);
+  FloorUnderSky& s = floor.scene;
+  const auto& rt = floor.rt();
+  const render::LightSet& lights = floor.lights;
+  ProbeFieldSettings settings = floor.settings();
   settings.skip.skip_converged = false;
   settings.update_budget = 5;
   ProbeField field(settings);

@@ -11,6 +11,7 @@
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "cli/runtime_options.h"
 #include "engine/core/progress.h"
 #include "engine/image/exr.h"
 #include "engine/render/camera_rays.h"
@@ -88,16 +89,8 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   ecs::World& world = scene.app->world();
   auto model = model::load_model(model_path);
   model::validate_model(model, world.resource<scene::SceneAssets>(), model_path);
-  runtime::TransGISettings settings = preset == "realtime" ? runtime::realtime_preset() : runtime::quality_preset();
+  runtime::TransGISettings settings = runtime_settings_from(args, "realtime");
   settings.direct_spp = static_cast<int>(args.integer("direct-spp", 0, 100000, settings.direct_spp));
-  settings.realtime.resolution_scale = static_cast<float>(args.number("gi-scale", 0.05, 1.0, settings.realtime.resolution_scale));
-  settings.probes.update_budget = static_cast<int>(args.integer("probe-budget", 0, 1 << 20, settings.probes.update_budget));
-  settings.probes.map.width = static_cast<int>(args.integer("map-width", 4, 4096, settings.probes.map.width));
-  settings.probes.map.height = std::max(2, settings.probes.map.width / 2);
-  if (args.has("direct"))
-    settings.direct_light = args.choice("direct", {"deterministic", "stochastic"}, "stochastic") == "deterministic"
-                                ? runtime::DirectLight::Deterministic
-                                : runtime::DirectLight::Stochastic;
   scene.app->add_plugin<runtime::TransGIPlugin>(settings);
   runtime::attach_latent_meshes(world, std::make_shared<const model::TransferModel>(std::move(model)));
   world.emplace<runtime::ProbeVolume>(world.spawn(), runtime::ProbeVolume{});

@@ -4,6 +4,7 @@
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "cli/runtime_options.h"
 #include "engine/core/progress.h"
 #include "engine/image/exr.h"
 #include "engine/image/tonemap.h"
@@ -113,21 +114,12 @@ int render_transgi(const Args& args, eval::LoadedScene& scene, int width, int he
   if (args.has("coefficient-maps")) throw std::runtime_error("--coefficient-maps needs --lighting environment");
 
   eval::TransgiRunOptions t;
-  t.settings = args.choice("preset", {"quality", "realtime"}, "quality") == "realtime" ? runtime::realtime_preset()
-                                                                                       : runtime::quality_preset();
-  t.settings.realtime.resolution_scale = static_cast<float>(args.number("gi-scale", 0.05, 1.0, t.settings.realtime.resolution_scale));
-  t.settings.probes.update_budget = static_cast<int>(args.integer("probe-budget", 0, 1 << 20, t.settings.probes.update_budget));
-  if (args.has("direct"))
-    t.settings.direct_light = args.choice("direct", {"deterministic", "stochastic"}, "stochastic") == "deterministic"
-                                  ? runtime::DirectLight::Deterministic
-                                  : runtime::DirectLight::Stochastic;
+  t.settings = runtime_settings_from(args, "quality");
   t.settings.gbuffer_spp = static_cast<int>(args.integer("spp", 1, 4096, 1));
   t.settings.seed = static_cast<std::uint64_t>(args.integer("seed", 0, INT64_MAX, 0));
   t.settings.direct_spp = o.pass == "gi" ? 0 : static_cast<int>(args.integer("direct-spp", 1, 100000, 16));
   t.settings.probes.rays_per_probe = static_cast<int>(args.integer("probe-rays", 1, 100000, 100));
   t.settings.probes.seed = t.settings.seed + 1;
-  t.settings.probes.map.width = static_cast<int>(args.integer("map-width", 4, 4096, t.settings.probes.map.width));
-  t.settings.probes.map.height = std::max(2, t.settings.probes.map.width / 2);
   const bool skip = args.choice("probe-skip", {"on", "off"}, "on") == "on";
   t.settings.probes.skip.classify = t.settings.probes.skip.skip_converged = skip;
   t.settings.probes.sharing.mode = args.choice("sharing", {"depth-guard", "paper"}, "depth-guard") == "paper"

@@ -1,8 +1,6 @@
 #include "runtime/transgi_plugin.h"
 
 #include <chrono>
-#include <limits>
-#include <unordered_map>
 
 #include "engine/render/camera_rays.h"
 #include "engine/render/light_plugin.h"
@@ -24,45 +22,15 @@ using transform::WorldTransform;
 
 struct SeenVersions {
   std::uint64_t lights = 0, geometry = 0;
-  // World bounds of every instance at the last sync, to find what moved.
-  std::unordered_map<Entity, std::pair<glm::vec3, glm::vec3>> bounds;
 };
-
-// The regions that changed since the last call: for every instance that
-// moved, appeared or went away, the union of its old and new world bounds.
-std::vector<std::pair<glm::vec3, glm::vec3>> changed_regions(const rt::RtScene& rt, SeenVersions& seen) {
-  std::vector<std::pair<glm::vec3, glm::vec3>> changed;
-  const scene::SceneAssets* assets = rt.assets();
-  if (!assets) return changed;
-  std::unordered_map<Entity, std::pair<glm::vec3, glm::vec3>> now;
-  rt.for_each_instance([&](const rt::InstanceRecord& inst) {
-    const scene::MeshAsset& mesh = *assets->meshes[inst.mesh];
-    glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-std::numeric_limits<float>::infinity());
-    for (int c = 0; c < 8; ++c) {
-      const glm::vec3 corner((c & 1) ? mesh.bounds_max.x : mesh.bounds_min.x, (c & 2) ? mesh.bounds_max.y : mesh.bounds_min.y,
-                             (c & 4) ? mesh.bounds_max.z : mesh.bounds_min.z);
-      const glm::vec3 w = inst.to_world.apply_point(corner);
-      lo = glm::min(lo, w);
-      hi = glm::max(hi, w);
-    }
-    now.emplace(inst.entity, std::make_pair(lo, hi));
-    auto it = seen.bounds.find(inst.entity);
-    if (it == seen.bounds.end())
-      changed.emplace_back(lo, hi);
-    else if (it->second.first != lo || it->second.second != hi)
-      changed.emplace_back(glm::min(lo, it->second.first), glm::max(hi, it->second.second));
-  });
-  for (const auto& [e, box] : seen.bounds)
-    if (!now.contains(e)) changed.push_back(box);
-  seen.bounds = std::move(now);
-  return changed;
-}
 
 void sync_probe_volumes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res<render::SceneLights> lights,
                         Res<TransGISettings> settings, Local<SeenVersions> seen) {
   const bool geometry_moved = lights->geometry_version != seen->geometry;
   const bool lighting_changed = lights->version != seen->lights;
-  const auto regions = geometry_moved ? changed_regions(*rt, *seen) : std::vector<std::pair<glm::vec3, glm::vec3>>{};
+  // Where it moved: probes there are updated first (RtScene keeps the list for its last commit).
+  static const std::vector<rt::WorldBounds> kNothing;
+  const auto& regions = geometry_moved ? rt->changed_at_last_commit() : kNothing;
   volumes.each([&](ProbeVolume& v) {
     if (v.fits_scene()) {
       // Fitted once: a later move must not shift every probe (and reset them).
@@ -76,7 +44,7 @@ void sync_probe_volumes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res
       return;
     }
     if (geometry_moved || lighting_changed) v.field->notify_scene_changed(geometry_moved);
-    for (const auto& [lo, hi] : regions) v.field->notify_region_changed(lo, hi);
+    for (const rt::WorldBounds& b : regions) v.field->notify_region_changed(b.min, b.max);
   });
   seen->geometry = lights->geometry_version;
   seen->lights = lights->version;
@@ -105,6 +73,22 @@ void update_probes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res<rend
 }
 
 using CameraView = View<Get<const scene::Camera, const WorldTransform>>;
+
+// The stochastic direct pass (direct_spp NEE samples per pixel, none at 0),
+// then full = gi + direct. Both paths end with it unless the real-time
+// path's direct light is deterministic.
+void add_stochastic_direct(const rt::RtScene& rt, const render::LightSet& lights, const render::CameraRays& rays,
+                           int direct_spp, std::uint64_t seed, GiFrame& frame) {
+  const auto t0 = std::chrono::steady_clock::now();
+  frame.direct = direct_spp > 0 ? render::render_direct_light(rt, lights, rays, frame.width, frame.height, direct_spp, seed)
+                                : image::ImageRGB(frame.width, frame.height);
+  frame.times.direct = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void compose_full(GiFrame& frame) {
+  frame.full = frame.gi;
+  for (std::size_t i = 0; i < frame.full.size(); ++i) frame.full.pixels[i] += frame.direct.pixels[i];
+}
 
 // The decoder packed for the fused kernel, repacked only when the model
 // changes, and the G-buffer storage kept from frame to frame.
@@ -142,18 +126,15 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   frame.inferred_samples = st.inferred;
   frame.realtime = st;
 
-  t0 = std::chrono::steady_clock::now();
   if (deterministic) {
+    t0 = std::chrono::steady_clock::now();
     frame.direct = shading::shade_direct_realtime(g, rt, lights, rays, &frame.direct_stats);
     for (std::size_t i = 0; i < frame.direct.size(); ++i) frame.direct.pixels[i] += probe_direct.pixels[i];
+    t.direct = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   } else {
-    frame.direct = settings.direct_spp > 0
-                       ? render::render_direct_light(rt, lights, rays, frame.width, frame.height, settings.direct_spp, seed)
-                       : image::ImageRGB(frame.width, frame.height);
+    add_stochastic_direct(rt, lights, rays, settings.direct_spp, seed, frame);
   }
-  t.direct = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  frame.full = frame.gi;
-  for (std::size_t i = 0; i < frame.full.size(); ++i) frame.full.pixels[i] += frame.direct.pixels[i];
+  compose_full(frame);
 }
 
 void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Get<const LatentMesh>> latents,
@@ -194,15 +175,7 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
       std::fill_n(out, 75, 0.0f);
       return;
     }
-    const probes::ProbeField* f = fields.front();
-    for (const probes::ProbeField* c : fields) {
-      const auto& g = c->settings().grid;
-      if (glm::all(glm::greaterThanEqual(p, g.min)) && glm::all(glm::lessThanEqual(p, g.max))) {
-        f = c;
-        break;
-      }
-    }
-    f->interpolate(p, n, out);
+    shading::field_holding(fields, p)->interpolate(p, n, out);
   };
   const shading::TransferRenderResult r = shading::render_transfer(
       *rt, *assets, model ? *model : kNoModel, *rays, frame->width, frame->height, light_at, nullptr,
@@ -219,13 +192,8 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
   frame->shaded_samples = r.shaded_samples;
   frame->inferred_samples = r.inferred_samples;
   frame->gi = r.image;
-  const auto t0 = std::chrono::steady_clock::now();
-  frame->direct = settings->direct_spp > 0 ? render::render_direct_light(*rt, lights->set, *rays, frame->width, frame->height,
-                                                                         settings->direct_spp, rs.seed)
-                                           : image::ImageRGB(frame->width, frame->height);
-  t.direct = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  frame->full = frame->gi;
-  for (std::size_t i = 0; i < frame->full.size(); ++i) frame->full.pixels[i] += frame->direct.pixels[i];
+  add_stochastic_direct(*rt, lights->set, *rays, settings->direct_spp, rs.seed, *frame);
+  compose_full(*frame);
 }
 
 }  // namespace

@@ -106,14 +106,6 @@ void plan_upsampling(const GBuffer& g, const RealtimeGiSettings& s, Upsampling& 
   });
 }
 
-const probes::ProbeField* field_at(std::span<const probes::ProbeField* const> fields, const glm::vec3& p) {
-  for (const probes::ProbeField* f : fields) {
-    const auto& grid = f->settings().grid;
-    if (glm::all(glm::greaterThanEqual(p, grid.min)) && glm::all(glm::lessThanEqual(p, grid.max))) return f;
-  }
-  return fields.front();
-}
-
 // Probe SH rotated into object frames, one copy per distinct rotation and
 // field; identity rotations read the field's own SH.
 class RotatedProbes {
@@ -160,6 +152,14 @@ class RotatedProbes {
 };
 
 }  // namespace
+
+const probes::ProbeField* field_holding(std::span<const probes::ProbeField* const> fields, const glm::vec3& p) {
+  for (const probes::ProbeField* f : fields) {
+    const auto& grid = f->settings().grid;
+    if (glm::all(glm::greaterThanEqual(p, grid.min)) && glm::all(glm::lessThanEqual(p, grid.max))) return f;
+  }
+  return fields.front();
+}
 
 GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                       const engine::render::CameraRays& camera, int width, int height) {
@@ -277,7 +277,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   engine::jobs::parallel_for<std::size_t>(0, net.size(), 256, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       const GSample& s = g.samples[decode[net[k]]];
-      const probes::ProbeField* f = field_at(fields, s.position);
+      const probes::ProbeField* f = field_holding(fields, s.position);
       if (with_direct)
         f->interpolate(s.position, s.normal_world, rotated.sh(rotation_of[k], f), light.data() + k * 75,
                        rotated.sh(rotation_of[k], f, true), light_direct.data() + k * 75);
@@ -290,8 +290,11 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     float world[75], world_direct[75];
     for (std::size_t k = b; k < e; ++k) {
       const GSample& s = g.samples[decode[diffuse[k]]];
-      const probes::ProbeField* f = field_at(fields, s.position);
-      f->interpolate(s.position, s.normal_world, f->light_sh_all().data(), world, f->direct_sh_all().data(), world_direct);
+      const probes::ProbeField* f = field_holding(fields, s.position);
+      if (with_direct)
+        f->interpolate(s.position, s.normal_world, f->light_sh_all().data(), world, f->direct_sh_all().data(), world_direct);
+      else
+        f->interpolate(s.position, s.normal_world, world);
       value[diffuse[k]] = s.diffuse * engine::math::kInvPi * sh_irradiance(world, s.normal_world);
       if (with_direct) value_direct[diffuse[k]] = s.diffuse * engine::math::kInvPi * sh_irradiance(world_direct, s.normal_world);
     }
