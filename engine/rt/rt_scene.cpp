@@ -71,6 +71,9 @@ struct RtScene::Impl {
     top = rtcNewScene(device);
     rtcSetSceneFlags(top, RTC_SCENE_FLAG_DYNAMIC);
     rtcSetSceneBuildQuality(top, RTC_BUILD_QUALITY_LOW);
+    // Committed empty, so a query before the first sync misses instead of
+    // leaving Embree's sticky "scene not committed" error for the next check.
+    rtcCommitScene(top);
   }
   ~Impl() {
     for (RTCScene s : blas)

@@ -227,3 +227,19 @@ TEST(RtScene, ReportsWhereTheLastCommitChangedTheGeometry) {
   EXPECT_EQ(f.rt().changed_at_last_commit()[0].max, glm::vec3(3.5f, 0.5f, 1.0f));
   EXPECT_EQ(f.rt().changed_at_last_commit()[0].min, glm::vec3(2.5f, -0.5f, 1.0f));
 }
+
+TEST(RtScene, AQueryBeforeTheFirstCommitMissesAndLeavesNoError) {
+  scene::SceneAssets assets = quad_assets(false);
+  RtScene rt;
+  rt.set_assets(&assets);
+  Ray r;
+  r.origin = {0, 0, 1};
+  r.direction = {0, 0, -1};
+  Hit h;
+  EXPECT_FALSE(rt.intersect(r, h));
+  EXPECT_FALSE(rt.occluded(r));
+  rt.upsert_instance(Entity{0, 0}, 0, transform::Similarity{});  // threw "scene not committed" before the fix
+  rt.commit();
+  EXPECT_TRUE(rt.intersect(r, h));
+  EXPECT_NEAR(h.t, 1.0f, 1e-6f);
+}
