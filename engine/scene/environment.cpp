@@ -17,6 +17,7 @@ Environment::Environment(image::ImageRGB image, float strength, const glm::mat4&
   const glm::mat3 m(matrix);
   to_world_ = glm::mat3(glm::normalize(m[0]), glm::normalize(m[1]), glm::normalize(m[2]));
   to_local_ = glm::inverse(to_world_);
+  loaded_to_world_ = to_world_;
   const int w = image_.width, h = image_.height;
   std::vector<float> weights(static_cast<std::size_t>(w) * h);
   for (int y = 0; y < h; ++y) {
@@ -25,6 +26,14 @@ Environment::Environment(image::ImageRGB image, float strength, const glm::mat4&
       weights[static_cast<std::size_t>(y) * w + x] = math::luminance(image_.at(x, y)) * sin_theta;
   }
   distribution_ = math::Distribution2D(weights, w, h);
+}
+
+void Environment::set_yaw(float radians) {
+  yaw_ = radians;
+  const float c = std::cos(radians), s = std::sin(radians);
+  const glm::mat3 about_y(glm::vec3(c, 0, -s), glm::vec3(0, 1, 0), glm::vec3(s, 0, c));  // columns
+  to_world_ = about_y * loaded_to_world_;
+  to_local_ = glm::transpose(to_world_);
 }
 
 glm::vec2 Environment::direction_to_uv(const glm::vec3& l) {

@@ -30,6 +30,13 @@ class Environment {
   // Map-local direction to world (the matrix's rotation).
   [[nodiscard]] glm::vec3 to_world(const glm::vec3& local) const { return to_world_ * local; }
   [[nodiscard]] float strength() const { return strength_; }
+  // Run-time sky control (a day-night cycle): turn the map about world +Y
+  // by `radians` from its loaded orientation, and scale its brightness. Both
+  // are cheap (the sampling distribution lives in map space). Whoever calls
+  // them bumps SceneAssets::environment_version so light caches rebuild.
+  void set_yaw(float radians);
+  [[nodiscard]] float yaw() const { return yaw_; }
+  void set_strength(float strength) { strength_ = strength; }
   [[nodiscard]] bool valid() const { return !image_.empty(); }
 
   // Map-local direction <-> (u, v).
@@ -41,6 +48,8 @@ class Environment {
   float strength_ = 1.0f;
   glm::mat3 to_world_{1.0f};
   glm::mat3 to_local_{1.0f};
+  glm::mat3 loaded_to_world_{1.0f};
+  float yaw_ = 0.0f;
   math::Distribution2D distribution_;
 };
 

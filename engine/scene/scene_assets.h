@@ -23,6 +23,9 @@ struct SceneAssets {
   std::vector<material::Material> materials;
   std::vector<Texture> textures;
   std::optional<Environment> environment;
+  // Bumped whenever the environment's yaw or strength changes at run time,
+  // so the light set (and the caches that follow it) rebuild.
+  std::uint64_t environment_version = 0;
 };
 
 // Next value for SceneAssets::generation.

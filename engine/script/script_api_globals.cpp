@@ -4,6 +4,7 @@
 //   input.down(key) / input.pressed(key) / input.released(key) -> bool;  input.mouse() -> x, y
 //   time.now() -> seconds, time.dt() -> seconds, time.frame() -> integer
 //   log.info(...) / log.warn(...) / log.error(...); print(...) is log.info
+//   sky.set_yaw(radians) / sky.get_yaw() / sky.set_strength(s) / sky.get_strength()  (the environment map)
 //   send(entity, id, msg)                    property(name, default) -> value
 #include <string>
 #include <vector>
@@ -170,6 +171,44 @@ int time_frame(lua_State* L) {
   return 1;
 }
 
+// --- sky ---------------------------------------------------------------------
+
+scene::Environment& environment_of(lua_State* L, scene::SceneAssets** assets_out = nullptr) {
+  auto* assets = world_of(L).try_resource<scene::SceneAssets>();
+  if (!assets || !assets->environment) luaL_error(L, "sky: this scene has no environment map");
+  if (assets_out) *assets_out = assets;
+  return *assets->environment;
+}
+int sky_set_yaw(lua_State* L) {
+  const float yaw = check_finite(L, 1, "yaw");
+  scene::SceneAssets* assets = nullptr;
+  scene::Environment& env = environment_of(L, &assets);
+  if (env.yaw() != yaw) {
+    env.set_yaw(yaw);
+    ++assets->environment_version;
+  }
+  return 0;
+}
+int sky_get_yaw(lua_State* L) {
+  lua_pushnumber(L, environment_of(L).yaw());
+  return 1;
+}
+int sky_set_strength(lua_State* L) {
+  const float s = check_finite(L, 1, "strength");
+  if (s < 0) luaL_error(L, "sky.set_strength: strength must be >= 0");
+  scene::SceneAssets* assets = nullptr;
+  scene::Environment& env = environment_of(L, &assets);
+  if (env.strength() != s) {
+    env.set_strength(s);
+    ++assets->environment_version;
+  }
+  return 0;
+}
+int sky_get_strength(lua_State* L) {
+  lua_pushnumber(L, environment_of(L).strength());
+  return 1;
+}
+
 // --- log, send, property -----------------------------------------------------
 
 std::string joined_arguments(lua_State* L) {
@@ -280,6 +319,9 @@ void register_api(lua_State* L) {
   set_table(L, "input", input_fns);
   set_table(L, "time", time_fns);
   set_table(L, "log", log_fns);
+  const luaL_Reg sky_fns[] = {{"set_yaw", sky_set_yaw}, {"get_yaw", sky_get_yaw}, {"set_strength", sky_set_strength},
+                              {"get_strength", sky_get_strength}, {nullptr, nullptr}};
+  set_table(L, "sky", sky_fns);
   lua_pushcfunction(L, log_at<0>);
   lua_setfield(L, -2, "print");
   lua_pushcfunction(L, send);

@@ -395,3 +395,25 @@ TEST(LuaSandbox, BinaryChunksAreRefused) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST_F(ScriptTest, SkyTurnsTheEnvironmentAndBumpsItsVersion) {
+  auto& assets = world().insert_resource<scene::SceneAssets>();
+  image::ImageRGB map(8, 4);
+  map.at(2, 1) = glm::vec3(100.0f);  // one bright texel: a sun
+  assets.environment = scene::Environment(map, 1.0f, glm::mat4(1.0f));
+  const glm::vec3 sun_local = scene::Environment::uv_to_direction({2.5f / 8, 1.5f / 4});
+  write("sky.lua", R"(
+    function init(self) sky.set_yaw(math.pi / 2); sky.set_strength(0.5); log.info(sky.get_yaw() > 1.57, sky.get_strength()) end)");
+  spawn_scripted("sky.lua");
+  app_.update();
+  EXPECT_EQ(assets.environment_version, 2u);
+  EXPECT_EQ(logged(core::LogLevel::Info), "true 0.5\n");
+  // The sun's texel now shines from its direction turned a quarter about +Y.
+  const glm::vec3 turned(sun_local.z, sun_local.y, -sun_local.x);
+  EXPECT_NEAR(assets.environment->radiance(turned).x, 50.0f, 1e-3f);
+  EXPECT_NEAR(assets.environment->to_world(sun_local).x, turned.x, 1e-5f);
+}
+
+}  // namespace
