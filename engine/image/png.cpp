@@ -1,7 +1,9 @@
 #include "engine/image/png.h"
 
+#include <algorithm>
 #include <cstddef>
 #include <span>
+#include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
 
 #include "engine/io/atomic_file.h"
@@ -22,6 +24,16 @@ void write_png(const std::filesystem::path& path, const Rgb8Image& image) {
   if (!stbi_write_png_to_func(sink, &encoded, image.width, image.height, 3, image.pixels.data(), image.width * 3))
     throw io::IoError(path.string() + ": PNG encoding failed");
   io::write_file_atomically(path, encoded);
+}
+
+Rgb8Image read_png(const std::filesystem::path& path) {
+  int w = 0, h = 0, channels = 0;
+  unsigned char* data = stbi_load(path.string().c_str(), &w, &h, &channels, 3);
+  if (!data) throw io::IoError(path.string() + ": cannot read PNG: " + (stbi_failure_reason() ? stbi_failure_reason() : "unknown"));
+  Rgb8Image img(w, h);
+  std::copy(data, data + img.pixels.size(), img.pixels.begin());
+  stbi_image_free(data);
+  return img;
 }
 
 }  // namespace engine::image

@@ -18,5 +18,7 @@ struct Rgb8Image {
 
 // Encodes and writes atomically (temp file + rename). Throws io::IoError.
 void write_png(const std::filesystem::path& path, const Rgb8Image& image);
+// Reads an 8-bit PNG as RGB. Throws io::IoError naming the file.
+Rgb8Image read_png(const std::filesystem::path& path);
 
 }  // namespace engine::image

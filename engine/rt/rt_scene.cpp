@@ -123,6 +123,7 @@ void RtScene::upsert_instance(ecs::Entity e, std::uint32_t mesh, const transform
   if (!assets_ || mesh >= assets_->meshes.size())
     throw RtError("instance of mesh " + std::to_string(mesh) + " but the scene has " +
                   std::to_string(assets_ ? assets_->meshes.size() : 0) + " meshes");
+  if (mesh >= impl_->blas.size()) impl_->blas.resize(assets_->meshes.size(), nullptr);  // meshes added at run time
   if (!impl_->blas[mesh]) {
     const scene::MeshAsset& m = *assets_->meshes[mesh];
     RTCScene s = rtcNewScene(impl_->device);

@@ -4,7 +4,7 @@
 //
 //   e.transform:get_position() / :set_position(x, y, z) / :translate(dx, dy, dz)
 //   e.transform:rotate(axis, radians) / :rotate(euler) / :get_rotation() / :set_rotation(euler)
-//   e.transform:get_scale() / :set_scale(s) / :get_world_position()
+//   e.transform:get_scale() / :set_scale(s) / :get_world_position() / :get_forward()
 //   e.light:set_intensity(x) / :get_intensity() / :set_color(r, g, b) / :set_enabled(b) / :is_enabled() / :set_range(r)
 //   e.name, e:alive(), tostring(e), e1 == e2
 #include <cmath>
@@ -110,6 +110,12 @@ int t_set_scale(lua_State* L) {
   if (!(s > 0)) luaL_error(L, "set_scale: the scale must be positive, got %f", static_cast<double>(s));
   transform_of(L).scale = s;
   return 0;
+}
+int t_get_forward(lua_State* L) {  // world-space -Z: where a camera or light points
+  const ecs::Entity e = live(L, 1, kTransformMeta);
+  const auto* w = context_of(L).world->try_get<transform::WorldTransform>(e);
+  const glm::quat q = w ? w->rotation : transform_of(L).rotation;
+  return push_vec3(L, q * glm::vec3(0.0f, 0.0f, -1.0f));
 }
 int t_get_world_position(lua_State* L) {
   const ecs::Entity e = live(L, 1, kTransformMeta);
@@ -237,7 +243,8 @@ void register_entity_types(lua_State* L) {
                                         {"translate", t_translate},       {"rotate", t_rotate},
                                         {"get_rotation", t_get_rotation}, {"set_rotation", t_set_rotation},
                                         {"get_scale", t_get_scale},       {"set_scale", t_set_scale},
-                                        {"get_world_position", t_get_world_position}, {nullptr, nullptr}};
+                                        {"get_world_position", t_get_world_position},
+                                        {"get_forward", t_get_forward}, {nullptr, nullptr}};
   const luaL_Reg light_methods[] = {{"set_intensity", l_set_intensity}, {"get_intensity", l_get_intensity},
                                     {"set_color", l_set_color},         {"set_enabled", l_set_enabled},
                                     {"is_enabled", l_is_enabled},       {"set_range", l_set_range},

@@ -1,0 +1,206 @@
+#include "editor/editor_tools.h"
+
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "engine/editor/gizmo_math.h"
+#include "engine/rt/rt_scene.h"
+#include "engine/scene/components.h"
+
+namespace game {
+
+namespace {
+
+using engine::ecs::Entity;
+using engine::ecs::World;
+namespace ed = engine::editor;
+namespace tf = engine::transform;
+
+glm::mat4 view_projection(const EditorView& v) {
+  return glm::perspective(v.fov_y, v.aspect, 0.01f, 1000.0f) * glm::inverse(v.camera.matrix());
+}
+
+glm::vec3 axis_of(GizmoHandle h) {
+  switch (h) {
+    case GizmoHandle::X: case GizmoHandle::RX: return {1, 0, 0};
+    case GizmoHandle::Y: case GizmoHandle::RY: return {0, 1, 0};
+    case GizmoHandle::Z: case GizmoHandle::RZ: return {0, 0, 1};
+    case GizmoHandle::None: break;
+  }
+  return {0, 0, 0};
+}
+
+bool is_ring(GizmoHandle h) { return h == GizmoHandle::RX || h == GizmoHandle::RY || h == GizmoHandle::RZ; }
+
+tf::Similarity parent_world(const World& world, Entity e) {
+  if (const auto* p = world.try_get<tf::Parent>(e))
+    if (world.alive(p->entity))
+      if (const auto* w = world.try_get<tf::WorldTransform>(p->entity)) return *w;
+  return {};
+}
+
+// The ring's point under the cursor, if the pick ray meets the ring's plane.
+std::optional<glm::vec3> ring_point(const ed::PickRay& ray, const HandleGeometry& g) {
+  const auto t = ed::ray_plane(ray, g.pivot, g.axis);
+  if (!t) return std::nullopt;
+  return ray.origin + *t * ray.direction;
+}
+
+GizmoHandle hovered_handle(const World& world, const EditorState& s, const EditorView& view, const glm::vec2& mouse) {
+  const glm::mat4 vp = view_projection(view);
+  const ed::PickRay ray = ed::pick_ray(view.camera, view.fov_y, view.aspect, view.viewport, mouse);
+  const auto handles = s.mode == GizmoMode::Translate
+                           ? std::array<GizmoHandle, 3>{GizmoHandle::X, GizmoHandle::Y, GizmoHandle::Z}
+                           : std::array<GizmoHandle, 3>{GizmoHandle::RX, GizmoHandle::RY, GizmoHandle::RZ};
+  GizmoHandle best = GizmoHandle::None;
+  float best_pixels = s.pick_pixels;
+  for (GizmoHandle h : handles) {
+    const HandleGeometry g = handle_geometry(world, s, view, h);
+    if (!g.visible) continue;
+    float pixels = INFINITY;
+    if (!is_ring(h)) {
+      const auto a = ed::project_to_pixels(vp, view.viewport, g.pivot + 0.15f * g.size * g.axis);
+      const auto b = ed::project_to_pixels(vp, view.viewport, g.pivot + g.size * g.axis);
+      if (a && b) pixels = ed::distance_to_segment(mouse, *a, *b);
+    } else if (const auto p = ring_point(ray, g)) {
+      const float off = std::abs(glm::length(*p - g.pivot) - g.size);  // world units off the ring
+      const float per_pixel = g.size / s.gizmo_pixels;
+      pixels = off / per_pixel;
+    }
+    if (pixels < best_pixels) {
+      best_pixels = pixels;
+      best = h;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+GizmoHandle parse_handle(const std::string& name) {
+  if (name == "x") return GizmoHandle::X;
+  if (name == "y") return GizmoHandle::Y;
+  if (name == "z") return GizmoHandle::Z;
+  if (name == "rx") return GizmoHandle::RX;
+  if (name == "ry") return GizmoHandle::RY;
+  if (name == "rz") return GizmoHandle::RZ;
+  return GizmoHandle::None;
+}
+
+HandleGeometry handle_geometry(const World& world, const EditorState& s, const EditorView& view, GizmoHandle h) {
+  HandleGeometry g;
+  if (h == GizmoHandle::None || s.selected.is_null() || !world.alive(s.selected)) return g;
+  const auto* w = world.try_get<tf::WorldTransform>(s.selected);
+  if (!w) return g;
+  g.pivot = s.active != GizmoHandle::None ? s.pivot : w->translation;
+  g.axis = axis_of(h);
+  const float distance = glm::length(g.pivot - view.camera.translation);
+  g.size = ed::world_size_for_pixels(s.gizmo_pixels, std::max(distance, 1e-3f), view.fov_y, view.viewport.y);
+  const glm::vec3 view_dir = glm::normalize(g.pivot - view.camera.translation);
+  g.visible = !ed::edge_on(view_dir, g.axis, is_ring(h));
+  return g;
+}
+
+std::optional<glm::vec2> handle_grab_pixel(const World& world, const EditorState& s, const EditorView& view, GizmoHandle h) {
+  const HandleGeometry g = handle_geometry(world, s, view, h);
+  if (!g.visible) return std::nullopt;
+  glm::vec3 p;
+  if (!is_ring(h)) {
+    p = g.pivot + 0.8f * g.size * g.axis;
+  } else {  // the ring's point facing most across the view
+    const glm::vec3 to_camera = glm::normalize(view.camera.translation - g.pivot);
+    const glm::vec3 across = glm::cross(g.axis, to_camera);
+    if (glm::length(across) < 1e-4f) return std::nullopt;
+    p = g.pivot + g.size * glm::normalize(across);
+  }
+  return ed::project_to_pixels(view_projection(view), view.viewport, p);
+}
+
+Entity pick_entity(World& world, const EditorView& view, const glm::vec2& pixel, float pick_pixels) {
+  const ed::PickRay ray = ed::pick_ray(view.camera, view.fov_y, view.aspect, view.viewport, pixel);
+  Entity best;
+  float best_t = INFINITY;
+  if (const auto* rt = world.try_resource<engine::rt::RtScene>()) {
+    engine::rt::Ray r;
+    r.origin = ray.origin;
+    r.direction = ray.direction;
+    engine::rt::Hit hit;
+    if (rt->intersect(r, hit) && world.alive(hit.entity)) {
+      best = hit.entity;
+      best_t = hit.t;
+    }
+  }
+  const glm::mat4 vp = view_projection(view);
+  world.view<const engine::scene::PunctualLight, const tf::WorldTransform>().each(
+      [&](Entity e, const engine::scene::PunctualLight&, const tf::WorldTransform& w) {
+        const auto px = ed::project_to_pixels(vp, view.viewport, w.translation);
+        const float t = glm::length(w.translation - ray.origin);
+        if (px && glm::length(*px - pixel) < pick_pixels * 1.5f && t < best_t) {
+          best = e;
+          best_t = t;
+        }
+      });
+  return best;
+}
+
+void update_editor(World& world, EditorState& s, const engine::input::InputState& in, const EditorView& view) {
+  if (!s.selected.is_null() && !world.alive(s.selected)) {  // despawned (by a script, say): drop it and any drag
+    s.selected = {};
+    s.active = s.hovered = GizmoHandle::None;
+  }
+  const bool ctrl = in.is_down("ctrl");
+  if (ctrl && in.was_pressed("Z")) s.undo.undo(world);
+  if (ctrl && in.was_pressed("Y")) s.undo.redo(world);
+  const glm::vec2 mouse = in.mouse;
+  const ed::PickRay ray = ed::pick_ray(view.camera, view.fov_y, view.aspect, view.viewport, mouse);
+
+  if (s.active == GizmoHandle::None) {
+    s.hovered = s.selected.is_null() ? GizmoHandle::None : hovered_handle(world, s, view, mouse);
+    if (!in.was_pressed("mouse_left")) return;
+    if (s.hovered == GizmoHandle::None) {
+      s.selected = pick_entity(world, view, mouse, s.pick_pixels);
+      return;
+    }
+    const HandleGeometry g = handle_geometry(world, s, view, s.hovered);
+    auto* t = world.try_get_mut<tf::Transform>(s.selected);
+    if (!t) return;
+    if (!is_ring(s.hovered)) {
+      const auto p = ed::closest_on_axis(ray, g.pivot, g.axis);
+      if (!p) return;
+      s.start_param = *p;
+    } else {
+      const auto p = ring_point(ray, g);
+      if (!p) return;
+      s.last_angle = ed::ring_angle(*p, g.pivot, g.axis, ed::ring_reference(g.axis));
+      s.angle = 0.0f;
+    }
+    s.active = s.hovered;
+    s.start = *t;
+    s.parent = parent_world(world, s.selected);
+    s.pivot = g.pivot;
+    return;
+  }
+
+  // Dragging.
+  const HandleGeometry g = handle_geometry(world, s, view, s.active);
+  auto* t = world.alive(s.selected) ? world.try_get_mut<tf::Transform>(s.selected) : nullptr;
+  if (t) {
+    if (!is_ring(s.active)) {
+      if (const auto p = ed::closest_on_axis(ray, g.pivot, g.axis))
+        *t = ed::translated(s.start, s.parent, (*p - s.start_param) * g.axis, ctrl ? s.translate_snap : 0.0f);
+    } else if (const auto p = ring_point(ray, g)) {
+      const float a = ed::ring_angle(*p, g.pivot, g.axis, ed::ring_reference(g.axis));
+      s.angle += ed::wrap_angle(a - s.last_angle);  // unwrapped total since the press
+      s.last_angle = a;
+      *t = ed::rotated(s.start, s.parent, g.axis, s.angle, ctrl ? glm::radians(s.rotate_snap_degrees) : 0.0f);
+    }
+  }
+  if (!in.is_down("mouse_left")) {
+    if (t) s.undo.push({s.selected, s.start, *t});
+    s.active = GizmoHandle::None;
+    ++s.drags;
+  }
+}
+
+}  // namespace game

@@ -1,0 +1,71 @@
+#pragma once
+// The editor's selection and gizmo drags, driven only by InputState and the
+// camera, so a window, a replay file and a test drive the same code. Drawing
+// (ImGui) reads EditorState and handle_geometry(); it decides nothing.
+//
+// A left click on a handle of the selection's gizmo starts a drag; anywhere
+// else it selects what is under the cursor (meshes through Embree, lights by
+// their icon). A drag sets the Transform to the start transform plus the
+// delta since the press (Ctrl snaps: 0.25 m, 15 degrees); releasing records
+// one undo entry. Ctrl+Z / Ctrl+Y undo and redo.
+#include <optional>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "engine/ecs/world.h"
+#include "engine/editor/undo_stack.h"
+#include "engine/input/input_state.h"
+#include "engine/transform/transform.h"
+
+namespace game {
+
+enum class GizmoMode { Translate, Rotate };
+enum class GizmoHandle { None, X, Y, Z, RX, RY, RZ };
+
+struct EditorView {
+  engine::transform::Similarity camera;  // world transform of the camera (looks down -Z)
+  float fov_y = 1.0f, aspect = 16.0f / 9.0f;
+  glm::vec2 viewport{640, 360};
+};
+
+struct EditorState {
+  engine::ecs::Entity selected;
+  GizmoMode mode = GizmoMode::Translate;
+  GizmoHandle hovered = GizmoHandle::None, active = GizmoHandle::None;
+  // Higher = bigger gizmo on screen at the cost of covering more of the object.
+  float gizmo_pixels = 90.0f;
+  // Higher = handles easier to hit at the cost of taking clicks meant for the scene.
+  float pick_pixels = 8.0f;
+  float translate_snap = 0.25f, rotate_snap_degrees = 15.0f;
+  engine::editor::UndoStack undo;
+  // The drag in progress.
+  engine::transform::Transform start;
+  engine::transform::Similarity parent;
+  glm::vec3 pivot{0.0f};
+  float start_param = 0.0f, angle = 0.0f, last_angle = 0.0f;
+  std::size_t drags = 0;  // finished drags, for tests and the stats overlay
+};
+
+// One handle's geometry in world space: an axis segment (translate) or a
+// ring (rotate) around `pivot` of radius `size`.
+struct HandleGeometry {
+  glm::vec3 pivot{0.0f}, axis{0.0f};
+  float size = 0.0f;
+  bool visible = false;  // false when edge-on
+};
+HandleGeometry handle_geometry(const engine::ecs::World& world, const EditorState& s, const EditorView& view, GizmoHandle h);
+// Where a person would grab the handle, in pixels (for replays and tests).
+std::optional<glm::vec2> handle_grab_pixel(const engine::ecs::World& world, const EditorState& s, const EditorView& view,
+                                           GizmoHandle h);
+
+// Applies this frame's mouse and keys.
+void update_editor(engine::ecs::World& world, EditorState& s, const engine::input::InputState& in, const EditorView& view);
+
+// The entity under a pixel: a mesh through the ray-tracing scene, or a
+// light whose icon (its projected position) lies within pick_pixels.
+engine::ecs::Entity pick_entity(engine::ecs::World& world, const EditorView& view, const glm::vec2& pixel, float pick_pixels);
+
+GizmoHandle parse_handle(const std::string& name);
+
+}  // namespace game

@@ -1,0 +1,131 @@
+#include "play/game_session.h"
+
+#include <chrono>
+#include <stdexcept>
+
+#include "engine/scene/components.h"
+#include "engine/script/script_plugin.h"
+#include "engine/transform/transform.h"
+#include "eval/method_runs.h"
+#include "level/level_manifest.h"
+#include "model/model_file.h"
+#include "play/fly_camera.h"
+#include "runtime/transgi_plugin.h"
+
+namespace game {
+
+namespace fs = std::filesystem;
+using engine::ecs::Entity;
+
+GameSession::GameSession(const GameOptions& options) : options_(options) {
+  if (options_.width < 16 || options_.height < 16 || options_.width > 8192 || options_.height > 8192)
+    throw std::runtime_error("--width/--height: must be in [16, 8192], got " + std::to_string(options_.width) + "x" +
+                             std::to_string(options_.height));
+  if (options_.view != "full" && options_.view != "gi" && options_.view != "direct")
+    throw std::runtime_error("--view: expected full, gi or direct, got '" + options_.view + "'");
+  if (!fs::exists(options_.scene)) throw std::runtime_error(options_.scene.string() + ": no such scene file");
+  const fs::path model_path = options_.model.empty() ? options_.scene.parent_path() / "transgi.tgm" : options_.model;
+  fs::path manifest_path = options_.manifest;
+  if (manifest_path.empty() && fs::exists(options_.scene.parent_path() / "game.json")) manifest_path = options_.scene.parent_path() / "game.json";
+
+  transgi::eval::LoadedScene scene = transgi::eval::load_scene(options_.scene.string(), {}, options_.threads);
+  app_ = std::move(scene.app);
+  camera_ = scene.camera;
+  engine::ecs::World& world = app_->world();
+  // The model was baked for the glTF alone: validate it before the game adds meshes.
+  auto model = std::make_shared<const transgi::model::TransferModel>(transgi::model::load_model(model_path));
+  transgi::model::validate_model(*model, world.resource<engine::scene::SceneAssets>(), model_path);
+  app_->add_plugin<transgi::runtime::TransGIPlugin>(transgi::runtime::realtime_preset());
+  transgi::runtime::attach_latent_meshes(world, model);
+  world.emplace<transgi::runtime::ProbeVolume>(world.spawn(), transgi::runtime::ProbeVolume{});
+
+  engine::script::ScriptSettings script_settings;
+  if (!manifest_path.empty()) {
+    const LevelManifest manifest = load_manifest(manifest_path);
+    apply_manifest(world, manifest);
+    script_settings.root = manifest.scripts_dir;
+  }
+  app_->add_plugin<engine::script::ScriptPlugin>(script_settings);
+  // scene.spawn("prefab") copies the prefab's latents too, so a copy of a baked object keeps its transfer.
+  world.resource<engine::script::ScriptRuntime>().add_clone_hook([](engine::ecs::World& w, Entity from, Entity to) {
+    if (const auto* l = w.try_get<transgi::runtime::LatentMesh>(from)) w.emplace<transgi::runtime::LatentMesh>(to, *l);
+  });
+  world.emplace<FlyCamera>(camera_, FlyCamera{});
+  add_fly_camera_system(*app_);
+
+  auto& frame = world.resource<transgi::runtime::GiFrame>();
+  frame.camera = camera_;
+  frame.width = options_.width;
+  frame.height = options_.height;
+}
+
+GameSession::~GameSession() {
+  if (app_)
+    if (auto* rt = app_->world().try_resource<engine::script::ScriptRuntime>()) rt->shutdown(app_->world());
+}
+
+engine::ecs::World& GameSession::world() { return app_->world(); }
+engine::input::InputState& GameSession::input() { return world().resource<engine::input::InputState>(); }
+
+Entity GameSession::find(const std::string& name) {
+  Entity found;
+  world().view<const engine::scene::Name>().each([&](Entity e, const engine::scene::Name& n) {
+    if (found.is_null() && n.value == name) found = e;
+  });
+  return found;
+}
+
+EditorView GameSession::view() {
+  EditorView v;
+  const auto* w = world().try_get<engine::transform::WorldTransform>(camera_);
+  if (w) v.camera = *w;
+  const auto& cam = world().get<engine::scene::Camera>(camera_);
+  v.fov_y = cam.yfov_radians;
+  v.aspect = static_cast<float>(options_.width) / static_cast<float>(options_.height);
+  v.viewport = {static_cast<float>(options_.width), static_cast<float>(options_.height)};
+  return v;
+}
+
+void GameSession::begin_input() { input().begin_frame(); }
+
+void GameSession::apply(const ReplayEvent& e) {
+  engine::input::InputState& in = input();
+  if (e.kind == "key_down") in.set_key(e.name, true);
+  else if (e.kind == "key_up") in.set_key(e.name, false);
+  else if (e.kind == "key_press") {
+    in.set_key(e.name, true);
+    in.pressed.insert(e.name);
+    in.down.erase(e.name);  // released again before the next frame; scripts see pressed()
+  } else if (e.kind == "mouse_move") in.move_mouse(e.xy);
+  else if (e.kind == "mouse_move_by") in.move_mouse(in.mouse + e.xy);
+  else if (e.kind == "mouse_down") in.set_key("mouse_" + e.name, true);
+  else if (e.kind == "mouse_up") in.set_key("mouse_" + e.name, false);
+  else if (e.kind == "select") {
+    const Entity s = find(e.name);
+    if (s.is_null()) throw std::runtime_error("replay line " + std::to_string(e.line) + ": select: no entity named '" + e.name + "'");
+    editor_.selected = s;
+  } else if (e.kind == "gizmo_mode") editor_.mode = e.name == "rotate" ? GizmoMode::Rotate : GizmoMode::Translate;
+  else if (e.kind == "gizmo_grab") {
+    const auto px = handle_grab_pixel(world(), editor_, view(), parse_handle(e.name));
+    if (!px) throw std::runtime_error("replay line " + std::to_string(e.line) + ": gizmo_grab " + e.name +
+                                      ": the handle is not visible (nothing selected, or edge-on)");
+    in.move_mouse(*px);
+  }
+}
+
+void GameSession::frame() {
+  const auto t0 = std::chrono::steady_clock::now();
+  update_editor(world(), editor_, input(), view());
+  app_->jobs().run([&] { app_->update(); });
+  last_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  ++frames_;
+}
+
+const engine::image::ImageRGB& GameSession::image() const {
+  const auto& f = app_->world().resource<transgi::runtime::GiFrame>();
+  if (options_.view == "gi") return f.gi;
+  if (options_.view == "direct") return f.direct;
+  return f.full;
+}
+
+}  // namespace game

@@ -1,0 +1,59 @@
+#pragma once
+// One running game: the level (glTF + baked GI model + game.json), the
+// TransGI plugin on its real-time preset, Lua scripts, the fly camera and
+// the editor tools. A window, a headless replay and the tests all drive it
+// the same way: set this frame's input, then frame().
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "editor/editor_tools.h"
+#include "engine/app/app.h"
+#include "engine/image/image.h"
+#include "engine/input/input_state.h"
+#include "replay/replay.h"
+
+namespace game {
+
+struct GameOptions {
+  std::filesystem::path scene;     // the level's glTF
+  std::filesystem::path model;     // empty = transgi.tgm beside the scene
+  std::filesystem::path manifest;  // empty = game.json beside the scene, if there is one
+  int width = 640, height = 360;
+  int threads = 0;                 // 0 = all cores
+  std::string view = "full";       // full | gi | direct
+};
+
+class GameSession {
+ public:
+  // Throws std::runtime_error naming the file and field on bad content.
+  explicit GameSession(const GameOptions& options);
+  ~GameSession();
+
+  // Starts a frame's input: clears last frame's presses, then applies the
+  // replay events (if any) for this frame.
+  void begin_input();
+  void apply(const ReplayEvent& e);
+  // Runs the editor tools and one App frame (scripts, transforms, GI).
+  void frame();
+
+  [[nodiscard]] const engine::image::ImageRGB& image() const;
+  [[nodiscard]] engine::ecs::World& world();
+  [[nodiscard]] engine::input::InputState& input();
+  [[nodiscard]] EditorState& editor() { return editor_; }
+  [[nodiscard]] EditorView view();
+  [[nodiscard]] engine::ecs::Entity find(const std::string& name);
+  [[nodiscard]] double last_frame_ms() const { return last_ms_; }
+  [[nodiscard]] std::uint64_t frames() const { return frames_; }
+
+ private:
+  GameOptions options_;
+  std::unique_ptr<engine::app::App> app_;
+  engine::ecs::Entity camera_;
+  EditorState editor_;
+  double last_ms_ = 0;
+  std::uint64_t frames_ = 0;
+};
+
+}  // namespace game
