@@ -17,6 +17,8 @@ std::optional<float> closest_on_axis(const PickRay& ray, const glm::vec3& point,
   const float denom = 1.0f - b * b;  // |a| = |d| = 1
   if (denom < 1e-6f) return std::nullopt;
   const float d = glm::dot(axis, w), e = glm::dot(ray.direction, w);
+  const float t = (e - b * d) / denom;  // where along the ray
+  if (t < 0.0f) return std::nullopt;    // the cursor is past the axis's vanishing point
   return (b * e - d) / denom;
 }
 

@@ -20,7 +20,8 @@ struct PickRay {
 
 // Parameter s of the point (point + s * axis) on the axis line that is
 // closest to the ray (axis unit length). Empty when the ray runs parallel
-// to the axis, where no drag along it can be read.
+// to the axis, where no drag along it can be read, and when that point lies
+// behind the ray's origin (the cursor went past the axis's vanishing point).
 std::optional<float> closest_on_axis(const PickRay& ray, const glm::vec3& point, const glm::vec3& axis);
 
 // Distance t along the ray to the plane through `point` with `normal`, or

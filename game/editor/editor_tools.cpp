@@ -65,7 +65,7 @@ GizmoHandle hovered_handle(const World& world, const EditorState& s, const Edito
       if (a && b) pixels = ed::distance_to_segment(mouse, *a, *b);
     } else if (const auto p = ring_point(ray, g)) {
       const float off = std::abs(glm::length(*p - g.pivot) - g.size);  // world units off the ring
-      const float per_pixel = g.size / s.gizmo_pixels;
+      const float per_pixel = g.size / (s.gizmo_fraction * view.viewport.y);
       pixels = off / per_pixel;
     }
     if (pixels < best_pixels) {
@@ -96,7 +96,7 @@ HandleGeometry handle_geometry(const World& world, const EditorState& s, const E
   g.pivot = s.active != GizmoHandle::None ? s.pivot : w->translation;
   g.axis = axis_of(h);
   const float distance = glm::length(g.pivot - view.camera.translation);
-  g.size = ed::world_size_for_pixels(s.gizmo_pixels, std::max(distance, 1e-3f), view.fov_y, view.viewport.y);
+  g.size = ed::world_size_for_pixels(s.gizmo_fraction * view.viewport.y, std::max(distance, 1e-3f), view.fov_y, view.viewport.y);
   const glm::vec3 view_dir = glm::normalize(g.pivot - view.camera.translation);
   g.visible = !ed::edge_on(view_dir, g.axis, is_ring(h));
   return g;

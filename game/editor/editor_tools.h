@@ -33,8 +33,10 @@ struct EditorState {
   engine::ecs::Entity selected;
   GizmoMode mode = GizmoMode::Translate;
   GizmoHandle hovered = GizmoHandle::None, active = GizmoHandle::None;
-  // Higher = bigger gizmo on screen at the cost of covering more of the object.
-  float gizmo_pixels = 90.0f;
+  // The gizmo's length as a fraction of the view's height, the same at every
+  // distance and resolution. Higher = easier to grab, at the cost of
+  // covering more of the scene.
+  float gizmo_fraction = 0.15f;
   // Higher = handles easier to hit at the cost of taking clicks meant for the scene.
   float pick_pixels = 8.0f;
   float translate_snap = 0.25f, rotate_snap_degrees = 15.0f;

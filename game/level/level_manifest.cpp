@@ -85,7 +85,7 @@ LevelManifest load_manifest(const std::filesystem::path& file) {
   json root;
   try {
     root = json::parse(in);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // syntax, and numbers out of double's range
     throw std::runtime_error(file.string() + ": not valid JSON: " + e.what());
   }
   if (!root.is_object()) fail(file, "(root)", "expected an object");

@@ -36,6 +36,17 @@ TEST(GizmoMath, ClosestPointOnAnAxisToASkewRay) {
   EXPECT_NEAR(*s2, 4.0f, 1e-5f) << "the ray crosses x = 4 at z = 0, one unit above the axis";
 }
 
+TEST(GizmoMath, PastTheVanishingPointNothingIsRead) {
+  // The axis runs away from a camera at the origin looking down -Z, offset
+  // one unit in x. A ray aimed across the axis's vanishing direction meets
+  // it only behind the camera.
+  const glm::vec3 axis = glm::normalize(glm::vec3(0.2f, 0, -1));
+  const PickRay ahead{{0, 0, 0}, glm::normalize(glm::vec3(1.5f, 0, -1))};
+  EXPECT_TRUE(closest_on_axis(ahead, {1, 0, -2}, axis).has_value());
+  const PickRay past{{0, 0, 0}, glm::normalize(glm::vec3(0.1f, 0, -1))};
+  EXPECT_FALSE(closest_on_axis(past, {1, 0, -2}, axis).has_value());
+}
+
 TEST(GizmoMath, AnAxisAlongTheRayCannotBeDragged) {
   const PickRay ray{{0, 0, 5}, {0, 0, -1}};
   EXPECT_FALSE(closest_on_axis(ray, {0, 0, 0}, {0, 0, 1}).has_value());

@@ -1,0 +1,162 @@
+// The game layer: replay and level files (errors name the file and line or
+// field), and a headless session in which a replayed gizmo drag moves the
+// chosen object by what the cursor asked and the GI near it changes.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "editor/editor_tools.h"
+#include "engine/editor/gizmo_math.h"
+#include "engine/transform/transform.h"
+#include "level/level_manifest.h"
+#include "play/game_session.h"
+#include "replay/replay.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kLevel = fs::path(TRANSGI_CONTENT_DIR) / "levels/living_room";
+
+std::string error_of(const std::function<void()>& fn) {
+  try {
+    fn();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(Replay, ParsesEventsInFrameOrder) {
+  const auto events = game::parse_replay("5 key_down W  # walk\n\n2 mouse_move 10 20\n5 select PlasticCube\n3 gizmo_grab rx\n", "r.txt");
+  ASSERT_EQ(events.size(), 4u);
+  EXPECT_EQ(events[0].kind, "mouse_move");
+  EXPECT_EQ(events[0].xy, glm::vec2(10, 20));
+  EXPECT_EQ(events[1].name, "rx");
+  EXPECT_EQ(events[2].name, "W");
+  EXPECT_EQ(events[3].name, "PlasticCube") << "file order is kept within a frame";
+}
+
+TEST(Replay, BadLinesNameTheFileAndLine) {
+  EXPECT_EQ(error_of([] { game::parse_replay("1 key_down W\n2 jump\n", "r.txt"); }), "r.txt:2: unknown event 'jump'");
+  EXPECT_EQ(error_of([] { game::parse_replay("x key_down W\n", "r.txt"); }), "r.txt:1: the frame must be a non-negative integer, got 'x'");
+  EXPECT_EQ(error_of([] { game::parse_replay("1 mouse_move 3\n", "r.txt"); }), "r.txt:1: mouse_move needs two finite numbers");
+  EXPECT_EQ(error_of([] { game::parse_replay("1 mouse_down middle\n", "r.txt"); }),
+            "r.txt:1: mouse_down: the button must be left or right, got 'middle'");
+  EXPECT_EQ(error_of([] { game::parse_replay("1 key_up W extra\n", "r.txt"); }), "r.txt:1: unexpected 'extra' after the event");
+}
+
+TEST(LevelManifest, BadFieldsNameTheFileAndField) {
+  const fs::path f = fs::temp_directory_path() / ("game_manifest_" + std::to_string(::getpid()) + ".json");
+  auto check = [&](const std::string& json, const std::string& want) {
+    std::ofstream(f) << json;
+    const std::string got = error_of([&] { game::load_manifest(f); });
+    EXPECT_NE(got.find(want), std::string::npos) << "got: " << got;
+  };
+  check("{", "not valid JSON");
+  check(R"({"meshes": [{"name": "A", "shape": "box", "size": [1, 1]}]})", "meshes[0].size: expected [x, y, z]");
+  check(R"({"meshes": [{"name": "A", "shape": "cone", "size": [1, 1, 1]}]})", "meshes[0].shape: expected box or sphere");
+  check(R"({"entities": [{"name": "L", "light": {"intensity": -1}}]})", "entities[0].light: color, intensity and range must be >= 0");
+  check(R"({"entities": [{"name": "L", "position": [0, 1e400, 0]}]})", "not valid JSON");
+  check(R"({"entities": [{"name": "L", "script": {"file": "a.lua", "properties": {"x": [1]}}}]})",
+        "entities[0].script.properties.x: expected a number, boolean or string");
+  EXPECT_NE(error_of([&] { game::load_manifest(f.string() + ".missing"); }).find("cannot open"), std::string::npos);
+  fs::remove(f);
+}
+
+TEST(LevelManifest, TheSampleLevelsFileLoads) {
+  const game::LevelManifest m = game::load_manifest(kLevel / "game.json");
+  EXPECT_EQ(m.meshes.size(), 2u);
+  EXPECT_TRUE(m.attach.contains("PlasticBall"));
+  for (const auto& e : m.entities)
+    if (e.script) EXPECT_TRUE(fs::exists(m.scripts_dir / e.script->path)) << e.script->path;
+}
+
+// Mean of the GI image over a pixel box.
+float region_mean(const engine::image::ImageRGB& img, glm::ivec2 lo, glm::ivec2 hi) {
+  double sum = 0;
+  int n = 0;
+  for (int y = std::max(0, lo.y); y < std::min(img.height, hi.y); ++y)
+    for (int x = std::max(0, lo.x); x < std::min(img.width, hi.x); ++x, ++n) sum += glm::dot(img.at(x, y), glm::vec3(1.0f / 3));
+  return n ? static_cast<float>(sum / n) : 0.0f;
+}
+
+TEST(GameSession, AReplayedGizmoDragMovesTheObjectUnderTheCursorAndTheGiFollows) {
+  game::GameOptions o;
+  o.scene = kLevel / "scene.gltf";
+  o.width = 192;
+  o.height = 108;
+  o.view = "gi";
+  auto run = [&](bool drag, glm::vec3* moved, glm::vec2* cursor_error) {
+    game::GameSession s(o);
+    const auto cube = s.find("PlasticCube");
+    EXPECT_FALSE(cube.is_null());
+    for (int f = 0; f < 24; ++f) {
+      s.begin_input();
+      s.frame();
+    }
+    const glm::vec3 before = s.world().get<engine::transform::Transform>(cube).translation;
+    if (drag) {
+      s.begin_input();
+      s.apply({0, "select", "PlasticCube", {}, 1});
+      s.apply({0, "gizmo_grab", "x", {}, 2});
+      const glm::vec2 grab = s.input().mouse;
+      // The X axis's direction on screen, from the handle geometry.
+      const game::HandleGeometry g = game::handle_geometry(s.world(), s.editor(), s.view(), game::GizmoHandle::X);
+      const game::EditorView v = s.view();
+      const glm::mat4 vp = glm::perspective(v.fov_y, v.aspect, 0.01f, 1000.0f) * glm::inverse(v.camera.matrix());
+      const glm::vec3 grab_world = g.pivot + 0.8f * g.size * g.axis;
+      const glm::vec2 tip = *engine::editor::project_to_pixels(vp, v.viewport, grab_world + 0.1f * g.axis);
+      const glm::vec2 along = glm::normalize(tip - grab);
+      s.apply({0, "mouse_down", "left", {}, 3});
+      s.frame();
+      for (int i = 0; i < 5; ++i) {
+        s.begin_input();
+        s.apply({0, "mouse_move_by", "", along * 3.0f, 4});
+        s.frame();
+      }
+      s.begin_input();
+      s.apply({0, "mouse_up", "left", {}, 5});
+      s.frame();
+      // The grabbed point of the axis followed the cursor.
+      const glm::vec3 after = s.world().get<engine::transform::Transform>(cube).translation;
+      const glm::vec2 now = *engine::editor::project_to_pixels(vp, v.viewport, grab_world + (after - before));
+      *cursor_error = now - s.input().mouse;
+      EXPECT_EQ(s.editor().drags, 1u);
+      EXPECT_EQ(s.editor().undo.undo_count(), 1u);
+    }
+    for (int f = 0; f < 16; ++f) {
+      s.begin_input();
+      s.frame();
+    }
+    *moved = s.world().get<engine::transform::Transform>(cube).translation - before;
+    // The cube's neighbourhood on screen, from its start position.
+    const game::EditorView v = s.view();
+    const glm::mat4 vp = glm::perspective(v.fov_y, v.aspect, 0.01f, 1000.0f) * glm::inverse(v.camera.matrix());
+    const glm::vec2 c = *engine::editor::project_to_pixels(vp, v.viewport, before);
+    return region_mean(s.image(), glm::ivec2(c) - glm::ivec2(6), glm::ivec2(c) + glm::ivec2(6));
+  };
+  glm::vec3 moved_drag, moved_still;
+  glm::vec2 cursor_error(0.0f), unused(0.0f);
+  const float gi_drag = run(true, &moved_drag, &cursor_error);
+  const float gi_still = run(false, &moved_still, &unused);
+  EXPECT_EQ(moved_still, glm::vec3(0.0f));
+  EXPECT_GT(moved_drag.x, 0.05f) << "15 pixels along the X handle";
+  EXPECT_EQ(moved_drag.y, 0.0f);
+  EXPECT_EQ(moved_drag.z, 0.0f);
+  EXPECT_LT(glm::length(cursor_error), 0.5f) << "the grabbed point ended " << cursor_error.x << ", " << cursor_error.y
+                                             << " pixels from the cursor";
+  const float change = std::abs(gi_drag - gi_still) / std::max(gi_still, 1e-6f);
+  std::printf("drag moved the cube %.3f m along x, cursor error %.3f px, mean GI near it %.4f moved vs %.4f unmoved (%.0f %%)\n",
+              static_cast<double>(moved_drag.x), static_cast<double>(glm::length(cursor_error)), static_cast<double>(gi_drag),
+              static_cast<double>(gi_still), 100.0 * static_cast<double>(change));
+  EXPECT_GT(change, 0.05f) << "moved " << moved_drag.x << " m; mean GI near the cube: " << gi_drag << " moved, " << gi_still << " unmoved";
+}
+
+}  // namespace
