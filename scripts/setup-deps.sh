@@ -8,7 +8,8 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libtbb-dev libglm-dev libstb-dev libopenexr-dev libtinygltf-dev nlohmann-json3-dev libembree-dev libdnnl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  liblua5.4-dev
+  liblua5.4-dev libglfw3-dev libimgui-dev libgl-dev libgl1-mesa-dri
+  xvfb xauth ffmpeg
 )
 
 missing=()
