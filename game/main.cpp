@@ -1,5 +1,6 @@
-// transgi-game: the sample level as a small game. Headless runs replay timed
-// input and record frames:
+// transgi-game: the sample level as a small game, in a window with the editor
+// (the default), or headless, replaying timed input and recording frames:
+//   transgi-game [--frames N --screenshot F.png] [--scene ...]
 //   transgi-game --headless --frames N [--script-input replay.txt] [--record DIR] [--screenshot F.png]
 //                [--scene level.gltf] [--model M.tgm] [--game game.json] [--width W --height H] [--view full|gi|direct]
 #include <cstdio>
@@ -14,13 +15,15 @@
 #include "play/game_session.h"
 #include "record/recorder.h"
 #include "replay/replay.h"
+#include "window/window_run.h"
 
 namespace {
 
 constexpr const char* kUsage =
     "usage: transgi-game [--headless] [--frames N] [--script-input replay.txt] [--record DIR] [--screenshot F.png]\n"
     "                    [--scene level.gltf] [--model M.tgm] [--game game.json] [--width W] [--height H]\n"
-    "                    [--view full|gi|direct] [--exposure STOPS] [--threads T]\n";
+    "                    [--view full|gi|direct] [--exposure STOPS] [--threads T]\n"
+    "  window only: [--select NAME] [--gizmo translate|rotate] (what the editor shows at start)\n";
 
 struct Cli {
   std::map<std::string, std::string> values;
@@ -29,7 +32,7 @@ struct Cli {
 
 Cli parse(int argc, char** argv) {
   static const std::vector<std::string> kValued = {"frames", "script-input", "record", "screenshot", "scene", "model",
-                                                   "game", "width", "height", "view", "exposure", "threads"};
+                                                   "game", "width", "height", "view", "exposure", "threads", "select", "gizmo"};
   Cli c;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -125,10 +128,22 @@ int main(int argc, char** argv) {
   try {
     const Cli cli = parse(argc, argv);
     if (!cli.headless) {
-      std::fprintf(stderr,
-                   "transgi-game: the window and editor are not built yet (issue 11, items 1-2); run with --headless\n%s",
-                   kUsage);
-      return 2;
+      for (const char* headless_only : {"script-input", "record"})
+        if (cli.values.contains(headless_only)) throw std::runtime_error(std::string("--") + headless_only + " needs --headless");
+      game::GameOptions o;
+      o.scene = value(cli, "scene", TRANSGI_DEFAULT_LEVEL);
+      o.model = value(cli, "model");
+      o.manifest = value(cli, "game");
+      o.width = integer(cli, "width", 16, 8192, 640);
+      o.height = integer(cli, "height", 16, 8192, 360);
+      o.threads = integer(cli, "threads", 0, 1024, 0);
+      o.view = value(cli, "view", "full");
+      game::WindowOptions w;
+      w.frames = integer(cli, "frames", 0, 1000000, 0);
+      w.screenshot = value(cli, "screenshot");
+      w.select = value(cli, "select");
+      w.gizmo = value(cli, "gizmo", "translate");
+      return game::run_window(o, w);
     }
     return run_headless(cli);
   } catch (const std::exception& e) {

@@ -3,11 +3,17 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "ddgi/ddgi_plugin.h"
+#include "engine/render/camera_rays.h"
+#include "engine/render/light_plugin.h"
+#include "engine/render/path_tracer.h"
+#include "engine/rt/rt_scene.h"
 #include "engine/scene/components.h"
 #include "engine/script/script_plugin.h"
 #include "engine/transform/transform.h"
 #include "eval/method_runs.h"
 #include "level/level_manifest.h"
+#include "level/level_save.h"
 #include "model/model_file.h"
 #include "play/fly_camera.h"
 #include "runtime/transgi_plugin.h"
@@ -17,7 +23,25 @@ namespace game {
 namespace fs = std::filesystem;
 using engine::ecs::Entity;
 
-GameSession::GameSession(const GameOptions& options) : options_(options) {
+const char* method_name(GameMethod m) {
+  switch (m) {
+    case GameMethod::TransGI: return "TransGI";
+    case GameMethod::Ddgi: return "DDGI";
+    case GameMethod::Reference: return "reference";
+  }
+  return "?";
+}
+
+// The progressive reference: restarted whenever the camera, the geometry or
+// the lights change, one sample per pixel added per frame otherwise.
+struct GameSession::Reference {
+  std::unique_ptr<engine::render::PathTracer> tracer;
+  engine::transform::Similarity camera;
+  std::uint64_t lights_version = UINT64_MAX, geometry_version = UINT64_MAX;
+  engine::image::ImageRGB image;
+};
+
+GameSession::GameSession(const GameOptions& options) : options_(options), reference_(std::make_unique<Reference>()) {
   if (options_.width < 16 || options_.height < 16 || options_.width > 8192 || options_.height > 8192)
     throw std::runtime_error("--width/--height: must be in [16, 8192], got " + std::to_string(options_.width) + "x" +
                              std::to_string(options_.height));
@@ -32,6 +56,10 @@ GameSession::GameSession(const GameOptions& options) : options_(options) {
   app_ = std::move(scene.app);
   camera_ = scene.camera;
   engine::ecs::World& world = app_->world();
+  {
+    const auto& assets = world.resource<engine::scene::SceneAssets>();
+    world.insert_resource<LevelOrigin>(LevelOrigin{options_.scene, assets.meshes.size(), assets.materials.size(), scene.entities});
+  }
   // The model was baked for the glTF alone: validate it before the game adds meshes.
   auto model = std::make_shared<const transgi::model::TransferModel>(transgi::model::load_model(model_path));
   transgi::model::validate_model(*model, world.resource<engine::scene::SceneAssets>(), model_path);
@@ -57,6 +85,54 @@ GameSession::GameSession(const GameOptions& options) : options_(options) {
   frame.camera = camera_;
   frame.width = options_.width;
   frame.height = options_.height;
+}
+
+void GameSession::set_view(const std::string& view) {
+  if (view != "full" && view != "gi" && view != "direct") throw std::runtime_error("view: expected full, gi or direct, got '" + view + "'");
+  options_.view = view;
+  reference_->lights_version = UINT64_MAX;  // re-read the pass
+}
+
+void GameSession::set_method(GameMethod m) {
+  if (m == method_) return;
+  method_ = m;
+  engine::ecs::World& w = world();
+  if (m == GameMethod::Ddgi && !app_->has_plugin("transgi::DdgiPlugin")) {
+    app_->add_plugin<transgi::ddgi::DdgiPlugin>();  // on first use: its probes cost time every frame
+    w.emplace<transgi::ddgi::DdgiProbeVolume>(w.spawn(), transgi::ddgi::DdgiProbeVolume{});
+  }
+  if (auto* d = w.try_resource<transgi::ddgi::DdgiFrame>()) {
+    d->camera = camera_;
+    d->width = m == GameMethod::Ddgi ? options_.width : 0;
+    d->height = m == GameMethod::Ddgi ? options_.height : 0;
+  }
+  auto& gi = w.resource<transgi::runtime::GiFrame>();  // TransGI's probes keep updating; its image only when shown
+  gi.width = m == GameMethod::TransGI ? options_.width : 0;
+  gi.height = m == GameMethod::TransGI ? options_.height : 0;
+  reference_->tracer.reset();
+}
+
+int GameSession::reference_spp() const { return reference_->tracer ? reference_->tracer->samples_per_pixel() : 0; }
+
+void GameSession::render_reference() {
+  engine::ecs::World& w = world();
+  const auto& lights = w.resource<engine::render::SceneLights>();
+  const auto* cam_world = w.try_get<engine::transform::WorldTransform>(camera_);
+  if (!cam_world) return;
+  Reference& r = *reference_;
+  if (!r.tracer || !(r.camera == *cam_world) || r.lights_version != lights.version || r.geometry_version != lights.geometry_version) {
+    engine::render::CameraRays rays(w.get<engine::scene::Camera>(camera_), *cam_world, options_.width, options_.height);
+    r.tracer = std::make_unique<engine::render::PathTracer>(w.resource<engine::rt::RtScene>(), lights.set, rays, options_.width,
+                                                             options_.height);
+    r.camera = *cam_world;
+    r.lights_version = lights.version;
+    r.geometry_version = lights.geometry_version;
+  }
+  app_->jobs().run([&] { r.tracer->render(1); });
+  const engine::render::Pass pass = options_.view == "gi"       ? engine::render::Pass::Gi
+                                    : options_.view == "direct" ? engine::render::Pass::Direct
+                                                                : engine::render::Pass::Full;
+  r.image = r.tracer->image(pass);
 }
 
 GameSession::~GameSession() {
@@ -117,11 +193,16 @@ void GameSession::frame() {
   const auto t0 = std::chrono::steady_clock::now();
   update_editor(world(), editor_, input(), view());
   app_->jobs().run([&] { app_->update(); });
+  if (method_ == GameMethod::Reference) render_reference();
   last_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   ++frames_;
 }
 
 const engine::image::ImageRGB& GameSession::image() const {
+  if (method_ == GameMethod::Reference && !reference_->image.empty()) return reference_->image;
+  if (method_ == GameMethod::Ddgi)
+    if (const auto* d = app_->world().try_resource<transgi::ddgi::DdgiFrame>(); d && !d->full.empty())
+      return options_.view == "gi" ? d->gi : options_.view == "direct" ? d->direct : d->full;
   const auto& f = app_->world().resource<transgi::runtime::GiFrame>();
   if (options_.view == "gi") return f.gi;
   if (options_.view == "direct") return f.direct;

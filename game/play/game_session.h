@@ -16,6 +16,11 @@
 
 namespace game {
 
+// What the view shows: TransGI (the game's renderer), the DDGI baseline, or
+// the reference path tracer accumulating while nothing moves.
+enum class GameMethod { TransGI, Ddgi, Reference };
+const char* method_name(GameMethod m);
+
 struct GameOptions {
   std::filesystem::path scene;     // the level's glTF
   std::filesystem::path model;     // empty = transgi.tgm beside the scene
@@ -39,6 +44,14 @@ class GameSession {
   void frame();
 
   [[nodiscard]] const engine::image::ImageRGB& image() const;
+  // Switch the method and pass (full | gi | direct); both take effect at the next frame.
+  void set_method(GameMethod m);
+  void set_view(const std::string& view);
+  [[nodiscard]] GameMethod method() const { return method_; }
+  [[nodiscard]] const std::string& view_name() const { return options_.view; }
+  // Reference samples per pixel accumulated since the last change.
+  [[nodiscard]] int reference_spp() const;
+  [[nodiscard]] const GameOptions& options() const { return options_; }
   [[nodiscard]] engine::ecs::World& world();
   [[nodiscard]] engine::input::InputState& input();
   [[nodiscard]] EditorState& editor() { return editor_; }
@@ -52,6 +65,10 @@ class GameSession {
   std::unique_ptr<engine::app::App> app_;
   engine::ecs::Entity camera_;
   EditorState editor_;
+  GameMethod method_ = GameMethod::TransGI;
+  struct Reference;
+  std::unique_ptr<Reference> reference_;
+  void render_reference();
   double last_ms_ = 0;
   std::uint64_t frames_ = 0;
 };

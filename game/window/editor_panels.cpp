@@ -1,0 +1,158 @@
+// The hierarchy, the inspector and saving the level.
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "engine/scene/components.h"
+#include "engine/script/script_runtime.h"
+#include "engine/transform/transform.h"
+#include "level/level_save.h"
+#include "runtime/components.h"
+#include "runtime/settings.h"
+#include "window/editor_ui.h"
+
+namespace game {
+
+namespace {
+using engine::ecs::Entity;
+namespace tf = engine::transform;
+
+std::string label_of(engine::ecs::World& w, Entity e) {
+  const auto* n = w.try_get<engine::scene::Name>(e);
+  return (n ? n->value : std::string("entity")) + "##" + std::to_string(e.index);
+}
+}  // namespace
+
+void EditorUi::hierarchy_node(Entity e) {
+  engine::ecs::World& w = session_.world();
+  std::vector<Entity> children;
+  w.view<const tf::Parent>().each([&](Entity c, const tf::Parent& p) {
+    if (p.entity == e) children.push_back(c);
+  });
+  EditorState& ed = session_.editor();
+  ImGuiTreeNodeFlags flags = ImGuiTreeNodeFlags_OpenOnArrow | ImGuiTreeNodeFlags_SpanAvailWidth;
+  if (children.empty()) flags |= ImGuiTreeNodeFlags_Leaf;
+  if (ed.selected == e) flags |= ImGuiTreeNodeFlags_Selected;
+  const bool open = ImGui::TreeNodeEx(label_of(w, e).c_str(), flags);
+  if (ImGui::IsItemClicked()) ed.selected = e;
+  if (open) {
+    for (Entity c : children) hierarchy_node(c);
+    ImGui::TreePop();
+  }
+}
+
+void EditorUi::hierarchy() {
+  ImGui::SetNextWindowPos(ImVec2(8, 40), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(240, 380), ImGuiCond_FirstUseEver);
+  if (!ImGui::Begin("Hierarchy")) {
+    ImGui::End();
+    return;
+  }
+  engine::ecs::World& w = session_.world();
+  std::vector<Entity> roots;
+  w.view<const engine::scene::Name>().each([&](Entity e, const engine::scene::Name&) {
+    if (!w.has<tf::Parent>(e)) roots.push_back(e);
+  });
+  std::sort(roots.begin(), roots.end());
+  for (Entity e : roots) hierarchy_node(e);
+  ImGui::End();
+}
+
+void EditorUi::inspector() {
+  const ImGuiIO& io = ImGui::GetIO();
+  ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 288, 40), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(280, 520), ImGuiCond_FirstUseEver);
+  if (!ImGui::Begin("Inspector")) {
+    ImGui::End();
+    return;
+  }
+  engine::ecs::World& w = session_.world();
+  EditorState& ed = session_.editor();
+  const Entity e = ed.selected;
+  if (e.is_null() || !w.alive(e)) {
+    ImGui::TextDisabled("Click an object in the view or the hierarchy.");
+  } else {
+    ImGui::Text("%s (entity %u)", label_of(w, e).substr(0, label_of(w, e).find("##")).c_str(), e.index);
+    if (const auto* t = w.try_get<tf::Transform>(e); t && ImGui::CollapsingHeader("Transform", ImGuiTreeNodeFlags_DefaultOpen)) {
+      tf::Transform edit = *t;
+      glm::vec3 euler = glm::degrees(glm::eulerAngles(edit.rotation));
+      bool changed = ImGui::DragFloat3("position", &edit.translation.x, 0.01f);
+      if (ImGui::DragFloat3("rotation", &euler.x, 0.5f, -360.0f, 360.0f, "%.1f deg")) {
+        edit.rotation = glm::quat(glm::radians(euler));
+        changed = true;
+      }
+      changed |= ImGui::DragFloat("scale", &edit.scale, 0.005f, 0.01f, 100.0f);
+      if (ImGui::IsItemActivated() || (changed && !editing_transform_)) {
+        editing_transform_ = true;
+        edit_start_ = *t;
+      }
+      if (changed && std::isfinite(edit.translation.x + edit.translation.y + edit.translation.z + edit.scale) && edit.scale > 0)
+        w.get_mut<tf::Transform>(e) = edit;
+      if (editing_transform_ && !ImGui::IsAnyItemActive()) {  // one undo entry per edit
+        ed.undo.push({e, edit_start_, w.get<tf::Transform>(e)});
+        editing_transform_ = false;
+      }
+    }
+    if (const auto* l = w.try_get<engine::scene::PunctualLight>(e); l && ImGui::CollapsingHeader("Light", ImGuiTreeNodeFlags_DefaultOpen)) {
+      engine::scene::PunctualLight edit = *l;
+      bool changed = ImGui::Checkbox("enabled", &edit.enabled);
+      changed |= ImGui::ColorEdit3("colour", &edit.color.x);
+      changed |= ImGui::DragFloat("intensity", &edit.intensity, 0.02f, 0.0f, 1e4f);
+      changed |= ImGui::DragFloat("range (0 = infinite)", &edit.range, 0.05f, 0.0f, 1e4f);
+      if (changed) w.get_mut<engine::scene::PunctualLight>(e) = edit;
+    }
+    if (const auto* s = w.try_get<engine::script::Script>(e); s && ImGui::CollapsingHeader("Script", ImGuiTreeNodeFlags_DefaultOpen)) {
+      auto& runtime = w.resource<engine::script::ScriptRuntime>();
+      ImGui::Text("%s  %s", s->path.c_str(), runtime.is_enabled(e) ? "(running)" : "(stopped: see the log)");
+      for (engine::script::ScriptProperty& p : runtime.properties(e)) {
+        if (double* d = std::get_if<double>(&p.value)) {
+          float v = static_cast<float>(*d);
+          if (ImGui::DragFloat(p.name.c_str(), &v, 0.01f)) runtime.set_property(w, e, p.name, static_cast<double>(v));
+        } else if (bool* b = std::get_if<bool>(&p.value)) {
+          if (ImGui::Checkbox(p.name.c_str(), b)) runtime.set_property(w, e, p.name, *b);
+        } else {
+          ImGui::Text("%s = \"%s\"", p.name.c_str(), std::get<std::string>(p.value).c_str());
+        }
+      }
+    }
+  }
+  gi_settings();
+  ImGui::End();
+}
+
+void EditorUi::gi_settings() {
+  engine::ecs::World& w = session_.world();
+  if (!ImGui::CollapsingHeader("TransGI settings")) return;
+  auto* s = w.try_resource<transgi::runtime::TransGISettings>();
+  if (!s) return;
+  transgi::runtime::TransGISettings edit = *s;
+  bool changed = ImGui::SliderFloat("GI resolution", &edit.realtime.resolution_scale, 0.25f, 1.0f, "%.2f");
+  changed |= ImGui::SliderFloat("depth tolerance", &edit.realtime.depth_tolerance, 0.01f, 0.5f, "%.2f");
+  changed |= ImGui::SliderInt("normal power", &edit.realtime.normal_power, 1, 64);
+  changed |= ImGui::Checkbox("edge-aware upsampling", &edit.realtime.edge_aware);
+  changed |= ImGui::SliderInt("probe budget / frame", &edit.probes.update_budget, 0, 512);
+  if (changed) *s = edit;
+  w.view<const transgi::runtime::ProbeVolume>().each([&](Entity e, const transgi::runtime::ProbeVolume& v) {
+    ImGui::PushID(static_cast<int>(e.index));
+    ImGui::Text("probe volume %u: %dx%dx%d probes", e.index, v.dims.x, v.dims.y, v.dims.z);
+    if (v.field) {
+      const auto& g = v.field->settings().grid;
+      ImGui::Text("bounds (%.2f %.2f %.2f) - (%.2f %.2f %.2f)", g.min.x, g.min.y, g.min.z, g.max.x, g.max.y, g.max.z);
+      ImGui::Text("state %.1f MB", static_cast<double>(v.field->memory_bytes()) / (1 << 20));
+    }
+    ImGui::PopID();
+  });
+}
+
+void EditorUi::save_level() {
+  try {
+    const auto path = save_level_gltf(session_.world(), session_.options().scene);
+    status_ = "saved " + path.string();
+  } catch (const std::exception& ex) {
+    status_ = std::string("save failed: ") + ex.what();
+  }
+}
+
+}  // namespace game

@@ -1,0 +1,21 @@
+#include "window/window_input.h"
+
+#include <GLFW/glfw3.h>
+
+namespace game {
+
+std::string key_name(int k) {
+  if (k >= GLFW_KEY_A && k <= GLFW_KEY_Z) return std::string(1, static_cast<char>('A' + (k - GLFW_KEY_A)));
+  if (k >= GLFW_KEY_0 && k <= GLFW_KEY_9) return std::string(1, static_cast<char>('0' + (k - GLFW_KEY_0)));
+  switch (k) {
+    case GLFW_KEY_SPACE: return "space";
+    case GLFW_KEY_LEFT_CONTROL: case GLFW_KEY_RIGHT_CONTROL: return "ctrl";
+    case GLFW_KEY_LEFT_SHIFT: case GLFW_KEY_RIGHT_SHIFT: return "shift";
+    case GLFW_KEY_ESCAPE: return "escape";
+    case GLFW_KEY_DELETE: return "delete";
+    case GLFW_KEY_TAB: return "tab";
+    default: return "";
+  }
+}
+
+}  // namespace game
