@@ -485,6 +485,7 @@ GltfLoadResult load_gltf(ecs::World& world, const fs::path& path, const GltfLoad
     world.emplace<transform::Transform>(e, nt.local);
     if (parent >= 0) world.emplace<transform::Parent>(e, transform::Parent{entity_of[static_cast<std::size_t>(parent)]});
     world.emplace<Name>(e, Name{n.name.empty() ? nf : n.name});
+    world.emplace<GltfNodeSource>(e, GltfNodeSource{static_cast<std::uint32_t>(ni), nt.local, nt.needs_bake});
 
     if (n.mesh >= 0) {
       if (static_cast<std::size_t>(n.mesh) >= model.meshes.size())

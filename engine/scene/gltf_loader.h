@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "engine/ecs/world.h"
+#include "engine/transform/transform.h"
 
 namespace engine::scene {
 
@@ -33,6 +34,16 @@ struct GltfLoadOptions {
   int max_json_depth = 64;
   int max_texture_dimension = 16384;
   bool load_environment = true;
+};
+
+// Where an entity came from, so an editor can write its edits back into the
+// same node of the same file: the node index and the local transform as
+// loaded (a node whose non-uniform scale was baked into its mesh has
+// `baked_scale` set and cannot take a new transform without re-baking).
+struct GltfNodeSource {
+  std::uint32_t node = 0;
+  transform::Transform loaded;
+  bool baked_scale = false;
 };
 
 struct GltfLoadResult {

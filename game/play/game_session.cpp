@@ -56,10 +56,7 @@ GameSession::GameSession(const GameOptions& options) : options_(options), refere
   app_ = std::move(scene.app);
   camera_ = scene.camera;
   engine::ecs::World& world = app_->world();
-  {
-    const auto& assets = world.resource<engine::scene::SceneAssets>();
-    world.insert_resource<LevelOrigin>(LevelOrigin{options_.scene, assets.meshes.size(), assets.materials.size(), scene.entities});
-  }
+  world.insert_resource<LevelOrigin>(LevelOrigin{options_.scene});
   // The model was baked for the glTF alone: validate it before the game adds meshes.
   auto model = std::make_shared<const transgi::model::TransferModel>(transgi::model::load_model(model_path));
   transgi::model::validate_model(*model, world.resource<engine::scene::SceneAssets>(), model_path);
