@@ -1,6 +1,7 @@
 #include "play/game_session.h"
 
 #include <chrono>
+#include <cstdio>
 #include <stdexcept>
 
 #include "ddgi/ddgi_plugin.h"
@@ -177,12 +178,18 @@ void GameSession::apply(const ReplayEvent& e) {
     const Entity s = find(e.name);
     if (s.is_null()) throw std::runtime_error("replay line " + std::to_string(e.line) + ": select: no entity named '" + e.name + "'");
     editor_.selected = s;
+  } else if (e.kind == "method") {
+    set_method(e.name == "ddgi" ? GameMethod::Ddgi : e.name == "reference" ? GameMethod::Reference : GameMethod::TransGI);
+  } else if (e.kind == "view") {
+    set_view(e.name);
   } else if (e.kind == "gizmo_mode") editor_.mode = e.name == "rotate" ? GizmoMode::Rotate : GizmoMode::Translate;
   else if (e.kind == "gizmo_grab") {
     const auto px = handle_grab_pixel(world(), editor_, view(), parse_handle(e.name));
     if (!px) throw std::runtime_error("replay line " + std::to_string(e.line) + ": gizmo_grab " + e.name +
                                       ": the handle is not visible (nothing selected, or edge-on)");
     in.move_mouse(*px);
+  } else {
+    throw std::runtime_error("replay line " + std::to_string(e.line) + ": unknown event '" + e.kind + "'");
   }
 }
 

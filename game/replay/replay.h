@@ -11,6 +11,8 @@
 //   gizmo_grab HANDLE          cursor onto the selection's gizmo handle:
 //                              x, y, z (translate axes) or rx, ry, rz (rings)
 //   gizmo_mode translate|rotate
+//   method transgi|ddgi|reference   what the view shows
+//   view full|gi|direct             which pass
 #include <filesystem>
 #include <string>
 #include <vector>

@@ -20,6 +20,7 @@
 #include "engine/image/png.h"
 #include "level/level_manifest.h"
 #include "level/level_save.h"
+#include "engine/script/script_runtime.h"
 #include "engine/scene/scene_assets.h"
 #include "play/game_session.h"
 #include "replay/replay.h"
@@ -169,6 +170,44 @@ TEST(GameSession, AReplayedGizmoDragMovesTheObjectUnderTheCursorAndTheGiFollows)
 
 namespace {
 
+TEST(GameSession, SwitchingToDdgiAndTheReferenceShowsTheirImages) {
+  game::GameOptions o;
+  o.scene = kLevel / "scene.gltf";
+  o.width = 64;
+  o.height = 36;
+  game::GameSession s(o);
+  auto mean = [](const engine::image::ImageRGB& img) {
+    double m = 0;
+    for (const glm::vec3& p : img.pixels) m += (p.x + p.y + p.z) / 3.0;
+    return img.pixels.empty() ? 0.0 : m / static_cast<double>(img.pixels.size());
+  };
+  for (int f = 0; f < 4; ++f) {
+    s.begin_input();
+    s.frame();
+  }
+  // Hold the sky still, so nothing moves and the reference accumulates.
+  ASSERT_TRUE(s.world().resource<engine::script::ScriptRuntime>().set_property(s.world(), s.find("DayNight"), "running", false));
+  const double transgi = mean(s.image());
+  const std::vector<glm::vec3> transgi_pixels = s.image().pixels;
+  for (const char* method : {"ddgi", "reference"}) {
+    s.begin_input();
+    s.apply({0, "method", method, {}, 1});
+    for (int f = 0; f < 4; ++f) {
+      s.frame();
+      s.begin_input();
+    }
+    EXPECT_EQ(s.image().width, 64) << method;
+    EXPECT_NE(s.image().pixels, transgi_pixels) << method << " shows its own image, not TransGI's last one";
+    // Each shows the lit room: within a factor 3 of TransGI's mean.
+    EXPECT_GT(mean(s.image()), transgi / 3) << method;
+    EXPECT_LT(mean(s.image()), transgi * 3) << method;
+  }
+  EXPECT_EQ(s.reference_spp(), 4) << "one sample per pixel per frame while nothing moves";
+  s.apply({0, "view", "gi", {}, 2});
+  s.frame();
+  EXPECT_EQ(s.reference_spp(), 1) << "a new pass restarts the reference";
+}
+
 TEST(LevelSave, AMovedObjectIsSavedAndTheModelStillFitsTheLevel) {
   const fs::path dir = fs::temp_directory_path() / ("level_save_" + std::to_string(::getpid()));
   fs::create_directories(dir);
@@ -209,7 +248,10 @@ int shell(const std::string& cmd) {
 TEST(WindowSmoke, TheWindowRendersTenFramesAndItsScreenshotIsNotBlank) {
   if (shell("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (Debian package xvfb)";
   const fs::path shot = fs::temp_directory_path() / ("window_smoke_" + std::to_string(::getpid()) + ".png");
-  const std::string cmd = "xvfb-run -a -s '-screen 0 1280x720x24' '" TRANSGI_GAME_BINARY "' --frames 10 --select PlasticCube --screenshot '" +
+  // Mesa's GL driver leaves a few allocations at exit from a module it has
+  // already unloaded (so they cannot be suppressed by name); the game code
+  // itself is leak-checked by the GameSession tests.
+  const std::string cmd = "ASAN_OPTIONS=detect_leaks=0 xvfb-run -a -s '-screen 0 1280x720x24' '" TRANSGI_GAME_BINARY "' --frames 10 --select PlasticCube --screenshot '" +
                           shot.string() + "' > /dev/null 2>&1";
   const int code = shell(cmd);
   if (code != 0 && !fs::exists(shot)) GTEST_SKIP() << "no X server could start under xvfb-run (exit " << code << ")";

@@ -42,6 +42,12 @@ function update(self, dt)
     local keep = math.max(0, 1 - 0.9 * dt)
     self.vx, self.vz = self.vx * keep, self.vz * keep
     if math.abs(self.vy) < 0.2 then self.vy = 0 end
+    if self.vx * self.vx + self.vz * self.vz < 1e-4 and self.vy == 0 then
+      -- At rest: leave the transform alone, so nothing is re-lit and the
+      -- progressive reference can accumulate.
+      self.vx, self.vz = 0, 0
+      return
+    end
   end
   t:set_position(x, y, z)
   local speed = math.sqrt(self.vx * self.vx + self.vz * self.vz)

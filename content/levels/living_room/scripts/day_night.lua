@@ -4,6 +4,7 @@
 property("seconds_per_day", 24)
 property("turn_per_second", 0.2)
 property("night_strength", 0.35)
+property("running", true)   -- untick in the inspector to hold the sky still (the reference then converges)
 
 function init(self)
   self.t = 0
@@ -13,6 +14,7 @@ function init(self)
 end
 
 function update(self, dt)
+  if not self.running then return end
   self.t = self.t + dt
   self.since = self.since + dt
   if self.since < 0.1 then return end

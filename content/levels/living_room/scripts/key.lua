@@ -1,5 +1,6 @@
--- The door's key: it spins on the table until the player walks within
--- `reach` metres, then tells the door and disappears.
+-- The door's key: it lies on the table until the player walks within
+-- `reach` metres, then tells the door and disappears. (It does not spin:
+-- anything that moves re-lights the scene and restarts the reference view.)
 property("door", "DoorHinge")
 property("reach", 1.2)
 
@@ -8,7 +9,6 @@ function init(self)
 end
 
 function update(self, dt)
-  self.entity.transform:rotate({0, 1, 0}, 1.5 * dt)
   local cx, cy, cz = self.camera.transform:get_world_position()
   local x, y, z = self.entity.transform:get_world_position()
   local d = math.sqrt((cx - x)^2 + (cy - y)^2 + (cz - z)^2)
