@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "ddgi/ddgi_plugin.h"
+#include "engine/core/log.h"
 #include "engine/render/camera_rays.h"
 #include "engine/render/light_plugin.h"
 #include "engine/render/path_tracer.h"
@@ -58,11 +59,16 @@ GameSession::GameSession(const GameOptions& options) : options_(options), refere
   camera_ = scene.camera;
   engine::ecs::World& world = app_->world();
   world.insert_resource<LevelOrigin>(LevelOrigin{options_.scene});
-  // The model was baked for the glTF alone: validate it before the game adds meshes.
-  auto model = std::make_shared<const transgi::model::TransferModel>(transgi::model::load_model(model_path));
-  transgi::model::validate_model(*model, world.resource<engine::scene::SceneAssets>(), model_path);
+  // The model was baked for the glTF alone: validate it before the game adds
+  // meshes. A glTF without one still plays: every surface is then shaded
+  // from the probes (the diffuse fallback) until it is baked.
+  std::shared_ptr<const transgi::model::TransferModel> model;
+  if (!options_.model.empty() || fs::exists(model_path)) {
+    model = std::make_shared<const transgi::model::TransferModel>(transgi::model::load_model(model_path));
+    transgi::model::validate_model(*model, world.resource<engine::scene::SceneAssets>(), model_path);
+  }
   app_->add_plugin<transgi::runtime::TransGIPlugin>(transgi::runtime::realtime_preset());
-  transgi::runtime::attach_latent_meshes(world, model);
+  if (model) transgi::runtime::attach_latent_meshes(world, model);
   world.emplace<transgi::runtime::ProbeVolume>(world.spawn(), transgi::runtime::ProbeVolume{});
 
   engine::script::ScriptSettings script_settings;
@@ -72,6 +78,10 @@ GameSession::GameSession(const GameOptions& options) : options_(options), refere
     script_settings.root = manifest.scripts_dir;
   }
   app_->add_plugin<engine::script::ScriptPlugin>(script_settings);
+  if (!model)
+    world.resource<engine::core::Log>().warning(
+        "game", "no baked model at " + model_path.string() + ": every surface is shaded from the probes alone (diffuse); bake one with: transgi bake --scene " +
+                    options_.scene.string() + " --out " + model_path.string());
   // scene.spawn("prefab") copies the prefab's latents too, so a copy of a baked object keeps its transfer.
   world.resource<engine::script::ScriptRuntime>().add_clone_hook([](engine::ecs::World& w, Entity from, Entity to) {
     if (const auto* l = w.try_get<transgi::runtime::LatentMesh>(from)) w.emplace<transgi::runtime::LatentMesh>(to, *l);

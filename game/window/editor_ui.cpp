@@ -36,6 +36,7 @@ void EditorUi::draw(ImTextureID frame_texture) {
   }
   if (show_stats_) stats_overlay(view);
   if (show_probes_) draw_probes(view);
+  if (show_editor_) draw_light_icons(view);
   draw_gizmo(view);
 }
 

@@ -46,6 +46,7 @@ class EditorUi {
   void log_panel();
   void stats_overlay(const ViewRect& view);
   void draw_gizmo(const ViewRect& view);
+  void draw_light_icons(const ViewRect& view);
   void draw_probes(const ViewRect& view);
   void save_level();
 

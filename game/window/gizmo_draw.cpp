@@ -4,6 +4,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "engine/editor/gizmo_math.h"
+#include "engine/scene/components.h"
+#include "engine/transform/transform.h"
 #include "runtime/components.h"
 #include "shading/sh_light.h"
 #include "window/editor_ui.h"
@@ -38,6 +40,22 @@ Projector projector(GameSession& s, const ViewRect& rect) {
 }
 
 }  // namespace
+
+void EditorUi::draw_light_icons(const ViewRect& rect) {
+  ImDrawList* dl = ImGui::GetForegroundDrawList();
+  const Projector project = projector(session_, rect);
+  const EditorState& s = session_.editor();
+  session_.world().view<const engine::scene::PunctualLight, const engine::transform::WorldTransform>().each(
+      [&](engine::ecs::Entity e, const engine::scene::PunctualLight& l, const engine::transform::WorldTransform& w) {
+        const auto c = project(w.translation);
+        if (!c) return;
+        const glm::vec3 k = glm::clamp(l.color, 0.0f, 1.0f);
+        const ImU32 colour = l.enabled ? IM_COL32(static_cast<int>(k.r * 255), static_cast<int>(k.g * 255), static_cast<int>(k.b * 255), 255)
+                                       : IM_COL32(90, 90, 90, 255);
+        dl->AddCircleFilled(*c, 6.0f, colour, 12);
+        dl->AddCircle(*c, 9.0f, s.selected == e ? IM_COL32(255, 230, 90, 255) : IM_COL32(20, 20, 20, 255), 12, 2.0f);
+      });
+}
 
 void EditorUi::draw_gizmo(const ViewRect& rect) {
   EditorState& s = session_.editor();

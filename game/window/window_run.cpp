@@ -133,6 +133,7 @@ int run_window(const GameOptions& game_options, const WindowOptions& wo) {
       glfwSwapBuffers(window);
     }
     glDeleteTextures(1, &texture);
+    std::printf("transgi-game: window closed after %llu frames\n", static_cast<unsigned long long>(session.frames()));
   }
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();

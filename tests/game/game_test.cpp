@@ -17,6 +17,7 @@
 #include "editor/editor_tools.h"
 #include "engine/editor/gizmo_math.h"
 #include "engine/transform/transform.h"
+#include "engine/core/log.h"
 #include "engine/image/png.h"
 #include "level/level_manifest.h"
 #include "level/level_save.h"
@@ -206,6 +207,24 @@ TEST(GameSession, SwitchingToDdgiAndTheReferenceShowsTheirImages) {
   s.apply({0, "view", "gi", {}, 2});
   s.frame();
   EXPECT_EQ(s.reference_spp(), 1) << "a new pass restarts the reference";
+}
+
+TEST(GameSession, AnyGltfPlaysWithoutABakedModel) {
+  game::GameOptions o;
+  o.scene = fs::path(TRANSGI_CONTENT_DIR) / "test_scenes/cornell_box/scene.gltf";
+  o.width = 48;
+  o.height = 48;
+  game::GameSession s(o);
+  for (int f = 0; f < 3; ++f) {
+    s.begin_input();
+    s.frame();
+  }
+  double sum = 0;
+  for (const glm::vec3& p : s.image().pixels) sum += p.x + p.y + p.z;
+  EXPECT_GT(sum, 0.0) << "lit by direct light and the probes";
+  const auto& log = s.world().resource<engine::core::Log>();
+  ASSERT_FALSE(log.entries().empty());
+  EXPECT_NE(log.entries().front().text.find("no baked model"), std::string::npos) << log.entries().front().text;
 }
 
 TEST(LevelSave, AMovedObjectIsSavedAndTheModelStillFitsTheLevel) {
