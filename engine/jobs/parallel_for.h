@@ -9,6 +9,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
 
 namespace engine::jobs {
 
@@ -22,6 +23,10 @@ void parallel_for(Index first, Index last, Index grain, Body&& body) {
       tbb::blocked_range<Index>(first, last, grain),
       [&body](const tbb::blocked_range<Index>& r) { body(r.begin(), r.end()); }, tbb::simple_partitioner{});
 }
+
+// Threads that may run the calling context's parallel loops (the job
+// system's arena inside JobSystem::run).
+inline int current_thread_count() { return tbb::this_task_arena::max_concurrency(); }
 
 // Per-index convenience form: fn(i) for every i in [first, last).
 template <class Index, class Fn>

@@ -22,25 +22,37 @@ double ms_since(Clock::time_point t) { return std::chrono::duration<double, std:
 
 constexpr std::size_t kNone = SIZE_MAX;
 
-// The cell grid and, for each output pixel, the grid samples that stand for it.
+// The cell grid and, for each output pixel, whether it is upsampled from
+// the grid, decoded on its own, or empty.
 struct Upsampling {
   int grid_w = 0, grid_h = 0;
-  std::vector<std::size_t> cell_pixel;  // per cell: the pixel it decodes
+  float sx = 1, sy = 1;                   // output pixels per cell
+  std::vector<std::size_t> cell_pixel;    // per cell: the pixel it decodes
+  enum : std::uint8_t { kUpsampled = 0, kOwn = 1, kMiss = 2 };
+  std::vector<std::uint8_t> kind;         // per pixel
+  // Per upsampled pixel: its four grid cells and normalised weights (32
+  // bytes; the composite reads them back rather than recomputing them).
   struct Taps {
-    std::array<std::size_t, 4> cell{kNone, kNone, kNone, kNone};
+    std::array<std::uint32_t, 4> cell{};
     std::array<float, 4> weight{};
-    bool own = false;  // no cell represents it: decoded on its own
   };
-  std::vector<Taps> taps;  // per pixel
+  std::vector<Taps> taps;
+};
+
+// The four grid samples standing for a pixel and their weights.
+struct Taps {
+  std::array<std::size_t, 4> cell{kNone, kNone, kNone, kNone};
+  std::array<float, 4> weight{};
+  float total = 0;
 };
 
 }  // namespace
 
 struct RealtimeGiScratch::Impl {
   Upsampling up;
+  std::vector<glm::vec4> guide;  // when the G-buffer came without one
   std::vector<std::size_t> decode, slot_of_pixel;
   std::vector<glm::vec3> value, value_direct, shaded, shaded_direct;
-  std::vector<float> light, light_direct;
   std::vector<TransferQuery> queries;
 };
 RealtimeGiScratch::RealtimeGiScratch() : impl(std::make_unique<Impl>()) {}
@@ -50,60 +62,85 @@ RealtimeGiScratch& RealtimeGiScratch::operator=(RealtimeGiScratch&&) noexcept = 
 
 namespace {
 
-float similarity(const GSample& p, const GSample& q, const RealtimeGiSettings& s) {
-  if (!q.hit) return 0.0f;
+// guide: world normal (xyz), depth (w; 0 = miss).
+float similarity(const glm::vec4& p, const glm::vec4& q, const RealtimeGiSettings& s) {
+  if (!(q.w > 0)) return 0.0f;
   if (!s.edge_aware) return 1.0f;
-  const float dz = (q.depth - p.depth) / (s.depth_tolerance * std::max(p.depth, 1e-6f));
+  const float dz = (q.w - p.w) / (s.depth_tolerance * std::max(p.w, 1e-6f));
   const float depth = std::max(0.0f, 1.0f - dz * dz);  // zero beyond the tolerance: silhouettes cut hard
-  float n = std::max(0.0f, glm::dot(p.normal_world, q.normal_world)), normal = 1.0f;
+  float n = std::max(0.0f, p.x * q.x + p.y * q.y + p.z * q.z), normal = 1.0f;
   for (int e = s.normal_power; e > 0; e >>= 1, n *= n)  // n^power by squaring
     if (e & 1) normal *= n;
   return depth * normal;
 }
 
-void plan_upsampling(const GBuffer& g, const RealtimeGiSettings& s, Upsampling& u) {
+// Bilinear weights times similarity, for pixel (x, y).
+Taps taps_of(int x, int y, const std::vector<glm::vec4>& guide, const Upsampling& u, const RealtimeGiSettings& s, int width) {
+  Taps t;
+  const glm::vec4& gp = guide[static_cast<std::size_t>(y) * width + x];
+  // Position in cell coordinates, cell centres at integers.
+  const float fx = (static_cast<float>(x) + 0.5f) / u.sx - 0.5f, fy = (static_cast<float>(y) + 0.5f) / u.sy - 0.5f;
+  const int i0 = static_cast<int>(std::floor(fx)), j0 = static_cast<int>(std::floor(fy));
+  const float tx = fx - static_cast<float>(i0), ty = fy - static_cast<float>(j0);
+  for (int k = 0; k < 4; ++k) {
+    const int i = std::clamp(i0 + (k & 1), 0, u.grid_w - 1), j = std::clamp(j0 + (k >> 1), 0, u.grid_h - 1);
+    const float bilinear = ((k & 1) ? tx : 1 - tx) * ((k >> 1) ? ty : 1 - ty);
+    const std::size_t cell = static_cast<std::size_t>(j) * u.grid_w + i;
+    const float w = bilinear * similarity(gp, guide[u.cell_pixel[cell]], s);
+    t.cell[static_cast<std::size_t>(k)] = cell;
+    t.weight[static_cast<std::size_t>(k)] = w;
+    t.total += w;
+  }
+  return t;
+}
+
+void plan_upsampling(const GBuffer& g, const std::vector<glm::vec4>& guide, const RealtimeGiSettings& s, Upsampling& u) {
   const float scale = std::clamp(s.resolution_scale, 1e-3f, 1.0f);
   u.grid_w = std::max(1, static_cast<int>(std::lround(static_cast<float>(g.width) * scale)));
   u.grid_h = std::max(1, static_cast<int>(std::lround(static_cast<float>(g.height) * scale)));
-  const float sx = static_cast<float>(g.width) / static_cast<float>(u.grid_w);
-  const float sy = static_cast<float>(g.height) / static_cast<float>(u.grid_h);
+  u.sx = static_cast<float>(g.width) / static_cast<float>(u.grid_w);
+  u.sy = static_cast<float>(g.height) / static_cast<float>(u.grid_h);
   u.cell_pixel.resize(static_cast<std::size_t>(u.grid_w) * u.grid_h);
   for (int j = 0; j < u.grid_h; ++j)
     for (int i = 0; i < u.grid_w; ++i) {
-      const int x = std::min(g.width - 1, static_cast<int>((static_cast<float>(i) + 0.5f) * sx));
-      const int y = std::min(g.height - 1, static_cast<int>((static_cast<float>(j) + 0.5f) * sy));
+      const int x = std::min(g.width - 1, static_cast<int>((static_cast<float>(i) + 0.5f) * u.sx));
+      const int y = std::min(g.height - 1, static_cast<int>((static_cast<float>(j) + 0.5f) * u.sy));
       u.cell_pixel[static_cast<std::size_t>(j) * u.grid_w + i] = static_cast<std::size_t>(y) * g.width + x;
     }
+  u.kind.resize(g.samples.size());
   u.taps.resize(g.samples.size());
   engine::jobs::parallel_for(0, g.height, 8, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < g.width; ++x) {
         const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
-        const GSample& sp = g.samples[p];
-        Upsampling::Taps& t = u.taps[p];
-        t = Upsampling::Taps{};  // storage is reused across frames
-        if (!sp.hit) continue;
-        // Position in cell coordinates, cell centres at integers.
-        const float fx = (static_cast<float>(x) + 0.5f) / sx - 0.5f, fy = (static_cast<float>(y) + 0.5f) / sy - 0.5f;
-        const int i0 = static_cast<int>(std::floor(fx)), j0 = static_cast<int>(std::floor(fy));
-        const float tx = fx - static_cast<float>(i0), ty = fy - static_cast<float>(j0);
-        float total = 0;
-        for (int k = 0; k < 4; ++k) {
-          const int i = std::clamp(i0 + (k & 1), 0, u.grid_w - 1), j = std::clamp(j0 + (k >> 1), 0, u.grid_h - 1);
-          const float bilinear = ((k & 1) ? tx : 1 - tx) * ((k >> 1) ? ty : 1 - ty);
-          const std::size_t cell = static_cast<std::size_t>(j) * u.grid_w + i;
-          const float w = bilinear * similarity(sp, g.samples[u.cell_pixel[cell]], s);
-          t.cell[static_cast<std::size_t>(k)] = cell;
-          t.weight[static_cast<std::size_t>(k)] = w;
-          total += w;
+        if (!(guide[p].w > 0)) {
+          u.kind[p] = Upsampling::kMiss;
+          continue;
         }
-        if (total < s.min_weight) {
-          t.own = true;
-        } else {
-          for (float& w : t.weight) w /= total;
+        const Taps t = taps_of(x, y, guide, u, s, g.width);
+        if (t.total < s.min_weight) {
+          u.kind[p] = Upsampling::kOwn;
+          continue;
+        }
+        u.kind[p] = Upsampling::kUpsampled;
+        Upsampling::Taps& stored = u.taps[p];
+        for (std::size_t k = 0; k < 4; ++k) {
+          stored.cell[k] = static_cast<std::uint32_t>(t.cell[k]);
+          stored.weight[k] = t.weight[k] / t.total;
         }
       }
   });
+}
+
+// The G-buffer's guide, or one derived from its samples.
+const std::vector<glm::vec4>& guide_of(const GBuffer& g, std::vector<glm::vec4>& scratch) {
+  if (g.guide.size() == g.samples.size()) return g.guide;
+  scratch.resize(g.samples.size());
+  for (std::size_t p = 0; p < g.samples.size(); ++p) {
+    const GSample& s = g.samples[p];
+    scratch[p] = s.hit ? glm::vec4(s.normal_world, std::max(s.depth, 1e-30f)) : glm::vec4(0.0f);
+  }
+  return scratch;
 }
 
 // Probe SH rotated into object frames, one copy per distinct rotation and
@@ -173,6 +210,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
   g.width = width;
   g.height = height;
   g.samples.resize(static_cast<std::size_t>(width) * height);
+  g.guide.resize(g.samples.size());
   // 4x4 pixel tiles as one Embree packet: neighbouring camera rays share
   // their traversal.
   const int tiles_x = (width + 3) / 4, tiles_y = (height + 3) / 4;
@@ -190,7 +228,10 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
           pixel[n] = static_cast<std::size_t>(y) * width + x;
         }
       scene.intersect16(rays, n, hits, found);
-      for (int i = 0; i < n; ++i) g.samples[pixel[i]] = make_gsample(scene, assets, rays[i], found[i] ? &hits[i] : nullptr, nullptr);
+      for (int i = 0; i < n; ++i) {
+        const GSample& s = g.samples[pixel[i]] = make_gsample(scene, assets, rays[i], found[i] ? &hits[i] : nullptr, nullptr);
+        g.guide[pixel[i]] = s.hit ? glm::vec4(s.normal_world, std::max(s.depth, 1e-30f)) : glm::vec4(0.0f);
+      }
     }
   });
 }
@@ -212,7 +253,8 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   auto t0 = Clock::now();
   RealtimeGiScratch local;
   RealtimeGiScratch::Impl& sc = *(scratch ? scratch : &local)->impl;
-  plan_upsampling(g, settings, sc.up);
+  const std::vector<glm::vec4>& guide = guide_of(g, sc.guide);
+  plan_upsampling(g, guide, settings, sc.up);
   const Upsampling& up = sc.up;
 
   // The pixels to decode: grid cells that hit, then pixels on their own.
@@ -228,7 +270,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   for (std::size_t p : up.cell_pixel) want(p);
   stats.grid_samples = decode.size();
   for (std::size_t p = 0; p < g.samples.size(); ++p)
-    if (up.taps[p].own) want(p);
+    if (up.kind[p] == Upsampling::kOwn) want(p);
   stats.edge_samples = decode.size() - stats.grid_samples;
   double plan_ms = ms_since(t0);
 
@@ -260,29 +302,21 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
 
   // Light per decoded sample: object-space SH for the network, irradiance
   // for the diffuse fallback; the probes' indirect light and, if asked, their
-  // direct sky and emitter light, with one set of interpolation weights.
+  // direct sky and emitter light, with one set of interpolation weights. The
+  // network samples' SH is interpolated tile by tile inside the fused
+  // decoder, so it stays in cache instead of going through memory.
   t0 = Clock::now();
   const bool with_direct = direct_out != nullptr;
   // Every entry below is written before it is read: resize, never refill.
   std::vector<glm::vec3>& value = sc.value;
   std::vector<glm::vec3>& value_direct = sc.value_direct;
-  std::vector<float>& light = sc.light;
-  std::vector<float>& light_direct = sc.light_direct;
   std::vector<TransferQuery>& queries = sc.queries;
   value.resize(decode.size());
   value_direct.resize(with_direct ? decode.size() : 0);
-  light.resize(net.size() * 75);
-  light_direct.resize(with_direct ? net.size() * 75 : 0);
   queries.resize(net.size());
-  engine::jobs::parallel_for<std::size_t>(0, net.size(), 256, [&](std::size_t b, std::size_t e) {
+  engine::jobs::parallel_for<std::size_t>(0, net.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       const GSample& s = g.samples[decode[net[k]]];
-      const probes::ProbeField* f = field_holding(fields, s.position);
-      if (with_direct)
-        f->interpolate(s.position, s.normal_world, rotated.sh(rotation_of[k], f), light.data() + k * 75,
-                       rotated.sh(rotation_of[k], f, true), light_direct.data() + k * 75);
-      else
-        f->interpolate(s.position, s.normal_world, rotated.sh(rotation_of[k], f), light.data() + k * 75);
       queries[k] = {s.mesh, s.triangle, s.bary, s.albedo, s.normal_obj, s.wo_obj};
     }
   });
@@ -299,45 +333,66 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
       if (with_direct) value_direct[diffuse[k]] = s.diffuse * engine::math::kInvPi * sh_irradiance(world_direct, s.normal_world);
     }
   });
-  stats.light_ms = ms_since(t0);
+  const double diffuse_light_ms = ms_since(t0);
 
   t0 = Clock::now();
+  double fill_seconds = 0;
   if (!net.empty()) {
     std::vector<glm::vec3>& shaded = sc.shaded;
     std::vector<glm::vec3>& shaded_direct = sc.shaded_direct;
     shaded.resize(net.size());
     shaded_direct.resize(with_direct ? net.size() : 0);
-    shade_transfer_fused(*decoder, *model, assets, queries, light.data(), shaded.data(),
-                         with_direct ? light_direct.data() : nullptr, with_direct ? shaded_direct.data() : nullptr);
+    const auto fill = [&](std::size_t b, std::size_t e, float* light, float* light_direct) {
+      for (std::size_t k = b; k < e; ++k) {
+        const GSample& s = g.samples[decode[net[k]]];
+        const probes::ProbeField* f = field_holding(fields, s.position);
+        float* l = light + (k - b) * 75;
+        if (light_direct)
+          f->interpolate(s.position, s.normal_world, rotated.sh(rotation_of[k], f), l, rotated.sh(rotation_of[k], f, true),
+                         light_direct + (k - b) * 75);
+        else
+          f->interpolate(s.position, s.normal_world, rotated.sh(rotation_of[k], f), l);
+      }
+    };
+    fill_seconds = shade_transfer_fused(*decoder, *model, assets, queries, fill, shaded.data(),
+                                        with_direct ? shaded_direct.data() : nullptr);
     for (std::size_t k = 0; k < net.size(); ++k) value[net[k]] = shaded[k];
     if (with_direct)
       for (std::size_t k = 0; k < net.size(); ++k) value_direct[net[k]] = shaded_direct[k];
   }
-  stats.inference_ms = ms_since(t0);
+  // The fused call's wall time, split by the share its threads spent
+  // interpolating light (reported as SH light) and decoding (inference).
+  const double fused_ms = ms_since(t0);
+  const double fill_ms = std::min(fused_ms, 1e3 * fill_seconds / std::max(1, engine::jobs::current_thread_count()));
+  stats.light_ms = diffuse_light_ms + fill_ms;
+  stats.inference_ms = fused_ms - fill_ms;
+
   stats.inferred = net.size();
   stats.diffuse = diffuse.size();
 
   t0 = Clock::now();
-  if (with_direct) *direct_out = engine::image::ImageRGB(g.width, g.height);
-  engine::jobs::parallel_for<std::size_t>(0, g.samples.size(), 4096, [&](std::size_t b, std::size_t e) {
-    for (std::size_t p = b; p < e; ++p) {
-      if (!g.samples[p].hit) continue;
-      const Upsampling::Taps& t = up.taps[p];
-      if (t.own) {
-        image.pixels[p] = value[slot_of_pixel[p]];
-        if (with_direct) direct_out->pixels[p] = value_direct[slot_of_pixel[p]];
-        continue;
+  engine::jobs::parallel_for(0, g.height, 8, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < g.width; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
+        if (up.kind[p] == Upsampling::kMiss) continue;
+        if (up.kind[p] == Upsampling::kOwn) {
+          image.pixels[p] = value[slot_of_pixel[p]];
+          if (with_direct) direct_out->pixels[p] = value_direct[slot_of_pixel[p]];
+          continue;
+        }
+        const Upsampling::Taps& t = up.taps[p];
+        glm::vec3 sum(0.0f), sum_direct(0.0f);
+        for (std::size_t k = 0; k < 4; ++k) {
+          if (!(t.weight[k] > 0)) continue;
+          const float w = t.weight[k];
+          const std::size_t slot = slot_of_pixel[up.cell_pixel[t.cell[k]]];
+          sum += w * value[slot];
+          if (with_direct) sum_direct += w * value_direct[slot];
+        }
+        image.pixels[p] = sum;
+        if (with_direct) direct_out->pixels[p] = sum_direct;
       }
-      glm::vec3 sum(0.0f), sum_direct(0.0f);
-      for (std::size_t k = 0; k < 4; ++k) {
-        if (!(t.weight[k] > 0)) continue;
-        const std::size_t slot = slot_of_pixel[up.cell_pixel[t.cell[k]]];
-        sum += t.weight[k] * value[slot];
-        if (with_direct) sum_direct += t.weight[k] * value_direct[slot];
-      }
-      image.pixels[p] = sum;
-      if (with_direct) direct_out->pixels[p] = sum_direct;
-    }
   });
   stats.upsample_ms = plan_ms + ms_since(t0);
   if (stats_out) *stats_out = stats;

@@ -1,6 +1,7 @@
 #include "shading/transfer_inference.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <vector>
 
@@ -47,25 +48,46 @@ InferenceTimings infer_transfer(const model::TransferModel& model, const engine:
   return t;
 }
 
-void shade_transfer_fused(const FusedDecoder& decoder, const model::TransferModel& model,
-                          const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
-                          const float* light, glm::vec3* out, const float* light2, glm::vec3* out2) {
+double shade_transfer_fused(const FusedDecoder& decoder, const model::TransferModel& model,
+                            const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
+                            const TileLightFill& fill, glm::vec3* out, glm::vec3* out2) {
   const int in_size = decoder.layout().inputs;
   const std::size_t tiles = (queries.size() + kFusedTile - 1) / kFusedTile;
+  std::atomic<std::int64_t> fill_ns{0};
   engine::jobs::parallel_for<std::size_t>(0, tiles, 4, [&](std::size_t tb, std::size_t te) {
     std::vector<float> inputs(static_cast<std::size_t>(kFusedTile) * static_cast<std::size_t>(in_size));
     std::vector<float> z(static_cast<std::size_t>(model.latent_dim));
+    std::vector<float> light(static_cast<std::size_t>(kFusedTile) * 75), light2(out2 ? light.size() : 0);
+    std::int64_t ns = 0;
     for (std::size_t tile = tb; tile < te; ++tile) {
       const std::size_t b = tile * kFusedTile, e = std::min(b + kFusedTile, queries.size());
+      const auto t0 = Clock::now();
+      fill(b, e, light.data(), out2 ? light2.data() : nullptr);
+      ns += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0).count();
       for (std::size_t i = b; i < e; ++i) {
         const TransferQuery& q = queries[i];
         model.meshes[q.mesh].latents.interpolate(*assets.meshes[q.mesh], q.triangle, q.barycentric, z.data());
         model::assemble_input(z.data(), model.latent_dim, q.albedo, q.normal, q.wo, inputs.data() + (i - b) * static_cast<std::size_t>(in_size));
       }
-      decoder.shade_tile(inputs.data(), light + b * 75, static_cast<int>(e - b), &out[b].x,
-                         light2 && out2 ? light2 + b * 75 : nullptr, light2 && out2 ? &out2[b].x : nullptr);
+      decoder.shade_tile(inputs.data(), light.data(), static_cast<int>(e - b), &out[b].x, out2 ? light2.data() : nullptr,
+                         out2 ? &out2[b].x : nullptr);
     }
+    fill_ns.fetch_add(ns, std::memory_order_relaxed);
   });
+  return static_cast<double>(fill_ns.load()) * 1e-9;
+}
+
+void shade_transfer_fused(const FusedDecoder& decoder, const model::TransferModel& model,
+                          const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
+                          const float* light, glm::vec3* out, const float* light2, glm::vec3* out2) {
+  const bool second = light2 && out2;
+  shade_transfer_fused(
+      decoder, model, assets, queries,
+      [&](std::size_t b, std::size_t e, float* l, float* l2) {
+        std::copy(light + b * 75, light + e * 75, l);
+        if (second) std::copy(light2 + b * 75, light2 + e * 75, l2);
+      },
+      out, second ? out2 : nullptr);
 }
 
 void infer_transfer_reference(const model::TransferModel& model, const engine::scene::SceneAssets& assets,

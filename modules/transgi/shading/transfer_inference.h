@@ -4,6 +4,7 @@
 // GEMM backend, which is SIMD and multi-threaded), and a plain scalar
 // reference that decodes one point with ordinary loops, to test it against.
 #include <cstdint>
+#include <functional>
 #include <span>
 
 #include <glm/glm.hpp>
@@ -37,6 +38,16 @@ InferenceTimings infer_transfer(const model::TransferModel& model, const engine:
 void shade_transfer_fused(const FusedDecoder& decoder, const model::TransferModel& model,
                           const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
                           const float* light, glm::vec3* out, const float* light2 = nullptr, glm::vec3* out2 = nullptr);
+
+// The same with each tile's light computed by `fill` just before the tile
+// is decoded (fill(begin, end, light, light2) writes (end - begin) x 75
+// values into each, light2 only when out2 is given), so the lights of a
+// frame never go to memory as a whole: they stay in the cache of the core
+// that decodes them. Returns the seconds spent in fill, summed over threads.
+using TileLightFill = std::function<void(std::size_t begin, std::size_t end, float* light, float* light2)>;
+double shade_transfer_fused(const FusedDecoder& decoder, const model::TransferModel& model,
+                            const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
+                            const TileLightFill& fill, glm::vec3* out, glm::vec3* out2 = nullptr);
 
 // The same for one point: latent interpolation, input assembly and every
 // layer as scalar loops (no GEMM library, no threads).
