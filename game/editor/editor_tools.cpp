@@ -1,6 +1,7 @@
 #include "editor/editor_tools.h"
 
 #include <cmath>
+#include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -26,12 +27,25 @@ glm::vec3 axis_of(GizmoHandle h) {
     case GizmoHandle::X: case GizmoHandle::RX: return {1, 0, 0};
     case GizmoHandle::Y: case GizmoHandle::RY: return {0, 1, 0};
     case GizmoHandle::Z: case GizmoHandle::RZ: return {0, 0, 1};
+    case GizmoHandle::XY: return {1, 0, 0};
+    case GizmoHandle::YZ: return {0, 1, 0};
+    case GizmoHandle::ZX: return {0, 0, 1};
     case GizmoHandle::None: break;
   }
   return {0, 0, 0};
 }
 
 bool is_ring(GizmoHandle h) { return h == GizmoHandle::RX || h == GizmoHandle::RY || h == GizmoHandle::RZ; }
+bool is_plane(GizmoHandle h) { return h == GizmoHandle::XY || h == GizmoHandle::YZ || h == GizmoHandle::ZX; }
+glm::vec3 second_axis_of(GizmoHandle h) {
+  switch (h) {
+    case GizmoHandle::XY: return {0, 1, 0};
+    case GizmoHandle::YZ: return {0, 0, 1};
+    case GizmoHandle::ZX: return {1, 0, 0};
+    default: return {0, 0, 0};
+  }
+}
+constexpr float kPlaneFrom = 0.2f, kPlaneTo = 0.45f;  // the square's extent, in gizmo sizes
 
 tf::Similarity parent_world(const World& world, Entity e) {
   if (const auto* p = world.try_get<tf::Parent>(e))
@@ -51,13 +65,23 @@ GizmoHandle hovered_handle(const World& world, const EditorState& s, const Edito
   const glm::mat4 vp = view_projection(view);
   const ed::PickRay ray = ed::pick_ray(view.camera, view.fov_y, view.aspect, view.viewport, mouse);
   const auto handles = s.mode == GizmoMode::Translate
-                           ? std::array<GizmoHandle, 3>{GizmoHandle::X, GizmoHandle::Y, GizmoHandle::Z}
-                           : std::array<GizmoHandle, 3>{GizmoHandle::RX, GizmoHandle::RY, GizmoHandle::RZ};
-  GizmoHandle best = GizmoHandle::None;
+                           ? std::vector<GizmoHandle>{GizmoHandle::X, GizmoHandle::Y, GizmoHandle::Z,
+                                                      GizmoHandle::XY, GizmoHandle::YZ, GizmoHandle::ZX}
+                           : std::vector<GizmoHandle>{GizmoHandle::RX, GizmoHandle::RY, GizmoHandle::RZ};
+  GizmoHandle best = GizmoHandle::None, plane = GizmoHandle::None;
   float best_pixels = s.pick_pixels;
   for (GizmoHandle h : handles) {
     const HandleGeometry g = handle_geometry(world, s, view, h);
     if (!g.visible) continue;
+    if (is_plane(h)) {  // a square under the cursor, if no axis is within reach (below)
+      const glm::vec3 n = glm::cross(g.axis, g.axis2);
+      if (const auto t = ed::ray_plane(ray, g.pivot, n); t && plane == GizmoHandle::None) {
+        const glm::vec3 d = (ray.origin + *t * ray.direction - g.pivot) / g.size;
+        const float a = glm::dot(d, g.axis), b = glm::dot(d, g.axis2);
+        if (a >= kPlaneFrom && a <= kPlaneTo && b >= kPlaneFrom && b <= kPlaneTo) plane = h;
+      }
+      continue;
+    }
     float pixels = INFINITY;
     if (!is_ring(h)) {
       const auto a = ed::project_to_pixels(vp, view.viewport, g.pivot + 0.15f * g.size * g.axis);
@@ -73,7 +97,7 @@ GizmoHandle hovered_handle(const World& world, const EditorState& s, const Edito
       best = h;
     }
   }
-  return best;
+  return best != GizmoHandle::None ? best : plane;  // an axis line is thin: it wins where it is
 }
 
 }  // namespace
@@ -82,6 +106,9 @@ GizmoHandle parse_handle(const std::string& name) {
   if (name == "x") return GizmoHandle::X;
   if (name == "y") return GizmoHandle::Y;
   if (name == "z") return GizmoHandle::Z;
+  if (name == "xy") return GizmoHandle::XY;
+  if (name == "yz") return GizmoHandle::YZ;
+  if (name == "zx") return GizmoHandle::ZX;
   if (name == "rx") return GizmoHandle::RX;
   if (name == "ry") return GizmoHandle::RY;
   if (name == "rz") return GizmoHandle::RZ;
@@ -95,10 +122,11 @@ HandleGeometry handle_geometry(const World& world, const EditorState& s, const E
   if (!w) return g;
   g.pivot = s.active != GizmoHandle::None ? s.pivot : w->translation;
   g.axis = axis_of(h);
+  g.axis2 = second_axis_of(h);
   const float distance = glm::length(g.pivot - view.camera.translation);
   g.size = ed::world_size_for_pixels(s.gizmo_fraction * view.viewport.y, std::max(distance, 1e-3f), view.fov_y, view.viewport.y);
   const glm::vec3 view_dir = glm::normalize(g.pivot - view.camera.translation);
-  g.visible = !ed::edge_on(view_dir, g.axis, is_ring(h));
+  g.visible = is_plane(h) ? !ed::edge_on(view_dir, glm::cross(g.axis, g.axis2), true) : !ed::edge_on(view_dir, g.axis, is_ring(h));
   return g;
 }
 
@@ -106,7 +134,9 @@ std::optional<glm::vec2> handle_grab_pixel(const World& world, const EditorState
   const HandleGeometry g = handle_geometry(world, s, view, h);
   if (!g.visible) return std::nullopt;
   glm::vec3 p;
-  if (!is_ring(h)) {
+  if (is_plane(h)) {
+    p = g.pivot + 0.5f * (kPlaneFrom + kPlaneTo) * g.size * (g.axis + g.axis2);
+  } else if (!is_ring(h)) {
     p = g.pivot + 0.8f * g.size * g.axis;
   } else {  // the ring's point facing most across the view
     const glm::vec3 to_camera = glm::normalize(view.camera.translation - g.pivot);
@@ -165,7 +195,11 @@ void update_editor(World& world, EditorState& s, const engine::input::InputState
     const HandleGeometry g = handle_geometry(world, s, view, s.hovered);
     auto* t = world.try_get_mut<tf::Transform>(s.selected);
     if (!t) return;
-    if (!is_ring(s.hovered)) {
+    if (is_plane(s.hovered)) {
+      const auto t = ed::ray_plane(ray, g.pivot, glm::cross(g.axis, g.axis2));
+      if (!t) return;
+      s.start_hit = ray.origin + *t * ray.direction;
+    } else if (!is_ring(s.hovered)) {
       const auto p = ed::closest_on_axis(ray, g.pivot, g.axis);
       if (!p) return;
       s.start_param = *p;
@@ -186,7 +220,14 @@ void update_editor(World& world, EditorState& s, const engine::input::InputState
   const HandleGeometry g = handle_geometry(world, s, view, s.active);
   auto* t = world.alive(s.selected) ? world.try_get_mut<tf::Transform>(s.selected) : nullptr;
   if (t) {
-    if (!is_ring(s.active)) {
+    if (is_plane(s.active)) {
+      const glm::vec3 n = glm::cross(g.axis, g.axis2);
+      if (const auto hit = ed::ray_plane(ray, g.pivot, n)) {
+        glm::vec3 delta = ray.origin + *hit * ray.direction - s.start_hit;
+        delta -= glm::dot(delta, n) * n;  // exactly in the plane: rounding must not lift the object
+        *t = ed::translated(s.start, s.parent, delta, ctrl ? s.translate_snap : 0.0f);
+      }
+    } else if (!is_ring(s.active)) {
       if (const auto p = ed::closest_on_axis(ray, g.pivot, g.axis))
         *t = ed::translated(s.start, s.parent, (*p - s.start_param) * g.axis, ctrl ? s.translate_snap : 0.0f);
     } else if (const auto p = ring_point(ray, g)) {

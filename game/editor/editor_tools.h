@@ -21,7 +21,9 @@
 namespace game {
 
 enum class GizmoMode { Translate, Rotate };
-enum class GizmoHandle { None, X, Y, Z, RX, RY, RZ };
+// X, Y, Z: translate along an axis; XY, YZ, ZX: translate in a plane (the
+// square between two axes); RX, RY, RZ: rotate about an axis (a ring).
+enum class GizmoHandle { None, X, Y, Z, XY, YZ, ZX, RX, RY, RZ };
 
 struct EditorView {
   engine::transform::Similarity camera;  // world transform of the camera (looks down -Z)
@@ -46,13 +48,16 @@ struct EditorState {
   engine::transform::Similarity parent;
   glm::vec3 pivot{0.0f};
   float start_param = 0.0f, angle = 0.0f, last_angle = 0.0f;
+  glm::vec3 start_hit{0.0f};  // plane drags: where the press met the plane
   std::size_t drags = 0;  // finished drags, for tests and the stats overlay
 };
 
-// One handle's geometry in world space: an axis segment (translate) or a
-// ring (rotate) around `pivot` of radius `size`.
+// One handle's geometry in world space around `pivot`: an axis segment of
+// length `size` (translate), a square from 0.2 to 0.45 size along `axis` and
+// `axis2` with normal `axis` x `axis2` (plane), or a ring of radius `size`
+// about `axis` (rotate).
 struct HandleGeometry {
-  glm::vec3 pivot{0.0f}, axis{0.0f};
+  glm::vec3 pivot{0.0f}, axis{0.0f}, axis2{0.0f};
   float size = 0.0f;
   bool visible = false;  // false when edge-on
 };

@@ -42,8 +42,8 @@ std::vector<ReplayEvent> parse_replay(const std::string& text, const std::string
         bad("method: expected transgi, ddgi or reference, got '" + e.name + "'");
       if (e.kind == "view" && e.name != "full" && e.name != "gi" && e.name != "direct")
         bad("view: expected full, gi or direct, got '" + e.name + "'");
-      if (e.kind == "gizmo_grab" && !std::set<std::string>{"x", "y", "z", "rx", "ry", "rz"}.contains(e.name))
-        bad("gizmo_grab: expected x, y, z, rx, ry or rz, got '" + e.name + "'");
+      if (e.kind == "gizmo_grab" && !std::set<std::string>{"x", "y", "z", "xy", "yz", "zx", "rx", "ry", "rz"}.contains(e.name))
+        bad("gizmo_grab: expected x, y, z, xy, yz, zx, rx, ry or rz, got '" + e.name + "'");
     } else if (kXY.contains(e.kind)) {
       if (!(words >> e.xy.x >> e.xy.y) || !std::isfinite(e.xy.x) || !std::isfinite(e.xy.y))
         bad(e.kind + " needs two finite numbers");

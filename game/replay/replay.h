@@ -9,7 +9,8 @@
 //   mouse_down B / mouse_up B  B = left | right; held as key "mouse_B"
 //   select NAME                the editor selects the entity (as a click in its list)
 //   gizmo_grab HANDLE          cursor onto the selection's gizmo handle:
-//                              x, y, z (translate axes) or rx, ry, rz (rings)
+//                              x, y, z (translate axes), xy, yz, zx (translate
+//                              planes) or rx, ry, rz (rings)
 //   gizmo_mode translate|rotate
 //   method transgi|ddgi|reference   what the view shows
 //   view full|gi|direct             which pass

@@ -86,6 +86,21 @@ void EditorUi::draw_gizmo(const ViewRect& rect) {
       if (n > 1) dl->AddPolyline(pts, n, c, 0, hot ? 4.0f : 2.5f);
     }
   }
+  if (rings) return;
+  // The plane squares, coloured by their normal's axis.
+  const GizmoHandle planes[3] = {GizmoHandle::YZ, GizmoHandle::ZX, GizmoHandle::XY};  // normals X, Y, Z
+  for (int a = 0; a < 3; ++a) {
+    const HandleGeometry g = handle_geometry(session_.world(), s, project.view, planes[a]);
+    if (!g.visible) continue;
+    const bool hot = s.active == planes[a] || (s.active == GizmoHandle::None && s.hovered == planes[a]);
+    const float lo = 0.2f * g.size, hi = 0.45f * g.size;
+    const auto p0 = project(g.pivot + lo * g.axis + lo * g.axis2), p1 = project(g.pivot + hi * g.axis + lo * g.axis2);
+    const auto p2 = project(g.pivot + hi * g.axis + hi * g.axis2), p3 = project(g.pivot + lo * g.axis + hi * g.axis2);
+    if (!p0 || !p1 || !p2 || !p3) continue;
+    const ImU32 c = axis_colour(a, hot);
+    dl->AddQuadFilled(*p0, *p1, *p2, *p3, (c & 0x00ffffffu) | (hot ? 0xb0000000u : 0x60000000u));
+    dl->AddQuad(*p0, *p1, *p2, *p3, c, 1.5f);
+  }
 }
 
 void EditorUi::draw_probes(const ViewRect& rect) {

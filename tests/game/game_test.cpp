@@ -13,6 +13,7 @@
 #include <functional>
 
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
 
 #include "editor/editor_tools.h"
 #include "engine/editor/gizmo_math.h"
@@ -170,6 +171,54 @@ TEST(GameSession, AReplayedGizmoDragMovesTheObjectUnderTheCursorAndTheGiFollows)
 }  // namespace
 
 namespace {
+
+// Plane and ring drags through the same replayed mouse: the XZ-plane (zx)
+// square moves the cube within the floor's plane, the Y ring turns it
+// about +Y only.
+TEST(GameSession, PlaneAndRingDragsMoveAndTurnAsAsked) {
+  game::GameOptions o;
+  o.scene = kLevel / "scene.gltf";
+  o.width = 320;
+  o.height = 180;
+  game::GameSession s(o);
+  s.begin_input();
+  s.frame();
+  const auto cube = s.find("PlasticCube");
+  const engine::transform::Transform start = s.world().get<engine::transform::Transform>(cube);
+  auto drag = [&](const char* mode, const char* handle, glm::vec2 by) {
+    s.begin_input();
+    s.apply({0, "select", "PlasticCube", {}, 1});
+    s.apply({0, "gizmo_mode", mode, {}, 2});
+    s.apply({0, "gizmo_grab", handle, {}, 3});
+    s.apply({0, "mouse_down", "left", {}, 4});
+    s.frame();
+    for (int i = 0; i < 4; ++i) {
+      s.begin_input();
+      s.apply({0, "mouse_move_by", "", by / 4.0f, 5});
+      s.frame();
+    }
+    s.begin_input();
+    s.apply({0, "mouse_up", "left", {}, 6});
+    s.frame();
+  };
+  drag("translate", "zx", {-12, 6});
+  const engine::transform::Transform moved = s.world().get<engine::transform::Transform>(cube);
+  EXPECT_EQ(moved.translation.y, start.translation.y) << "a ZX-plane drag keeps the height";
+  EXPECT_GT(glm::length(moved.translation - start.translation), 0.05f);
+  EXPECT_EQ(moved.rotation, start.rotation);
+  drag("rotate", "ry", {-10, 8});
+  const engine::transform::Transform turned = s.world().get<engine::transform::Transform>(cube);
+  EXPECT_EQ(turned.translation, moved.translation);
+  const glm::quat delta = turned.rotation * glm::inverse(moved.rotation);
+  const float angle = 2.0f * std::acos(std::min(1.0f, std::abs(delta.w)));
+  EXPECT_GT(angle, 0.05f) << "the ring drag turned the cube";
+  const glm::vec3 axis = glm::normalize(glm::vec3(delta.x, delta.y, delta.z));
+  EXPECT_NEAR(std::abs(axis.y), 1.0f, 1e-4f) << "about +Y only: axis " << axis.x << ", " << axis.y << ", " << axis.z;
+  EXPECT_EQ(s.editor().undo.undo_count(), 2u);
+  ASSERT_TRUE(s.editor().undo.undo(s.world()));
+  ASSERT_TRUE(s.editor().undo.undo(s.world()));
+  EXPECT_EQ(s.world().get<engine::transform::Transform>(cube), start) << "two undos restore the start";
+}
 
 TEST(GameSession, SwitchingToDdgiAndTheReferenceShowsTheirImages) {
   game::GameOptions o;
