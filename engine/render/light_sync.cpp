@@ -13,7 +13,7 @@ struct SeenState {
   std::uint64_t commits = UINT64_MAX;  // RtScene top-level commits at the last rebuild
   std::uint64_t assets_generation = UINT64_MAX;
   bool split_sun = false;
-  std::uint64_t environment_version = 0;
+  std::uint64_t environment_version = 0, material_version = 0;
 };
 
 void sync_lights(LightView lights, Removed<scene::PunctualLight> removed, Res<rt::RtScene> rt, Res<LightSettings> settings,
@@ -28,8 +28,9 @@ void sync_lights(LightView lights, Removed<scene::PunctualLight> removed, Res<rt
   const std::uint64_t generation = assets ? assets->generation : 0;
   const bool geometry_changed = rt->stats().top_level_commits != seen->commits;
   const bool sky_changed = assets && assets->environment_version != seen->environment_version;
+  const bool materials_changed = assets && assets->material_version != seen->material_version;
   const bool assets_changed = generation != seen->assets_generation;
-  lights_changed = lights_changed || sky_changed;
+  lights_changed = lights_changed || sky_changed || materials_changed;
   if (!lights_changed && !geometry_changed && !assets_changed) return;
   // Emissive triangles are stored in world space, so moved geometry also
   // means a rebuilt light set.
@@ -48,6 +49,7 @@ void sync_lights(LightView lights, Removed<scene::PunctualLight> removed, Res<rt
   seen->assets_generation = generation;
   seen->split_sun = settings->split_sun;
   seen->environment_version = assets ? assets->environment_version : 0;
+  seen->material_version = assets ? assets->material_version : 0;
 }
 
 }  // namespace

@@ -26,6 +26,9 @@ struct SceneAssets {
   // Bumped whenever the environment's yaw or strength changes at run time,
   // so the light set (and the caches that follow it) rebuild.
   std::uint64_t environment_version = 0;
+  // Bumped whenever a material changes at run time (an editor's knob), for
+  // the same reason: emission and reflectance feed the light set and probes.
+  std::uint64_t material_version = 0;
 };
 
 // Next value for SceneAssets::generation.

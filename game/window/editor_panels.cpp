@@ -1,11 +1,13 @@
 // The hierarchy, the inspector and saving the level.
 #include <algorithm>
+#include <set>
 #include <cmath>
 #include <vector>
 
 #include <glm/gtc/quaternion.hpp>
 
 #include "engine/scene/components.h"
+#include "engine/scene/scene_assets.h"
 #include "engine/script/script_runtime.h"
 #include "engine/transform/transform.h"
 #include "level/level_save.h"
@@ -102,6 +104,27 @@ void EditorUi::inspector() {
       changed |= ImGui::DragFloat("intensity", &edit.intensity, 0.02f, 0.0f, 1e4f);
       changed |= ImGui::DragFloat("range (0 = infinite)", &edit.range, 0.05f, 0.0f, 1e4f);
       if (changed) w.get_mut<engine::scene::PunctualLight>(e) = edit;
+    }
+    if (const auto* m = w.try_get<engine::scene::MeshInstance>(e); m && ImGui::CollapsingHeader("Material")) {
+      // Run-time material knobs: TransGI takes albedo as a network input, so
+      // a colour change needs no re-bake. A material is shared by every
+      // mesh that uses it.
+      auto& assets = w.resource<engine::scene::SceneAssets>();
+      std::set<std::uint32_t> used;
+      if (m->mesh < assets.meshes.size())
+        for (std::uint32_t id : assets.meshes[m->mesh]->triangle_material) used.insert(id);
+      for (std::uint32_t id : used) {
+        if (id >= assets.materials.size()) continue;
+        engine::material::Material& mat = assets.materials[id];
+        ImGui::PushID(static_cast<int>(id));
+        ImGui::Text("%s (material %u)", mat.name.c_str(), id);
+        bool changed = ImGui::ColorEdit3("base colour", &mat.base_color_factor.x);
+        changed |= ImGui::SliderFloat("roughness", &mat.roughness_factor, 0.0f, 1.0f);
+        changed |= ImGui::SliderFloat("metallic", &mat.metallic_factor, 0.0f, 1.0f);
+        changed |= ImGui::DragFloat("emission strength", &mat.emissive_strength, 0.05f, 0.0f, 1000.0f);
+        if (changed) ++assets.material_version;  // the light set and probes follow
+        ImGui::PopID();
+      }
     }
     if (const auto* s = w.try_get<engine::script::Script>(e); s && ImGui::CollapsingHeader("Script", ImGuiTreeNodeFlags_DefaultOpen)) {
       auto& runtime = w.resource<engine::script::ScriptRuntime>();

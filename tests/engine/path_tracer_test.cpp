@@ -7,10 +7,13 @@
 #include "engine/app/app.h"
 #include "engine/jobs/job_system.h"
 #include "engine/math/sampling.h"
+#include "engine/render/light_plugin.h"
 #include "engine/render/path_tracer.h"
 #include "engine/rt/rt_plugin.h"
 #include "engine/scene/procedural.h"
 #include "engine/scene/scene_assets.h"
+#include "engine/scene/components.h"
+#include "engine/transform/transform.h"
 
 using namespace engine;
 using namespace engine::render;
@@ -161,4 +164,38 @@ TEST(PathTracer, SameSeedSameImageWhateverTheThreadCount) {
       ASSERT_EQ(one[p].pixels[i], two[p].pixels[i]) << "pass " << p << " pixel " << i;
   const auto other_seed = s.render(16, 12, 8, 6, 2);
   EXPECT_NE(one[0].pixels, other_seed[0].pixels) << "a different seed must give different noise";
+}
+
+// Run-time sky and material edits reach the light set: its version moves
+// (so probes wake) and an emitter made dark leaves the emissive list.
+TEST(LightSync, SkyAndMaterialEditsRebuildTheLightSet) {
+  using namespace engine;
+  app::App app(app::AppOptions{.jobs = {.threads = 1}});
+  auto& assets = app.world().insert_resource<scene::SceneAssets>();
+  assets.generation = scene::next_scene_generation();
+  assets.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({0.5f, 0.5f}, 0))};
+  material::Material lamp;
+  lamp.emissive_factor = glm::vec3(1.0f);
+  lamp.emissive_strength = 5.0f;
+  assets.materials = {lamp};
+  assets.environment = scene::uniform_environment(glm::vec3(0.5f));
+  app.add_plugin<render::LightPlugin>();
+  const ecs::Entity e = app.world().spawn();
+  app.world().emplace<transform::Transform>(e);
+  app.world().emplace<scene::MeshInstance>(e, scene::MeshInstance{0});
+  app.update();
+  const auto& lights = app.world().resource<render::SceneLights>();
+  const std::uint64_t v0 = lights.version;
+  EXPECT_GT(lights.set.emissive_triangle_count(), 0u);
+  app.update();
+  EXPECT_EQ(lights.version, v0) << "nothing changed";
+  assets.environment->set_strength(0.25f);
+  ++assets.environment_version;
+  app.update();
+  EXPECT_EQ(lights.version, v0 + 1) << "the sky changed";
+  assets.materials[0].emissive_strength = 0.0f;
+  ++assets.material_version;
+  app.update();
+  EXPECT_EQ(lights.version, v0 + 2) << "a material changed";
+  EXPECT_EQ(lights.set.emissive_triangle_count(), 0u) << "the dark lamp is no longer an emitter";
 }

@@ -417,3 +417,36 @@ TEST_F(ScriptTest, SkyTurnsTheEnvironmentAndBumpsItsVersion) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST_F(ScriptTest, WorldPositionForwardAndLogLevels) {
+  write("world.lua", R"(
+    function update(self, dt)
+      local x, y, z = self.entity.transform:get_world_position()
+      local fx, fy, fz = self.entity.transform:get_forward()
+      local function r(v) return math.floor(v * 1000 + 0.5) / 1000 end  -- no "-0.000" from rounding noise
+      log.info(string.format("%.3f %.3f %.3f  %.3f %.3f %.3f", r(x), r(y), r(z), r(fx), r(fy), r(fz)))
+      log.warn("careful")
+      log.error("bad", 42)
+      print("printed")
+    end)");
+  const Entity parent = world().spawn();
+  transform::Transform pt = transform::Transform::from_translation({10, 0, 0});
+  pt.rotation = glm::angleAxis(3.14159265f / 2, glm::vec3(0, 1, 0));  // local -Z turns to world -X
+  world().emplace<transform::Transform>(parent, pt);
+  const Entity child = spawn_scripted("world.lua", "child", glm::vec3(0, 0, -2));
+  world().emplace<transform::Parent>(child, transform::Parent{parent});
+  app_.update();  // the WorldTransform is written in PostUpdate, after the scripts
+  world().resource<core::Log>().clear();
+  app_.update();
+  // The child 2 m down its parent's -Z: the parent faces world -X from x = 10.
+  EXPECT_EQ(logged(core::LogLevel::Info), "8.000 0.000 0.000  -1.000 0.000 0.000\nprinted\n");
+  EXPECT_EQ(logged(core::LogLevel::Warning), "careful\n");
+  EXPECT_EQ(logged(core::LogLevel::Error), "bad 42\n");
+  const auto& entries = world().resource<core::Log>().entries();
+  ASSERT_FALSE(entries.empty());
+  EXPECT_NE(entries.front().source.find("world.lua:"), std::string::npos) << "the source names the file and line";
+}
+
+}  // namespace
