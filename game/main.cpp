@@ -71,7 +71,8 @@ std::string value(const Cli& c, const std::string& key, const std::string& fallb
   return it == c.values.end() ? fallback : it->second;
 }
 
-int run_headless(const Cli& cli) {
+// What the window and headless runs share.
+game::GameOptions game_options(const Cli& cli) {
   game::GameOptions o;
   o.scene = value(cli, "scene", TRANSGI_DEFAULT_LEVEL);
   o.model = value(cli, "model");
@@ -80,6 +81,11 @@ int run_headless(const Cli& cli) {
   o.height = integer(cli, "height", 16, 8192, 360);
   o.threads = integer(cli, "threads", 0, 1024, 0);
   o.view = value(cli, "view", "full");
+  return o;
+}
+
+int run_headless(const Cli& cli) {
+  const game::GameOptions o = game_options(cli);
   const int frames = integer(cli, "frames", 1, 1000000, 120);
   float exposure = 0.0f;
   if (auto e = value(cli, "exposure"); !e.empty()) {
@@ -130,14 +136,7 @@ int main(int argc, char** argv) {
     if (!cli.headless) {
       for (const char* headless_only : {"script-input", "record"})
         if (cli.values.contains(headless_only)) throw std::runtime_error(std::string("--") + headless_only + " needs --headless");
-      game::GameOptions o;
-      o.scene = value(cli, "scene", TRANSGI_DEFAULT_LEVEL);
-      o.model = value(cli, "model");
-      o.manifest = value(cli, "game");
-      o.width = integer(cli, "width", 16, 8192, 640);
-      o.height = integer(cli, "height", 16, 8192, 360);
-      o.threads = integer(cli, "threads", 0, 1024, 0);
-      o.view = value(cli, "view", "full");
+      const game::GameOptions o = game_options(cli);
       game::WindowOptions w;
       w.frames = integer(cli, "frames", 0, 1000000, 0);
       w.screenshot = value(cli, "screenshot");

@@ -33,6 +33,23 @@ namespace {
 
 const fs::path kLevel = fs::path(TRANSGI_CONTENT_DIR) / "levels/living_room";
 
+// The sample level at a test-sized resolution.
+game::GameOptions level_options(int width, int height) {
+  game::GameOptions o;
+  o.scene = kLevel / "scene.gltf";
+  o.width = width;
+  o.height = height;
+  return o;
+}
+
+// Frames with no input.
+void idle(game::GameSession& s, int frames) {
+  for (int f = 0; f < frames; ++f) {
+    s.begin_input();
+    s.frame();
+  }
+}
+
 std::string error_of(const std::function<void()>& fn) {
   try {
     fn();
@@ -97,19 +114,13 @@ float region_mean(const engine::image::ImageRGB& img, glm::ivec2 lo, glm::ivec2 
 }
 
 TEST(GameSession, AReplayedGizmoDragMovesTheObjectUnderTheCursorAndTheGiFollows) {
-  game::GameOptions o;
-  o.scene = kLevel / "scene.gltf";
-  o.width = 192;
-  o.height = 108;
+  game::GameOptions o = level_options(192, 108);
   o.view = "gi";
   auto run = [&](bool drag, glm::vec3* moved, glm::vec2* cursor_error) {
     game::GameSession s(o);
     const auto cube = s.find("PlasticCube");
     EXPECT_FALSE(cube.is_null());
-    for (int f = 0; f < 24; ++f) {
-      s.begin_input();
-      s.frame();
-    }
+    idle(s, 24);
     const glm::vec3 before = s.world().get<engine::transform::Transform>(cube).translation;
     if (drag) {
       s.begin_input();
@@ -140,10 +151,7 @@ TEST(GameSession, AReplayedGizmoDragMovesTheObjectUnderTheCursorAndTheGiFollows)
       EXPECT_EQ(s.editor().drags, 1u);
       EXPECT_EQ(s.editor().undo.undo_count(), 1u);
     }
-    for (int f = 0; f < 16; ++f) {
-      s.begin_input();
-      s.frame();
-    }
+    idle(s, 16);
     *moved = s.world().get<engine::transform::Transform>(cube).translation - before;
     // The cube's neighbourhood on screen, from its start position.
     const game::EditorView v = s.view();
@@ -176,13 +184,8 @@ namespace {
 // square moves the cube within the floor's plane, the Y ring turns it
 // about +Y only.
 TEST(GameSession, PlaneAndRingDragsMoveAndTurnAsAsked) {
-  game::GameOptions o;
-  o.scene = kLevel / "scene.gltf";
-  o.width = 320;
-  o.height = 180;
-  game::GameSession s(o);
-  s.begin_input();
-  s.frame();
+  game::GameSession s(level_options(320, 180));
+  idle(s, 1);
   const auto cube = s.find("PlasticCube");
   const engine::transform::Transform start = s.world().get<engine::transform::Transform>(cube);
   auto drag = [&](const char* mode, const char* handle, glm::vec2 by) {
@@ -221,20 +224,13 @@ TEST(GameSession, PlaneAndRingDragsMoveAndTurnAsAsked) {
 }
 
 TEST(GameSession, SwitchingToDdgiAndTheReferenceShowsTheirImages) {
-  game::GameOptions o;
-  o.scene = kLevel / "scene.gltf";
-  o.width = 64;
-  o.height = 36;
-  game::GameSession s(o);
+  game::GameSession s(level_options(64, 36));
   auto mean = [](const engine::image::ImageRGB& img) {
     double m = 0;
     for (const glm::vec3& p : img.pixels) m += (p.x + p.y + p.z) / 3.0;
     return img.pixels.empty() ? 0.0 : m / static_cast<double>(img.pixels.size());
   };
-  for (int f = 0; f < 4; ++f) {
-    s.begin_input();
-    s.frame();
-  }
+  idle(s, 4);
   // Hold the sky still, so nothing moves and the reference accumulates.
   ASSERT_TRUE(s.world().resource<engine::script::ScriptRuntime>().set_property(s.world(), s.find("DayNight"), "running", false));
   const double transgi = mean(s.image());
@@ -264,10 +260,7 @@ TEST(GameSession, AnyGltfPlaysWithoutABakedModel) {
   o.width = 48;
   o.height = 48;
   game::GameSession s(o);
-  for (int f = 0; f < 3; ++f) {
-    s.begin_input();
-    s.frame();
-  }
+  idle(s, 3);
   double sum = 0;
   for (const glm::vec3& p : s.image().pixels) sum += p.x + p.y + p.z;
   EXPECT_GT(sum, 0.0) << "lit by direct light and the probes";
@@ -281,13 +274,8 @@ TEST(LevelSave, AMovedObjectIsSavedAndTheModelStillFitsTheLevel) {
   fs::create_directories(dir);
   glm::vec3 moved_to(0.0f);
   {
-    game::GameOptions o;
-    o.scene = kLevel / "scene.gltf";
-    o.width = 64;
-    o.height = 36;
-    game::GameSession s(o);
-    s.begin_input();
-    s.frame();
+    game::GameSession s(level_options(64, 36));
+    idle(s, 1);
     const auto cube = s.find("PlasticCube");
     moved_to = s.world().get<engine::transform::Transform>(cube).translation + glm::vec3(0.5f, 0.0f, -0.25f);
     s.world().get_mut<engine::transform::Transform>(cube).translation = moved_to;
@@ -295,11 +283,9 @@ TEST(LevelSave, AMovedObjectIsSavedAndTheModelStillFitsTheLevel) {
   }
   // It loads with the level's own model (validated mesh by mesh), the cube
   // where it was left, and without what game.json added.
-  game::GameOptions o;
+  game::GameOptions o = level_options(64, 36);
   o.scene = dir / "scene.gltf";
   o.model = kLevel / "transgi.tgm";
-  o.width = 64;
-  o.height = 36;
   game::GameSession s(o);
   EXPECT_EQ(s.world().get<engine::transform::Transform>(s.find("PlasticCube")).translation, moved_to);
   EXPECT_TRUE(s.find("WindowDoor").is_null()) << "game.json's entities are not part of the saved glTF";

@@ -120,18 +120,19 @@ runtime::TransGISettings small_settings() {
   return s;
 }
 
-}  // namespace
-
-TEST(TransferInference, BatchedMatchesTheScalarReference) {
-  const scene::SceneAssets assets = floor_and_cube();
-  auto m = bake::make_untrained_model(assets, 7, model::MlpLayout{.width = 48, .hidden_layers = 3}, 11);
-  math::Pcg32 rng(3, 4);
+// A decoder of the given width with random latents, and biases too, so
+// every layer's bias path is exercised.
+model::TransferModel random_model(const scene::SceneAssets& assets, int width, math::Pcg32& rng) {
+  auto m = bake::make_untrained_model(assets, 7, model::MlpLayout{.width = width, .hidden_layers = 3}, 11);
   for (auto& mesh : m.meshes)
     for (float& v : mesh.latents.values) v = 2.0f * rng.next_float() - 1.0f;
-  // Biases too, so every layer's bias path is exercised.
   for (float& v : m.decoder.params()) v += 0.05f * (2.0f * rng.next_float() - 1.0f);
-  // More queries than one inference chunk (8192), so the chunk seam is covered.
-  std::vector<shading::TransferQuery> queries(9000);
+  return m;
+}
+
+// Shading points spread over the two meshes, with random albedo and directions.
+std::vector<shading::TransferQuery> random_queries(const scene::SceneAssets& assets, std::size_t n, math::Pcg32& rng) {
+  std::vector<shading::TransferQuery> queries(n);
   for (auto& q : queries) {
     q.mesh = rng.next_float() < 0.5f ? 0u : 1u;
     q.triangle = static_cast<std::uint32_t>(rng.next_float() * static_cast<float>(assets.meshes[q.mesh]->triangles.size())) %
@@ -142,6 +143,17 @@ TEST(TransferInference, BatchedMatchesTheScalarReference) {
     q.normal = math::sample_uniform_sphere({rng.next_float(), rng.next_float()});
     q.wo = math::sample_uniform_sphere({rng.next_float(), rng.next_float()});
   }
+  return queries;
+}
+
+}  // namespace
+
+TEST(TransferInference, BatchedMatchesTheScalarReference) {
+  const scene::SceneAssets assets = floor_and_cube();
+  math::Pcg32 rng(3, 4);
+  const model::TransferModel m = random_model(assets, 48, rng);
+  // More queries than one inference chunk (8192), so the chunk seam is covered.
+  const std::vector<shading::TransferQuery> queries = random_queries(assets, 9000, rng);
   std::vector<float> batched(queries.size() * 75);
   jobs::JobSystem jobs({.threads = 2});
   jobs.run([&] { shading::infer_transfer(m, assets, queries, batched.data()); });
@@ -166,23 +178,11 @@ TEST(TransferInference, BatchedMatchesTheScalarReference) {
 // the same light, over several tiles and a ragged last one.
 TEST(TransferInference, FusedTilesWithFilledLightMatchTheScalarReference) {
   const scene::SceneAssets assets = floor_and_cube();
-  auto m = bake::make_untrained_model(assets, 7, model::MlpLayout{.width = 128, .hidden_layers = 3}, 11);
   math::Pcg32 rng(5, 6);
-  for (auto& mesh : m.meshes)
-    for (float& v : mesh.latents.values) v = 2.0f * rng.next_float() - 1.0f;
-  for (float& v : m.decoder.params()) v += 0.05f * (2.0f * rng.next_float() - 1.0f);
-  std::vector<shading::TransferQuery> queries(3 * shading::kFusedTile + 17);
+  const model::TransferModel m = random_model(assets, 128, rng);
+  const std::vector<shading::TransferQuery> queries = random_queries(assets, 3 * shading::kFusedTile + 17, rng);
   std::vector<float> light(queries.size() * 75), light2(queries.size() * 75);
   for (std::size_t i = 0; i < queries.size(); ++i) {
-    auto& q = queries[i];
-    q.mesh = rng.next_float() < 0.5f ? 0u : 1u;
-    q.triangle = static_cast<std::uint32_t>(rng.next_float() * static_cast<float>(assets.meshes[q.mesh]->triangles.size())) %
-                 static_cast<std::uint32_t>(assets.meshes[q.mesh]->triangles.size());
-    const float b1 = rng.next_float(), b2 = rng.next_float() * (1 - b1);
-    q.barycentric = {b1, b2};
-    q.albedo = {rng.next_float(), rng.next_float(), rng.next_float()};
-    q.normal = math::sample_uniform_sphere({rng.next_float(), rng.next_float()});
-    q.wo = math::sample_uniform_sphere({rng.next_float(), rng.next_float()});
     for (int k = 0; k < 75; ++k) {
       light[i * 75 + static_cast<std::size_t>(k)] = rng.next_float();
       light2[i * 75 + static_cast<std::size_t>(k)] = rng.next_float() - 0.5f;
