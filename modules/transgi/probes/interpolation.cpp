@@ -38,7 +38,8 @@ InterpolationResult interpolate_probes(const ProbeGrid& grid, const MapLayout& l
       if (d > 1e-6f) {
         const auto t = static_cast<std::size_t>(layout.texel_of(from_probe / d));
         const ProbeMapState& st = states[static_cast<std::size_t>(q)];
-        if (chebyshev_visibility(st.depth.mean[t], st.depth_squared[t], d) < s.visibility_threshold) keep = false;
+        const glm::vec2 m = st.depth.moments[t];
+        if (chebyshev_visibility(m.x, m.y, d) < s.visibility_threshold) keep = false;
       }
     }
     if (!keep && cage.weights[i] > 0) ++r.pruned;

@@ -83,7 +83,7 @@ std::size_t ProbeField::memory_bytes() const {
                   direct_frames_.size() * sizeof(std::uint32_t);
   for (const ProbeMapState& st : states_)
     b += st.radiance.size() * sizeof(glm::vec3) +
-         (st.sampled.size() + st.depth.mean.size() + st.depth_squared.size() + st.depth_weight.size()) * sizeof(float);
+         st.sampled.size() * sizeof(std::uint8_t) + st.depth.moments.size() * sizeof(glm::vec2);
   return b;
 }
 

@@ -9,10 +9,8 @@ namespace transgi::probes {
 void ProbeMapState::reset(int texels) {
   const auto n = static_cast<std::size_t>(texels);
   radiance.assign(n, glm::vec3(0.0f));
-  sampled.assign(n, 0.0f);
-  depth.mean.assign(n, std::numeric_limits<float>::quiet_NaN());
-  depth_squared.assign(n, 0.0f);
-  depth_weight.assign(n, 0.0f);
+  sampled.assign(n, 0);
+  depth.moments.assign(n, glm::vec2(std::numeric_limits<float>::quiet_NaN(), 0.0f));
   noise_variance = 0.0f;
   noise_frames = 0;
   frames = 0;
@@ -71,13 +69,13 @@ bool accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSett
       // Nothing new: keep the history, unless the lighting just changed, in
       // which case the history is wrong and the texel is refilled from
       // fresh neighbours until it is sampled again.
-      if (changed) st.sampled[t] = 0.0f;
+      if (changed) st.sampled[t] = 0;
       continue;
     }
     const glm::vec3 mean = f.sum[t] / f.count[t];
-    if (st.sampled[t] == 0.0f) {
+    if (st.sampled[t] == 0) {
       st.radiance[t] = mean;
-      st.sampled[t] = 1.0f;
+      st.sampled[t] = 1;
       continue;
     }
     st.radiance[t] = h * st.radiance[t] + (1.0f - h) * mean;
@@ -96,20 +94,19 @@ void update_own_depth(ProbeMapState& st, const MapLayout& layout, const std::vec
   for (const ShadedPoint& p : own) {
     if (!std::isfinite(p.distance)) continue;
     const auto t = static_cast<std::size_t>(layout.texel_of(p.direction));
-    if (st.depth_weight[t] == 0.0f) {
-      st.depth.mean[t] = p.distance;
-      st.depth_squared[t] = p.distance * p.distance;
-      st.depth_weight[t] = 1.0f;
+    glm::vec2& m = st.depth.moments[t];
+    if (std::isnan(m.x)) {  // the texel's first own hit (distances are finite)
+      m = {p.distance, p.distance * p.distance};
     } else {
-      st.depth.mean[t] = h * st.depth.mean[t] + (1 - h) * p.distance;
-      st.depth_squared[t] = h * st.depth_squared[t] + (1 - h) * p.distance * p.distance;
+      m.x = h * m.x + (1 - h) * p.distance;
+      m.y = h * m.y + (1 - h) * p.distance * p.distance;
     }
   }
 }
 
 std::vector<glm::vec3> filled_radiance(const ProbeMapState& st, const MapLayout& layout, int passes) {
   std::vector<glm::vec3> r = st.radiance;
-  std::vector<float> known = st.sampled;
+  std::vector<std::uint8_t> known = st.sampled;
   const int w = layout.width, h = layout.height;
   // Each pass fills the holes next to known texels from the state before the
   // pass (a Jacobi step): fills are collected, then applied, so only the
@@ -142,7 +139,7 @@ std::vector<glm::vec3> filled_radiance(const ProbeMapState& st, const MapLayout&
       }
     for (const auto& [t, value] : fills) {
       r[t] = value;
-      known[t] = 1.0f;
+      known[t] = 1;
     }
     if (!any_missing) return r;
   }

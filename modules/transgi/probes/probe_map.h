@@ -2,6 +2,7 @@
 // One probe's accumulated state: its radiance map over frames, its own
 // hit-distance moments (for the sharing depth guard and Chebyshev
 // visibility), and the SH projection shading reads.
+#include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -38,10 +39,8 @@ struct AccumulationSettings {
 
 struct ProbeMapState {
   std::vector<glm::vec3> radiance;   // history, per texel
-  std::vector<float> sampled;        // 0 until a texel receives its first sample
-  DepthMap depth;                    // own mean hit distance (NaN = never hit)
-  std::vector<float> depth_squared;  // own mean squared hit distance
-  std::vector<float> depth_weight;
+  std::vector<std::uint8_t> sampled; // 0 until a texel receives its first sample (a flag: one byte)
+  DepthMap depth;                    // own hit distance moments (mean NaN = never hit)
   float noise_variance = 0.0f;  // running mean of (relative frame change)^2 under steady light
   int noise_frames = 0;
   int frames = 0;  // frames accumulated since reset

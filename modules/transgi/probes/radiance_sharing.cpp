@@ -37,7 +37,7 @@ SharingStats rasterize_shared(const ProbeGrid& grid, const MapLayout& layout,
           d /= dist;
           const int t = layout.texel_of(d);
           if (q != p && s.mode == SharingMode::DepthGuard && depth) {
-            const float own = depth->mean[static_cast<std::size_t>(t)];
+            const float own = depth->mean(static_cast<std::size_t>(t));
             if (std::isfinite(own) && dist > own * (1.0f + s.relative_tolerance) + s.absolute_tolerance) {
               ++rej;
               continue;

@@ -51,10 +51,13 @@ struct FrameSamples {
   }
 };
 
-// Mean own hit distance per texel (NaN where the probe's own rays never hit),
-// which the guard compares against.
+// Per texel, the mean own hit distance (x; NaN where the probe's own rays
+// never hit), which the sharing guard compares against, and the mean of its
+// square (y), for the Chebyshev visibility test. One interleaved array: a
+// visibility lookup reads both from one cache line.
 struct DepthMap {
-  std::vector<float> mean;
+  std::vector<glm::vec2> moments;
+  [[nodiscard]] float mean(std::size_t texel) const { return moments[texel].x; }
 };
 
 struct SharingStats {
