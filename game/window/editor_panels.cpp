@@ -76,7 +76,8 @@ void EditorUi::inspector() {
   if (e.is_null() || !w.alive(e)) {
     ImGui::TextDisabled("Click an object in the view or the hierarchy.");
   } else {
-    ImGui::Text("%s (entity %u)", label_of(w, e).substr(0, label_of(w, e).find("##")).c_str(), e.index);
+    const std::string label = label_of(w, e);
+    ImGui::Text("%s (entity %u)", label.substr(0, label.find("##")).c_str(), e.index);
     if (const auto* t = w.try_get<tf::Transform>(e); t && ImGui::CollapsingHeader("Transform", ImGuiTreeNodeFlags_DefaultOpen)) {
       tf::Transform edit = *t;
       glm::vec3 euler = glm::degrees(glm::eulerAngles(edit.rotation));

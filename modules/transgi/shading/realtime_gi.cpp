@@ -39,8 +39,9 @@ struct Upsampling {
   std::vector<Taps> taps;
 };
 
-// The four grid samples standing for a pixel and their weights.
-struct Taps {
+// The four grid samples standing for a pixel and their unnormalised
+// weights, as computed (Upsampling::Taps is the stored, normalised form).
+struct RawTaps {
   std::array<std::size_t, 4> cell{kNone, kNone, kNone, kNone};
   std::array<float, 4> weight{};
   float total = 0;
@@ -75,8 +76,8 @@ float similarity(const glm::vec4& p, const glm::vec4& q, const RealtimeGiSetting
 }
 
 // Bilinear weights times similarity, for pixel (x, y).
-Taps taps_of(int x, int y, const std::vector<glm::vec4>& guide, const Upsampling& u, const RealtimeGiSettings& s, int width) {
-  Taps t;
+RawTaps taps_of(int x, int y, const std::vector<glm::vec4>& guide, const Upsampling& u, const RealtimeGiSettings& s, int width) {
+  RawTaps t;
   const glm::vec4& gp = guide[static_cast<std::size_t>(y) * width + x];
   // Position in cell coordinates, cell centres at integers.
   const float fx = (static_cast<float>(x) + 0.5f) / u.sx - 0.5f, fy = (static_cast<float>(y) + 0.5f) / u.sy - 0.5f;
@@ -117,7 +118,7 @@ void plan_upsampling(const GBuffer& g, const std::vector<glm::vec4>& guide, cons
           u.kind[p] = Upsampling::kMiss;
           continue;
         }
-        const Taps t = taps_of(x, y, guide, u, s, g.width);
+        const RawTaps t = taps_of(x, y, guide, u, s, g.width);
         if (t.total < s.min_weight) {
           u.kind[p] = Upsampling::kOwn;
           continue;
