@@ -5,10 +5,10 @@
 //                [--scene level.gltf] [--model M.tgm] [--game game.json] [--width W --height H] [--view full|gi|direct]
 #include <cstdio>
 #include <cstdlib>
-#include <map>
 #include <string>
 #include <vector>
 
+#include "engine/core/args.h"
 #include "engine/core/log.h"
 #include "engine/core/progress.h"
 #include "engine/image/tonemap.h"
@@ -25,81 +25,34 @@ constexpr const char* kUsage =
     "                    [--view full|gi|direct] [--exposure STOPS] [--threads T]\n"
     "  window only: [--select NAME] [--gizmo translate|rotate] (what the editor shows at start)\n";
 
-struct Cli {
-  std::map<std::string, std::string> values;
-  bool headless = false;
-};
-
-Cli parse(int argc, char** argv) {
-  static const std::vector<std::string> kValued = {"frames", "script-input", "record", "screenshot", "scene", "model",
-                                                   "game", "width", "height", "view", "exposure", "threads", "select", "gizmo"};
-  Cli c;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--headless") {
-      c.headless = true;
-      continue;
-    }
-    if (a == "--help" || a == "-h") {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    }
-    if (a.rfind("--", 0) != 0) throw std::runtime_error("unexpected argument '" + a + "'");
-    const std::string key = a.substr(2);
-    if (std::find(kValued.begin(), kValued.end(), key) == kValued.end()) throw std::runtime_error("unknown option --" + key);
-    if (i + 1 >= argc) throw std::runtime_error("--" + key + " needs a value");
-    c.values[key] = argv[++i];
-  }
-  return c;
-}
-
-int integer(const Cli& c, const std::string& key, int lo, int hi, int fallback) {
-  auto it = c.values.find(key);
-  if (it == c.values.end()) return fallback;
-  try {
-    std::size_t used = 0;
-    const long v = std::stol(it->second, &used);
-    if (used == it->second.size() && v >= lo && v <= hi) return static_cast<int>(v);
-  } catch (const std::exception&) {
-  }
-  throw std::runtime_error("--" + key + ": expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got '" +
-                           it->second + "'");
-}
-
-std::string value(const Cli& c, const std::string& key, const std::string& fallback = {}) {
-  auto it = c.values.find(key);
-  return it == c.values.end() ? fallback : it->second;
+engine::core::Args parse(int argc, char** argv) {
+  return engine::core::Args("transgi-game", std::vector<std::string>(argv + 1, argv + argc),
+                            {"frames", "script-input", "record", "screenshot", "scene", "model", "game", "width", "height", "view",
+                             "exposure", "threads", "select", "gizmo"},
+                            {"headless", "help"});
 }
 
 // What the window and headless runs share.
-game::GameOptions game_options(const Cli& cli) {
+game::GameOptions game_options(const engine::core::Args& args) {
   game::GameOptions o;
-  o.scene = value(cli, "scene", TRANSGI_DEFAULT_LEVEL);
-  o.model = value(cli, "model");
-  o.manifest = value(cli, "game");
-  o.width = integer(cli, "width", 16, 8192, 640);
-  o.height = integer(cli, "height", 16, 8192, 360);
-  o.threads = integer(cli, "threads", 0, 1024, 0);
-  o.view = value(cli, "view", "full");
+  o.scene = args.str("scene", TRANSGI_DEFAULT_LEVEL);
+  o.model = args.str("model", std::string());
+  o.manifest = args.str("game", std::string());
+  o.width = static_cast<int>(args.integer("width", 16, 8192, 640));
+  o.height = static_cast<int>(args.integer("height", 16, 8192, 360));
+  o.threads = static_cast<int>(args.integer("threads", 0, 1024, 0));
+  o.view = args.choice("view", {"full", "gi", "direct"}, "full");
   return o;
 }
 
-int run_headless(const Cli& cli) {
-  const game::GameOptions o = game_options(cli);
-  const int frames = integer(cli, "frames", 1, 1000000, 120);
-  float exposure = 0.0f;
-  if (auto e = value(cli, "exposure"); !e.empty()) {
-    try {
-      exposure = std::stof(e);
-    } catch (const std::exception&) {
-      throw std::runtime_error("--exposure: expected a number of stops, got '" + e + "'");
-    }
-    if (!std::isfinite(exposure) || std::abs(exposure) > 20) throw std::runtime_error("--exposure: must be within [-20, 20] stops");
-  }
+int run_headless(const engine::core::Args& args) {
+  const game::GameOptions o = game_options(args);
+  const int frames = static_cast<int>(args.integer("frames", 1, 1000000, 120));
+  const auto exposure = static_cast<float>(args.number("exposure", -20.0, 20.0, 0.0));
   std::vector<game::ReplayEvent> events;
-  if (auto r = value(cli, "script-input"); !r.empty()) events = game::load_replay(r);
+  if (args.has("script-input")) events = game::load_replay(args.str("script-input"));
   std::unique_ptr<game::Recorder> recorder;
-  if (auto dir = value(cli, "record"); !dir.empty()) recorder = std::make_unique<game::Recorder>(dir, exposure);
+  if (args.has("record")) recorder = std::make_unique<game::Recorder>(args.str("record"), exposure);
 
   game::GameSession session(o);
   engine::core::ProgressBar bar("transgi-game", static_cast<std::uint64_t>(frames), true);
@@ -119,7 +72,8 @@ int run_headless(const Cli& cli) {
               o.width, o.height, total_ms / frames);
   const auto& log = session.world().resource<engine::core::Log>();
   std::printf("log: %zu errors, %zu warnings\n", log.count(engine::core::LogLevel::Error), log.count(engine::core::LogLevel::Warning));
-  if (auto shot = value(cli, "screenshot"); !shot.empty()) {
+  if (args.has("screenshot")) {
+    const std::string shot = args.str("screenshot");
     engine::image::write_png_srgb(shot, session.image(), exposure);
     std::printf("wrote %s\n", shot.c_str());
   }
@@ -132,19 +86,26 @@ int run_headless(const Cli& cli) {
 
 int main(int argc, char** argv) {
   try {
-    const Cli cli = parse(argc, argv);
-    if (!cli.headless) {
-      for (const char* headless_only : {"script-input", "record"})
-        if (cli.values.contains(headless_only)) throw std::runtime_error(std::string("--") + headless_only + " needs --headless");
-      const game::GameOptions o = game_options(cli);
-      game::WindowOptions w;
-      w.frames = integer(cli, "frames", 0, 1000000, 0);
-      w.screenshot = value(cli, "screenshot");
-      w.select = value(cli, "select");
-      w.gizmo = value(cli, "gizmo", "translate");
-      return game::run_window(o, w);
+    const engine::core::Args args = parse(argc, argv);
+    if (args.has("help")) {
+      std::fputs(kUsage, stdout);
+      return 0;
     }
-    return run_headless(cli);
+    if (!args.positional().empty()) throw engine::core::UsageError("transgi-game: unexpected argument '" + args.positional()[0] + "'");
+    if (!args.has("headless")) {
+      for (const char* headless_only : {"script-input", "record"})
+        if (args.has(headless_only)) throw engine::core::UsageError(std::string("transgi-game: --") + headless_only + " needs --headless");
+      game::WindowOptions w;
+      w.frames = static_cast<int>(args.integer("frames", 0, 1000000, 0));
+      w.screenshot = args.str("screenshot", std::string());
+      w.select = args.str("select", std::string());
+      w.gizmo = args.choice("gizmo", {"translate", "rotate"}, "translate");
+      return game::run_window(game_options(args), w);
+    }
+    return run_headless(args);
+  } catch (const engine::core::UsageError& e) {
+    std::fprintf(stderr, "%s\n%s", e.what(), kUsage);
+    return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "transgi-game: %s\n", e.what());
     return 1;

@@ -13,7 +13,7 @@ struct SeenState {
   std::uint64_t commits = UINT64_MAX;  // RtScene top-level commits at the last rebuild
   std::uint64_t assets_generation = UINT64_MAX;
   bool split_sun = false;
-  std::uint64_t environment_version = 0, material_version = 0;
+  std::uint64_t edit_version = 0;  // SceneAssets::edit_version at the last rebuild
 };
 
 void sync_lights(LightView lights, Removed<scene::PunctualLight> removed, Res<rt::RtScene> rt, Res<LightSettings> settings,
@@ -27,10 +27,9 @@ void sync_lights(LightView lights, Removed<scene::PunctualLight> removed, Res<rt
   const scene::SceneAssets* assets = rt->assets();
   const std::uint64_t generation = assets ? assets->generation : 0;
   const bool geometry_changed = rt->stats().top_level_commits != seen->commits;
-  const bool sky_changed = assets && assets->environment_version != seen->environment_version;
-  const bool materials_changed = assets && assets->material_version != seen->material_version;
+  const bool edited = assets && assets->edit_version != seen->edit_version;
   const bool assets_changed = generation != seen->assets_generation;
-  lights_changed = lights_changed || sky_changed || materials_changed;
+  lights_changed = lights_changed || edited;
   if (!lights_changed && !geometry_changed && !assets_changed) return;
   // Emissive triangles are stored in world space, so moved geometry also
   // means a rebuilt light set.
@@ -38,7 +37,7 @@ void sync_lights(LightView lights, Removed<scene::PunctualLight> removed, Res<rt
   if (!settings->split_sun || !env) {
     out->sun_split.reset();
     out->sun_split_of = nullptr;
-  } else if (out->sun_split_of != env || assets_changed || sky_changed || !out->sun_split) {
+  } else if (out->sun_split_of != env || assets_changed || edited || !out->sun_split) {
     out->sun_split = std::make_shared<const scene::SunSplit>(scene::split_sun(*env, settings->extraction));
     out->sun_split_of = env;
   }
@@ -48,8 +47,7 @@ void sync_lights(LightView lights, Removed<scene::PunctualLight> removed, Res<rt
   seen->commits = rt->stats().top_level_commits;
   seen->assets_generation = generation;
   seen->split_sun = settings->split_sun;
-  seen->environment_version = assets ? assets->environment_version : 0;
-  seen->material_version = assets ? assets->material_version : 0;
+  seen->edit_version = assets ? assets->edit_version : 0;
 }
 
 }  // namespace

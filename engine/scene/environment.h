@@ -33,7 +33,7 @@ class Environment {
   // Run-time sky control (a day-night cycle): turn the map about world +Y
   // by `radians` from its loaded orientation, and scale its brightness. Both
   // are cheap (the sampling distribution lives in map space). Whoever calls
-  // them bumps SceneAssets::environment_version so light caches rebuild.
+  // them bumps SceneAssets::edit_version so light caches rebuild.
   void set_yaw(float radians);
   [[nodiscard]] float yaw() const { return yaw_; }
   void set_strength(float strength) { strength_ = strength; }

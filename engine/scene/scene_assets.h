@@ -23,12 +23,11 @@ struct SceneAssets {
   std::vector<material::Material> materials;
   std::vector<Texture> textures;
   std::optional<Environment> environment;
-  // Bumped whenever the environment's yaw or strength changes at run time,
-  // so the light set (and the caches that follow it) rebuild.
-  std::uint64_t environment_version = 0;
-  // Bumped whenever a material changes at run time (an editor's knob), for
-  // the same reason: emission and reflectance feed the light set and probes.
-  std::uint64_t material_version = 0;
+  // Bumped by whoever edits these assets in place at run time (the sky's yaw
+  // or strength, a material's knobs), so the light set, the sun split and
+  // the probes that follow them rebuild. Not `generation`: a new generation
+  // means a different scene, and mirrors drop everything.
+  std::uint64_t edit_version = 0;
 };
 
 // Next value for SceneAssets::generation.

@@ -16,6 +16,7 @@
 #include "engine/input/input_state.h"
 #include "engine/rt/rt_scene.h"
 #include "engine/scene/components.h"
+#include "engine/scene/find_named.h"
 #include "engine/scene/scene_assets.h"
 #include "engine/script/script_api.h"
 #include "engine/script/script_context.h"
@@ -31,16 +32,8 @@ ecs::World& world_of(lua_State* L) { return *context_of(L).world; }
 
 // --- scene -------------------------------------------------------------------
 
-ecs::Entity find_named(ecs::World& world, const std::string& name) {
-  ecs::Entity found;
-  world.view<const scene::Name>().each([&](ecs::Entity e, const scene::Name& n) {
-    if (found.is_null() && n.value == name) found = e;
-  });
-  return found;
-}
-
 int scene_find(lua_State* L) {
-  const ecs::Entity e = find_named(world_of(L), luaL_checkstring(L, 1));
+  const ecs::Entity e = scene::find_named(world_of(L), luaL_checkstring(L, 1));
   if (e.is_null()) lua_pushnil(L);
   else push_entity(L, e);
   return 1;
@@ -51,7 +44,7 @@ int scene_spawn(lua_State* L) {
   const std::string name = luaL_checkstring(L, 1);
   const bool placed = !lua_isnoneornil(L, 2);
   const glm::vec3 at = placed ? check_vec3(L, 2, "spawn position") : glm::vec3(0.0f);
-  const ecs::Entity prefab = find_named(world, name);
+  const ecs::Entity prefab = scene::find_named(world, name);
   ecs::Entity e;
   if (!prefab.is_null()) {
     e = world.spawn();
@@ -185,7 +178,7 @@ int sky_set_yaw(lua_State* L) {
   scene::Environment& env = environment_of(L, &assets);
   if (env.yaw() != yaw) {
     env.set_yaw(yaw);
-    ++assets->environment_version;
+    ++assets->edit_version;
   }
   return 0;
 }
@@ -200,7 +193,7 @@ int sky_set_strength(lua_State* L) {
   scene::Environment& env = environment_of(L, &assets);
   if (env.strength() != s) {
     env.set_strength(s);
-    ++assets->environment_version;
+    ++assets->edit_version;
   }
   return 0;
 }

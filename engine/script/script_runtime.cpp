@@ -136,7 +136,7 @@ struct ScriptRuntime::Impl {
     call_hook(e, inst, name, [](lua_State*) { return 0; });
   }
 
-  void start(ecs::World& world, ecs::Entity e, const Script& script) {
+  void start(ecs::Entity e, const Script& script) {
     Instance inst;
     inst.path = script.path;
     inst.file = fs::path(script.path).is_absolute() ? fs::path(script.path) : settings.root / script.path;
@@ -148,7 +148,6 @@ struct ScriptRuntime::Impl {
     inst.self_ref = luaL_ref(L, LUA_REGISTRYINDEX);
     inst.enabled = run_file(e, inst, script.overrides);
     Instance& placed = instances.emplace(e, std::move(inst)).first->second;
-    (void)world;
     call_hook(e, placed, "init");
   }
 
@@ -222,7 +221,7 @@ void ScriptRuntime::run_frame(ecs::World& world, double dt) {
   std::sort(fresh.begin(), fresh.end());
   for (ecs::Entity e : fresh)
     if (world.alive(e))
-      if (const Script* s = world.try_get<Script>(e)) m.start(world, e, *s);
+      if (const Script* s = world.try_get<Script>(e)) m.start(e, *s);
   // 3. Hot reload.
   if (m.settings.hot_reload) m.reload_changed(world);
   // 4. update(self, dt); a hook may despawn entities or add scripts.

@@ -193,12 +193,12 @@ void update_editor(World& world, EditorState& s, const engine::input::InputState
       return;
     }
     const HandleGeometry g = handle_geometry(world, s, view, s.hovered);
-    auto* t = world.try_get_mut<tf::Transform>(s.selected);
+    const auto* t = world.try_get<tf::Transform>(s.selected);  // a press alone changes nothing
     if (!t) return;
     if (is_plane(s.hovered)) {
-      const auto t = ed::ray_plane(ray, g.pivot, glm::cross(g.axis, g.axis2));
-      if (!t) return;
-      s.start_hit = ray.origin + *t * ray.direction;
+      const auto hit = ed::ray_plane(ray, g.pivot, glm::cross(g.axis, g.axis2));
+      if (!hit) return;
+      s.start_hit = ray.origin + *hit * ray.direction;
     } else if (!is_ring(s.hovered)) {
       const auto p = ed::closest_on_axis(ray, g.pivot, g.axis);
       if (!p) return;

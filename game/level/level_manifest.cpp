@@ -7,6 +7,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <nlohmann/json.hpp>
 
+#include "engine/scene/find_named.h"
 #include "engine/scene/procedural.h"
 #include "engine/scene/scene_assets.h"
 #include "engine/transform/transform.h"
@@ -134,17 +135,6 @@ LevelManifest load_manifest(const std::filesystem::path& file) {
   return m;
 }
 
-namespace {
-
-Entity find_named(World& world, const std::string& name) {
-  Entity found;
-  world.view<const engine::scene::Name>().each([&](Entity e, const engine::scene::Name& n) {
-    if (found.is_null() && n.value == name) found = e;
-  });
-  return found;
-}
-
-}  // namespace
 
 void apply_manifest(World& world, const LevelManifest& manifest) {
   auto& assets = world.resource<engine::scene::SceneAssets>();
@@ -169,7 +159,7 @@ void apply_manifest(World& world, const LevelManifest& manifest) {
     t.rotation = glm::quat(glm::radians(me.euler_degrees));
     world.emplace<engine::transform::Transform>(e, t);
     if (!me.parent.empty()) {
-      const Entity p = find_named(world, me.parent);
+      const Entity p = engine::scene::find_named(world, me.parent);
       if (p.is_null()) throw std::runtime_error(manifest.file.string() + ": entity '" + me.name + "': no parent named '" + me.parent + "'");
       world.emplace<engine::transform::Parent>(e, engine::transform::Parent{p});
     }
@@ -184,7 +174,7 @@ void apply_manifest(World& world, const LevelManifest& manifest) {
     if (me.script) world.emplace<engine::script::Script>(e, *me.script);
   }
   for (const auto& [node, script] : manifest.attach) {
-    const Entity e = find_named(world, node);
+    const Entity e = engine::scene::find_named(world, node);
     if (e.is_null()) throw std::runtime_error(manifest.file.string() + ": attach: no node named '" + node + "' in the level");
     world.emplace<engine::script::Script>(e, script);
   }

@@ -11,6 +11,7 @@
 #include "engine/render/path_tracer.h"
 #include "engine/rt/rt_scene.h"
 #include "engine/scene/components.h"
+#include "engine/scene/find_named.h"
 #include "engine/script/script_plugin.h"
 #include "engine/transform/transform.h"
 #include "eval/method_runs.h"
@@ -151,13 +152,7 @@ GameSession::~GameSession() {
 engine::ecs::World& GameSession::world() { return app_->world(); }
 engine::input::InputState& GameSession::input() { return world().resource<engine::input::InputState>(); }
 
-Entity GameSession::find(const std::string& name) {
-  Entity found;
-  world().view<const engine::scene::Name>().each([&](Entity e, const engine::scene::Name& n) {
-    if (found.is_null() && n.value == name) found = e;
-  });
-  return found;
-}
+Entity GameSession::find(const std::string& name) { return engine::scene::find_named(world(), name); }
 
 EditorView GameSession::view() {
   EditorView v;

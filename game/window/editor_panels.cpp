@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <set>
 #include <cmath>
+#include <map>
 #include <vector>
 
 #include <glm/gtc/quaternion.hpp>
@@ -27,12 +28,11 @@ std::string label_of(engine::ecs::World& w, Entity e) {
 }
 }  // namespace
 
-void EditorUi::hierarchy_node(Entity e) {
+void EditorUi::hierarchy_node(Entity e, const std::map<Entity, std::vector<Entity>>& children_of) {
   engine::ecs::World& w = session_.world();
-  std::vector<Entity> children;
-  w.view<const tf::Parent>().each([&](Entity c, const tf::Parent& p) {
-    if (p.entity == e) children.push_back(c);
-  });
+  static const std::vector<Entity> kNoChildren;
+  const auto found = children_of.find(e);
+  const std::vector<Entity>& children = found == children_of.end() ? kNoChildren : found->second;
   EditorState& ed = session_.editor();
   ImGuiTreeNodeFlags flags = ImGuiTreeNodeFlags_OpenOnArrow | ImGuiTreeNodeFlags_SpanAvailWidth;
   if (children.empty()) flags |= ImGuiTreeNodeFlags_Leaf;
@@ -40,7 +40,7 @@ void EditorUi::hierarchy_node(Entity e) {
   const bool open = ImGui::TreeNodeEx(label_of(w, e).c_str(), flags);
   if (ImGui::IsItemClicked()) ed.selected = e;
   if (open) {
-    for (Entity c : children) hierarchy_node(c);
+    for (Entity c : children) hierarchy_node(c, children_of);
     ImGui::TreePop();
   }
 }
@@ -58,7 +58,11 @@ void EditorUi::hierarchy() {
     if (!w.has<tf::Parent>(e)) roots.push_back(e);
   });
   std::sort(roots.begin(), roots.end());
-  for (Entity e : roots) hierarchy_node(e);
+  // Children found in one pass, not one pass per node: levels have thousands.
+  std::map<Entity, std::vector<Entity>> children_of;
+  w.view<const tf::Parent>().each([&](Entity c, const tf::Parent& p) { children_of[p.entity].push_back(c); });
+  for (auto& [parent, children] : children_of) std::sort(children.begin(), children.end());
+  for (Entity e : roots) hierarchy_node(e, children_of);
   ImGui::End();
 }
 
@@ -123,7 +127,7 @@ void EditorUi::inspector() {
         changed |= ImGui::SliderFloat("roughness", &mat.roughness_factor, 0.0f, 1.0f);
         changed |= ImGui::SliderFloat("metallic", &mat.metallic_factor, 0.0f, 1.0f);
         changed |= ImGui::DragFloat("emission strength", &mat.emissive_strength, 0.05f, 0.0f, 1000.0f);
-        if (changed) ++assets.material_version;  // the light set and probes follow
+        if (changed) ++assets.edit_version;  // the light set and probes follow
         ImGui::PopID();
       }
     }

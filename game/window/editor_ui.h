@@ -5,6 +5,8 @@
 // session, the ECS and EditorState; selection and drags are decided by
 // update_editor() (editor_tools.h), which the game's frame() runs.
 #include <deque>
+#include <map>
+#include <vector>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -40,7 +42,7 @@ class EditorUi {
  private:
   void menu_bar();
   void hierarchy();
-  void hierarchy_node(engine::ecs::Entity e);
+  void hierarchy_node(engine::ecs::Entity e, const std::map<engine::ecs::Entity, std::vector<engine::ecs::Entity>>& children_of);
   void inspector();
   void gi_settings();
   void log_panel();

@@ -190,11 +190,11 @@ TEST(LightSync, SkyAndMaterialEditsRebuildTheLightSet) {
   app.update();
   EXPECT_EQ(lights.version, v0) << "nothing changed";
   assets.environment->set_strength(0.25f);
-  ++assets.environment_version;
+  ++assets.edit_version;
   app.update();
   EXPECT_EQ(lights.version, v0 + 1) << "the sky changed";
   assets.materials[0].emissive_strength = 0.0f;
-  ++assets.material_version;
+  ++assets.edit_version;
   app.update();
   EXPECT_EQ(lights.version, v0 + 2) << "a material changed";
   EXPECT_EQ(lights.set.emissive_triangle_count(), 0u) << "the dark lamp is no longer an emitter";

@@ -408,7 +408,7 @@ TEST_F(ScriptTest, SkyTurnsTheEnvironmentAndBumpsItsVersion) {
     function init(self) sky.set_yaw(math.pi / 2); sky.set_strength(0.5); log.info(sky.get_yaw() > 1.57, sky.get_strength()) end)");
   spawn_scripted("sky.lua");
   app_.update();
-  EXPECT_EQ(assets.environment_version, 2u);
+  EXPECT_EQ(assets.edit_version, 2u);
   EXPECT_EQ(logged(core::LogLevel::Info), "true 0.5\n");
   // The sun's texel now shines from its direction turned a quarter about +Y.
   const glm::vec3 turned(sun_local.z, sun_local.y, -sun_local.x);

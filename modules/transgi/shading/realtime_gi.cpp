@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
 #include <map>
 #include <unordered_map>
 
@@ -51,7 +52,6 @@ struct RawTaps {
 
 struct RealtimeGiScratch::Impl {
   Upsampling up;
-  std::vector<glm::vec4> guide;  // when the G-buffer came without one
   std::vector<std::size_t> decode, slot_of_pixel;
   std::vector<glm::vec3> value, value_direct, shaded, shaded_direct;
   std::vector<TransferQuery> queries;
@@ -131,17 +131,6 @@ void plan_upsampling(const GBuffer& g, const std::vector<glm::vec4>& guide, cons
         }
       }
   });
-}
-
-// The G-buffer's guide, or one derived from its samples.
-const std::vector<glm::vec4>& guide_of(const GBuffer& g, std::vector<glm::vec4>& scratch) {
-  if (g.guide.size() == g.samples.size()) return g.guide;
-  scratch.resize(g.samples.size());
-  for (std::size_t p = 0; p < g.samples.size(); ++p) {
-    const GSample& s = g.samples[p];
-    scratch[p] = s.hit ? glm::vec4(s.normal_world, std::max(s.depth, 1e-30f)) : glm::vec4(0.0f);
-  }
-  return scratch;
 }
 
 // Probe SH rotated into object frames, one copy per distinct rotation and
@@ -254,7 +243,9 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   auto t0 = Clock::now();
   RealtimeGiScratch local;
   RealtimeGiScratch::Impl& sc = *(scratch ? scratch : &local)->impl;
-  const std::vector<glm::vec4>& guide = guide_of(g, sc.guide);
+  if (g.guide.size() != g.samples.size())
+    throw std::invalid_argument("shade_gi_realtime: the G-buffer has no guide; make it with trace_gbuffer");
+  const std::vector<glm::vec4>& guide = g.guide;
   plan_upsampling(g, guide, settings, sc.up);
   const Upsampling& up = sc.up;
 

@@ -52,9 +52,8 @@ struct GBuffer {
   int width = 0, height = 0;
   std::vector<GSample> samples;  // row-major, pixel (0, 0) top-left
   // Per pixel: world normal (xyz) and depth (w; 0 = no hit), what the
-  // upsampling compares. trace_gbuffer writes it; if its size does not
-  // match `samples` (a G-buffer built by hand), it is derived from them.
-  // 16 bytes a pixel instead of a whole GSample keeps those passes in cache.
+  // upsampling compares; written by trace_gbuffer. 16 bytes a pixel instead
+  // of a whole GSample keeps those passes in cache.
   std::vector<glm::vec4> guide;
 };
 
