@@ -68,11 +68,14 @@ transform::Transform translated(const transform::Transform& start, const transfo
 }
 
 transform::Transform rotated(const transform::Transform& start, const transform::Similarity& parent,
-                             const glm::vec3& world_axis, float radians, float snap_step) {
+                             const glm::vec3& world_axis, float radians, const glm::vec3& world_pivot, float snap_step) {
   const float angle = snap(radians, snap_step);
   const glm::vec3 local_axis = glm::normalize(glm::inverse(parent.rotation) * world_axis);
+  const glm::quat turn = glm::angleAxis(angle, local_axis);
+  const glm::vec3 pivot = parent.inverse().apply_point(world_pivot);
   transform::Transform t = start;
-  t.rotation = glm::normalize(glm::angleAxis(angle, local_axis) * start.rotation);
+  t.rotation = glm::normalize(turn * start.rotation);
+  t.translation = pivot + turn * (start.translation - pivot);
   return t;
 }
 

@@ -57,10 +57,12 @@ float wrap_angle(float radians);
 // component snapped when snap_step > 0 (Ctrl held).
 transform::Transform translated(const transform::Transform& start, const transform::Similarity& parent,
                                 const glm::vec3& world_delta, float snap_step = 0.0f);
-// Rotation about a world axis by `radians` (snapped to snap_step if > 0),
-// applied after the start rotation.
+// Rotation about a world axis through `world_pivot` by `radians` (snapped
+// to snap_step if > 0), applied after the start rotation; the pivot stays
+// put. The pivot is the gizmo's: the object's origin, or the centre of its
+// bounds for meshes whose vertices were exported in world space.
 transform::Transform rotated(const transform::Transform& start, const transform::Similarity& parent,
-                             const glm::vec3& world_axis, float radians, float snap_step = 0.0f);
+                             const glm::vec3& world_axis, float radians, const glm::vec3& world_pivot, float snap_step = 0.0f);
 
 // Screen-space helpers for picking a handle: the projection of a world point
 // to pixels (y down; empty behind the camera) and the distance in pixels

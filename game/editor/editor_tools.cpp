@@ -115,12 +115,22 @@ GizmoHandle parse_handle(const std::string& name) {
   return GizmoHandle::None;
 }
 
+glm::vec3 gizmo_pivot(const World& world, Entity e) {
+  const glm::vec3 origin = world.get<tf::WorldTransform>(e).translation;
+  const auto* rt = world.try_resource<engine::rt::RtScene>();
+  const engine::rt::InstanceRecord* inst = rt ? rt->instance_of(e) : nullptr;
+  if (!inst || !inst->active) return origin;
+  const engine::rt::WorldBounds& b = inst->bounds;
+  const bool inside = glm::all(glm::greaterThanEqual(origin, b.min)) && glm::all(glm::lessThanEqual(origin, b.max));
+  return inside ? origin : 0.5f * (b.min + b.max);
+}
+
 HandleGeometry handle_geometry(const World& world, const EditorState& s, const EditorView& view, GizmoHandle h) {
   HandleGeometry g;
   if (h == GizmoHandle::None || s.selected.is_null() || !world.alive(s.selected)) return g;
   const auto* w = world.try_get<tf::WorldTransform>(s.selected);
   if (!w) return g;
-  g.pivot = s.active != GizmoHandle::None ? s.pivot : w->translation;
+  g.pivot = s.active != GizmoHandle::None ? s.pivot : gizmo_pivot(world, s.selected);
   g.axis = axis_of(h);
   g.axis2 = second_axis_of(h);
   const float distance = glm::length(g.pivot - view.camera.translation);
@@ -234,7 +244,7 @@ void update_editor(World& world, EditorState& s, const engine::input::InputState
       const float a = ed::ring_angle(*p, g.pivot, g.axis, ed::ring_reference(g.axis));
       s.angle += ed::wrap_angle(a - s.last_angle);  // unwrapped total since the press
       s.last_angle = a;
-      *t = ed::rotated(s.start, s.parent, g.axis, s.angle, ctrl ? glm::radians(s.rotate_snap_degrees) : 0.0f);
+      *t = ed::rotated(s.start, s.parent, g.axis, s.angle, s.pivot, ctrl ? glm::radians(s.rotate_snap_degrees) : 0.0f);
     }
   }
   if (!in.is_down("mouse_left")) {

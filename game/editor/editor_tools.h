@@ -57,6 +57,9 @@ struct EditorState {
 // `axis2` with normal `axis` x `axis2` (plane), or a ring of radius `size`
 // about `axis` (rotate).
 struct HandleGeometry {
+  // The object's origin, or the centre of its world bounds when the origin
+  // lies outside them (meshes exported with world-space vertices and an
+  // identity transform, common in converted content).
   glm::vec3 pivot{0.0f}, axis{0.0f}, axis2{0.0f};
   float size = 0.0f;
   bool visible = false;  // false when edge-on

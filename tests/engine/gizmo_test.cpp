@@ -114,20 +114,38 @@ TEST(GizmoDrag, TranslateIsStartPlusDeltaInTheParentFrame) {
 TEST(GizmoDrag, RotateAboutAWorldAxisWithSnapping) {
   transform::Transform start;
   start.rotation = glm::angleAxis(0.3f, glm::vec3(1, 0, 0));
-  const transform::Transform t = rotated(start, {}, {0, 1, 0}, kPi / 2);
+  const transform::Transform t = rotated(start, {}, {0, 1, 0}, kPi / 2, start.translation);
   // The object's local +Z, first tilted by the start rotation, then turned about world Y.
   const glm::vec3 want = glm::angleAxis(kPi / 2, glm::vec3(0, 1, 0)) * (start.rotation * glm::vec3(0, 0, 1));
   expect_vec3(t.rotation * glm::vec3(0, 0, 1), want, 1e-6f);
   // 15-degree snapping: 50 degrees becomes 45.
   const float step = kPi / 12;
-  const transform::Transform s = rotated(transform::Transform{}, {}, {0, 0, 1}, 50.0f * kPi / 180, step);
+  const transform::Transform s = rotated(transform::Transform{}, {}, {0, 0, 1}, 50.0f * kPi / 180, glm::vec3(0.0f), step);
   expect_vec3(s.rotation * glm::vec3(1, 0, 0), {std::cos(kPi / 4), std::sin(kPi / 4), 0}, 1e-6f);
   // Under a rotated parent the world axis is honoured.
   transform::Similarity parent;
   parent.rotation = glm::angleAxis(kPi / 2, glm::vec3(1, 0, 0));
-  const transform::Transform c = rotated(transform::Transform{}, parent, {0, 1, 0}, kPi / 2);
+  const transform::Transform c = rotated(transform::Transform{}, parent, {0, 1, 0}, kPi / 2, glm::vec3(0.0f));
   const glm::vec3 world_x = parent.rotation * (c.rotation * glm::vec3(1, 0, 0));
   expect_vec3(world_x, {0, 0, -1}, 1e-6f);
+}
+
+TEST(GizmoDrag, RotateAboutAPivotKeepsThePivotInPlace) {
+  // An object at the origin turned a quarter about +Y through (1, 0, 0):
+  // its origin swings from (0, 0, 0) to (1, 0, 1).
+  const transform::Transform t = rotated(transform::Transform{}, {}, {0, 1, 0}, kPi / 2, {1, 0, 0});
+  expect_vec3(t.translation, {1, 0, 1}, 1e-6f);
+  // Under a scaled, moved parent the world pivot still stays where it was.
+  transform::Similarity parent;
+  parent.translation = {2, 0, 0};
+  parent.rotation = glm::angleAxis(0.7f, glm::vec3(0, 0, 1));
+  parent.scale = 2.0f;
+  transform::Transform start = transform::Transform::from_translation({0.5f, 0.25f, -1});
+  const glm::vec3 pivot(3, 1, -1.5f);
+  const transform::Transform r = rotated(start, parent, glm::normalize(glm::vec3(1, 1, 0)), 1.1f, pivot);
+  // The point of the object that sat on the pivot is still on it.
+  const glm::vec3 local_before = (parent * start).inverse().apply_point(pivot);
+  expect_vec3((parent * r).apply_point(local_before), pivot, 1e-5f);
 }
 
 TEST(GizmoPicking, ProjectionAndPickRayAgree) {
