@@ -46,14 +46,17 @@ Surface make_surface(const rt::RtScene& scene, const rt::Hit& hit, const glm::ve
   glm::vec3 ns = inst.to_world.apply_direction(b0 * mesh.normals[t.x] + b1 * mesh.normals[t.y] + b2 * mesh.normals[t.z]);
   const float ns_len = glm::length(ns);
   ns = ns_len > 0 ? ns / ns_len : ng;
-  s.back_face = glm::dot(ng, incoming_dir) > 0;
-  if (s.back_face) ng = -ng;  // face the viewer
+  s.material = mesh.triangle_material[hit.primitive];
+  const bool behind = glm::dot(ng, incoming_dir) > 0;
+  // Only a single-sided material has an inside; a double-sided one met from
+  // behind is a surface like any other (mixed winding in real content).
+  s.back_face = behind && !assets.materials[s.material].double_sided;
+  if (behind) ng = -ng;  // face the viewer
   if (glm::dot(ns, ng) < 0) ns = -ns;            // shading normal on the same side
   s.geometric_normal = ng;
   s.shading_normal = ns;
   s.frame = math::Frame::from_normal(ns);
   if (!mesh.uvs.empty()) s.uv = b0 * mesh.uvs[t.x] + b1 * mesh.uvs[t.y] + b2 * mesh.uvs[t.z];
-  s.material = mesh.triangle_material[hit.primitive];
   s.brdf = evaluate_material(assets, s.material, s.uv);
   s.emission = evaluate_emission(assets, s.material, s.uv);
   s.area_scale = inst.to_world.scale * inst.to_world.scale;

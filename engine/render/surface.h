@@ -17,9 +17,11 @@ struct Surface {
   material::BrdfParams brdf;
   std::uint32_t material = 0;
   float area_scale = 1.0f;  // world area / object area (uniform scale squared)
-  // The ray arrived from the side opposite the triangle's winding normal.
-  // Materials are two-sided; this is for callers that need to know whether a
-  // point lies inside closed geometry (probe classification).
+  // The ray arrived from the side opposite the triangle's winding normal of
+  // a single-sided material. Shading is two-sided either way; this is for
+  // callers that need to know whether a point lies inside closed geometry
+  // (probe classification). A double-sided material has no back face: its
+  // winding says nothing about where the solid is.
   bool back_face = false;
   math::Frame frame;        // around shading_normal
 };

@@ -91,8 +91,9 @@ TEST(Ddgi, FurnaceConvergesToTheAnalyticIrradiance) {
   }
 }
 
-// Optional classification (off by default, as in RTXGI): a probe inside a
-// closed box sees only back faces and becomes inactive; an outside one stays.
+// Classification (on here, off by default in RTXGI): a probe inside a closed
+// single-sided box sees only back faces and becomes inactive; an outside one
+// stays. (Double-sided content: open_space_test.cpp.)
 TEST(Ddgi, ClassificationDisablesAProbeInsideGeometry) {
   scene::SceneAssets a;
   a.generation = scene::next_scene_generation();
@@ -114,7 +115,8 @@ TEST(Ddgi, ClassificationDisablesAProbeInsideGeometry) {
   EXPECT_FALSE(volume.active(0)) << "the probe inside the box";
   EXPECT_TRUE(volume.active(1)) << "the probe outside";
   DdgiSettings off;
+  off.classification = false;
   DdgiVolume unclassified(transgi::probes::ProbeGrid{{0, 0, 0}, {2, 0, 0}, {2, 1, 1}}, off);
   app.jobs().run([&] { unclassified.update(app.world().resource<rt::RtScene>(), no_lights); });
-  EXPECT_TRUE(unclassified.active(0)) << "classification is off by default";
+  EXPECT_TRUE(unclassified.active(0)) << "classification off";
 }

@@ -8,6 +8,7 @@
 #include "engine/jobs/parallel_for.h"
 #include "engine/math/rng.h"
 #include "engine/math/sampling.h"
+#include "probes/open_space.h"
 #include "probes/probe_rays.h"
 
 namespace transgi::ddgi {
@@ -107,7 +108,7 @@ void blend_distance(OctahedralMap<glm::vec2>& map, const std::vector<RayRecord>&
 }  // namespace
 
 DdgiVolume::DdgiVolume(const probes::ProbeGrid& grid, const DdgiSettings& settings)
-    : grid_(grid), settings_(settings), directions_(probes::spherical_fibonacci(settings.rays_per_probe)) {
+    : grid_(grid), placed_(grid), settings_(settings), directions_(probes::spherical_fibonacci(settings.rays_per_probe)) {
   const auto count = static_cast<std::size_t>(grid.count());
   irradiance_.assign(count, OctahedralMap<glm::vec3>(settings.irradiance_texels, glm::vec3(0.0f)));
   // Until measured, distances read as "far": nothing is occluded.
@@ -135,12 +136,13 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
   auto t0 = Clock::now();
   std::vector<std::vector<RayRecord>> records(static_cast<std::size_t>(probes));
   std::atomic<std::size_t> rays{0};
+  std::vector<std::uint8_t> saw_light(static_cast<std::size_t>(probes), 0);
   jobs::parallel_for(0, probes, 1, [&](int b, int e) {
     for (int q = b; q < e; ++q) {
       if (!active_[static_cast<std::size_t>(q)]) continue;
       auto& out = records[static_cast<std::size_t>(q)];
       out.resize(static_cast<std::size_t>(M));
-      const glm::vec3 origin = grid_.position(q);
+      const glm::vec3 origin = placed_.position(q);
       for (int i = 0; i < M; ++i) {
         math::Pcg32 rng = math::make_rng(settings_.seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
         const glm::vec3 dir = glm::normalize(rotation * directions_[static_cast<std::size_t>(i)]);
@@ -148,6 +150,7 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
             scene, lights, origin, dir, rng, [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3& towards_probe) {
               return frame_ > 0 ? irradiance(p, n, -towards_probe) : glm::vec3(0.0f);
             });
+        if (h.saw_light) saw_light[static_cast<std::size_t>(q)] = 1;
         RayRecord& r = out[static_cast<std::size_t>(i)];
         r.direction = dir;
         if (!h.hit) {
@@ -168,10 +171,18 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
   stats.trace_ms = ms_since(t0);
 
   if (classify_now) {
+    // Back faces (single-sided materials only) as RTXGI counts them, and the
+    // winding-proof link to light for double-sided content (open_space.h).
+    const probes::OpenSpace open = probes::find_open_space(scene, grid_, saw_light, settings_.relocation);
+    placed_.offsets.assign(static_cast<std::size_t>(probes), glm::vec3(0.0f));
     for (int q = 0; q < probes; ++q) {
+      const auto i = static_cast<std::size_t>(q);
       int backfaces = 0;
-      for (const RayRecord& r : records[static_cast<std::size_t>(q)]) backfaces += r.distance < 0 ? 1 : 0;
-      active_[static_cast<std::size_t>(q)] = static_cast<float>(backfaces) <= settings_.fixed_ray_backface_threshold * static_cast<float>(M);
+      for (const RayRecord& r : records[i]) backfaces += r.distance < 0 ? 1 : 0;
+      active_[i] = static_cast<float>(backfaces) <= settings_.fixed_ray_backface_threshold * static_cast<float>(M) && open.open[i];
+      if (active_[i]) placed_.offsets[i] = open.offsets[i];
+      // A moved probe's rays this frame left from its old place.
+      if (!active_[i] || placed_.offsets[i] != glm::vec3(0.0f)) records[i].clear();
     }
     classified_ = true;
   }
@@ -214,7 +225,7 @@ glm::vec3 DdgiVolume::irradiance(const glm::vec3& position, const glm::vec3& n, 
     const glm::ivec3 c = glm::clamp(base + offset, glm::ivec3(0), grid_.dims - 1);
     const int q = grid_.index(c);
     if (!active_[static_cast<std::size_t>(q)]) continue;
-    const glm::vec3 probe = grid_.position(q);
+    const glm::vec3 probe = placed_.position(q);
     const glm::vec3 to_probe = glm::normalize(probe - position);
     const glm::vec3 biased_to_probe = probe - biased;
     const float biased_dist = glm::length(biased_to_probe);

@@ -13,6 +13,7 @@
 #include "engine/render/light_set.h"
 #include "engine/rt/rt_scene.h"
 #include "engine/scene/environment.h"
+#include "probes/open_space.h"
 #include "probes/probe_grid.h"
 
 namespace transgi::ddgi {
@@ -48,10 +49,17 @@ struct DdgiSettings {
   float view_bias = 0.1f;
   // A probe whose rays hit back faces more often than this skips irradiance blending.
   float random_ray_backface_threshold = 0.1f;
-  // Optional, off as in RTXGI: mark probes inside geometry (more than this
-  // fraction of back-face hits) inactive: they trace nothing and get no weight.
-  bool classification = false;
+  // Mark probes inside geometry inactive on the first update: they trace
+  // nothing and get no weight. Inside = more than `fixed_ray_backface_threshold`
+  // of the rays hit back faces of single-sided materials (RTXGI's test, off
+  // by default there), or no chain of clear segments links the probe to light
+  // (probes/open_space.h; winding-proof, for double-sided content). On = no
+  // dark probes inside walls, at the cost of one classification pass.
+  bool classification = true;
   float fixed_ray_backface_threshold = 0.25f;
+  // With classification: probes that no chain links to light are moved out of
+  // the geometry where a linked neighbour shows the way (probes/open_space.h).
+  probes::RelocationSettings relocation;
   EscapedRays escaped = EscapedRays::Zero;
   // Not in RTXGI (0 = off, as there): over the first `warmup_frames` updates
   // the hysteresis ramps up from 0.5 and the brightness clamp is off, the
@@ -85,6 +93,8 @@ class DdgiVolume {
   [[nodiscard]] glm::vec3 irradiance(const glm::vec3& position, const glm::vec3& normal, const glm::vec3& view_dir) const;
 
   [[nodiscard]] const probes::ProbeGrid& grid() const { return grid_; }
+  // grid() with each probe where relocation moved it.
+  [[nodiscard]] const probes::ProbeGrid& placed_grid() const { return placed_; }
   [[nodiscard]] const DdgiSettings& settings() const { return settings_; }
   [[nodiscard]] const OctahedralMap<glm::vec3>& irradiance_map(int probe) const { return irradiance_[static_cast<std::size_t>(probe)]; }
   [[nodiscard]] const OctahedralMap<glm::vec2>& distance_map(int probe) const { return distance_[static_cast<std::size_t>(probe)]; }
@@ -94,6 +104,7 @@ class DdgiVolume {
 
  private:
   probes::ProbeGrid grid_;
+  probes::ProbeGrid placed_;
   DdgiSettings settings_;
   std::vector<glm::vec3> directions_;  // unrotated spherical Fibonacci set
   std::vector<OctahedralMap<glm::vec3>> irradiance_;  // gamma-encoded E / (2 pi)

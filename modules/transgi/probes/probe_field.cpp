@@ -13,6 +13,7 @@
 #include "engine/math/rng.h"
 #include "engine/math/sampling.h"
 #include "engine/math/sh.h"
+#include "probes/open_space.h"
 #include "probes/probe_rays.h"
 #include "probes/radiance_map.h"
 #include "shading/sh_light.h"
@@ -26,7 +27,7 @@ double ms_since(Clock::time_point t) { return std::chrono::duration<double, std:
 
 
 ProbeField::ProbeField(ProbeFieldSettings s)
-    : settings_(s), projector_(s.map), fibonacci_(spherical_fibonacci(s.rays_per_probe)) {
+    : settings_(s), grid_(s.grid), projector_(s.map), fibonacci_(spherical_fibonacci(s.rays_per_probe)) {
   states_.resize(static_cast<std::size_t>(s.grid.count()));
   for (auto& st : states_) st.reset(s.map.texel_count());
   state_.assign(states_.size(), ProbeState::Active);
@@ -40,7 +41,7 @@ ProbeField::ProbeField(ProbeFieldSettings s)
 void ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, float* out) const { interpolate(p, n, sh_.data(), out); }
 
 void ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float* probe_sh, float* out) const {
-  const InterpolationResult r = interpolate_probes(settings_.grid, settings_.map, states_, p, n, settings_.interpolation, usable_);
+  const InterpolationResult r = interpolate_probes(grid_, settings_.map, states_, p, n, settings_.interpolation, usable_);
   for (int k = 0; k < 75; ++k) out[k] = 0.0f;
   for (std::size_t i = 0; i < 8; ++i) {
     if (r.weights[i] == 0.0f) continue;
@@ -68,7 +69,7 @@ __attribute__((target_clones("default", "avx2", "arch=x86-64-v4"))) void blend_t
 
 void ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float* sh_a, float* out_a, const float* sh_b,
                              float* out_b) const {
-  blend_two(interpolate_probes(settings_.grid, settings_.map, states_, p, n, settings_.interpolation, usable_), sh_a, out_a,
+  blend_two(interpolate_probes(grid_, settings_.map, states_, p, n, settings_.interpolation, usable_), sh_a, out_a,
             sh_b, out_b);
 }
 
@@ -104,7 +105,7 @@ void ProbeField::notify_scene_changed(bool geometry_moved) {
 }
 
 void ProbeField::notify_region_changed(const glm::vec3& lo, const glm::vec3& hi) {
-  const ProbeGrid& grid = settings_.grid;
+  const ProbeGrid& grid = grid_;
   const glm::vec3 margin = grid.spacing();
   urgent_.resize(states_.size(), 0);
   for (int q = 0; q < grid.count(); ++q) {
@@ -134,7 +135,7 @@ void ProbeField::select_within_budget(std::vector<std::uint8_t>& traced) const {
 ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights) {
   using namespace engine;
   ProbeFrameStats stats;
-  const ProbeGrid& grid = settings_.grid;
+  const ProbeGrid& grid = grid_;
   const int probes = grid.count(), M = settings_.rays_per_probe;
   const std::uint64_t seed = settings_.fixed_pattern ? 0x5EEDu : settings_.seed;
   math::Pcg32 frame_rng = math::make_rng(seed, 0xF00D, frame_);
@@ -155,6 +156,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   auto t0 = Clock::now();
   std::vector<std::vector<ShadedPoint>> points(static_cast<std::size_t>(probes));
   std::vector<int> backfaces(static_cast<std::size_t>(probes), 0);
+  saw_light_.resize(static_cast<std::size_t>(probes), 0);
   std::vector<float> nearest(static_cast<std::size_t>(probes), std::numeric_limits<float>::infinity());
   std::atomic<std::size_t> hits{0};
   std::vector<float> direct_frame(static_cast<std::size_t>(probes) * 75, 0.0f);
@@ -165,6 +167,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
       const glm::vec3 origin = grid.position(q);
       auto& out = points[static_cast<std::size_t>(q)];
       out.reserve(static_cast<std::size_t>(M));
+      bool saw_light = false;
       for (int i = 0; i < M; ++i) {
         math::Pcg32 rng = math::make_rng(seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
         const glm::vec3 dir = glm::normalize(rotation * fibonacci_[static_cast<std::size_t>(i)]);
@@ -189,15 +192,23 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
           backfaces[static_cast<std::size_t>(q)] += h.back_face ? 1 : 0;
           nearest[static_cast<std::size_t>(q)] = std::min(nearest[static_cast<std::size_t>(q)], h.distance);
         }
+        saw_light = saw_light || h.saw_light;
         out.push_back(sp);
       }
+      saw_light_[static_cast<std::size_t>(q)] = saw_light ? 1 : 0;
     }
   });
   for (std::uint8_t t : traced) stats.traced += t;
   stats.rays = static_cast<std::size_t>(stats.traced) * static_cast<std::size_t>(M);
   stats.hits = hits.load();
+  std::vector<std::uint8_t> skip_this_frame(static_cast<std::size_t>(probes), 0);  // relocated probes
   if (classify || budgeted) {
     const float far = settings_.skip.far_cells * glm::length(grid.spacing());
+    bool any_pending = classify;
+    for (std::size_t q = 0; q < state_.size() && !any_pending; ++q) any_pending = traced[q] && needs_classify_[q];
+    const OpenSpace open =
+        settings_.skip.open_space && any_pending ? find_open_space(scene, settings_.grid, saw_light_, settings_.skip.relocation) : OpenSpace{};
+    if (!open.open.empty() && grid_.offsets.empty()) grid_.offsets.assign(state_.size(), glm::vec3(0.0f));
     for (std::size_t q = 0; q < state_.size(); ++q) {
       if (traced[q]) {
         last_traced_[q] = frame_;
@@ -206,8 +217,26 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
       // Budgeted frames classify only the probes queued for it.
       if (!classify && !(traced[q] && needs_classify_[q])) continue;
       needs_classify_[q] = 0;
-      const bool buried = static_cast<float>(backfaces[q]) > settings_.skip.buried_backface_fraction * static_cast<float>(M);
-      state_[q] = buried ? ProbeState::Buried : nearest[q] > far ? ProbeState::Far : ProbeState::Active;
+      const bool buried = static_cast<float>(backfaces[q]) > settings_.skip.buried_backface_fraction * static_cast<float>(M) ||
+                          (!open.open.empty() && !open.open[q]);
+      bool moved = false;
+      if (!open.open.empty() && !buried && open.offsets[q] != grid_.offsets[q]) {
+        // This frame's rays left from where the probe stood: it starts afresh
+        // from its new place next frame.
+        grid_.offsets[q] = open.offsets[q];
+        moved = true;
+      }
+      const bool relocated = !grid_.offsets.empty() && grid_.offsets[q] != glm::vec3(0.0f);
+      state_[q] = buried ? ProbeState::Buried : nearest[q] > far && !relocated ? ProbeState::Far : ProbeState::Active;
+      if (moved) {
+        states_[q].reset(settings_.map.texel_count());
+        std::fill_n(sh_.data() + q * 75, 75, 0.0f);
+        std::fill_n(direct_mean_.data() + q * 75, 75, 0.0f);
+        std::fill_n(direct_sh_.data() + q * 75, 75, 0.0f);
+        direct_frames_[q] = 0;
+        points[q].clear();
+        skip_this_frame[q] = 1;
+      }
       usable_[q] = state_[q] == ProbeState::Active ? 1 : 0;
       if (!usable_[q]) {
         // Holds no light; if it becomes active again it starts afresh.
@@ -227,7 +256,8 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   t0 = Clock::now();
   // Untraced probes (outside the budget) keep their state this frame.
   auto updates = [&](int q) {
-    return state_[static_cast<std::size_t>(q)] == ProbeState::Active && (!budgeted || traced[static_cast<std::size_t>(q)]);
+    return state_[static_cast<std::size_t>(q)] == ProbeState::Active && (!budgeted || traced[static_cast<std::size_t>(q)]) &&
+           !skip_this_frame[static_cast<std::size_t>(q)];
   };
   for (int q = 0; q < probes; ++q)
     if (updates(q))
@@ -270,6 +300,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
     stats.converged += state_[q] == ProbeState::Converged;
     stats.buried += state_[q] == ProbeState::Buried;
     stats.far += state_[q] == ProbeState::Far;
+    stats.relocated += !grid_.offsets.empty() && grid_.offsets[q] != glm::vec3(0.0f) && state_[q] != ProbeState::Buried;
   }
   ++frame_;
   return stats;

@@ -27,6 +27,7 @@
 #include "engine/render/light_set.h"
 #include "engine/rt/rt_scene.h"
 #include "probes/interpolation.h"
+#include "probes/open_space.h"
 #include "probes/probe_map.h"
 
 namespace transgi::probes {
@@ -43,10 +44,18 @@ struct ProbeSkipSettings {
   // probe classification). On = less work and no light from inside walls,
   // at the cost of one frame tracing every probe after each move.
   bool classify = true;
-  // A probe whose rays hit back faces more often than this is buried.
-  // Higher = fewer probes counted buried, at the cost of more light leaking
-  // from probes that sit inside walls.
+  // A probe whose rays hit back faces (of single-sided materials) more often
+  // than this is buried. Higher = fewer probes counted buried, at the cost
+  // of more light leaking from probes that sit inside walls.
   float buried_backface_fraction = 0.25f;
+  // A probe that no chain of clear probe-to-probe segments links to light is
+  // buried (open_space.h): the winding-proof test for double-sided content.
+  // On = probes inside walls and closed furniture hold no light, at the cost
+  // of 13 segment tests per probe on classification frames.
+  bool open_space = true;
+  // Probes that the open-space test finds unlinked are moved out of the
+  // geometry where a linked neighbour shows the way (open_space.h).
+  RelocationSettings relocation;
   // A probe whose nearest hit is beyond this many cell diagonals is far.
   // Higher = fewer probes skipped, at the cost of tracing empty space.
   float far_cells = 1.0f;
@@ -107,6 +116,7 @@ struct ProbeFrameStats {
   int traced = 0;  // probes that traced rays this frame
   // Probe states after this frame.
   int active = 0, converged = 0, buried = 0, far = 0;
+  int relocated = 0;  // probes standing off their grid points
   bool classified = false;  // this frame traced every probe to classify them
   double scatter_ms = 0, raster_ms = 0, project_ms = 0;
 
@@ -121,6 +131,7 @@ struct ProbeFrameStats {
     converged += o.converged;
     buried += o.buried;
     far += o.far;
+    relocated += o.relocated;
     classified = classified || o.classified;
     scatter_ms += o.scatter_ms;
     raster_ms += o.raster_ms;
@@ -164,6 +175,8 @@ class ProbeField {
   [[nodiscard]] glm::vec3 irradiance(const glm::vec3& position, const glm::vec3& normal) const;
 
   [[nodiscard]] const ProbeFieldSettings& settings() const { return settings_; }
+  // settings().grid with each probe where relocation moved it.
+  [[nodiscard]] const ProbeGrid& grid() const { return grid_; }
   [[nodiscard]] std::uint64_t frame() const { return frame_; }
   [[nodiscard]] const std::vector<ProbeMapState>& states() const { return states_; }
   [[nodiscard]] ProbeState state(int probe) const { return state_[static_cast<std::size_t>(probe)]; }
@@ -179,10 +192,12 @@ class ProbeField {
   void select_within_budget(std::vector<std::uint8_t>& traced) const;
 
   ProbeFieldSettings settings_;
+  ProbeGrid grid_;  // settings_.grid, relocated
   MapProjector projector_;
   std::vector<ProbeMapState> states_;
   std::vector<ProbeState> state_;
   std::vector<std::uint8_t> usable_;  // 1 unless buried or far (read by interpolation)
+  std::vector<std::uint8_t> saw_light_;  // per probe, from its latest traced frame (open_space.h)
   bool classify_pending_ = true;
   // Budgeted updates: the frame each probe last traced, and which probes
   // must be classified again when next traced.

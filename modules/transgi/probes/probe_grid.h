@@ -1,7 +1,9 @@
 #pragma once
 // A regular grid of probes over an axis-aligned box (8 x 8 x 8 by default),
-// probe 0 at `min`, the last at `max`.
+// probe 0 at `min`, the last at `max`; each probe may be moved off its grid
+// point (relocation, open_space.h) by up to half a cell.
 #include <array>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -10,6 +12,9 @@ namespace transgi::probes {
 struct ProbeGrid {
   glm::vec3 min{0.0f}, max{1.0f};
   glm::ivec3 dims{8};
+  // Per probe, where relocation moved it from its grid point; empty = none
+  // moved. Trilinear weights (cage) stay those of the grid points, as in RTXGI.
+  std::vector<glm::vec3> offsets;
 
   bool operator==(const ProbeGrid&) const = default;
 
@@ -28,7 +33,10 @@ struct ProbeGrid {
   // probe has no spacing (0) and is ignored by cage() and min_spacing().
   [[nodiscard]] glm::vec3 spacing() const { return (max - min) / glm::vec3(glm::max(dims - 1, glm::ivec3(1))); }
   [[nodiscard]] float min_spacing() const;
-  [[nodiscard]] glm::vec3 position(int i) const { return min + glm::vec3(coords(i)) * spacing(); }
+  [[nodiscard]] glm::vec3 grid_point(int i) const { return min + glm::vec3(coords(i)) * spacing(); }
+  [[nodiscard]] glm::vec3 position(int i) const {
+    return offsets.empty() ? grid_point(i) : grid_point(i) + offsets[static_cast<std::size_t>(i)];
+  }
 
   // The 8 probes around p (clamped to the grid) and their trilinear weights.
   struct Cage {

@@ -25,7 +25,10 @@ glm::quat low_discrepancy_rotation(std::uint64_t index);
 
 struct ProbeRayHit {
   bool hit = false;
-  bool back_face = false;  // hit the side opposite the winding normal
+  bool back_face = false;  // hit a single-sided material from behind (Surface::back_face)
+  // The ray escaped, met an emitter, or met a surface that its next-event
+  // sample found directly lit: the probe is linked to light (open_space.h).
+  bool saw_light = false;
   float distance = std::numeric_limits<float>::infinity();
   glm::vec3 position{0.0f};
   glm::vec3 radiance{0.0f};  // leaving the hit towards the probe
@@ -50,6 +53,7 @@ ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::rend
   if (!scene.intersect(rt::Ray{origin, dir}, hit)) {
     if (const scene::Environment* env = lights.environment()) r.emitted = env->radiance(dir);
     if (!std::isfinite(r.emitted.r + r.emitted.g + r.emitted.b)) r.emitted = glm::vec3(0.0f);
+    r.saw_light = true;
     return r;
   }
   const render::Surface s = render::make_surface(scene, hit, dir);
@@ -60,6 +64,7 @@ ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::rend
   r.distance = hit.t;
   r.position = s.position;
   const bool emitter = s.emission.r > 0 || s.emission.g > 0 || s.emission.b > 0;
+  r.saw_light = emitter;
   const glm::vec3 wo = s.frame.to_local(-dir);
   if (emitter || wo.z <= 0) return r;
   render::LightSample ls;
@@ -71,7 +76,10 @@ ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::rend
     if (f != glm::vec3(0.0f)) {
       const glm::vec3 o = rt::offset_ray_origin(s.position, s.geometric_normal);
       const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
-      if (!scene.occluded(rt::Ray{o, ls.direction, 0.0f, tmax})) r.radiance += f * wi.z * ls.radiance / (ls.delta ? 1.0f : ls.pdf);
+      if (!scene.occluded(rt::Ray{o, ls.direction, 0.0f, tmax})) {
+        r.radiance += f * wi.z * ls.radiance / (ls.delta ? 1.0f : ls.pdf);
+        r.saw_light = true;
+      }
     }
   }
   r.radiance += material::diffuse_albedo(s.brdf) * math::kInvPi * feedback(s.position, s.shading_normal, -dir);

@@ -182,7 +182,7 @@ class RotatedProbes {
 
 const probes::ProbeField* field_holding(std::span<const probes::ProbeField* const> fields, const glm::vec3& p) {
   for (const probes::ProbeField* f : fields) {
-    const auto& grid = f->settings().grid;
+    const auto& grid = f->grid();
     if (glm::all(glm::greaterThanEqual(p, grid.min)) && glm::all(glm::lessThanEqual(p, grid.max))) return f;
   }
   return fields.front();

@@ -1,0 +1,139 @@
+#include "probes/open_space.h"
+
+#include <cmath>
+#include <deque>
+#include <limits>
+
+#include "engine/jobs/parallel_for.h"
+
+namespace transgi::probes {
+
+namespace {
+
+// The 13 "forward" offsets of the 26-neighbourhood: each segment is tested once.
+constexpr int kForward = 13;
+glm::ivec3 forward_offset(int k) {
+  int n = 0;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const glm::ivec3 o(dx, dy, dz);
+        if (o == glm::ivec3(0)) return glm::ivec3(0);  // the first 13 come before the centre
+        if (n++ == k) return o;
+      }
+  return glm::ivec3(0);
+}
+
+bool inside_grid(const ProbeGrid& grid, glm::ivec3 c) {
+  return glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c, grid.dims));
+}
+
+// Moves unlinked probes towards linked neighbours (see the header). Passes
+// repeat, so a probe in a corner can follow one moved out of the wall beside
+// it; each pass only uses probes linked before it, so the order of the probes
+// does not matter.
+void relocate(const engine::rt::RtScene& scene, const ProbeGrid& grid, const RelocationSettings& s, OpenSpace& r) {
+  using namespace engine;
+  const glm::vec3 limit = s.max_offset * grid.spacing();
+  const float margin = s.margin * grid.min_spacing();
+  for (int pass = 0; pass < 3; ++pass) {
+    const std::vector<std::uint8_t> linked = r.open;
+    int moved = 0;
+    for (int q = 0; q < grid.count(); ++q) {
+      if (linked[static_cast<std::size_t>(q)]) continue;
+      const glm::vec3 target = grid.grid_point(q);
+      float best = std::numeric_limits<float>::infinity();
+      glm::vec3 best_offset(0.0f);
+      grid.for_each_neighbour(q, [&](int n) {
+        if (n == q || !linked[static_cast<std::size_t>(n)]) return;
+        const glm::vec3 from = grid.grid_point(n) + r.offsets[static_cast<std::size_t>(n)];
+        const glm::vec3 d = target - from;
+        const float len = glm::length(d);
+        if (!(len > 0)) return;
+        rt::Hit hit;
+        const float t = scene.intersect(rt::Ray{from, d / len, 0.0f, len}, hit) ? hit.t - std::min(margin, 0.5f * hit.t) : len;
+        const glm::vec3 offset = from + d / len * t - target;
+        if (glm::any(glm::greaterThan(glm::abs(offset), limit))) return;
+        const float size = glm::length(offset);
+        if (size < best) {
+          best = size;
+          best_offset = offset;
+        }
+      });
+      if (std::isfinite(best)) {
+        r.offsets[static_cast<std::size_t>(q)] = best_offset;
+        r.open[static_cast<std::size_t>(q)] = 1;
+        ++moved;
+      }
+    }
+    r.relocated += moved;
+    if (moved == 0) break;
+  }
+}
+
+}  // namespace
+
+OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& grid, std::span<const std::uint8_t> saw_light,
+                          const RelocationSettings& relocation) {
+  using namespace engine;
+  const int probes = grid.count();
+  OpenSpace r;
+  r.open.assign(static_cast<std::size_t>(probes), 0);
+  r.offsets.assign(static_cast<std::size_t>(probes), glm::vec3(0.0f));
+  std::deque<int> queue;
+  for (int q = 0; q < probes && q < static_cast<int>(saw_light.size()); ++q)
+    if (saw_light[static_cast<std::size_t>(q)]) {
+      r.open[static_cast<std::size_t>(q)] = 1;
+      queue.push_back(q);
+    }
+  r.seeds = static_cast<int>(queue.size());
+  if (r.seeds == 0) {
+    std::fill(r.open.begin(), r.open.end(), 1);
+    r.open_count = probes;
+    return r;
+  }
+
+  // links[q] bit k: the segment from q to q + forward_offset(k) is clear.
+  std::vector<std::uint16_t> links(static_cast<std::size_t>(probes), 0);
+  jobs::parallel_for(0, probes, 8, [&](int b, int e) {
+    for (int q = b; q < e; ++q) {
+      const glm::ivec3 c = grid.coords(q);
+      const glm::vec3 from = grid.grid_point(q);
+      for (int k = 0; k < kForward; ++k) {
+        const glm::ivec3 n = c + forward_offset(k);
+        if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, grid.dims))) continue;
+        const glm::vec3 d = grid.grid_point(grid.index(n)) - from;
+        const float len = glm::length(d);
+        if (!(len > 0)) continue;
+        if (!scene.occluded(rt::Ray{from, d / len, 0.0f, len})) links[static_cast<std::size_t>(q)] |= std::uint16_t(1u << k);
+      }
+    }
+  });
+  auto visit = [&](int q) {
+    if (r.open[static_cast<std::size_t>(q)]) return;
+    r.open[static_cast<std::size_t>(q)] = 1;
+    queue.push_back(q);
+  };
+  while (!queue.empty()) {
+    const int q = queue.front();
+    queue.pop_front();
+    const glm::ivec3 c = grid.coords(q);
+    for (int k = 0; k < kForward; ++k) {
+      const glm::ivec3 o = forward_offset(k);
+      // Forward link of q, and q as the forward neighbour of c - o.
+      const glm::ivec3 ahead = c + o, behind = c - o;
+      if (glm::all(glm::greaterThanEqual(ahead, glm::ivec3(0))) && glm::all(glm::lessThan(ahead, grid.dims)) &&
+          (links[static_cast<std::size_t>(q)] >> k & 1u))
+        visit(grid.index(ahead));
+      if (glm::all(glm::greaterThanEqual(behind, glm::ivec3(0))) && glm::all(glm::lessThan(behind, grid.dims))) {
+        const int p = grid.index(behind);
+        if (links[static_cast<std::size_t>(p)] >> k & 1u) visit(p);
+      }
+    }
+  }
+  if (relocation.enabled) relocate(scene, grid, relocation, r);
+  for (std::uint8_t o : r.open) r.open_count += o;
+  return r;
+}
+
+}  // namespace transgi::probes

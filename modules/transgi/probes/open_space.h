@@ -1,0 +1,61 @@
+#pragma once
+// Which probes stand in open space, whatever the triangles' winding (shared by
+// TransGI's probes and the DDGI baseline).
+//
+// Much real content has double-sided materials on meshes whose winding is
+// mixed: a room's ceiling, or half of its walls, faces outwards. A probe ray
+// that meets such a triangle from behind has met a surface, not the inside of
+// a solid, so counting back-face hits (RTXGI's classification) buries the
+// probes of a whole room. Connectivity does not depend on winding: a probe is
+// in open space when a chain of unoccluded segments between neighbouring
+// probes (26-neighbourhood) links it to a probe that saw light (a ray that
+// escaped, met an emitter, or met a surface lit directly). A probe inside a
+// wall, a closed box or a piece of furniture sees only surfaces that light
+// never reaches, and every segment to its neighbours crosses a face, so no
+// chain reaches it.
+//
+// Relocation (RTXGI moves probes out of geometry too, by back faces): a probe
+// that no chain reaches is moved, by at most `max_offset` cells per axis,
+// along a clear segment from a linked neighbour to just short of the
+// surface that blocked it (`margin` cells before it), so a grid layer that
+// lands inside a wall comes to stand in front of it.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "engine/rt/rt_scene.h"
+#include "probes/probe_grid.h"
+
+namespace transgi::probes {
+
+struct OpenSpace {
+  std::vector<std::uint8_t> open;  // per probe: 1 = linked to light (after relocation)
+  std::vector<glm::vec3> offsets;  // per probe: relocation from its grid point (zero if none)
+  int seeds = 0;                   // probes that saw light themselves
+  int open_count = 0;
+  int relocated = 0;
+};
+
+struct RelocationSettings {
+  // Off = unlinked probes stay where they are (and are not used).
+  bool enabled = true;
+  // Largest move per axis, in cells (RTXGI keeps probes within 0.45). Higher =
+  // more probes rescued from thick walls, at the cost of cages that no longer
+  // surround their points.
+  float max_offset = 0.45f;
+  // Distance kept from the blocking surface, in cells of the smallest spacing.
+  // Higher = depth maps less dominated by one nearby wall, at the cost of a
+  // probe further from the wall it stands in for.
+  float margin = 0.1f;
+
+  bool operator==(const RelocationSettings&) const = default;
+};
+
+// saw_light: per probe, 1 if one of its rays escaped, met an emitter or met a
+// directly lit surface. Where no probe saw light (a dark scene, nothing to
+// link to), every probe counts as open: darkness is no evidence of a wall.
+// Uses the grid points (grid.offsets are ignored).
+OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& grid, std::span<const std::uint8_t> saw_light,
+                          const RelocationSettings& relocation = {});
+
+}  // namespace transgi::probes
