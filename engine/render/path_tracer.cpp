@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "engine/jobs/parallel_for.h"
+#include "engine/math/sampling.h"
 #include "engine/render/surface.h"
 
 namespace engine::render {
@@ -33,7 +34,11 @@ PathTracer::PathTracer(const rt::RtScene& scene, const LightSet& lights, CameraR
       settings_(settings),
       sum_full_(static_cast<std::size_t>(width) * height, glm::dvec3(0.0)),
       sum_direct_(sum_full_.size(), glm::dvec3(0.0)),
-      sum_gi_(sum_full_.size(), glm::dvec3(0.0)) {}
+      sum_gi_(sum_full_.size(), glm::dvec3(0.0)),
+      sum_sq_full_(sum_full_.size(), 0.0),
+      sum_sq_direct_(sum_full_.size(), 0.0),
+      sum_sq_gi_(sum_full_.size(), 0.0),
+      count_(sum_full_.size(), 0) {}
 
 PathRadiance PathTracer::trace(rt::Ray ray, math::Pcg32& rng) const {
   PathRadiance L;
@@ -113,45 +118,90 @@ PathRadiance PathTracer::trace(rt::Ray ray, math::Pcg32& rng) const {
   return L;
 }
 
+void PathTracer::add_samples(int n, const std::vector<std::uint8_t>& want) {
+  std::atomic<std::uint64_t> discarded{0}, samples{0};
+  jobs::parallel_for(0, height_, 1, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < width_; ++x) {
+        const std::size_t pixel = static_cast<std::size_t>(y) * width_ + x;
+        if (!want.empty() && !want[pixel]) continue;
+        const std::uint32_t first = count_[pixel];
+        for (std::uint32_t s = first; s < first + static_cast<std::uint32_t>(n); ++s) {
+          math::Pcg32 rng = math::make_rng(settings_.seed, pixel, static_cast<std::uint64_t>(s));
+          const glm::vec2 u(rng.next_float(), rng.next_float());
+          const rt::Ray ray = camera_.generate_filtered(x, y, u, settings_.filter_width);
+          const PathRadiance L = trace(ray, rng);
+          if (!finite(L.full) || !finite(L.direct) || !finite(L.gi)) {
+            discarded.fetch_add(1, std::memory_order_relaxed);
+            continue;  // counts as a zero sample
+          }
+          sum_full_[pixel] += glm::dvec3(L.full);
+          sum_direct_[pixel] += glm::dvec3(L.direct);
+          sum_gi_[pixel] += glm::dvec3(L.gi);
+          const double lf = math::luminance(L.full), ld = math::luminance(L.direct), lg = math::luminance(L.gi);
+          sum_sq_full_[pixel] += lf * lf;
+          sum_sq_direct_[pixel] += ld * ld;
+          sum_sq_gi_[pixel] += lg * lg;
+        }
+        count_[pixel] = first + static_cast<std::uint32_t>(n);
+        samples.fetch_add(static_cast<std::uint64_t>(n), std::memory_order_relaxed);
+      }
+  });
+  stats_.samples += samples.load();
+  stats_.discarded_non_finite += discarded.load();
+}
+
 void PathTracer::render(int spp, const std::function<void(int, int)>& progress) {
   const auto start = std::chrono::steady_clock::now();
-  std::atomic<std::uint64_t> discarded{0};
   const int target = spp_ + spp;
+  const std::vector<std::uint8_t> all;
   while (spp_ < target) {
     const int batch = std::min(settings_.batch_spp, target - spp_);
-    const int first = spp_;
-    jobs::parallel_for(0, height_, 1, [&](int y0, int y1) {
-      for (int y = y0; y < y1; ++y)
-        for (int x = 0; x < width_; ++x) {
-          const std::size_t pixel = static_cast<std::size_t>(y) * width_ + x;
-          for (int s = first; s < first + batch; ++s) {
-            math::Pcg32 rng = math::make_rng(settings_.seed, pixel, static_cast<std::uint64_t>(s));
-            const glm::vec2 u(rng.next_float(), rng.next_float());
-            const rt::Ray ray = camera_.generate_filtered(x, y, u, settings_.filter_width);
-            const PathRadiance L = trace(ray, rng);
-            if (!finite(L.full) || !finite(L.direct) || !finite(L.gi)) {
-              discarded.fetch_add(1, std::memory_order_relaxed);
-              continue;  // counts as a zero sample
-            }
-            sum_full_[pixel] += glm::dvec3(L.full);
-            sum_direct_[pixel] += glm::dvec3(L.direct);
-            sum_gi_[pixel] += glm::dvec3(L.gi);
-          }
-        }
-    });
+    add_samples(batch, all);
     spp_ += batch;
     if (progress) progress(spp_ - (target - spp), spp);
   }
-  stats_.samples += static_cast<std::uint64_t>(spp) * width_ * height_;
-  stats_.discarded_non_finite += discarded.load();
   stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void PathTracer::render_adaptive(const AdaptiveSampling& a, const std::function<void(int, int)>& progress) {
+  if (spp_ < a.min_spp) render(a.min_spp - spp_);
+  const auto start = std::chrono::steady_clock::now();
+  const auto& sums = a.pass == Pass::Direct ? sum_direct_ : a.pass == Pass::Gi ? sum_gi_ : sum_full_;
+  const auto& squares = a.pass == Pass::Direct ? sum_sq_direct_ : a.pass == Pass::Gi ? sum_sq_gi_ : sum_sq_full_;
+  const int pixels = width_ * height_;
+  std::vector<std::uint8_t> want(static_cast<std::size_t>(pixels), 0);
+  for (;;) {
+    double image_mean = 0;
+    for (std::size_t i = 0; i < sums.size(); ++i) image_mean += math::luminance(glm::vec3(sums[i] / static_cast<double>(std::max(1u, count_[i]))));
+    image_mean /= std::max(1, pixels);
+    const double floor = std::max(1e-12, a.floor * image_mean);
+    int open = 0;
+    for (std::size_t i = 0; i < sums.size(); ++i) {
+      const double n = static_cast<double>(std::max(1u, count_[i]));
+      const double mean = math::luminance(glm::vec3(sums[i] / n));
+      const double variance = std::max(0.0, squares[i] / n - mean * mean) * n / std::max(1.0, n - 1);
+      const double error = std::sqrt(variance / n) / std::max(std::abs(mean), floor);
+      want[i] = error > a.target_error && count_[i] < static_cast<std::uint32_t>(a.max_spp) ? 1 : 0;
+      open += want[i];
+    }
+    if (progress) progress(pixels - open, pixels);
+    if (open == 0) break;
+    add_samples(a.round_spp, want);
+  }
+  stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+double PathTracer::mean_samples_per_pixel() const {
+  double sum = 0;
+  for (std::uint32_t c : count_) sum += c;
+  return count_.empty() ? 0.0 : sum / static_cast<double>(count_.size());
 }
 
 image::ImageRGB PathTracer::image(Pass pass) const {
   const auto& sums = pass == Pass::Direct ? sum_direct_ : pass == Pass::Gi ? sum_gi_ : sum_full_;
   image::ImageRGB out(width_, height_);
-  const double inv = spp_ > 0 ? 1.0 / spp_ : 0.0;
-  for (std::size_t i = 0; i < sums.size(); ++i) out.pixels[i] = glm::vec3(sums[i] * inv);
+  for (std::size_t i = 0; i < sums.size(); ++i) out.pixels[i] = count_[i] > 0 ? glm::vec3(sums[i] / static_cast<double>(count_[i])) : glm::vec3(0.0f);
   return out;
 }
 

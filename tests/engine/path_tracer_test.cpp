@@ -199,3 +199,45 @@ TEST(LightSync, SkyAndMaterialEditsRebuildTheLightSet) {
   EXPECT_EQ(lights.version, v0 + 2) << "a material changed";
   EXPECT_EQ(lights.set.emissive_triangle_count(), 0u) << "the dark lamp is no longer an emitter";
 }
+
+// Adaptive sampling (issue 14, item 1) against the furnace's known answer:
+// every pixel's gi is Le a^2 / (1 - a). Rendered to a target relative error
+// of 2 %, the pixels' RMS relative error is about the target (tolerance:
+// 1.3x) and no pixel is off by more than 5x the target (5 sigma); the image
+// is the same on 1 and 2 threads, since the rounds' choices depend only on
+// the samples.
+TEST(PathTracer, AdaptiveSamplingMeetsItsTargetErrorInTheFurnace) {
+  const float a = 0.8f, le = 1.0f;
+  const double expected = le * a * a / (1 - a);
+  Scene s({scene::make_box(glm::vec3(2.0f), /*inward=*/true)}, {lambert(glm::vec3(a), glm::vec3(le))}, {0.3f, 0.2f, 0.1f});
+  s.app.update();
+  auto& world = s.app.world();
+  const auto& rt_scene = world.resource<rt::RtScene>();
+  const LightSet lights(rt_scene, {}, nullptr);
+  const CameraRays cam(world.get<scene::Camera>(s.camera), world.get<transform::WorldTransform>(s.camera), 12, 12);
+  AdaptiveSampling adaptive;
+  adaptive.target_error = 0.02f;
+  adaptive.min_spp = 16;
+  adaptive.round_spp = 16;
+  image::ImageRGB images[2];
+  double mean_spp = 0;
+  for (int threads : {1, 2}) {
+    PathTracer pt(rt_scene, lights, cam, 12, 12, PathTracerSettings{.seed = 5});
+    jobs::JobSystem jobs({.threads = threads});
+    jobs.run([&] { pt.render_adaptive(adaptive); });
+    images[threads - 1] = pt.image(Pass::Gi);
+    mean_spp = pt.mean_samples_per_pixel();
+  }
+  double sq = 0, worst = 0;
+  for (const glm::vec3& p : images[1].pixels) {
+    const double rel = math::luminance(p) / expected - 1.0;
+    sq += rel * rel;
+    worst = std::max(worst, std::abs(rel));
+  }
+  const double rms = std::sqrt(sq / static_cast<double>(images[1].pixels.size()));
+  std::printf("adaptive to 2 %%: %.0f spp on average, RMS relative error %.4f, worst pixel %.4f\n", mean_spp, rms, worst);
+  EXPECT_LT(rms, 1.3 * adaptive.target_error) << "expected about " << adaptive.target_error << ", got " << rms;
+  EXPECT_LT(worst, 5.0 * adaptive.target_error);
+  EXPECT_GT(mean_spp, adaptive.min_spp) << "the furnace's gi is noisy at 16 spp: rounds must have run";
+  for (std::size_t i = 0; i < images[0].pixels.size(); ++i) ASSERT_EQ(images[0].pixels[i], images[1].pixels[i]) << "pixel " << i;
+}

@@ -37,12 +37,13 @@ void write_image(const std::filesystem::path& dir, const std::string& name, cons
 int run_eval(const std::vector<std::string>& argv) {
   const Args args("eval", argv,
                   {"scene", "model", "out", "width", "height", "spp", "frames", "ddgi-frames", "ddgi-warmup", "probe-grid",
-                   "gbuffer-spp", "camera", "threads", "cache", "seed"});
+                   "gbuffer-spp", "camera", "threads", "cache", "seed", "reference-error"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const std::filesystem::path out = args.str("out");
   const int width = static_cast<int>(args.integer("width", 16, 8192, 320));
   const int height = static_cast<int>(args.integer("height", 16, 8192, 180));
-  const int spp = static_cast<int>(args.integer("spp", 1, 1'000'000, 1024));
+  const int spp = static_cast<int>(args.integer("spp", 2, 1'000'000, 1024));
+  const float reference_error = static_cast<float>(args.number("reference-error", 0.0, 1.0, 0.0));
   const int threads = static_cast<int>(args.integer("threads", 0, 1024, 0));
   const auto seed = static_cast<std::uint64_t>(args.integer("seed", 0, INT64_MAX, 0));
   const std::string camera = args.str("camera", std::string());
@@ -71,8 +72,10 @@ int run_eval(const std::vector<std::string>& argv) {
   std::filesystem::create_directories(out / "images");
   std::filesystem::create_directories(out / "heat");
 
-  const eval::ReferenceImages ref = eval::reference_images(reference_scene, width, height, spp, seed, cache);
-  std::printf("reference: %s (%d spp, %.1f s)%s\n", ref.key.c_str(), ref.spp, ref.seconds, ref.from_cache ? ", from the cache" : "");
+  const eval::ReferenceImages ref =
+      eval::reference_images(reference_scene, width, height, eval::ReferenceOptions{spp, reference_error, seed}, cache);
+  std::printf("reference: %s (%.0f spp on average, %.1f s)%s\n", ref.key.c_str(), ref.mean_spp, ref.seconds,
+              ref.from_cache ? ", from the cache" : "");
 
   eval::EvalReport report;
   report.scene = scene_path;
@@ -83,6 +86,10 @@ int run_eval(const std::vector<std::string>& argv) {
   report.reference_seconds = ref.seconds;
   report.reference_cached = ref.from_cache;
   report.reference_key = ref.key;
+  report.reference_mean_spp = ref.mean_spp;
+  report.reference_target_error = ref.target_error;
+  report.reference_noise_gi = ref.noise_gi;
+  report.reference_noise_full = ref.noise_full;
   {
     const auto& assets = reference_scene.app->world().resource<scene::SceneAssets>();
     for (const auto& m : assets.meshes) report.vertices += m->positions.size();
@@ -130,12 +137,16 @@ int run_eval(const std::vector<std::string>& argv) {
       image::write_png(out / "heat" / (m.slug + "_" + setup + ".png"), image::error_heatmap(img, target, scale));
     }
   }
+  double smallest = 0;
+  for (const auto& m : report.methods) smallest = smallest > 0 ? std::min(smallest, m.gi.rmse) : m.gi.rmse;
+  report.reference_note = eval::reference_noise_note(ref, smallest);
   eval::write_results_json(out / "results.json", report);
   eval::write_results_markdown(out / "results.md", report);
   eval::write_index_html(out / "index.html", report);
   for (const auto& m : report.methods)
     std::printf("%-8s GI: RMSE %.4f L1 %.4f SSIM %.3f | GI+DI: RMSE %.4f L1 %.4f SSIM %.3f | frame %.2f ms\n", m.name.c_str(),
                 m.gi.rmse, m.gi.l1, m.gi.ssim, m.gi_di.rmse, m.gi_di.l1, m.gi_di.ssim, m.run.frame_ms);
+  std::printf("%s\n", report.reference_note.c_str());
   std::printf("wrote %s (index.html, results.md, results.json, images/, heat/)\n", out.string().c_str());
   return 0;
 }

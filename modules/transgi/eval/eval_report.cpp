@@ -72,7 +72,9 @@ void write_results_json(const std::filesystem::path& path, const EvalReport& r) 
   o << "{\n  \"scene\": " << json_string(r.scene) << ",\n  \"command\": " << json_string(r.command) << ",\n  \"width\": " << r.width
     << ", \"height\": " << r.height << ",\n  \"reference\": {\"spp\": " << r.reference_spp
     << ", \"seconds\": " << fmt("%.3f", r.reference_seconds) << ", \"cached\": " << (r.reference_cached ? "true" : "false")
-    << ", \"key\": " << json_string(r.reference_key) << "},\n  \"methods\": [\n";
+    << ", \"key\": " << json_string(r.reference_key) << ", \"mean_spp\": " << fmt("%.1f", r.reference_mean_spp)
+    << ", \"target_error\": " << fmt("%g", r.reference_target_error) << ", \"noise_rmse_gi\": " << fmt("%.6f", r.reference_noise_gi)
+    << ", \"noise_rmse_full\": " << fmt("%.6f", r.reference_noise_full) << "},\n  \"methods\": [\n";
   for (std::size_t i = 0; i < r.methods.size(); ++i) {
     const auto& m = r.methods[i];
     o << "    {\"name\": " << json_string(m.name) << ", \"settings\": " << json_string(m.settings) << ",\n     \"gi\": " << json_metrics(m.gi)
@@ -90,11 +92,19 @@ void write_results_json(const std::filesystem::path& path, const EvalReport& r) 
 
 void write_results_markdown(const std::filesystem::path& path, const EvalReport& r) {
   std::ostringstream o;
-  o << "# Evaluation: " << r.scene << "\n\n" << r.width << "x" << r.height << ", reference: path tracer at " << r.reference_spp << " spp ("
-    << (r.reference_cached ? "cached, " : "") << fmt("%.1f", r.reference_seconds) << " s).\n\nCommand: `" << r.command << "`\n\n";
+  o << "# Evaluation: " << r.scene << "\n\n" << r.width << "x" << r.height << ", reference: path tracer, "
+    << (r.reference_target_error > 0 ? "adaptive to relative error " + fmt("%g", r.reference_target_error) + " per pixel (at most " +
+                                           std::to_string(r.reference_spp) + " spp), "
+                                     : std::to_string(r.reference_spp) + " spp, ")
+    << fmt("%.0f", r.reference_mean_spp) << " spp on average (" << (r.reference_cached ? "cached, " : "") << fmt("%.1f", r.reference_seconds)
+    << " s).\n\nCommand: `" << r.command << "`\n\n";
   for (const auto& m : r.methods) o << "- " << m.name << ": " << m.settings << "; " << m.run.probe_summary << "\n";
-  o << "\n## GI only (Table 1)\n\n" << metrics_table(r, false) << "\n## GI + DI (Table 2; DI = the reference's direct pass)\n\n"
-    << metrics_table(r, true) << "\n## Per-stage times, one frame (Table 4)\n\nMedians of the last timed frames; the CPU oracle path, "
+  const std::string noise = "\nThe reference's own noise, estimated from two independent halves: RMSE " + fmt("%.4f", r.reference_noise_gi) +
+                            " (GI), " + fmt("%.4f", r.reference_noise_full) + " (full). " +
+                            (r.reference_note.find("warning") != std::string::npos ? "**It exceeds 1/5 of the smallest error in these tables.**\n"
+                                                                                    : "Below 1/5 of every error in these tables.\n");
+  o << "\n## GI only (Table 1)\n\n" << metrics_table(r, false) << noise << "\n## GI + DI (Table 2; DI = the reference's direct pass)\n\n"
+    << metrics_table(r, true) << noise << "\n## Per-stage times, one frame (Table 4)\n\nMedians of the last timed frames; the CPU oracle path, "
     << "2 threads unless stated.\n\n" << timing_table(r) << "\n## Memory (Table 5)\n\n| Vertices (welded) | Network (KB) | Vertex features (MB) |"
     << " Probe storage TransGI / DDGI (MB) |\n| --- | --- | --- | --- |\n| " << r.vertices << " (" << r.latent_rows << ") | "
     << fmt("%.1f", static_cast<double>(r.decoder_bytes) / 1024.0) << " | " << fmt("%.2f", static_cast<double>(r.latent_bytes) / (1024.0 * 1024.0))

@@ -27,6 +27,10 @@ struct EvalReport {
   double reference_seconds = 0;
   bool reference_cached = false;
   std::string reference_key;
+  double reference_mean_spp = 0;
+  float reference_target_error = 0;             // 0 = uniform sampling
+  double reference_noise_gi = 0, reference_noise_full = 0;  // estimated RMSE (two halves)
+  std::string reference_note;                   // the noise line, and a warning if it is too high
   std::vector<MethodResult> methods;
   // Table 5: the model's memory.
   std::size_t vertices = 0, latent_rows = 0, decoder_bytes = 0, latent_bytes = 0;
