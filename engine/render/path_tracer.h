@@ -51,7 +51,7 @@ struct AdaptiveSampling {
   // Higher = pixels with rare bright paths converge too, at the cost of time there.
   int max_spp = 16384;
   int round_spp = 32;
-  float floor = 0.25f;
+  float floor = 1.0f;
   Pass pass = Pass::Gi;
 };
 

@@ -1,17 +1,46 @@
 #include "engine/render/surface.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace engine::render {
 
-material::BrdfParams evaluate_material(const scene::SceneAssets& assets, std::uint32_t index, glm::vec2 uv) {
+float uv_footprint(const scene::MeshAsset& mesh, std::uint32_t triangle, float scale, float cone_width, float cos_theta) {
+  if (mesh.uvs.empty() || !(cone_width > 0)) return 0.0f;
+  const glm::uvec3 t = mesh.triangles[triangle];
+  const float world_area = 0.5f * glm::length(glm::cross(mesh.positions[t.y] - mesh.positions[t.x], mesh.positions[t.z] - mesh.positions[t.x])) *
+                           scale * scale;
+  const glm::vec2 a = mesh.uvs[t.y] - mesh.uvs[t.x], b = mesh.uvs[t.z] - mesh.uvs[t.x];
+  const float uv_area = 0.5f * std::abs(a.x * b.y - a.y * b.x);
+  if (!(world_area > 0) || !(uv_area > 0)) return 0.0f;
+  // Seen at a grazing angle the cone's footprint stretches; the isotropic
+  // estimate takes its long side (over-blurs across it, as rasterisers
+  // without anisotropic filtering do), capped at 20x.
+  const float f = cone_width / std::max(std::abs(cos_theta), 0.05f) * std::sqrt(uv_area / world_area);
+  return std::isfinite(f) ? f : 0.0f;
+}
+
+float texture_lod(float footprint, int w, int h) {
+  if (!(footprint > 0) || w <= 0 || h <= 0) return 0.0f;
+  return std::log2(footprint * std::sqrt(static_cast<float>(w) * static_cast<float>(h)));
+}
+
+namespace {
+glm::vec4 sample_texture(const scene::Texture& t, glm::vec2 uv, bool srgb, float footprint) {
+  return footprint > 0 ? t.sample(uv, srgb, texture_lod(footprint, t.width, t.height)) : t.sample(uv, srgb);
+}
+}  // namespace
+
+material::BrdfParams evaluate_material(const scene::SceneAssets& assets, std::uint32_t index, glm::vec2 uv, float footprint) {
   const material::Material& m = assets.materials[index];
   material::BrdfParams p;
   glm::vec4 base = m.base_color_factor;
-  if (m.base_color_texture >= 0) base *= assets.textures[static_cast<std::size_t>(m.base_color_texture)].sample(uv, true);
+  if (m.base_color_texture >= 0) base *= sample_texture(assets.textures[static_cast<std::size_t>(m.base_color_texture)], uv, true, footprint);
   p.base_color = glm::vec3(base);
   p.metallic = m.metallic_factor;
   p.roughness = m.roughness_factor;
   if (m.metallic_roughness_texture >= 0) {
-    const glm::vec4 mr = assets.textures[static_cast<std::size_t>(m.metallic_roughness_texture)].sample(uv, false);
+    const glm::vec4 mr = sample_texture(assets.textures[static_cast<std::size_t>(m.metallic_roughness_texture)], uv, false, footprint);
     p.roughness *= mr.g;
     p.metallic *= mr.b;
   }
@@ -20,11 +49,11 @@ material::BrdfParams evaluate_material(const scene::SceneAssets& assets, std::ui
   return p;
 }
 
-glm::vec3 evaluate_emission(const scene::SceneAssets& assets, std::uint32_t index, glm::vec2 uv) {
+glm::vec3 evaluate_emission(const scene::SceneAssets& assets, std::uint32_t index, glm::vec2 uv, float footprint) {
   const material::Material& m = assets.materials[index];
   glm::vec3 e = m.emission();
   if (m.emissive_texture >= 0 && (e.r > 0 || e.g > 0 || e.b > 0))
-    e *= glm::vec3(assets.textures[static_cast<std::size_t>(m.emissive_texture)].sample(uv, true));
+    e *= glm::vec3(sample_texture(assets.textures[static_cast<std::size_t>(m.emissive_texture)], uv, true, footprint));
   return e;
 }
 

@@ -30,8 +30,20 @@ struct Surface {
 Surface make_surface(const rt::RtScene& scene, const rt::Hit& hit, const glm::vec3& incoming_dir);
 
 // The material at a point on a mesh (base colour, roughness, ... from
-// factors and textures). Shared by the renderer and the bake.
-material::BrdfParams evaluate_material(const scene::SceneAssets& assets, std::uint32_t material, glm::vec2 uv);
-glm::vec3 evaluate_emission(const scene::SceneAssets& assets, std::uint32_t material, glm::vec2 uv);
+// factors and textures). Shared by the renderer and the bake. uv_footprint:
+// the width of the area to average, in UV units (0 = a point sample, as
+// Monte Carlo renderers take); textures are then read at the mip level it
+// asks for (Texture::sample with lod).
+material::BrdfParams evaluate_material(const scene::SceneAssets& assets, std::uint32_t material, glm::vec2 uv, float uv_footprint = 0);
+glm::vec3 evaluate_emission(const scene::SceneAssets& assets, std::uint32_t material, glm::vec2 uv, float uv_footprint = 0);
+
+// Ray cones (Akenine-Moller et al. 2019, "Texture Level of Detail Strategies
+// for Real-Time Ray Tracing"): a cone `cone_width` wide where it meets
+// triangle `triangle` of `mesh` (scaled by `scale` into the world) at an angle
+// whose cosine is cos_theta covers this width in UV units. 0 when the mesh
+// has no UVs or the triangle no area.
+float uv_footprint(const scene::MeshAsset& mesh, std::uint32_t triangle, float scale, float cone_width, float cos_theta);
+// The mip level for a footprint on a texture of w x h texels.
+float texture_lod(float uv_footprint, int w, int h);
 
 }  // namespace engine::render

@@ -445,6 +445,15 @@ GltfLoadResult load_gltf(ecs::World& world, const fs::path& path, const GltfLoad
   sa.source = path;
   sa.textures = load_textures(c);
   sa.materials = load_materials(c);
+  {
+    // Mips for footprint-filtered lookups, averaged in the space each
+    // texture is read in (colour: linear light).
+    std::vector<std::uint8_t> colour(sa.textures.size(), 0);
+    for (const material::Material& m : sa.materials)
+      for (const auto t : {m.base_color_texture, m.emissive_texture})
+        if (t >= 0) colour[static_cast<std::size_t>(t)] = 1;
+    for (std::size_t t = 0; t < sa.textures.size(); ++t) sa.textures[t].build_mips(colour[t] != 0);
+  }
   const auto default_material = static_cast<std::uint32_t>(sa.materials.size() - 1);
   const AccessorReader reader{model, c.file};
   std::vector<std::shared_ptr<const MeshAsset>> gltf_meshes;

@@ -1,5 +1,6 @@
 #include "engine/scene/texture.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -37,10 +38,77 @@ int wrap_index(int i, int n, Wrap mode) {
   }
 }
 
+std::uint8_t encode_srgb(float v) {
+  v = std::clamp(v, 0.0f, 1.0f);
+  const float e = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+  return static_cast<std::uint8_t>(std::lround(e * 255.0f));
+}
+
+glm::vec4 bilinear(const std::uint8_t* rgba, int width, int height, Wrap wrap_s, Wrap wrap_t, glm::vec2 uv, bool srgb);
+
 }  // namespace
 
 glm::vec4 Texture::sample(glm::vec2 uv, bool srgb) const {
   if (width <= 0 || height <= 0) return glm::vec4(1.0f);
+  return bilinear(rgba.data(), width, height, wrap_s, wrap_t, uv, srgb);
+}
+
+glm::vec4 Texture::sample(glm::vec2 uv, bool srgb, float lod) const {
+  if (width <= 0 || height <= 0) return glm::vec4(1.0f);
+  if (!(lod > 0) || mips.empty()) return sample(uv, srgb);
+  lod = std::min(lod, static_cast<float>(mips.size()));
+  const int lo = static_cast<int>(std::floor(lod));
+  const float t = lod - static_cast<float>(lo);
+  auto level = [&](int l) {
+    if (l == 0) return bilinear(rgba.data(), width, height, wrap_s, wrap_t, uv, srgb);
+    const MipLevel& m = mips[static_cast<std::size_t>(l - 1)];
+    return bilinear(m.rgba.data(), m.width, m.height, wrap_s, wrap_t, uv, srgb);
+  };
+  const glm::vec4 a = level(lo);
+  if (t <= 0 || lo >= static_cast<int>(mips.size())) return a;
+  return (1 - t) * a + t * level(lo + 1);
+}
+
+void Texture::build_mips(bool srgb) {
+  mips.clear();
+  if (width <= 0 || height <= 0) return;
+  const auto& lut = srgb_lut();
+  const std::uint8_t* src = rgba.data();
+  int w = width, h = height;
+  while (w > 1 || h > 1) {
+    MipLevel m;
+    m.width = std::max(1, (w + 1) / 2);
+    m.height = std::max(1, (h + 1) / 2);
+    m.rgba.resize(static_cast<std::size_t>(m.width) * m.height * 4);
+    for (int y = 0; y < m.height; ++y)
+      for (int x = 0; x < m.width; ++x) {
+        float sum[4] = {0, 0, 0, 0};
+        int n = 0;
+        for (int dy = 0; dy < 2; ++dy)
+          for (int dx = 0; dx < 2; ++dx) {
+            const int sx = std::min(2 * x + dx, w - 1), sy = std::min(2 * y + dy, h - 1);
+            const std::uint8_t* p = src + (static_cast<std::size_t>(sy) * w + sx) * 4;
+            for (int c = 0; c < 3; ++c) sum[c] += srgb ? lut[p[c]] : static_cast<float>(p[c]) / 255.0f;
+            sum[3] += static_cast<float>(p[3]) / 255.0f;
+            ++n;
+          }
+        std::uint8_t* d = &m.rgba[(static_cast<std::size_t>(y) * m.width + x) * 4];
+        for (int c = 0; c < 3; ++c) {
+          const float v = sum[c] / static_cast<float>(n);
+          d[c] = srgb ? encode_srgb(v) : static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+        }
+        d[3] = static_cast<std::uint8_t>(std::lround(std::clamp(sum[3] / static_cast<float>(n), 0.0f, 1.0f) * 255.0f));
+      }
+    mips.push_back(std::move(m));
+    src = mips.back().rgba.data();
+    w = mips.back().width;
+    h = mips.back().height;
+  }
+}
+
+namespace {
+
+glm::vec4 bilinear(const std::uint8_t* rgba, int width, int height, Wrap wrap_s, Wrap wrap_t, glm::vec2 uv, bool srgb) {
   if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = glm::vec2(0.0f);
   // Keep the coordinate small before flooring so huge UVs stay exact enough.
   const float x = std::fmod(uv.x, 4096.0f) * static_cast<float>(width) - 0.5f;
@@ -51,13 +119,15 @@ glm::vec4 Texture::sample(glm::vec2 uv, bool srgb) const {
   const auto& lut = srgb_lut();
   auto texel = [&](int xi, int yi) {
     const int cx = wrap_index(xi, width, wrap_s), cy = wrap_index(yi, height, wrap_t);
-    const std::uint8_t* p = &rgba[(static_cast<std::size_t>(cy) * width + cx) * 4];
+    const std::uint8_t* p = rgba + (static_cast<std::size_t>(cy) * width + cx) * 4;
     if (srgb) return glm::vec4(lut[p[0]], lut[p[1]], lut[p[2]], static_cast<float>(p[3]) / 255.0f);
     return glm::vec4(p[0], p[1], p[2], p[3]) / 255.0f;
   };
   const glm::vec4 a = texel(x0, y0), b = texel(x0 + 1, y0), c = texel(x0, y0 + 1), d = texel(x0 + 1, y0 + 1);
   return (1 - ty) * ((1 - tx) * a + tx * b) + ty * ((1 - tx) * c + tx * d);
 }
+
+}  // namespace
 
 float Texture::alpha_nearest(glm::vec2 uv) const {
   if (width <= 0 || height <= 0) return 1.0f;

@@ -46,6 +46,12 @@ struct TransGISettings {
   // cost of tracing time. 0 = GI only.
   int direct_spp = 4;
   DirectLight direct_light = DirectLight::Stochastic;
+  // Quality path: metals with roughness at most this reflect by one ray per
+  // sample, shaded with the probes' GI and direct light at the hit, instead
+  // of asking SH-4 for a mirror (shading::TransferRenderSettings). Negative =
+  // off (the paper's setting). Higher = more surfaces mirror-traced, at the
+  // cost of a ray and a few shadow rays per such sample.
+  float mirror_roughness = 0.05f;
   std::uint64_t seed = 0;
 };
 

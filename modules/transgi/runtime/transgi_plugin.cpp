@@ -157,6 +157,8 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
 
   shading::TransferRenderSettings rs;
   rs.spp = settings->gbuffer_spp;
+  rs.lights = &lights->set;
+  rs.mirror_roughness = settings->mirror_roughness;
   rs.seed = settings->seed + frame->probe_frames;
   rs.has_transfer = [&](Entity e) {
     const LatentMesh* l = latents.try_read<LatentMesh>(e);

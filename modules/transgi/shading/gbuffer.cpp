@@ -7,14 +7,15 @@
 namespace transgi::shading {
 
 GSample trace_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
-                      const engine::rt::Ray& ray, const engine::scene::Environment* background) {
+                      const engine::rt::Ray& ray, const engine::scene::Environment* background, float spread) {
   engine::rt::Hit hit;
   const bool found = scene.intersect(ray, hit);
-  return make_gsample(scene, assets, ray, found ? &hit : nullptr, background);
+  return make_gsample(scene, assets, ray, found ? &hit : nullptr, background, spread);
 }
 
 GSample make_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
-                     const engine::rt::Ray& ray, const engine::rt::Hit* found, const engine::scene::Environment* background) {
+                     const engine::rt::Ray& ray, const engine::rt::Hit* found, const engine::scene::Environment* background,
+                     float spread) {
   using namespace engine;
   GSample out;
   if (!found) {
@@ -40,15 +41,17 @@ GSample make_gsample(const engine::rt::RtScene& scene, const engine::scene::Scen
   out.normal_obj = nobj;
   out.wo_obj = wo;
   const std::uint32_t material = mesh.triangle_material[hit.primitive];
-  out.brdf = render::evaluate_material(assets, material, uv);
-  out.albedo = out.brdf.base_color;  // the network's input
-  out.diffuse = material::diffuse_albedo(out.brdf);
-  out.emission = render::evaluate_emission(assets, material, uv);
   out.position = ray.origin + hit.t * ray.direction;
   out.normal_world = glm::normalize(inst.to_world.apply_direction(nobj));
   out.wo_world = glm::normalize(-ray.direction);
   glm::vec3 ng = glm::cross(mesh.positions[t.y] - mesh.positions[t.x], mesh.positions[t.z] - mesh.positions[t.x]);
   ng = glm::length(ng) > 0 ? glm::normalize(inst.to_world.apply_direction(glm::normalize(ng))) : out.normal_world;
+  const float footprint =
+      spread > 0 ? render::uv_footprint(mesh, hit.primitive, inst.to_world.scale, hit.t * spread, glm::dot(ng, out.wo_world)) : 0.0f;
+  out.brdf = render::evaluate_material(assets, material, uv, footprint);
+  out.albedo = out.brdf.base_color;  // the network's input
+  out.diffuse = material::diffuse_albedo(out.brdf);
+  out.emission = render::evaluate_emission(assets, material, uv, footprint);
   out.geometric_normal = glm::dot(ng, out.wo_world) < 0 ? -ng : ng;
   out.depth = hit.t;
   return out;

@@ -26,12 +26,16 @@ struct GSample {
 
 // Traces `ray` and fills the sample; a miss records the background's
 // radiance (none if background is null). Normals face the viewer (surfaces
-// are two-sided).
+// are two-sided). spread: the ray cone's spread angle (CameraRays::
+// pixel_spread()); textures are read at the mip level of the cone's
+// footprint, as a rasteriser would, so the albedo fed to the network and to
+// shading is a pixel's average, not one texel. 0 = point samples.
 GSample trace_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
-                      const engine::rt::Ray& ray, const engine::scene::Environment* background);
+                      const engine::rt::Ray& ray, const engine::scene::Environment* background, float spread = 0);
 // The sample for a hit found elsewhere (a packet query); `hit` may be null
 // for a miss.
 GSample make_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
-                     const engine::rt::Ray& ray, const engine::rt::Hit* hit, const engine::scene::Environment* background);
+                     const engine::rt::Ray& ray, const engine::rt::Hit* hit, const engine::scene::Environment* background,
+                     float spread = 0);
 
 }  // namespace transgi::shading

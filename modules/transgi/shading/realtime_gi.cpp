@@ -204,6 +204,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
   // 4x4 pixel tiles as one Embree packet: neighbouring camera rays share
   // their traversal.
   const int tiles_x = (width + 3) / 4, tiles_y = (height + 3) / 4;
+  const float spread = camera.pixel_spread();
   engine::jobs::parallel_for(0, tiles_x * tiles_y, 16, [&](int t0, int t1) {
     engine::rt::Ray rays[16];
     engine::rt::Hit hits[16];
@@ -219,7 +220,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
         }
       scene.intersect16(rays, n, hits, found);
       for (int i = 0; i < n; ++i) {
-        const GSample& s = g.samples[pixel[i]] = make_gsample(scene, assets, rays[i], found[i] ? &hits[i] : nullptr, nullptr);
+        const GSample& s = g.samples[pixel[i]] = make_gsample(scene, assets, rays[i], found[i] ? &hits[i] : nullptr, nullptr, spread);
         g.guide[pixel[i]] = s.hit ? glm::vec4(s.normal_world, std::max(s.depth, 1e-30f)) : glm::vec4(0.0f);
       }
     }

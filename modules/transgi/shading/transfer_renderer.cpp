@@ -1,6 +1,8 @@
 #include "shading/transfer_renderer.h"
 
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <mutex>
 
 #include <glm/gtc/quaternion.hpp>
@@ -9,6 +11,7 @@
 #include "engine/jobs/parallel_for.h"
 #include "engine/math/rng.h"
 #include "engine/render/surface.h"
+#include "engine/rt/ray.h"
 #include "shading/gbuffer.h"
 #include "shading/transfer_inference.h"
 
@@ -25,6 +28,46 @@ constexpr std::array<int, 3> kMapCoefficients = {0, 2, 6};  // (0,0), (1,0), (2,
 
 }  // namespace
 
+bool is_mirror(const engine::material::BrdfParams& brdf, float mirror_roughness) {
+  return mirror_roughness >= 0 && brdf.metallic >= 0.5f && brdf.roughness <= mirror_roughness;
+}
+
+glm::vec3 shade_mirror_gi(const engine::rt::RtScene& scene, const GSample& smp, const LightAt& light_at,
+                          const engine::render::LightSet* lights, int light_samples, engine::math::Pcg32& rng) {
+  using namespace engine;
+  const glm::vec3 n = smp.normal_world, wo = smp.wo_world;
+  const float cos_o = glm::dot(n, wo);
+  if (cos_o <= 0) return glm::vec3(0.0f);
+  const glm::vec3 wi = glm::normalize(2.0f * cos_o * n - wo);
+  if (glm::dot(wi, smp.geometric_normal) <= 0) return glm::vec3(0.0f);
+  rt::Hit hit;
+  if (!scene.intersect(rt::Ray{rt::offset_ray_origin(smp.position, smp.geometric_normal), wi}, hit)) return glm::vec3(0.0f);
+  const render::Surface s = render::make_surface(scene, hit, wi);
+  if (s.emission.r > 0 || s.emission.g > 0 || s.emission.b > 0) return glm::vec3(0.0f);  // direct light
+  const glm::vec3 albedo = material::diffuse_albedo(s.brdf);
+  if (albedo == glm::vec3(0.0f)) return glm::vec3(0.0f);
+  float sh[75];
+  light_at(s.position, s.shading_normal, sh);
+  glm::vec3 irradiance = sh_irradiance(sh, s.shading_normal);
+  if (lights && light_samples > 0) {
+    const glm::vec3 origin = rt::offset_ray_origin(s.position, s.geometric_normal);
+    glm::vec3 direct(0.0f);
+    for (int k = 0; k < light_samples; ++k) {
+      render::LightSample ls;
+      const float u_sel = rng.next_float();
+      const glm::vec2 u(rng.next_float(), rng.next_float());
+      if (!lights->sample(s.position, u_sel, u, ls) || glm::dot(ls.direction, s.geometric_normal) <= 0) continue;
+      const float cos_i = glm::dot(ls.direction, s.shading_normal);
+      if (cos_i <= 0) continue;
+      const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
+      if (scene.occluded(rt::Ray{origin, ls.direction, 0.0f, tmax})) continue;
+      direct += ls.radiance * cos_i / (ls.delta ? 1.0f : ls.pdf);
+    }
+    irradiance += direct / static_cast<float>(light_samples);
+  }
+  return material::schlick_fresnel(smp.brdf.base_color, cos_o) * albedo * math::kInvPi * glm::max(irradiance, glm::vec3(0.0f));
+}
+
 TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                                      const model::TransferModel& model, const engine::render::CameraRays& camera,
                                      int width, int height, const LightAt& light_at,
@@ -38,6 +81,7 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
   // 1. G-buffer: one filtered primary ray per sample.
   auto t0 = Clock::now();
   std::vector<Sample> samples(n);
+  const float spread = s.texture_filtering ? camera.pixel_spread() : 0.0f;
   jobs::parallel_for(0, height, 1, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < width; ++x)
@@ -47,13 +91,13 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
           const glm::vec2 u(rng.next_float(), rng.next_float());
           const rt::Ray ray = camera.generate_filtered(x, y, u, s.filter_width);
           Sample& out = samples[pixel * static_cast<std::size_t>(s.spp) + static_cast<std::size_t>(si)];
-          out = trace_gsample(scene, assets, ray, background);
+          out = trace_gsample(scene, assets, ray, background, spread);
         }
   });
   result.timings.gbuffer_ms = ms_since(t0);
 
   // Samples with transfer first (they go through inference), then the rest.
-  std::vector<std::size_t> hits, diffuse_only;
+  std::vector<std::size_t> hits, diffuse_only, mirrors;
   {
     std::unordered_map<engine::ecs::Entity, bool> cache;
     auto has_transfer = [&](engine::ecs::Entity e) {
@@ -63,10 +107,12 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
       return it->second;
     };
     for (std::size_t i = 0; i < n; ++i)
-      if (samples[i].hit) (has_transfer(samples[i].entity) ? hits : diffuse_only).push_back(i);
+      if (samples[i].hit)
+        (is_mirror(samples[i].brdf, s.mirror_roughness) ? mirrors : has_transfer(samples[i].entity) ? hits : diffuse_only).push_back(i);
   }
   result.inferred_samples = hits.size();
-  result.shaded_samples = hits.size() + diffuse_only.size();
+  result.mirror_samples = mirrors.size();
+  result.shaded_samples = hits.size() + diffuse_only.size() + mirrors.size();
   std::vector<float> transfer(hits.size() * bake::kTransferValues, 0.0f);
 
   if (source == TransferSource::Network) {
@@ -135,6 +181,12 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
       const Sample& smp = samples[diffuse_only[j]];
       light_at(smp.position, smp.normal_world, world);
       shaded[diffuse_only[j]] = smp.diffuse * math::kInvPi * sh_irradiance(world, smp.normal_world);
+    }
+  });
+  jobs::parallel_for<std::size_t>(0, mirrors.size(), 64, [&](std::size_t b, std::size_t e) {
+    for (std::size_t j = b; j < e; ++j) {
+      math::Pcg32 rng = math::make_rng(s.seed ^ 0x4D1Bull, mirrors[j], 0);
+      shaded[mirrors[j]] = shade_mirror_gi(scene, samples[mirrors[j]], light_at, s.lights, s.mirror_light_samples, rng);
     }
   });
   result.light_ms = ms_since(t0);

@@ -10,8 +10,11 @@
 
 #include "engine/image/image.h"
 #include "engine/render/camera_rays.h"
+#include "engine/math/rng.h"
+#include "engine/render/light_set.h"
 #include "engine/rt/rt_scene.h"
 #include "model/transfer_model.h"
+#include "shading/gbuffer.h"
 #include "shading/sh_light.h"
 
 namespace transgi::shading {
@@ -21,6 +24,9 @@ enum class TransferSource {
   GroundTruth,  // integrated per pixel (measures SH truncation alone)
 };
 
+// World-space SH light arriving at a shading point (position, normal).
+using LightAt = std::function<void(const glm::vec3& position, const glm::vec3& normal, float* out75)>;
+
 struct TransferRenderSettings {
   int spp = 4;                 // G-buffer samples per pixel (filtered like the reference)
   // Which entities carry baked transfer (a LatentMesh). Null = every entity.
@@ -28,9 +34,30 @@ struct TransferRenderSettings {
   // light: diffuse albedo / pi x irradiance.
   std::function<bool(engine::ecs::Entity)> has_transfer = nullptr;
   int ground_truth_rays = 2048;
+  // Textures read at the mip level of each primary ray's cone (ray cones), as
+  // rasterisers do. Off = point samples, which alias at one sample per pixel.
+  bool texture_filtering = true;
   std::uint64_t seed = 0;
   float filter_width = 1.5f;
+  // Near-mirrors (metallic, roughness at most this; negative = off) get one
+  // reflection ray instead of SH transfer, which cannot hold a mirror (the
+  // paper's limitation; engines trace reflections): the hit's radiance is its
+  // diffuse albedo / pi times the probe irradiance there (light_at) plus
+  // `mirror_light_samples` next-event samples of `lights` (null: none),
+  // weighted by the mirror's Fresnel. Higher = more surfaces reflect sharply,
+  // at the cost of one ray per such sample and glossy blur lost.
+  float mirror_roughness = 0.05f;
+  int mirror_light_samples = 4;
+  const engine::render::LightSet* lights = nullptr;
 };
+
+// The light leaving a point of a near-mirror towards the viewer, as GI: its
+// Fresnel times what the reflection ray finds, shaded as above. Emitters and
+// the sky seen in the mirror are direct light (the reference's passes), not GI.
+glm::vec3 shade_mirror_gi(const engine::rt::RtScene& scene, const GSample& sample, const LightAt& light_at,
+                          const engine::render::LightSet* lights, int light_samples, engine::math::Pcg32& rng);
+// Whether a sample takes the mirror path.
+bool is_mirror(const engine::material::BrdfParams& brdf, float mirror_roughness);
 
 struct TransferRenderTimings {
   double gbuffer_ms = 0, inputs_ms = 0, inference_ms = 0, shading_ms = 0;
@@ -42,13 +69,12 @@ struct TransferRenderResult {
   // k = (0,0), (1,0), (2,0), averaged over the pixel's samples (Fig. 10).
   std::array<engine::image::ImageRGB, 3> coefficient_maps;
   std::size_t shaded_samples = 0;
-  std::size_t inferred_samples = 0;  // of which had transfer decoded (the rest: diffuse fallback)
+  std::size_t inferred_samples = 0;  // of which had transfer decoded (the rest: diffuse fallback or mirror)
+  std::size_t mirror_samples = 0;    // of which took the mirror path
   TransferRenderTimings timings;
   double light_ms = 0;  // fetching the SH light per shaded sample (probe interpolation)
 };
 
-// World-space SH light arriving at a shading point (position, normal).
-using LightAt = std::function<void(const glm::vec3& position, const glm::vec3& normal, float* out75)>;
 
 TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                                      const model::TransferModel& model, const engine::render::CameraRays& camera,
