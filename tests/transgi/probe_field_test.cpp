@@ -147,3 +147,26 @@ TEST(ProbeField, SwitchingALightOffSettlesInFewFrames) {
   EXPECT_LE(adaptive, 40) << "the probes' change detection should react within tens of frames";
   EXPECT_GE(fixed_097, 3 * adaptive) << "and clearly faster than RTXGI's fixed 0.97 hysteresis";
 }
+
+// The oracle probes of the error decomposition (issue 14, item 2) hold the
+// same analytic answer, path-traced in one go instead of accumulated.
+TEST(ProbeField, OracleProbesAboveALitFloorHoldTheAnalyticSh) {
+  const float a = 0.5f;
+  FloorUnderSky s(a);
+  const auto& assets = s.app.world().resource<scene::SceneAssets>();
+  const render::LightSet lights(s.app.world().resource<rt::RtScene>(), {}, &*assets.environment);
+  ProbeFieldSettings settings;
+  settings.grid = ProbeGrid{{-1, 0.5f, -1}, {1, 1.5f, 1}, {2, 2, 2}};
+  settings.map = MapLayout{32, 16};
+  ProbeField field(settings);
+  s.app.jobs().run([&] {
+    field.update(s.app.world().resource<rt::RtScene>(), lights);  // classifies the probes
+    field.replace_with_oracle(s.app.world().resource<rt::RtScene>(), lights, 16, 9);
+  });
+  const double pi = 3.14159265358979323846;
+  for (int p = 0; p < settings.grid.count(); ++p) {
+    const float* L = field.light_sh(p);
+    EXPECT_NEAR(L[0], a * std::sqrt(pi), 0.02 * a * std::sqrt(pi)) << "probe " << p << " L00";
+    EXPECT_NEAR(L[1], -a * 0.488603 * pi, 0.02 * a * 0.488603 * pi) << "probe " << p << " L(1,-1)";
+  }
+}

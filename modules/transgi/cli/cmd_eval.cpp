@@ -8,6 +8,7 @@
 #include "engine/image/png.h"
 #include "engine/image/tonemap.h"
 #include "engine/scene/scene_assets.h"
+#include "eval/decomposition.h"
 #include "eval/eval_report.h"
 #include "eval/reference_cache.h"
 #include "model/model_file.h"
@@ -37,7 +38,8 @@ void write_image(const std::filesystem::path& dir, const std::string& name, cons
 int run_eval(const std::vector<std::string>& argv) {
   const Args args("eval", argv,
                   {"scene", "model", "out", "width", "height", "spp", "frames", "ddgi-frames", "ddgi-warmup", "probe-grid",
-                   "gbuffer-spp", "camera", "threads", "cache", "seed", "reference-error"});
+                   "gbuffer-spp", "camera", "threads", "cache", "seed", "reference-error"},
+                  {"decompose"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const std::filesystem::path out = args.str("out");
   const int width = static_cast<int>(args.integer("width", 16, 8192, 320));
@@ -101,12 +103,14 @@ int run_eval(const std::vector<std::string>& argv) {
   }
   const auto shared_model = std::make_shared<const model::TransferModel>(std::move(model));
 
+  std::vector<eval::DecompositionRow> decomposition;
   {
     eval::LoadedScene s = eval::load_scene(scene_path, camera, threads);
     eval::MethodResult m{"TransGI", "transgi", "", eval::run_transgi(s, shared_model, width, height, t), {}, {}};
     m.settings = std::to_string(t.frames) + " probe frames, " + std::to_string(t.settings.probes.rays_per_probe) + " rays per probe, " +
                  std::to_string(t.settings.probes.map.width) + "x" + std::to_string(t.settings.probes.map.height) + " maps";
     report.methods.push_back(std::move(m));
+    if (args.has("decompose")) decomposition = eval::decompose_transgi(s, ref.gi, width, height, eval::DecompositionOptions{});
   }
   {
     eval::LoadedScene s = eval::load_scene(scene_path, camera, threads);
@@ -146,6 +150,7 @@ int run_eval(const std::vector<std::string>& argv) {
   for (const auto& m : report.methods)
     std::printf("%-8s GI: RMSE %.4f L1 %.4f SSIM %.3f | GI+DI: RMSE %.4f L1 %.4f SSIM %.3f | frame %.2f ms\n", m.name.c_str(),
                 m.gi.rmse, m.gi.l1, m.gi.ssim, m.gi_di.rmse, m.gi_di.l1, m.gi_di.ssim, m.run.frame_ms);
+  if (!decomposition.empty()) eval::write_decomposition(out, decomposition, ref.gi, ref.noise_gi, report.command);
   std::printf("%s\n", report.reference_note.c_str());
   std::printf("wrote %s (index.html, results.md, results.json, images/, heat/)\n", out.string().c_str());
   return 0;

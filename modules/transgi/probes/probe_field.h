@@ -155,6 +155,15 @@ class ProbeField {
   // other, so a moving object re-lights its neighbourhood first.
   void notify_region_changed(const glm::vec3& min, const glm::vec3& max);
 
+  // Error decomposition: every probe that holds light gets its radiance map
+  // path-traced instead (`rays_per_texel` paths per texel, stratified, each
+  // the radiance leaving its first hit towards the probe, emission excluded:
+  // what the probes hold), its depth moments from the same first hits, and
+  // the same SH projection. What is left of the error is interpolation, SH
+  // truncation and everything that is not the probes.
+  void replace_with_oracle(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, int rays_per_texel,
+                           std::uint64_t seed);
+
   // 75 SH coefficients of probe i, [c * 25 + k], world space.
   [[nodiscard]] const float* light_sh(int probe) const { return sh_.data() + static_cast<std::size_t>(probe) * 75; }
   // Interpolated SH light at a surface point (pruned trilinear).

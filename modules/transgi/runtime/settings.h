@@ -5,6 +5,7 @@
 
 #include "probes/probe_field.h"
 #include "shading/realtime_gi.h"
+#include "shading/transfer_renderer.h"
 
 namespace transgi::runtime {
 
@@ -52,6 +53,14 @@ struct TransGISettings {
   // off (the paper's setting). Higher = more surfaces mirror-traced, at the
   // cost of a ray and a few shadow rays per such sample.
   float mirror_roughness = 0.05f;
+  // Quality path: where each sample's transfer comes from. GroundTruth
+  // integrates it per sample with `ground_truth_rays` rays (the bake's
+  // estimator): the network replaced by its oracle, for error decomposition.
+  shading::TransferSource transfer = shading::TransferSource::Network;
+  int ground_truth_rays = 512;
+  // The probes keep their state and trace nothing (error decomposition
+  // renders several variants of one probe state; debugging).
+  bool freeze_probes = false;
   std::uint64_t seed = 0;
 };
 

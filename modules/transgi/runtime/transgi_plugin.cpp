@@ -63,7 +63,8 @@ void request_light_settings(Res<TransGISettings> settings, ResMut<render::LightS
 }
 
 void update_probes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res<render::SceneLights> lights,
-                   ResMut<GiFrame> frame) {
+                   Res<TransGISettings> settings, ResMut<GiFrame> frame) {
+  if (settings->freeze_probes) return;
   probes::ProbeFrameStats total;
   volumes.each([&](ProbeVolume& v) {
     if (v.field) total += v.field->update(*rt, lights->set);
@@ -159,6 +160,7 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
   rs.spp = settings->gbuffer_spp;
   rs.lights = &lights->set;
   rs.mirror_roughness = settings->mirror_roughness;
+  rs.ground_truth_rays = settings->ground_truth_rays;
   rs.seed = settings->seed + frame->probe_frames;
   rs.has_transfer = [&](Entity e) {
     const LatentMesh* l = latents.try_read<LatentMesh>(e);
@@ -180,8 +182,7 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
     shading::field_holding(fields, p)->interpolate(p, n, out);
   };
   const shading::TransferRenderResult r = shading::render_transfer(
-      *rt, *assets, model ? *model : kNoModel, *rays, frame->width, frame->height, light_at, nullptr,
-      shading::TransferSource::Network, rs);
+      *rt, *assets, model ? *model : kNoModel, *rays, frame->width, frame->height, light_at, nullptr, settings->transfer, rs);
 
   GiStageTimes& t = frame->times;
   t.gbuffer = r.timings.gbuffer_ms;
