@@ -3,6 +3,10 @@
 //   test_scenes/furnace/       a diffuse sphere under a uniform white sky
 //   test_scenes/object_metal/  a glossy metal teapot-like object under a studio map
 //   test_scenes/object_textured/ a textured diffuse object under the same map
+//   test_scenes/thick_room/    a room of 0.3 m walls with mixed winding under
+//                              double-sided materials, furniture, a striped
+//                              wallpaper and a window onto a sky with a sun
+//                              (issue 14's real-content problems, of our making)
 //   levels/living_room/        the sample level: a room with a window lit by
 //                              a sky map, a ceiling area light, large diffuse
 //                              pieces, a glossy metal sphere, a mirror panel
@@ -272,6 +276,70 @@ GltfSceneDesc object_textured() {
   return s;
 }
 
+// ---- thick-walled room (issue 14) -----------------------------------------------------
+
+// Fine stripes of two tones, 4 texels wide, 256 texels across a 4-5 m wall: a
+// pixel of a 320x180 view covers several stripes.
+image::Rgb8Image wallpaper_texture() {
+  image::Rgb8Image img(256, 256);
+  for (int y = 0; y < 256; ++y)
+    for (int x = 0; x < 256; ++x) {
+      const bool on = ((x / 4) % 2) == 0;
+      std::uint8_t* p = img.at(x, y);
+      p[0] = on ? 235 : 150;
+      p[1] = on ? 225 : 120;
+      p[2] = on ? 205 : 95;
+    }
+  return img;
+}
+
+GltfSceneDesc thick_room() {
+  GltfSceneDesc s;
+  enum : std::uint32_t { Paper, Floor, Ceiling, Wood, Fabric };
+  material::Material paper = diffuse("Wallpaper", glm::vec3(1.0f));
+  paper.base_color_texture = 0;
+  s.materials = {paper, diffuse("Floor", {0.55f, 0.42f, 0.3f}), diffuse("Ceiling", {0.9f, 0.9f, 0.88f}),
+                 diffuse("Wood", {0.4f, 0.25f, 0.14f}), diffuse("Fabric", {0.3f, 0.45f, 0.35f})};
+  s.images = {"wallpaper.png"};
+  // Interior x in [-2.5, 2.5], y in [0, 2.8], z in [-2, 2]; walls, floor and
+  // ceiling 0.3 m thick. Mixed winding, as in much real content: the ceiling,
+  // the back wall and the left wall face into their own solids (inward
+  // boxes), so from the room one sees their back faces; all materials are
+  // double-sided.
+  const float t = 0.15f;
+  auto slab = [&](glm::vec3 half, std::uint32_t m, bool flipped) { return scene::make_box(half, flipped, m); };
+  add(s, slab({2.5f + 2 * t, t, 2 + 2 * t}, Floor, false), "Floor", {0, -t, 0});
+  add(s, slab({2.5f + 2 * t, t, 2 + 2 * t}, Ceiling, true), "Ceiling", {0, 2.8f + t, 0});
+  add(s, slab({2.5f, 1.4f, t}, Paper, true), "BackWall", {0, 1.4f, -2 - t});
+  add(s, slab({2.5f, 1.4f, t}, Paper, false), "FrontWall", {0, 1.4f, 2 + t});
+  add(s, slab({t, 1.4f, 2 + 2 * t}, Paper, true), "LeftWall", {-2.5f - t, 1.4f, 0});
+  // Right wall (+x) around a window: z in [-0.9, 0.9], y in [0.9, 2.2].
+  add(s, slab({t, 0.45f, 2 + 2 * t}, Paper, false), "RightWallBelow", {2.5f + t, 0.45f, 0});
+  add(s, slab({t, 0.3f, 2 + 2 * t}, Paper, false), "RightWallAbove", {2.5f + t, 2.5f, 0});
+  add(s, slab({t, 0.65f, 0.55f + t}, Paper, false), "RightWallBack", {2.5f + t, 1.55f, -1.45f - t});
+  add(s, slab({t, 0.65f, 0.55f + t}, Paper, false), "RightWallFront", {2.5f + t, 1.55f, 1.45f + t});
+  // Furniture: a table, a shelf against the back wall, a sofa.
+  add(s, box({0.6f, 0.03f, 0.4f}, Wood), "TableTop", {0.2f, 0.72f, 0.1f});
+  scene::MeshAsset leg = box({0.03f, 0.345f, 0.03f}, Wood);
+  leg.name = "TableLeg";
+  s.meshes.push_back(leg);
+  const int leg_mesh = static_cast<int>(s.meshes.size() - 1);
+  for (int i = 0; i < 4; ++i) {
+    GltfNodeDesc n;
+    n.name = "TableLeg" + std::to_string(i);
+    n.mesh = leg_mesh;
+    n.transform.translation = {0.2f + (i % 2 ? 0.54f : -0.54f), 0.345f, 0.1f + (i / 2 ? 0.34f : -0.34f)};
+    s.nodes.push_back(n);
+    s.roots.push_back(static_cast<int>(s.nodes.size() - 1));
+  }
+  add(s, box({0.9f, 0.9f, 0.2f}, Wood), "Shelf", {-1.2f, 0.9f, -1.8f});
+  add(s, box({0.4f, 0.25f, 1.0f}, Fabric), "SofaSeat", {-2.05f, 0.25f, 0.4f});
+  add(s, box({0.12f, 0.45f, 1.0f}, Fabric), "SofaBack", {-2.38f, 0.65f, 0.4f});
+  add_camera(s, {-1.9f, 1.6f, 1.7f}, {1.0f, 0.9f, -1.2f}, 60.0f, 16.0f / 9.0f);
+  s.environment = scene::GltfEnvironmentDesc{"sky.exr", 1.0f, glm::mat4(1.0f)};
+  return s;
+}
+
 image::Rgb8Image checker_texture() {
   image::Rgb8Image img(64, 64);
   for (int y = 0; y < 64; ++y)
@@ -307,6 +375,9 @@ int main(int argc, char** argv) {
     scene::write_gltf(out / "test_scenes/object_metal/scene.gltf", object_metal());
     image::write_png(out / "test_scenes/object_textured/checker.png", checker_texture());
     scene::write_gltf(out / "test_scenes/object_textured/scene.gltf", object_textured());
+    image::write_exr(out / "test_scenes/thick_room/sky.exr", sky_map(glm::normalize(glm::vec3(1.0f, 0.6f, 0.3f))), image::ExrPixelType::Half);
+    image::write_png(out / "test_scenes/thick_room/wallpaper.png", wallpaper_texture());
+    scene::write_gltf(out / "test_scenes/thick_room/scene.gltf", thick_room());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "content_generator: %s\n", e.what());
     return 1;

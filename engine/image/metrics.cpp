@@ -133,7 +133,12 @@ double ssim_luminance(const ImageRGB& a, const ImageRGB& b) {
 }
 
 ErrorMetrics compare_images(const ImageRGB& a, const ImageRGB& b) {
-  return {rmse_clamped(a, b), l1_clamped(a, b), ssim_luminance(a, b), relmse(a, b)};
+  double la = 0, lb = 0;
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) {
+    la += 0.2126 * a.pixels[i].r + 0.7152 * a.pixels[i].g + 0.0722 * a.pixels[i].b;
+    lb += 0.2126 * b.pixels[i].r + 0.7152 * b.pixels[i].g + 0.0722 * b.pixels[i].b;
+  }
+  return {rmse_clamped(a, b), l1_clamped(a, b), ssim_luminance(a, b), relmse(a, b), lb > 0 ? la / lb : 0.0};
 }
 
 Rgb8Image error_heatmap(const ImageRGB& a, const ImageRGB& b, double max_error, double* used_max) {

@@ -12,6 +12,7 @@ struct ErrorMetrics {
   double l1 = 0;
   double ssim = 0;
   double relmse = 0;
+  double mean_ratio = 0;  // mean luminance of a over b's (1 = the same overall light; 0 if b is black)
 };
 
 inline constexpr double kRelMseEpsilon = 1e-2;

@@ -12,6 +12,7 @@ namespace engine::render {
 
 CameraRays::CameraRays(const scene::Camera& camera, const transform::Similarity& to_world, int width, int height)
     : origin_(to_world.translation),
+      to_world_(to_world),
       rotation_(glm::mat3_cast(to_world.rotation)),
       width_(width),
       height_(height) {

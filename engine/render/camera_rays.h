@@ -18,12 +18,14 @@ struct CameraRays {
   // two uniform numbers u.
   [[nodiscard]] rt::Ray generate_filtered(int x, int y, glm::vec2 u, float filter_width) const;
   [[nodiscard]] glm::vec3 position() const { return origin_; }
+  [[nodiscard]] const transform::Similarity& to_world() const { return to_world_; }
   // A pixel's angular size at the image centre (radians): the spread of a
   // primary ray's cone, for texture footprints (ray cones).
   [[nodiscard]] float pixel_spread() const { return 2.0f * tan_half_y_ / static_cast<float>(height_); }
 
  private:
   glm::vec3 origin_;
+  transform::Similarity to_world_;
   glm::mat3 rotation_;
   float tan_half_y_, tan_half_x_;
   int width_, height_;

@@ -25,10 +25,11 @@ int run_compare(const std::vector<std::string>& argv) {
   }
   if (args.has("top-error")) {
     const double f = args.number("top-error", 0.0, 100.0) / 100.0;
-    std::printf("{\"rmse\": %.8g, \"l1\": %.8g, \"ssim\": %.8g, \"relmse\": %.8g, \"top_error_share\": %.6g}\n", m.rmse, m.l1,
-                m.ssim, m.relmse, engine::image::top_error_share(a, b, f));
+    std::printf("{\"rmse\": %.8g, \"l1\": %.8g, \"ssim\": %.8g, \"relmse\": %.8g, \"mean_ratio\": %.6g, \"top_error_share\": %.6g}\n",
+                m.rmse, m.l1, m.ssim, m.relmse, m.mean_ratio, engine::image::top_error_share(a, b, f));
   } else {
-    std::printf("{\"rmse\": %.8g, \"l1\": %.8g, \"ssim\": %.8g, \"relmse\": %.8g}\n", m.rmse, m.l1, m.ssim, m.relmse);
+    std::printf("{\"rmse\": %.8g, \"l1\": %.8g, \"ssim\": %.8g, \"relmse\": %.8g, \"mean_ratio\": %.6g}\n", m.rmse, m.l1, m.ssim, m.relmse,
+                m.mean_ratio);
   }
   return 0;
 }

@@ -38,7 +38,7 @@ void write_image(const std::filesystem::path& dir, const std::string& name, cons
 int run_eval(const std::vector<std::string>& argv) {
   const Args args("eval", argv,
                   {"scene", "model", "out", "width", "height", "spp", "frames", "ddgi-frames", "ddgi-warmup", "probe-grid",
-                   "gbuffer-spp", "camera", "threads", "cache", "seed", "reference-error"},
+                   "gbuffer-spp", "camera", "threads", "cache", "seed", "reference-error", "temporal"},
                   {"decompose"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const std::filesystem::path out = args.str("out");
@@ -58,6 +58,11 @@ int run_eval(const std::vector<std::string>& argv) {
   t.settings.direct_spp = 0;  // both setups take direct light from the reference
   t.settings.seed = seed;
   t.settings.probes.seed = seed + 1;
+  // Both methods alike: the GI image of the last N frames averaged, each with
+  // its own jittered G-buffer sample (a still view's temporal antialiasing).
+  const int temporal = static_cast<int>(args.integer("temporal", 1, 1024, 1));
+  t.settings.temporal_window = temporal;
+  t.timing_frames = std::max(t.timing_frames, temporal);
   eval::DdgiRunOptions d;
   d.frames = static_cast<int>(args.integer("ddgi-frames", 1, 100000, 200));
   d.settings.warmup_frames = static_cast<int>(args.integer("ddgi-warmup", 0, 100000, 64));
@@ -65,6 +70,8 @@ int run_eval(const std::vector<std::string>& argv) {
   d.render.gbuffer_spp = t.settings.gbuffer_spp;
   d.render.direct_spp = 0;
   d.render.seed = seed;
+  d.render.temporal_window = temporal;
+  d.timing_frames = std::max(d.timing_frames, temporal);
   d.settings.seed = seed + 1;
 
   // Fail on a bad model before minutes of reference rendering.
@@ -148,8 +155,8 @@ int run_eval(const std::vector<std::string>& argv) {
   eval::write_results_markdown(out / "results.md", report);
   eval::write_index_html(out / "index.html", report);
   for (const auto& m : report.methods)
-    std::printf("%-8s GI: RMSE %.4f L1 %.4f SSIM %.3f | GI+DI: RMSE %.4f L1 %.4f SSIM %.3f | frame %.2f ms\n", m.name.c_str(),
-                m.gi.rmse, m.gi.l1, m.gi.ssim, m.gi_di.rmse, m.gi_di.l1, m.gi_di.ssim, m.run.frame_ms);
+    std::printf("%-8s GI: RMSE %.4f L1 %.4f SSIM %.3f mean x%.3f | GI+DI: RMSE %.4f L1 %.4f SSIM %.3f | frame %.2f ms\n", m.name.c_str(),
+                m.gi.rmse, m.gi.l1, m.gi.ssim, m.gi.mean_ratio, m.gi_di.rmse, m.gi_di.l1, m.gi_di.ssim, m.run.frame_ms);
   if (!decomposition.empty()) eval::write_decomposition(out, decomposition, ref.gi, ref.noise_gi, report.command);
   std::printf("%s\n", report.reference_note.c_str());
   std::printf("wrote %s (index.html, results.md, results.json, images/, heat/)\n", out.string().c_str());

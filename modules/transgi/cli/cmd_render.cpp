@@ -147,7 +147,8 @@ int render_ddgi(const Args& args, eval::LoadedScene& scene, int width, int heigh
   d.settings.seed = d.render.seed + 1;
   d.settings.hysteresis = static_cast<float>(args.number("hysteresis", 0.0, 1.0, d.settings.hysteresis));
   d.settings.brightness_threshold = static_cast<float>(args.number("brightness-threshold", 0.0, 1e30, d.settings.brightness_threshold));
-  d.settings.warmup_frames = static_cast<int>(args.integer("warmup-frames", 0, 100000, 0));
+  // eval's cold start: RTXGI's (0) leaves a room nearly black for hundreds of updates.
+  d.settings.warmup_frames = static_cast<int>(args.integer("warmup-frames", 0, 100000, 64));
   d.settings.irradiance_gamma = static_cast<float>(args.number("irradiance-gamma", 0.1, 20.0, d.settings.irradiance_gamma));
   d.frames = static_cast<int>(args.integer("frames", 1, 100000, 400));
   d.timing_frames = static_cast<int>(args.integer("timing-frames", 1, 1000, 3));

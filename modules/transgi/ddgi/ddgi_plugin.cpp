@@ -4,6 +4,7 @@
 
 #include "ddgi/ddgi_renderer.h"
 #include "engine/render/light_plugin.h"
+#include "engine/render/temporal_accumulation.h"
 #include "engine/render/path_tracer.h"
 #include "engine/scene/components.h"
 #include "engine/transform/transform.h"
@@ -63,7 +64,8 @@ void update_volumes(View<Get<DdgiProbeVolume>> volumes, Res<rt::RtScene> rt, Res
 }
 
 void render_frame(View<Get<const scene::Camera, const transform::WorldTransform>> cameras, View<Get<const DdgiProbeVolume>> volumes,
-                  Res<rt::RtScene> rt, Res<render::SceneLights> lights, Res<DdgiRenderOptions> options, ResMut<DdgiFrame> frame) {
+                  Res<rt::RtScene> rt, Res<render::SceneLights> lights, Res<DdgiRenderOptions> options, ResMut<DdgiFrame> frame,
+                  Local<render::TemporalAccumulation> history) {
   if (frame->width <= 0 || frame->height <= 0) return;
   const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
   if (!rays) throw std::runtime_error("ddgi::render: DdgiFrame asks for an image but the world has no camera");
@@ -74,7 +76,9 @@ void render_frame(View<Get<const scene::Camera, const transform::WorldTransform>
   if (!volume) throw std::runtime_error("ddgi::render: no DdgiProbeVolume in the world");
   const std::uint64_t seed = options->seed + frame->frames;
   auto t0 = Clock::now();
-  frame->gi = render_ddgi_gi(*rt, *volume, *rays, frame->width, frame->height, {.spp = options->gbuffer_spp, .seed = seed});
+  frame->gi = render::accumulate(*history, render_ddgi_gi(*rt, *volume, *rays, frame->width, frame->height, {.spp = options->gbuffer_spp, .seed = seed}),
+                                 render::view_key(rays->to_world(), frame->width, frame->height, lights->geometry_version, lights->version),
+                                 options->temporal_window);
   frame->times.shading = ms_since(t0);
   t0 = Clock::now();
   frame->direct = options->direct_spp > 0 ? render::render_direct_light(*rt, lights->set, *rays, frame->width, frame->height,

@@ -26,6 +26,9 @@ struct DdgiProbeVolume {
 struct DdgiRenderOptions {
   int gbuffer_spp = 1;  // higher = antialiased edges, at the cost of that many irradiance lookups
   int direct_spp = 4;   // higher = less direct-light noise, at the cost of tracing time; 0 = GI only
+  // While the view is still, the GI image is the mean of the last this many
+  // jittered frames (as TransGI's TransGISettings::temporal_window). 1 = off.
+  int temporal_window = 1;
   std::uint64_t seed = 0;
 };
 

@@ -24,7 +24,7 @@ std::string json_string(const std::string& s) {
 
 std::string json_metrics(const engine::image::ErrorMetrics& m) {
   return "{\"rmse\": " + fmt("%.6g", m.rmse) + ", \"l1\": " + fmt("%.6g", m.l1) + ", \"ssim\": " + fmt("%.6g", m.ssim) +
-         ", \"relmse\": " + fmt("%.6g", m.relmse) + "}";
+         ", \"relmse\": " + fmt("%.6g", m.relmse) + ", \"mean_ratio\": " + fmt("%.4f", m.mean_ratio) + "}";
 }
 
 std::string html_escape(const std::string& s) {
@@ -38,7 +38,7 @@ std::string cell(double v, double best, const char* f) { return v == best ? "**"
 
 std::string metrics_table(const EvalReport& r, bool with_di) {
   std::ostringstream o;
-  o << "| Method | RMSE | L1 | SSIM |\n| --- | --- | --- | --- |\n";
+  o << "| Method | RMSE | L1 | SSIM | mean / reference mean |\n| --- | --- | --- | --- | --- |\n";
   double best_rmse = 1e30, best_l1 = 1e30, best_ssim = -1e30;
   for (const auto& m : r.methods) {
     const auto& e = with_di ? m.gi_di : m.gi;
@@ -49,7 +49,7 @@ std::string metrics_table(const EvalReport& r, bool with_di) {
   for (const auto& m : r.methods) {
     const auto& e = with_di ? m.gi_di : m.gi;
     o << "| " << m.name << (with_di ? "+DI" : "") << " | " << cell(e.rmse, best_rmse, "%.4f") << " | " << cell(e.l1, best_l1, "%.4f")
-      << " | " << cell(e.ssim, best_ssim, "%.3f") << " |\n";
+      << " | " << cell(e.ssim, best_ssim, "%.3f") << " | " << fmt("%.3f", e.mean_ratio) << " |\n";
   }
   return o.str();
 }

@@ -35,7 +35,7 @@ bool inside_grid(const ProbeGrid& grid, glm::ivec3 c) {
 void relocate(const engine::rt::RtScene& scene, const ProbeGrid& grid, const RelocationSettings& s, OpenSpace& r) {
   using namespace engine;
   const glm::vec3 limit = s.max_offset * grid.spacing();
-  const float margin = s.margin * grid.min_spacing();
+  const float margin = s.margin * grid.min_spacing(), min_margin = s.min_margin * grid.min_spacing();
   for (int pass = 0; pass < 3; ++pass) {
     const std::vector<std::uint8_t> linked = r.open;
     int moved = 0;
@@ -50,10 +50,20 @@ void relocate(const engine::rt::RtScene& scene, const ProbeGrid& grid, const Rel
         const glm::vec3 d = target - from;
         const float len = glm::length(d);
         if (!(len > 0)) return;
+        const glm::vec3 dir = d / len;
         rt::Hit hit;
-        const float t = scene.intersect(rt::Ray{from, d / len, 0.0f, len}, hit) ? hit.t - std::min(margin, 0.5f * hit.t) : len;
+        float t = len;
+        if (scene.intersect(rt::Ray{from, dir, 0.0f, len}, hit)) {
+          // As far before the surface as `margin`, if the offset allows;
+          // never closer than `min_margin`. The offset is (len - t) along dir.
+          float reach = std::numeric_limits<float>::infinity();
+          for (int a = 0; a < 3; ++a)
+            if (std::abs(dir[a]) > 1e-6f) reach = std::min(reach, limit[a] / std::abs(dir[a]));
+          t = std::max(hit.t - margin, len - reach);
+          if (t > hit.t - std::min(min_margin, 0.5f * hit.t)) return;
+        }
         const glm::vec3 offset = from + d / len * t - target;
-        if (glm::any(glm::greaterThan(glm::abs(offset), limit))) return;
+        if (glm::any(glm::greaterThan(glm::abs(offset), limit * 1.001f))) return;
         const float size = glm::length(offset);
         if (size < best) {
           best = size;

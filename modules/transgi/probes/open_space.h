@@ -43,10 +43,13 @@ struct RelocationSettings {
   // more probes rescued from thick walls, at the cost of cages that no longer
   // surround their points.
   float max_offset = 0.45f;
-  // Distance kept from the blocking surface, in cells of the smallest spacing.
-  // Higher = depth maps less dominated by one nearby wall, at the cost of a
-  // probe further from the wall it stands in for.
+  // Distance kept from the blocking surface, in cells of the smallest
+  // spacing: `margin` where the offset allows, never less than `min_margin`.
+  // Higher = probes clear of the shading biases near walls (DDGI's 0.1 m
+  // normal and view offsets), at the cost of a probe further from the wall
+  // it stands in for.
   float margin = 0.1f;
+  float min_margin = 0.05f;
 
   bool operator==(const RelocationSettings&) const = default;
 };

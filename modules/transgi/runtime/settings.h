@@ -58,6 +58,13 @@ struct TransGISettings {
   // estimator): the network replaced by its oracle, for error decomposition.
   shading::TransferSource transfer = shading::TransferSource::Network;
   int ground_truth_rays = 512;
+  // Quality path: while the camera, geometry and lights stay still, the GI
+  // image is the mean of the last `temporal_window` frames, each with its own
+  // jittered G-buffer sample (engine/render/temporal_accumulation.h): a
+  // still view antialiases at one sample per pixel per frame. 1 = off.
+  // Higher = smoother edges and less noise, at the cost of that many frames
+  // before a still view settles.
+  int temporal_window = 1;
   // The probes keep their state and trace nothing (error decomposition
   // renders several variants of one probe state; debugging).
   bool freeze_probes = false;

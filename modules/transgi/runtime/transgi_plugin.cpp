@@ -10,6 +10,7 @@
 #include "engine/transform/transform.h"
 #include "shading/realtime_direct.h"
 #include "shading/realtime_gi.h"
+#include "engine/render/temporal_accumulation.h"
 #include "shading/transfer_renderer.h"
 
 namespace transgi::runtime {
@@ -98,6 +99,7 @@ struct PackedDecoder {
   std::unique_ptr<shading::FusedDecoder> decoder;
   shading::GBuffer gbuffer;
   shading::RealtimeGiScratch scratch;
+  render::TemporalAccumulation history;  // quality path, still views
 };
 
 // Realtime path: fills the frame's gi, direct and full images and its stage times.
@@ -194,7 +196,9 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
   t.probe_projection = frame->probe_stats.project_ms;
   frame->shaded_samples = r.shaded_samples;
   frame->inferred_samples = r.inferred_samples;
-  frame->gi = r.image;
+  frame->gi = render::accumulate(packed->history, r.image,
+                                 render::view_key(rays->to_world(), frame->width, frame->height, lights->geometry_version, lights->version),
+                                 settings->temporal_window);
   add_stochastic_direct(*rt, lights->set, *rays, settings->direct_spp, rs.seed, *frame);
   compose_full(*frame);
 }
