@@ -220,8 +220,9 @@ TEST(OpenSpace, ProbesInsideWallsAreNotLinkedToLight) {
 // still be lit correctly: each method's indirect irradiance at eight points
 // on the floor, walls and ceiling against the path tracer's. Tolerances: a
 // mean relative error of 12 % over the points and 30 % at any one (what an
-// 8-probe cage 1.1 m wide resolves near corners); the probes in the walls,
-// were they kept, darken the room by a third.
+// 8-probe cage 1.1 m wide resolves near corners). The probes in the walls,
+// were they kept, spoil the room: 8 % mean error (34 % before radiance
+// sharing kept to the side of a surface its probe saw).
 TEST(OpenSpace, AGridWithALayerInsideThickWallsStillLightsTheRoom) {
   Room room(Shell::Thick, true);
   const auto ref = reference_irradiance(room);
@@ -242,12 +243,14 @@ TEST(OpenSpace, AGridWithALayerInsideThickWallsStillLightsTheRoom) {
   // 82 in the walls are moved into the room.
   EXPECT_EQ(wall_stats.buried, 0);
   EXPECT_EQ(wall_stats.relocated, 100 - 18);
-  EXPECT_LT(check("TransGI, grid in the walls", walls, 0.12, 0.30), 0.12);
+  const double with_test = check("TransGI, grid in the walls", walls, 0.12, 0.30);
+  EXPECT_LT(with_test, 0.12);
   EXPECT_LT(check("TransGI, grid inside the room", transgi_irradiance(room, field_settings(kInsideGrid), 64), 0.12, 0.30), 0.12);
   ProbeFieldSettings no_open = field_settings(kWallGrid);
   no_open.skip.open_space = false;
-  EXPECT_GT(check("TransGI, grid in the walls, no open-space test", transgi_irradiance(room, no_open, 64), 0, 0), 0.25)
-      << "the probes in the walls must darken the room when kept, or this test shows nothing";
+  const double without_test = check("TransGI, grid in the walls, no open-space test", transgi_irradiance(room, no_open, 64), 0, 0);
+  EXPECT_GT(without_test, std::max(0.05, 3 * with_test))
+      << "the probes in the walls must spoil the room when kept, or this test shows nothing";
   no_open.skip.open_space = true;
   no_open.skip.relocation.enabled = false;
   check("TransGI, grid in the walls, not relocated", transgi_irradiance(room, no_open, 64), 0, 0);

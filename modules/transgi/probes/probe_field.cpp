@@ -187,6 +187,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
         sp.distance = h.distance;
         sp.position = h.position;
         sp.radiance = h.radiance;
+        sp.normal = h.normal;
         if (h.hit) {
           hits.fetch_add(1, std::memory_order_relaxed);
           backfaces[static_cast<std::size_t>(q)] += h.back_face ? 1 : 0;

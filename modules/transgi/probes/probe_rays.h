@@ -31,6 +31,7 @@ struct ProbeRayHit {
   bool saw_light = false;
   float distance = std::numeric_limits<float>::infinity();
   glm::vec3 position{0.0f};
+  glm::vec3 normal{0.0f};    // geometric, facing the probe
   glm::vec3 radiance{0.0f};  // leaving the hit towards the probe
   // Light arriving straight from an emitter or the (residual) environment:
   // not part of `radiance`, which is indirect light only; the probes keep it
@@ -63,6 +64,7 @@ ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::rend
   r.back_face = s.back_face;
   r.distance = hit.t;
   r.position = s.position;
+  r.normal = s.geometric_normal;
   const bool emitter = s.emission.r > 0 || s.emission.g > 0 || s.emission.b > 0;
   r.saw_light = emitter;
   const glm::vec3 wo = s.frame.to_local(-dir);

@@ -36,6 +36,10 @@ SharingStats rasterize_shared(const ProbeGrid& grid, const MapLayout& layout,
           if (!(dist > 1e-6f)) continue;
           d /= dist;
           const int t = layout.texel_of(d);
+          if (q != p && s.mode == SharingMode::DepthGuard && s.same_side && glm::dot(pt.normal, d) > 0) {
+            ++rej;  // the target sees the point's surface from behind
+            continue;
+          }
           if (q != p && s.mode == SharingMode::DepthGuard && depth) {
             const float own = depth->mean(static_cast<std::size_t>(t));
             if (std::isfinite(own) && dist > own * (1.0f + s.relative_tolerance) + s.absolute_tolerance) {

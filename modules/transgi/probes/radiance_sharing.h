@@ -12,7 +12,9 @@
 // A neighbour's point can lie behind a wall that the target probe's own rays
 // hit first. With the depth guard on, such a point is rejected when its
 // distance exceeds the target's own mean hit distance in that texel by more
-// than the tolerance. SharingMode::PaperFaithful keeps every point (ablation).
+// than the tolerance, or (same_side) when the target stands behind the
+// surface the point lies on. SharingMode::PaperFaithful keeps every point
+// (ablation).
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -29,6 +31,7 @@ struct ShadedPoint {
   glm::vec3 radiance{0.0f};  // leaving the point towards its own probe
   glm::vec3 direction{0.0f}; // unit, from the shooting probe
   float distance = 0.0f;     // from the shooting probe; infinity when the ray escaped
+  glm::vec3 normal{0.0f};    // the surface's geometric normal, on the shooting probe's side
 };
 
 enum class SharingMode { DepthGuard, PaperFaithful };
@@ -38,6 +41,12 @@ struct SharingSettings {
   // A neighbour's point is rejected beyond own_depth * (1 + relative) + absolute.
   float relative_tolerance = 0.1f;
   float absolute_tolerance = 0.05f;  // world units
+  // A neighbour's point is shared only with probes on the side of its surface
+  // that the shooting probe saw: the light leaving one side of a thin wall
+  // (a single sheet, as much real content has) says nothing of the other
+  // side, and the depth guard cannot tell the two sides apart. On = no light
+  // through thin walls by sharing, at the cost of one dot product per point.
+  bool same_side = true;
   bool operator==(const SharingSettings&) const = default;
 };
 
