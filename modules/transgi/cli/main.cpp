@@ -23,7 +23,7 @@ void usage() {
                "  render   --scene S.gltf --method ddgi [--frames F] [--probe-grid N] [--probe-rays M] [--warmup-frames W] ...\n"
                "  transfer-study --scene S.gltf [--points N] [--outgoing K] [--reference-rays R]\n"
                "  eval     --scene S.gltf --model M.tgm --out DIR [--width W --height H --spp N --frames F --ddgi-frames F2]\n"
-               "           [--probe-grid N] [--cache DIR]\n"
+               "           [--probe-grid N] [--cache DIR] [--reference-error E] [--temporal N] [--decompose]\n"
                "  bench-pareto --scene S.gltf --model M.tgm --out DIR [--width W --height H --spp N] [--quick]\n"
                "  bench-frame --scene S.gltf --model M.tgm [--width W --height H --frames N --warmup W --preset realtime|quality --csv F]\n");
 }

@@ -25,6 +25,10 @@ image::ImageRGB render_frozen(LoadedScene& scene, int width, int height, const s
   const runtime::TransGISettings saved = settings;
   change(settings);
   settings.freeze_probes = true;
+  // One frame each: the variants compare as single images (a 16-sample
+  // G-buffer row stands for what accumulation buys), not blended into the
+  // run's temporal history.
+  settings.temporal_window = 1;
   auto& frame = world.resource<runtime::GiFrame>();
   frame.width = width;
   frame.height = height;
