@@ -17,6 +17,8 @@
 #include "engine/scene/components.h"
 #include "engine/scene/procedural.h"
 #include "lambert.h"
+#include "probes/probe_field.h"
+#include "shading/realtime_gi.h"
 #include "shading/transfer_renderer.h"
 
 using namespace engine;
@@ -91,4 +93,22 @@ TEST(MirrorPath, AFlatMirrorUnderALitCeilingShowsTheCeilingsRadiance) {
   });
   EXPECT_EQ(r.mirror_samples, 0u);
   EXPECT_EQ(r.image.at(16, 16).g, 0.0f);
+
+  // The real-time path traces the same ray at full resolution: the same
+  // answer. Its probes hold no light yet (a field never updated).
+  probes::ProbeFieldSettings ps;
+  ps.grid = probes::ProbeGrid{{-1, 0.5f, -1}, {1, 1.5f, 1}, {2, 2, 2}};
+  ps.map = probes::MapLayout{8, 4};
+  const probes::ProbeField field(ps);
+  const probes::ProbeField* fields[] = {&field};
+  shading::GBuffer g;
+  engine::image::ImageRGB realtime;
+  app.jobs().run([&] {
+    shading::trace_gbuffer(rt, w.resource<scene::SceneAssets>(), rays, 32, 32, g);
+    realtime = shading::shade_gi_realtime(g, rt, w.resource<scene::SceneAssets>(), nullptr, nullptr, {}, fields,
+                                          shading::RealtimeGiSettings{}, nullptr, nullptr, nullptr, &lights);
+  });
+  for (int y = 14; y < 18; ++y)
+    for (int x = 14; x < 18; ++x)
+      EXPECT_NEAR(realtime.at(x, y).g, expected, 1e-4f * expected) << "real-time path, pixel (" << x << ", " << y << ")";
 }

@@ -207,8 +207,15 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
     const float far = settings_.skip.far_cells * glm::length(grid.spacing());
     bool any_pending = classify;
     for (std::size_t q = 0; q < state_.size() && !any_pending; ++q) any_pending = traced[q] && needs_classify_[q];
+    // A probe standing off its grid point saw light from where it stands, which
+    // says nothing of the grid point (else it would be moved back, then out
+    // again, every other classification).
+    std::vector<std::uint8_t> seeds = saw_light_;
+    if (!grid_.offsets.empty())
+      for (std::size_t q = 0; q < seeds.size(); ++q)
+        if (grid_.offsets[q] != glm::vec3(0.0f)) seeds[q] = 0;
     const OpenSpace open =
-        settings_.skip.open_space && any_pending ? find_open_space(scene, settings_.grid, saw_light_, settings_.skip.relocation) : OpenSpace{};
+        settings_.skip.open_space && any_pending ? find_open_space(scene, settings_.grid, seeds, settings_.skip.relocation) : OpenSpace{};
     if (!open.open.empty() && grid_.offsets.empty()) grid_.offsets.assign(state_.size(), glm::vec3(0.0f));
     for (std::size_t q = 0; q < state_.size(); ++q) {
       if (traced[q]) {

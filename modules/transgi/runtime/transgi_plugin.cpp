@@ -119,7 +119,7 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   shading::RealtimeGiStats st;
   image::ImageRGB probe_direct;
   frame.gi = shading::shade_gi_realtime(g, rt, assets, model.get(), model ? packed.decoder.get() : nullptr, has_transfer, fields,
-                                        settings.realtime, &st, deterministic ? &probe_direct : nullptr, &packed.scratch);
+                                        settings.realtime, &st, deterministic ? &probe_direct : nullptr, &packed.scratch, &lights);
   GiStageTimes& t = frame.times;
   t.network_input = 0;  // inside the fused kernel, counted as inference
   t.inference = st.inference_ms;

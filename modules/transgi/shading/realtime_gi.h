@@ -23,6 +23,7 @@
 #include "probes/probe_field.h"
 #include "shading/fused_decoder.h"
 #include "shading/gbuffer.h"
+#include "shading/transfer_renderer.h"
 
 namespace transgi::shading {
 
@@ -44,6 +45,12 @@ struct RealtimeGiSettings {
   float min_weight = 0.05f;
   // Off = plain bilinear upsampling (only to show what the guidance prevents).
   bool edge_aware = true;
+  // Near-mirrors (metallic, roughness at most this; negative = off) show one
+  // reflection ray's hit, shaded with the probes' GI and `mirror_light_samples`
+  // next-event samples (transfer_renderer.h's mirror path), at full
+  // resolution. Higher = more surfaces mirror-traced, at the cost of rays.
+  float mirror_roughness = 0.05f;
+  int mirror_light_samples = 4;
 
   bool operator==(const RealtimeGiSettings&) const = default;
 };
@@ -104,6 +111,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
                                           std::span<const probes::ProbeField* const> fields,
                                           const RealtimeGiSettings& settings, RealtimeGiStats* stats = nullptr,
                                           engine::image::ImageRGB* direct_out = nullptr,
-                                          RealtimeGiScratch* scratch = nullptr);
+                                          RealtimeGiScratch* scratch = nullptr,
+                                          const engine::render::LightSet* mirror_lights = nullptr);
 
 }  // namespace transgi::shading
