@@ -40,7 +40,10 @@ int run_bake(const std::vector<std::string>& argv) {
 
   engine::jobs::JobSystem jobs({.threads = threads});
   engine::ecs::World world;
-  const auto loaded = engine::scene::load_gltf(world, scene_path, {.load_environment = false});
+  // The transfer does not depend on the lighting, but the scene is checked
+  // as every command checks it: an environment outside the scene's folder,
+  // missing or malformed is refused here too.
+  const auto loaded = engine::scene::load_gltf(world, scene_path);
   for (const auto& w : loaded.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   const auto& assets = world.resource<engine::scene::SceneAssets>();
 
