@@ -24,7 +24,7 @@ int run_transfer_study(const std::vector<std::string>& argv) {
   const auto seed = static_cast<std::uint64_t>(args.integer("seed", 0, INT64_MAX, 3));
   engine::jobs::JobSystem jobs({.threads = static_cast<int>(args.integer("threads", 0, 1024, 0))});
   engine::ecs::World world;
-  engine::scene::load_gltf(world, args.str("scene"), {.load_environment = false});
+  engine::scene::load_gltf(world, args.str("scene"));  // checked as every command checks a scene
   const auto& assets = world.resource<engine::scene::SceneAssets>();
   const std::vector<int> counts = {256, 512, 1000, 2000};
   struct Acc {
