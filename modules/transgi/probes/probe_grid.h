@@ -14,7 +14,7 @@ struct ProbeGrid {
   glm::ivec3 dims{8};
   // Per probe, where relocation moved it from its grid point; empty = none
   // moved. Trilinear weights (cage) stay those of the grid points, as in RTXGI.
-  std::vector<glm::vec3> offsets;
+  std::vector<glm::vec3> offsets{};
 
   bool operator==(const ProbeGrid&) const = default;
 
