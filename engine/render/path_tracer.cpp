@@ -78,7 +78,7 @@ PathRadiance PathTracer::trace(rt::Ray ray, math::Pcg32& rng) const {
 
     const glm::vec3 wo = s.frame.to_local(-ray.direction);
     if (wo.z <= 0) break;  // the shading normal disagrees with the view: no reflection
-    const glm::vec3 origin = rt::offset_ray_origin(s.position, s.geometric_normal);
+    const glm::vec3 origin = rt::offset_ray_origin(s.position, s.geometric_normal, scene_.offset_scale());
 
     // Next-event estimation.
     LightSample ls;

@@ -5,9 +5,9 @@
 
 namespace engine::rt {
 
-glm::vec3 offset_ray_origin(const glm::vec3& p, const glm::vec3& n) {
-  constexpr float kOrigin = 1.0f / 32.0f;
-  constexpr float kFloatScale = 1.0f / 65536.0f;
+glm::vec3 offset_ray_origin(const glm::vec3& p, const glm::vec3& n, float scale) {
+  const float kOrigin = scale / 32.0f;
+  const float kFloatScale = scale / 65536.0f;
   constexpr float kIntScale = 256.0f;
   glm::vec3 out;
   for (int i = 0; i < 3; ++i) {

@@ -28,7 +28,12 @@ struct Hit {
 // Offsets a ray origin off a surface along its geometric normal, scaled to
 // the floating-point precision of the position (Waechter and Binder 2019,
 // Ray Tracing Gems ch. 6), so spawned rays do not re-hit their surface.
-glm::vec3 offset_ray_origin(const glm::vec3& p, const glm::vec3& geometric_normal);
+// scale: the scene's size where it is under a metre (RtScene::offset_scale).
+// Their fixed offset near the origin (1/65536 within 1/32 of it) suits
+// scenes of metres; in a scene of millimetres it is the thickness of a wall,
+// and rays started beyond walls (a Cornell box scaled by 1e-3 lost half its
+// GI), so it shrinks with the scene.
+glm::vec3 offset_ray_origin(const glm::vec3& p, const glm::vec3& geometric_normal, float scale = 1.0f);
 
 inline bool is_finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 

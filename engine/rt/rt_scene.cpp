@@ -2,6 +2,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -228,6 +229,9 @@ void RtScene::commit() {
     bounds_min_ = {b.lower_x, b.lower_y, b.lower_z};
     bounds_max_ = {b.upper_x, b.upper_y, b.upper_z};
   }
+  const glm::vec3 m = glm::max(glm::abs(bounds_min_), glm::abs(bounds_max_));
+  const float extent = std::max(m.x, std::max(m.y, m.z));
+  offset_scale_ = std::isfinite(extent) && extent > 0 ? std::clamp(extent, 1e-6f, 1.0f) : 1.0f;
 }
 
 namespace {

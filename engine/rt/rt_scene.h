@@ -91,6 +91,9 @@ class RtScene {
   // World-space bounds of all instances (valid after commit()).
   [[nodiscard]] glm::vec3 bounds_min() const { return bounds_min_; }
   [[nodiscard]] glm::vec3 bounds_max() const { return bounds_max_; }
+  // For offset_ray_origin: the largest coordinate's magnitude of the bounds,
+  // clamped to [1e-6, 1] (1 for any scene of a metre or more).
+  [[nodiscard]] float offset_scale() const { return offset_scale_; }
 
  private:
   struct Impl;
@@ -102,6 +105,7 @@ class RtScene {
   RtStats stats_;
   bool dirty_ = false;
   glm::vec3 bounds_min_{0.0f}, bounds_max_{0.0f};
+  float offset_scale_ = 1.0f;
   std::vector<WorldBounds> changed_pending_, changed_at_commit_;
   mutable std::atomic<std::uint64_t> rejected_{0};
 };

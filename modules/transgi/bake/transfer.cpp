@@ -99,7 +99,7 @@ void MeshTransfer::estimate(const SurfacePoint& p, std::span<const glm::vec3> wo
   }
   const float total = static_cast<float>(per * proposals);  // failed draws count as zero samples
 
-  const glm::vec3 origin = rt::offset_ray_origin(p.position, p.geometric_normal);
+  const glm::vec3 origin = rt::offset_ray_origin(p.position, p.geometric_normal, tracer_.offset_scale());
   for (const glm::vec3& wi : dirs) {
     const glm::vec3 wi_obj = frame.to_world(wi);
     if (glm::dot(wi_obj, p.geometric_normal) <= 0) continue;  // blocked by the surface itself

@@ -76,7 +76,7 @@ ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::rend
     const glm::vec3 wi = s.frame.to_local(ls.direction);
     const glm::vec3 f = wi.z > 0 ? material::brdf_eval(s.brdf, wo, wi) : glm::vec3(0.0f);
     if (f != glm::vec3(0.0f)) {
-      const glm::vec3 o = rt::offset_ray_origin(s.position, s.geometric_normal);
+      const glm::vec3 o = rt::offset_ray_origin(s.position, s.geometric_normal, scene.offset_scale());
       const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
       if (!scene.occluded(rt::Ray{o, ls.direction, 0.0f, tmax})) {
         r.radiance += f * wi.z * ls.radiance / (ls.delta ? 1.0f : ls.pdf);

@@ -76,7 +76,7 @@ engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt
             const glm::vec3 c = material::brdf_eval(s.brdf, wo, wi) * wi.z * ls.radiance;
             if (!(c.r > 0 || c.g > 0 || c.b > 0)) continue;
             const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
-            rays[n] = rt::Ray{rt::offset_ray_origin(s.position, s.geometric_normal), ls.direction, 0.0f, tmax};
+            rays[n] = rt::Ray{rt::offset_ray_origin(s.position, s.geometric_normal, scene.offset_scale()), ls.direction, 0.0f, tmax};
             pixel[n] = p;
             contribution[n] = c;
             ++n;

@@ -41,7 +41,7 @@ glm::vec3 shade_mirror_gi(const engine::rt::RtScene& scene, const GSample& smp, 
   const glm::vec3 wi = glm::normalize(2.0f * cos_o * n - wo);
   if (glm::dot(wi, smp.geometric_normal) <= 0) return glm::vec3(0.0f);
   rt::Hit hit;
-  if (!scene.intersect(rt::Ray{rt::offset_ray_origin(smp.position, smp.geometric_normal), wi}, hit)) return glm::vec3(0.0f);
+  if (!scene.intersect(rt::Ray{rt::offset_ray_origin(smp.position, smp.geometric_normal, scene.offset_scale()), wi}, hit)) return glm::vec3(0.0f);
   const render::Surface s = render::make_surface(scene, hit, wi);
   if (s.emission.r > 0 || s.emission.g > 0 || s.emission.b > 0) return glm::vec3(0.0f);  // direct light
   const glm::vec3 albedo = material::diffuse_albedo(s.brdf);
@@ -50,7 +50,7 @@ glm::vec3 shade_mirror_gi(const engine::rt::RtScene& scene, const GSample& smp, 
   light_at(s.position, s.shading_normal, sh);
   glm::vec3 irradiance = sh_irradiance(sh, s.shading_normal);
   if (lights && light_samples > 0) {
-    const glm::vec3 origin = rt::offset_ray_origin(s.position, s.geometric_normal);
+    const glm::vec3 origin = rt::offset_ray_origin(s.position, s.geometric_normal, scene.offset_scale());
     glm::vec3 direct(0.0f);
     for (int k = 0; k < light_samples; ++k) {
       render::LightSample ls;
