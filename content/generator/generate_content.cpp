@@ -95,6 +95,22 @@ void add_camera(GltfSceneDesc& s, glm::vec3 eye, glm::vec3 target, float yfov_de
 
 scene::MeshAsset box(glm::vec3 half, std::uint32_t material) { return scene::make_box(half, false, material); }
 
+// Four table legs sharing one mesh, standing at (x +- spread.x, z +- spread.y).
+void add_table_legs(GltfSceneDesc& s, std::uint32_t material, float half_height, glm::vec2 centre, glm::vec2 spread) {
+  scene::MeshAsset leg = box({0.03f, half_height, 0.03f}, material);
+  leg.name = "TableLeg";
+  s.meshes.push_back(leg);
+  const int leg_mesh = static_cast<int>(s.meshes.size() - 1);
+  for (int i = 0; i < 4; ++i) {
+    GltfNodeDesc n;
+    n.name = "TableLeg" + std::to_string(i);
+    n.mesh = leg_mesh;
+    n.transform.translation = {centre.x + (i % 2 ? spread.x : -spread.x), half_height, centre.y + (i / 2 ? spread.y : -spread.y)};
+    s.nodes.push_back(n);
+    s.roots.push_back(static_cast<int>(s.nodes.size() - 1));
+  }
+}
+
 // ---- Cornell box ------------------------------------------------------------
 
 GltfSceneDesc cornell_box() {
@@ -177,19 +193,7 @@ GltfSceneDesc living_room() {
   add(s, box({1.1f, 0.4f, 0.12f}, Sofa), "SofaBack", {-1.6f, 0.62f, -2.33f});
   add(s, box({1.6f, 0.01f, 1.1f}, Rug), "Rug", {-0.4f, 0.01f, -0.6f});
   add(s, box({0.7f, 0.03f, 0.45f}, Wood), "TableTop", {-0.4f, 0.5f, -0.6f});
-  // Four legs sharing one mesh.
-  scene::MeshAsset leg = box({0.03f, 0.235f, 0.03f}, Wood);
-  leg.name = "TableLeg";
-  s.meshes.push_back(leg);
-  const int leg_mesh = static_cast<int>(s.meshes.size() - 1);
-  for (int i = 0; i < 4; ++i) {
-    GltfNodeDesc n;
-    n.name = "TableLeg" + std::to_string(i);
-    n.mesh = leg_mesh;
-    n.transform.translation = {-0.4f + (i % 2 ? 0.62f : -0.62f), 0.235f, -0.6f + (i / 2 ? 0.38f : -0.38f)};
-    s.nodes.push_back(n);
-    s.roots.push_back(static_cast<int>(s.nodes.size() - 1));
-  }
+  add_table_legs(s, Wood, 0.235f, {-0.4f, -0.6f}, {0.62f, 0.38f});
   add(s, scene::make_uv_sphere(0.18f, 48, 24, Gold), "GoldSphere", {-0.6f, 0.71f, -0.55f});
   add(s, box({0.2f, 0.2f, 0.2f}, BluePlastic), "PlasticCube", {1.4f, 0.2f, 0.4f},
       glm::angleAxis(glm::radians(30.0f), glm::vec3(0, 1, 0)));
@@ -320,18 +324,7 @@ GltfSceneDesc thick_room() {
   add(s, slab({t, 0.65f, 0.55f + t}, Paper, false), "RightWallFront", {2.5f + t, 1.55f, 1.45f + t});
   // Furniture: a table, a shelf against the back wall, a sofa.
   add(s, box({0.6f, 0.03f, 0.4f}, Wood), "TableTop", {0.2f, 0.72f, 0.1f});
-  scene::MeshAsset leg = box({0.03f, 0.345f, 0.03f}, Wood);
-  leg.name = "TableLeg";
-  s.meshes.push_back(leg);
-  const int leg_mesh = static_cast<int>(s.meshes.size() - 1);
-  for (int i = 0; i < 4; ++i) {
-    GltfNodeDesc n;
-    n.name = "TableLeg" + std::to_string(i);
-    n.mesh = leg_mesh;
-    n.transform.translation = {0.2f + (i % 2 ? 0.54f : -0.54f), 0.345f, 0.1f + (i / 2 ? 0.34f : -0.34f)};
-    s.nodes.push_back(n);
-    s.roots.push_back(static_cast<int>(s.nodes.size() - 1));
-  }
+  add_table_legs(s, Wood, 0.345f, {0.2f, 0.1f}, {0.54f, 0.34f});
   add(s, box({0.9f, 0.9f, 0.2f}, Wood), "Shelf", {-1.2f, 0.9f, -1.8f});
   add(s, box({0.4f, 0.25f, 1.0f}, Fabric), "SofaSeat", {-2.05f, 0.25f, 0.4f});
   add(s, box({0.12f, 0.45f, 1.0f}, Fabric), "SofaBack", {-2.38f, 0.65f, 0.4f});

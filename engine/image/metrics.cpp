@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "engine/math/sampling.h"
+
 namespace engine::image {
 
 namespace {
@@ -135,8 +137,8 @@ double ssim_luminance(const ImageRGB& a, const ImageRGB& b) {
 ErrorMetrics compare_images(const ImageRGB& a, const ImageRGB& b) {
   double la = 0, lb = 0;
   for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) {
-    la += 0.2126 * a.pixels[i].r + 0.7152 * a.pixels[i].g + 0.0722 * a.pixels[i].b;
-    lb += 0.2126 * b.pixels[i].r + 0.7152 * b.pixels[i].g + 0.0722 * b.pixels[i].b;
+    la += math::luminance(a.pixels[i]);
+    lb += math::luminance(b.pixels[i]);
   }
   return {rmse_clamped(a, b), l1_clamped(a, b), ssim_luminance(a, b), relmse(a, b), lb > 0 ? la / lb : 0.0};
 }

@@ -69,7 +69,7 @@ TEST(MirrorPath, AFlatMirrorUnderALitCeilingShowsTheCeilingsRadiance) {
   s.spp = 1;
   s.has_transfer = [](ecs::Entity) { return false; };
   s.lights = &lights;
-  s.mirror_light_samples = 1;
+  s.mirror.light_samples = 1;
   const shading::LightAt no_probe_light = [](const glm::vec3&, const glm::vec3&, float* out) { std::fill_n(out, 75, 0.0f); };
   const model::TransferModel no_model;
   shading::TransferRenderResult r;
@@ -86,7 +86,7 @@ TEST(MirrorPath, AFlatMirrorUnderALitCeilingShowsTheCeilingsRadiance) {
 
   // Off (the paper's setting), SH transfer or a diffuse fallback cannot show
   // a mirror: a metal has no diffuse albedo, so the pixel is black.
-  s.mirror_roughness = -1;
+  s.mirror.max_roughness = -1;
   app.jobs().run([&] {
     r = shading::render_transfer(rt, w.resource<scene::SceneAssets>(), no_model, rays, 32, 32, no_probe_light, nullptr,
                                  shading::TransferSource::Network, s);

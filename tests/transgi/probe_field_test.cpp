@@ -18,28 +18,46 @@
 using namespace transgi::probes;
 using namespace engine;
 
-TEST(ProbeField, ProbesAboveALitFloorConvergeToTheAnalyticSh) {
-  const float a = 0.5f;
-  FloorUnderSky s(a);
-  const auto& assets = s.app.world().resource<scene::SceneAssets>();
-  const render::LightSet lights(s.app.world().resource<rt::RtScene>(), {}, &*assets.environment);
+namespace {
+
+// Eight probes above the floor, maps small enough to converge fast.
+ProbeFieldSettings floor_probes() {
   ProbeFieldSettings settings;
   settings.grid = ProbeGrid{{-1, 0.5f, -1}, {1, 1.5f, 1}, {2, 2, 2}};
   settings.map = MapLayout{32, 16};
   settings.window = false;  // compare the raw projection with the analytic one
+  return settings;
+}
+
+render::LightSet sky_lights(FloorUnderSky& s) {
+  return render::LightSet(s.app.world().resource<rt::RtScene>(), {}, &*s.app.world().resource<scene::SceneAssets>().environment);
+}
+
+// L00 = a sqrt(pi) and L(1,-1) = -a 0.4886 pi at every probe, to `relative`.
+void expect_floor_sh(const ProbeField& field, float a, double relative) {
+  const double pi = 3.14159265358979323846;
+  for (int p = 0; p < field.settings().grid.count(); ++p) {
+    const float* L = field.light_sh(p);
+    EXPECT_NEAR(L[0], a * std::sqrt(pi), relative * a * std::sqrt(pi)) << "probe " << p << " L00";
+    EXPECT_NEAR(L[1], -a * 0.488603 * pi, relative * a * 0.488603 * pi) << "probe " << p << " L(1,-1)";
+  }
+}
+
+}  // namespace
+
+TEST(ProbeField, ProbesAboveALitFloorConvergeToTheAnalyticSh) {
+  const float a = 0.5f;
+  FloorUnderSky s(a);
+  const render::LightSet lights = sky_lights(s);
+  const ProbeFieldSettings settings = floor_probes();
   ProbeField field(settings);
   s.app.jobs().run([&] {
     // 200 frames: with hysteresis 0.95 the history spans ~20-40 frames, and
     // 40 frames left 4 % of Monte Carlo noise in L(1,-1).
     for (int f = 0; f < 200; ++f) field.update(s.app.world().resource<rt::RtScene>(), lights);
   });
-  const double pi = 3.14159265358979323846;
-  for (int p = 0; p < settings.grid.count(); ++p) {
-    const float* L = field.light_sh(p);
-    EXPECT_NEAR(L[0], a * std::sqrt(pi), 0.04 * a * std::sqrt(pi)) << "probe " << p << " L00";
-    EXPECT_NEAR(L[1], -a * 0.488603 * pi, 0.04 * a * 0.488603 * pi) << "probe " << p << " L(1,-1)";
-    EXPECT_NEAR(L[25], L[0], 1e-5) << "grey: channels agree";
-  }
+  expect_floor_sh(field, a, 0.04);
+  for (int p = 0; p < settings.grid.count(); ++p) EXPECT_NEAR(field.light_sh(p)[25], field.light_sh(p)[0], 1e-5) << "grey: channels agree";
   // The floor's irradiance from the probes (upper hemisphere sees only the
   // sky, which the probes do not hold) is near zero.
   EXPECT_LT(field.irradiance({0, 0.01f, 0}, {0, 1, 0}).g, 0.1f);
@@ -153,20 +171,11 @@ TEST(ProbeField, SwitchingALightOffSettlesInFewFrames) {
 TEST(ProbeField, OracleProbesAboveALitFloorHoldTheAnalyticSh) {
   const float a = 0.5f;
   FloorUnderSky s(a);
-  const auto& assets = s.app.world().resource<scene::SceneAssets>();
-  const render::LightSet lights(s.app.world().resource<rt::RtScene>(), {}, &*assets.environment);
-  ProbeFieldSettings settings;
-  settings.grid = ProbeGrid{{-1, 0.5f, -1}, {1, 1.5f, 1}, {2, 2, 2}};
-  settings.map = MapLayout{32, 16};
-  ProbeField field(settings);
+  const render::LightSet lights = sky_lights(s);
+  ProbeField field(floor_probes());
   s.app.jobs().run([&] {
     field.update(s.app.world().resource<rt::RtScene>(), lights);  // classifies the probes
     field.replace_with_oracle(s.app.world().resource<rt::RtScene>(), lights, 16, 9);
   });
-  const double pi = 3.14159265358979323846;
-  for (int p = 0; p < settings.grid.count(); ++p) {
-    const float* L = field.light_sh(p);
-    EXPECT_NEAR(L[0], a * std::sqrt(pi), 0.02 * a * std::sqrt(pi)) << "probe " << p << " L00";
-    EXPECT_NEAR(L[1], -a * 0.488603 * pi, 0.02 * a * 0.488603 * pi) << "probe " << p << " L(1,-1)";
-  }
+  expect_floor_sh(field, a, 0.02);
 }

@@ -10,19 +10,10 @@ namespace transgi::probes {
 
 namespace {
 
-// The 13 "forward" offsets of the 26-neighbourhood: each segment is tested once.
+// The 13 "forward" offsets of the 26-neighbourhood (those before the centre
+// in z, y, x order): each segment is tested once.
 constexpr int kForward = 13;
-glm::ivec3 forward_offset(int k) {
-  int n = 0;
-  for (int dz = -1; dz <= 1; ++dz)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const glm::ivec3 o(dx, dy, dz);
-        if (o == glm::ivec3(0)) return glm::ivec3(0);  // the first 13 come before the centre
-        if (n++ == k) return o;
-      }
-  return glm::ivec3(0);
-}
+glm::ivec3 forward_offset(int k) { return {k % 3 - 1, k / 3 % 3 - 1, k / 9 - 1}; }
 
 bool inside_grid(const ProbeGrid& grid, glm::ivec3 c) {
   return glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c, grid.dims));
@@ -92,7 +83,7 @@ OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& gri
   r.offsets.assign(static_cast<std::size_t>(probes), glm::vec3(0.0f));
   std::deque<int> queue;
   for (int q = 0; q < probes && q < static_cast<int>(saw_light.size()); ++q)
-    if (saw_light[static_cast<std::size_t>(q)]) {
+    if (saw_light[static_cast<std::size_t>(q)] && (grid.offsets.empty() || grid.offsets[static_cast<std::size_t>(q)] == glm::vec3(0.0f))) {
       r.open[static_cast<std::size_t>(q)] = 1;
       queue.push_back(q);
     }
@@ -111,7 +102,7 @@ OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& gri
       const glm::vec3 from = grid.grid_point(q);
       for (int k = 0; k < kForward; ++k) {
         const glm::ivec3 n = c + forward_offset(k);
-        if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, grid.dims))) continue;
+        if (!inside_grid(grid, n)) continue;
         const glm::vec3 d = grid.grid_point(grid.index(n)) - from;
         const float len = glm::length(d);
         if (!(len > 0)) continue;
@@ -132,10 +123,9 @@ OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& gri
       const glm::ivec3 o = forward_offset(k);
       // Forward link of q, and q as the forward neighbour of c - o.
       const glm::ivec3 ahead = c + o, behind = c - o;
-      if (glm::all(glm::greaterThanEqual(ahead, glm::ivec3(0))) && glm::all(glm::lessThan(ahead, grid.dims)) &&
-          (links[static_cast<std::size_t>(q)] >> k & 1u))
+      if (inside_grid(grid, ahead) && (links[static_cast<std::size_t>(q)] >> k & 1u))
         visit(grid.index(ahead));
-      if (glm::all(glm::greaterThanEqual(behind, glm::ivec3(0))) && glm::all(glm::lessThan(behind, grid.dims))) {
+      if (inside_grid(grid, behind)) {
         const int p = grid.index(behind);
         if (links[static_cast<std::size_t>(p)] >> k & 1u) visit(p);
       }

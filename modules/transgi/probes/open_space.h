@@ -57,7 +57,10 @@ struct RelocationSettings {
 // saw_light: per probe, 1 if one of its rays escaped, met an emitter or met a
 // directly lit surface. Where no probe saw light (a dark scene, nothing to
 // link to), every probe counts as open: darkness is no evidence of a wall.
-// Uses the grid points (grid.offsets are ignored).
+// Links and relocations are worked out from the grid points. A probe that
+// stands off its grid point (grid.offsets) saw light from where it stands,
+// which says nothing of its grid point: it is no seed, or every other
+// classification would move it back into the wall and out again.
 OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& grid, std::span<const std::uint8_t> saw_light,
                           const RelocationSettings& relocation = {});
 

@@ -132,6 +132,15 @@ void ProbeField::select_within_budget(std::vector<std::uint8_t>& traced) const {
   for (std::size_t i = 0; i < k; ++i) traced[std::get<3>(order[i])] = 1;
 }
 
+void ProbeField::forget_light(int probe) {
+  const auto q = static_cast<std::size_t>(probe);
+  states_[q].reset(settings_.map.texel_count());
+  std::fill_n(sh_.data() + q * 75, 75, 0.0f);
+  std::fill_n(direct_mean_.data() + q * 75, 75, 0.0f);
+  std::fill_n(direct_sh_.data() + q * 75, 75, 0.0f);
+  direct_frames_[q] = 0;
+}
+
 ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights) {
   using namespace engine;
   ProbeFrameStats stats;
@@ -207,15 +216,8 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
     const float far = settings_.skip.far_cells * glm::length(grid.spacing());
     bool any_pending = classify;
     for (std::size_t q = 0; q < state_.size() && !any_pending; ++q) any_pending = traced[q] && needs_classify_[q];
-    // A probe standing off its grid point saw light from where it stands, which
-    // says nothing of the grid point (else it would be moved back, then out
-    // again, every other classification).
-    std::vector<std::uint8_t> seeds = saw_light_;
-    if (!grid_.offsets.empty())
-      for (std::size_t q = 0; q < seeds.size(); ++q)
-        if (grid_.offsets[q] != glm::vec3(0.0f)) seeds[q] = 0;
     const OpenSpace open =
-        settings_.skip.open_space && any_pending ? find_open_space(scene, settings_.grid, seeds, settings_.skip.relocation) : OpenSpace{};
+        settings_.skip.open_space && any_pending ? find_open_space(scene, grid_, saw_light_, settings_.skip.relocation) : OpenSpace{};
     if (!open.open.empty() && grid_.offsets.empty()) grid_.offsets.assign(state_.size(), glm::vec3(0.0f));
     for (std::size_t q = 0; q < state_.size(); ++q) {
       if (traced[q]) {
@@ -236,23 +238,12 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
       }
       const bool relocated = !grid_.offsets.empty() && grid_.offsets[q] != glm::vec3(0.0f);
       state_[q] = buried ? ProbeState::Buried : nearest[q] > far && !relocated ? ProbeState::Far : ProbeState::Active;
-      if (moved) {
-        states_[q].reset(settings_.map.texel_count());
-        std::fill_n(sh_.data() + q * 75, 75, 0.0f);
-        std::fill_n(direct_mean_.data() + q * 75, 75, 0.0f);
-        std::fill_n(direct_sh_.data() + q * 75, 75, 0.0f);
-        direct_frames_[q] = 0;
-        points[q].clear();
-        skip_this_frame[q] = 1;
-      }
+      if (moved) skip_this_frame[q] = 1;
       usable_[q] = state_[q] == ProbeState::Active ? 1 : 0;
-      if (!usable_[q]) {
-        // Holds no light; if it becomes active again it starts afresh.
-        states_[q].reset(settings_.map.texel_count());
-        std::fill_n(sh_.data() + q * 75, 75, 0.0f);
-        std::fill_n(direct_mean_.data() + q * 75, 75, 0.0f);
-        std::fill_n(direct_sh_.data() + q * 75, 75, 0.0f);
-        direct_frames_[q] = 0;
+      // Holds no light (and starts afresh if it becomes active again), or its
+      // light was gathered where it no longer stands.
+      if (moved || !usable_[q]) {
+        forget_light(static_cast<int>(q));
         points[q].clear();
       }
     }

@@ -197,6 +197,8 @@ class ProbeField {
   [[nodiscard]] std::size_t memory_bytes() const;
 
  private:
+  // Clears probe q's maps, SH and direct-light history.
+  void forget_light(int probe);
   // Marks the probes this frame's budget updates (update_budget > 0).
   void select_within_budget(std::vector<std::uint8_t>& traced) const;
 

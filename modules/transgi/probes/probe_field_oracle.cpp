@@ -36,8 +36,8 @@ void ProbeField::replace_with_oracle(const engine::rt::RtScene& scene, const eng
         int hits = 0;
         for (int i = 0; i < side * side; ++i) {
           math::Pcg32 rng = math::make_rng(seed, static_cast<std::uint64_t>(q) * texels + t, static_cast<std::uint64_t>(i));
-          const double u = (x + (i % side + rng.next_float()) / side) / layout.width;
-          const double cy = c0 + (c1 - c0) * (i / side + rng.next_float()) / side;
+          const double u = (x + (i % side + static_cast<double>(rng.next_float())) / side) / layout.width;
+          const double cy = c0 + (c1 - c0) * (i / side + static_cast<double>(rng.next_float())) / side;
           const double sy = std::sqrt(std::max(0.0, 1.0 - cy * cy));
           const glm::vec3 dir(static_cast<float>(std::sin(2 * M_PI * u) * sy), static_cast<float>(cy),
                               static_cast<float>(-std::cos(2 * M_PI * u) * sy));

@@ -47,12 +47,10 @@ struct TransGISettings {
   // cost of tracing time. 0 = GI only.
   int direct_spp = 4;
   DirectLight direct_light = DirectLight::Stochastic;
-  // Quality path: metals with roughness at most this reflect by one ray per
-  // sample, shaded with the probes' GI and direct light at the hit, instead
-  // of asking SH-4 for a mirror (shading::TransferRenderSettings). Negative =
-  // off (the paper's setting). Higher = more surfaces mirror-traced, at the
-  // cost of a ray and a few shadow rays per such sample.
-  float mirror_roughness = 0.05f;
+  // Both paths: near-mirror metals reflect by one ray, shaded with the
+  // probes' GI and direct light at the hit, instead of asking SH-4 for a
+  // mirror (shading::MirrorRay; max_roughness < 0 = off, the paper's setting).
+  shading::MirrorRay mirror;
   // Quality path: where each sample's transfer comes from. GroundTruth
   // integrates it per sample with `ground_truth_rays` rays (the bake's
   // estimator): the network replaced by its oracle, for error decomposition.

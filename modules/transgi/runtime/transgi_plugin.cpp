@@ -119,7 +119,7 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   shading::RealtimeGiStats st;
   image::ImageRGB probe_direct;
   frame.gi = shading::shade_gi_realtime(g, rt, assets, model.get(), model ? packed.decoder.get() : nullptr, has_transfer, fields,
-                                        settings.realtime, &st, deterministic ? &probe_direct : nullptr, &packed.scratch, &lights);
+                                        settings.realtime, &st, deterministic ? &probe_direct : nullptr, &packed.scratch, &lights, settings.mirror);
   GiStageTimes& t = frame.times;
   t.network_input = 0;  // inside the fused kernel, counted as inference
   t.inference = st.inference_ms;
@@ -161,7 +161,7 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
   shading::TransferRenderSettings rs;
   rs.spp = settings->gbuffer_spp;
   rs.lights = &lights->set;
-  rs.mirror_roughness = settings->mirror_roughness;
+  rs.mirror = settings->mirror;
   rs.ground_truth_rays = settings->ground_truth_rays;
   rs.seed = settings->seed + frame->probe_frames;
   rs.has_transfer = [&](Entity e) {

@@ -234,7 +234,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
                                           std::span<const probes::ProbeField* const> fields,
                                           const RealtimeGiSettings& settings, RealtimeGiStats* stats_out,
                                           engine::image::ImageRGB* direct_out, RealtimeGiScratch* scratch,
-                                          const engine::render::LightSet* mirror_lights) {
+                                          const engine::render::LightSet* mirror_lights, const MirrorRay& mirror) {
   RealtimeGiStats stats;
   engine::image::ImageRGB image(g.width, g.height);
   if (direct_out) *direct_out = engine::image::ImageRGB(g.width, g.height);
@@ -390,16 +390,16 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   });
   stats.upsample_ms = plan_ms + ms_since(t0);
 
-  // Mirrors at full resolution: SH-4 transfer cannot hold one.
-  if (settings.mirror_roughness >= 0) {
+  // Mirrors at full resolution (transfer_renderer.h's MirrorRay).
+  if (mirror.max_roughness >= 0) {
     t0 = Clock::now();
     const LightAt light_at = [&](const glm::vec3& p, const glm::vec3& n, float* out) { field_holding(fields, p)->interpolate(p, n, out); };
     engine::jobs::parallel_for<std::size_t>(0, g.samples.size(), 1024, [&](std::size_t b, std::size_t e) {
       for (std::size_t p = b; p < e; ++p) {
         const GSample& s = g.samples[p];
-        if (!s.hit || !is_mirror(s.brdf, settings.mirror_roughness)) continue;
+        if (!s.hit || !is_mirror(s.brdf, mirror)) continue;
         engine::math::Pcg32 rng = engine::math::make_rng(0x4D1Bull, p, 0);  // fixed: the real-time image has no seed
-        image.pixels[p] = shade_mirror_gi(scene, s, light_at, mirror_lights, settings.mirror_light_samples, rng);
+        image.pixels[p] = shade_mirror_gi(scene, s, light_at, mirror_lights, mirror, rng);
       }
     });
     stats.upsample_ms += ms_since(t0);

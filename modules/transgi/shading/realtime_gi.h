@@ -45,12 +45,6 @@ struct RealtimeGiSettings {
   float min_weight = 0.05f;
   // Off = plain bilinear upsampling (only to show what the guidance prevents).
   bool edge_aware = true;
-  // Near-mirrors (metallic, roughness at most this; negative = off) show one
-  // reflection ray's hit, shaded with the probes' GI and `mirror_light_samples`
-  // next-event samples (transfer_renderer.h's mirror path), at full
-  // resolution. Higher = more surfaces mirror-traced, at the cost of rays.
-  float mirror_roughness = 0.05f;
-  int mirror_light_samples = 4;
 
   bool operator==(const RealtimeGiSettings&) const = default;
 };
@@ -112,6 +106,6 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
                                           const RealtimeGiSettings& settings, RealtimeGiStats* stats = nullptr,
                                           engine::image::ImageRGB* direct_out = nullptr,
                                           RealtimeGiScratch* scratch = nullptr,
-                                          const engine::render::LightSet* mirror_lights = nullptr);
+                                          const engine::render::LightSet* mirror_lights = nullptr, const MirrorRay& mirror = {});
 
 }  // namespace transgi::shading

@@ -28,12 +28,13 @@ constexpr std::array<int, 3> kMapCoefficients = {0, 2, 6};  // (0,0), (1,0), (2,
 
 }  // namespace
 
-bool is_mirror(const engine::material::BrdfParams& brdf, float mirror_roughness) {
-  return mirror_roughness >= 0 && brdf.metallic >= 0.5f && brdf.roughness <= mirror_roughness;
+bool is_mirror(const engine::material::BrdfParams& brdf, const MirrorRay& mirror) {
+  return mirror.max_roughness >= 0 && brdf.metallic >= 0.5f && brdf.roughness <= mirror.max_roughness;
 }
 
 glm::vec3 shade_mirror_gi(const engine::rt::RtScene& scene, const GSample& smp, const LightAt& light_at,
-                          const engine::render::LightSet* lights, int light_samples, engine::math::Pcg32& rng) {
+                          const engine::render::LightSet* lights, const MirrorRay& mirror, engine::math::Pcg32& rng) {
+  const int light_samples = mirror.light_samples;
   using namespace engine;
   const glm::vec3 n = smp.normal_world, wo = smp.wo_world;
   const float cos_o = glm::dot(n, wo);
@@ -108,7 +109,7 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
     };
     for (std::size_t i = 0; i < n; ++i)
       if (samples[i].hit)
-        (is_mirror(samples[i].brdf, s.mirror_roughness) ? mirrors : has_transfer(samples[i].entity) ? hits : diffuse_only).push_back(i);
+        (is_mirror(samples[i].brdf, s.mirror) ? mirrors : has_transfer(samples[i].entity) ? hits : diffuse_only).push_back(i);
   }
   result.inferred_samples = hits.size();
   result.mirror_samples = mirrors.size();
@@ -186,7 +187,7 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
   jobs::parallel_for<std::size_t>(0, mirrors.size(), 64, [&](std::size_t b, std::size_t e) {
     for (std::size_t j = b; j < e; ++j) {
       math::Pcg32 rng = math::make_rng(s.seed ^ 0x4D1Bull, mirrors[j], 0);
-      shaded[mirrors[j]] = shade_mirror_gi(scene, samples[mirrors[j]], light_at, s.lights, s.mirror_light_samples, rng);
+      shaded[mirrors[j]] = shade_mirror_gi(scene, samples[mirrors[j]], light_at, s.lights, s.mirror, rng);
     }
   });
   result.light_ms = ms_since(t0);

@@ -24,6 +24,20 @@ enum class TransferSource {
   GroundTruth,  // integrated per pixel (measures SH truncation alone)
 };
 
+// Near-mirrors (metallic, roughness at most `max_roughness`; negative = off)
+// get one reflection ray instead of SH transfer, which cannot hold a mirror
+// (the paper's limitation; engines trace reflections): the hit's radiance is
+// its diffuse albedo / pi times the probe irradiance there plus
+// `light_samples` next-event samples, weighted by the mirror's Fresnel. Used
+// by the quality and the real-time path alike. Higher max_roughness = more
+// surfaces reflect sharply, at the cost of one ray per such pixel and the
+// glossy blur lost.
+struct MirrorRay {
+  float max_roughness = 0.05f;
+  int light_samples = 4;
+  bool operator==(const MirrorRay&) const = default;
+};
+
 // World-space SH light arriving at a shading point (position, normal).
 using LightAt = std::function<void(const glm::vec3& position, const glm::vec3& normal, float* out75)>;
 
@@ -39,25 +53,17 @@ struct TransferRenderSettings {
   bool texture_filtering = true;
   std::uint64_t seed = 0;
   float filter_width = 1.5f;
-  // Near-mirrors (metallic, roughness at most this; negative = off) get one
-  // reflection ray instead of SH transfer, which cannot hold a mirror (the
-  // paper's limitation; engines trace reflections): the hit's radiance is its
-  // diffuse albedo / pi times the probe irradiance there (light_at) plus
-  // `mirror_light_samples` next-event samples of `lights` (null: none),
-  // weighted by the mirror's Fresnel. Higher = more surfaces reflect sharply,
-  // at the cost of one ray per such sample and glossy blur lost.
-  float mirror_roughness = 0.05f;
-  int mirror_light_samples = 4;
-  const engine::render::LightSet* lights = nullptr;
+  MirrorRay mirror{};
+  const engine::render::LightSet* lights = nullptr;  // for the mirror ray's next-event samples (null: none)
 };
 
 // The light leaving a point of a near-mirror towards the viewer, as GI: its
 // Fresnel times what the reflection ray finds, shaded as above. Emitters and
 // the sky seen in the mirror are direct light (the reference's passes), not GI.
 glm::vec3 shade_mirror_gi(const engine::rt::RtScene& scene, const GSample& sample, const LightAt& light_at,
-                          const engine::render::LightSet* lights, int light_samples, engine::math::Pcg32& rng);
+                          const engine::render::LightSet* lights, const MirrorRay& mirror, engine::math::Pcg32& rng);
 // Whether a sample takes the mirror path.
-bool is_mirror(const engine::material::BrdfParams& brdf, float mirror_roughness);
+bool is_mirror(const engine::material::BrdfParams& brdf, const MirrorRay& mirror);
 
 struct TransferRenderTimings {
   double gbuffer_ms = 0, inputs_ms = 0, inference_ms = 0, shading_ms = 0;
