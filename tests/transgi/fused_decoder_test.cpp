@@ -107,7 +107,7 @@ Error compare(const shading::FusedDecoder& d, const model::Mlp& mlp, const Batch
 // up to 1.6e-2 on 3 points through 6 layers, against 1.8e-3 for the level's
 // trained decoder, which is held to the 1e-2.
 double tolerance(FusedIsa isa, bool trained = false) {
-  if (isa != FusedIsa::Avx512Bf16) return 1e-5;
+  if (!shading::is_bf16(isa)) return 1e-5;
   return trained ? 1e-2 : 3e-2;
 }
 
@@ -130,7 +130,7 @@ TEST(FusedDecoder, EveryBackendMatchesTheDoubleOracle) {
   const std::vector<model::MlpLayout> layouts = {
       {}, {.inputs = 32}, {.width = 64}, {.width = 256, .hidden_layers = 5}, {.width = 32, .hidden_layers = 1}};
   int tested = 0;
-  for (FusedIsa isa : {FusedIsa::Scalar, FusedIsa::Avx2, FusedIsa::Avx512Bf16}) {
+  for (FusedIsa isa : {FusedIsa::Scalar, FusedIsa::Avx2, FusedIsa::Avx512Bf16, FusedIsa::Amx}) {
     if (!shading::cpu_supports(isa)) {
       std::printf("[ skipped  ] %s: not supported by this CPU\n", shading::fused_isa_name(isa));
       continue;
@@ -172,7 +172,7 @@ TEST(FusedDecoder, TrainedLevelDecoderWithinOnePercent) {
       for (int k = 0; k < 3; ++k) x[m.latent_dim + 3 + 3 * v + k] = d[k];
     }
   }
-  for (FusedIsa isa : {FusedIsa::Avx2, FusedIsa::Avx512Bf16}) {
+  for (FusedIsa isa : {FusedIsa::Avx2, FusedIsa::Avx512Bf16, FusedIsa::Amx}) {
     if (!shading::cpu_supports(isa)) continue;
     const shading::FusedDecoder d(m.decoder, isa);
     const Error e = compare(d, m.decoder, b, n);
@@ -196,7 +196,7 @@ TEST(FusedDecoder, UnsupportedLayoutFallsBackToScalar) {
 // outputs must equal a one-light call with that light (same backend, same
 // rounding, so exactly), for tile tails too.
 TEST(FusedDecoder, SecondLightEqualsASeparateCall) {
-  for (FusedIsa isa : {FusedIsa::Scalar, FusedIsa::Avx2, FusedIsa::Avx512Bf16}) {
+  for (FusedIsa isa : {FusedIsa::Scalar, FusedIsa::Avx2, FusedIsa::Avx512Bf16, FusedIsa::Amx}) {
     if (!shading::cpu_supports(isa)) continue;
     const model::Mlp mlp = random_mlp({}, 8);
     const shading::FusedDecoder d(mlp, isa);

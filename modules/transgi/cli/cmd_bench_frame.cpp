@@ -103,8 +103,10 @@ int run_bench_frame(const std::vector<std::string>& argv) {
 
   eval::MachinePeak peak;
   scene.app->jobs().run([&] { peak = eval::measure_machine_peak(world.resource<rt::RtScene>()); });
-  std::printf("machine, measured now: bf16 %.0f GFLOP/s, fp32 %.0f GFLOP/s, incoherent rays %.2f Mrays/s (%d threads)\n",
-              peak.bf16_gflops, peak.fp32_gflops, peak.incoherent_mrays, scene.app->jobs().thread_count());
+  std::printf("machine, measured now: bf16 %.0f GFLOP/s (vdpbf16ps), amx bf16 %.0f GFLOP/s, fp32 %.0f GFLOP/s, incoherent rays "
+              "%.2f Mrays/s (%d threads); fused kernel: %s\n",
+              peak.bf16_gflops, peak.amx_gflops, peak.fp32_gflops, peak.incoherent_mrays, scene.app->jobs().thread_count(),
+              shading::fused_isa_name(shading::best_fused_isa()));
   std::printf("moving '%s' on a %.3f m orbit, a full turn every 120 frames; preset %s, %dx%d\n",
               mover_name ? mover_name->value.c_str() : "?", static_cast<double>(radius), preset.c_str(), width, height);
 

@@ -1,5 +1,9 @@
 #include "eval/machine_peak.h"
 
+// GCC 12's _mm512_reduce_add_ps reads an undefined vector; the warning is
+// about the header, not this code.
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <immintrin.h>
 
 #include <algorithm>
@@ -12,6 +16,7 @@
 #include "engine/math/rng.h"
 #include "engine/math/sampling.h"
 #include "shading/fused_decoder.h"
+#include "shading/fused_kernels.h"
 
 namespace transgi::eval {
 
@@ -91,11 +96,14 @@ double all_threads_gflops(Loop loop, double flop_per_rep, double seconds) {
 }  // namespace
 
 double bf16_peak_loop(long long reps) { return bf16_loop(reps); }
+double amx_peak_loop(long long reps) { return shading::detail::amx_peak_loop(reps); }
 
 MachinePeak measure_machine_peak(const engine::rt::RtScene& scene, double seconds) {
   MachinePeak p;
   if (shading::cpu_supports(shading::FusedIsa::Avx512Bf16))
     p.bf16_gflops = all_threads_gflops(bf16_loop, 24.0 * 64.0, seconds / 3);
+  if (shading::cpu_supports(shading::FusedIsa::Amx))
+    p.amx_gflops = all_threads_gflops(shading::detail::amx_peak_loop, 4.0 * 16384.0, seconds / 3);
   if (__builtin_cpu_supports("avx512f"))
     p.fp32_gflops = all_threads_gflops(fp32_loop_avx512, 24.0 * 32.0, seconds / 3);
   else if (__builtin_cpu_supports("avx2"))

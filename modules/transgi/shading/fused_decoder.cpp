@@ -7,6 +7,10 @@
 #include <stdexcept>
 #include <string>
 
+#include <cpuid.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include "shading/fused_kernels.h"
 
 namespace transgi::shading {
@@ -20,6 +24,28 @@ std::uint16_t to_bf16(float x) {
 
 float from_bf16(std::uint16_t x) { return std::bit_cast<float>(static_cast<std::uint32_t>(x) << 16); }
 
+namespace {
+
+// AMX-TILE and AMX-BF16 in CPUID, and Linux's permission to use the tile
+// state: without ARCH_REQ_XCOMP_PERM the first tile instruction is SIGILL.
+bool amx_usable() {
+  static const bool usable = [] {
+    unsigned a = 0, b = 0, c = 0, d = 0;
+    if (!__get_cpuid_count(7, 0, &a, &b, &c, &d)) return false;
+    const bool tile = (d >> 24) & 1u, bf16 = (d >> 22) & 1u;
+    if (!tile || !bf16) return false;
+#ifdef SYS_arch_prctl
+    constexpr long kArchReqXcompPerm = 0x1023, kXfeatureXtiledata = 18;
+    return syscall(SYS_arch_prctl, kArchReqXcompPerm, kXfeatureXtiledata) == 0;
+#else
+    return false;
+#endif
+  }();
+  return usable;
+}
+
+}  // namespace
+
 bool cpu_supports(FusedIsa isa) {
   switch (isa) {
     case FusedIsa::Scalar: return true;
@@ -27,6 +53,7 @@ bool cpu_supports(FusedIsa isa) {
     case FusedIsa::Avx512Bf16:
       return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
              __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bf16");
+    case FusedIsa::Amx: return cpu_supports(FusedIsa::Avx512Bf16) && amx_usable();
   }
   return false;
 }
@@ -36,20 +63,22 @@ const char* fused_isa_name(FusedIsa isa) {
     case FusedIsa::Scalar: return "scalar";
     case FusedIsa::Avx2: return "avx2";
     case FusedIsa::Avx512Bf16: return "avx512bf16";
+    case FusedIsa::Amx: return "amx";
   }
   return "?";
 }
 
 FusedIsa best_fused_isa() {
   if (const char* v = std::getenv("TRANSGI_FUSED_ISA")) {
-    for (FusedIsa isa : {FusedIsa::Scalar, FusedIsa::Avx2, FusedIsa::Avx512Bf16})
+    for (FusedIsa isa : {FusedIsa::Scalar, FusedIsa::Avx2, FusedIsa::Avx512Bf16, FusedIsa::Amx})
       if (std::string(v) == fused_isa_name(isa)) {
         if (!cpu_supports(isa))
           throw std::runtime_error(std::string("TRANSGI_FUSED_ISA=") + v + ": this CPU does not support it");
         return isa;
       }
-    throw std::runtime_error(std::string("TRANSGI_FUSED_ISA: expected scalar, avx2 or avx512bf16, got '") + v + "'");
+    throw std::runtime_error(std::string("TRANSGI_FUSED_ISA: expected scalar, avx2, avx512bf16 or amx, got '") + v + "'");
   }
+  if (cpu_supports(FusedIsa::Amx)) return FusedIsa::Amx;
   if (cpu_supports(FusedIsa::Avx512Bf16)) return FusedIsa::Avx512Bf16;
   if (cpu_supports(FusedIsa::Avx2)) return FusedIsa::Avx2;
   return FusedIsa::Scalar;
@@ -63,6 +92,37 @@ bool simd_layout_ok(const model::MlpLayout& l) {
 }
 
 int round_up(int x, int m) { return (x + m - 1) / m * m; }
+
+// The AMX kernel's tile products run over whole 32-wide steps of k and
+// blocks of 32 outputs.
+bool amx_layout_ok(const model::MlpLayout& l) { return simd_layout_ok(l) && l.width % 32 == 0; }
+
+// Weights as [k / 2][output][k % 2] over all outputs (one AMX weight tile is
+// 16 k-pairs of 16 outputs, rows out_padded * 4 bytes apart). The output
+// layer's columns are blocked by colour channel, c * 32 + k for k < 25.
+PackedLayer pack_layer_amx(const model::Mlp& mlp, int layer) {
+  const model::MlpLayout& lay = mlp.layout();
+  const float* w = mlp.params().data() + lay.weight_offset(layer);  // [out][in]
+  const float* b = mlp.params().data() + lay.bias_offset(layer);
+  PackedLayer p;
+  p.in = lay.in_of(layer);
+  p.out = lay.out_of(layer);
+  p.relu = layer < lay.hidden_layers;
+  p.bf16 = true;
+  const bool output = layer == lay.hidden_layers;
+  p.out_padded = output ? detail::kAmxOutputs : round_up(p.out, 32);
+  auto source = [&](int column) { return output ? (column % 32 < 25 ? column / 32 * 25 + column % 32 : -1) : column; };
+  p.bias.assign(static_cast<std::size_t>(p.out_padded), 0.0f);
+  p.w_bf16.assign(static_cast<std::size_t>(p.in) * p.out_padded, 0);
+  for (int col = 0; col < p.out_padded; ++col) {
+    const int o = source(col);
+    if (o < 0 || o >= p.out) continue;
+    p.bias[static_cast<std::size_t>(col)] = b[o];
+    for (int k = 0; k < p.in; ++k)
+      p.w_bf16[(static_cast<std::size_t>(k / 2) * p.out_padded + col) * 2 + k % 2] = to_bf16(w[static_cast<std::size_t>(o) * p.in + k]);
+  }
+  return p;
+}
 
 PackedLayer pack_layer(const model::Mlp& mlp, int layer, int lane, int group, bool bf16) {
   const model::MlpLayout& lay = mlp.layout();
@@ -106,8 +166,14 @@ FusedDecoder::FusedDecoder(const model::Mlp& mlp, FusedIsa isa) : layout_(mlp.la
     throw std::invalid_argument("FusedDecoder: the decoder must output 75 SH transfer values, has " +
                                 std::to_string(layout_.outputs));
   if (!cpu_supports(isa_)) throw std::invalid_argument(std::string("FusedDecoder: CPU lacks ") + fused_isa_name(isa_));
+  if (isa_ == FusedIsa::Amx && !amx_layout_ok(layout_)) isa_ = FusedIsa::Avx512Bf16;
   if (isa_ != FusedIsa::Scalar && !simd_layout_ok(layout_)) isa_ = FusedIsa::Scalar;
   if (isa_ == FusedIsa::Scalar) return;
+  if (isa_ == FusedIsa::Amx) {
+    layers_.push_back(pack_layer(mlp, 0, 16, detail::kGroupAvx512, false));
+    for (int l = 1; l < layout_.layer_count(); ++l) layers_.push_back(pack_layer_amx(mlp, l));
+    return;
+  }
   const bool avx512 = isa_ == FusedIsa::Avx512Bf16;
   const int lane = avx512 ? 16 : 8;
   const int group = avx512 ? detail::kGroupAvx512 : detail::kGroupAvx2;
@@ -121,6 +187,7 @@ void FusedDecoder::shade_tile(const float* inputs, const float* light, int n, fl
   if (n > kFusedTile) throw std::invalid_argument("FusedDecoder::shade_tile: more than kFusedTile points");
   switch (isa_) {
     case FusedIsa::Avx512Bf16: detail::shade_tile_avx512bf16(layers_, layout_.inputs, inputs, light, n, rgb, light2, rgb2); return;
+    case FusedIsa::Amx: detail::shade_tile_amx(layers_, layout_.inputs, inputs, light, n, rgb, light2, rgb2); return;
     case FusedIsa::Avx2: detail::shade_tile_avx2(layers_, layout_.inputs, inputs, light, n, rgb, light2, rgb2); return;
     case FusedIsa::Scalar: break;
   }

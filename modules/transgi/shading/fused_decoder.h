@@ -4,8 +4,11 @@
 // light run in one pass over a tile held in L1, so the 75 transfer
 // coefficients never reach memory and the weights stay in cache across tiles.
 //
-// Backends, chosen at run time (TRANSGI_FUSED_ISA=scalar|avx2|avx512bf16
+// Backends, chosen at run time (TRANSGI_FUSED_ISA=scalar|avx2|avx512bf16|amx
 // overrides):
+//  - Amx: hidden and output layers as AMX bf16 tile products with fp32
+//    accumulation (Intel cores where vdpbf16ps runs at half the FMA rate);
+//    the first layer fp32 as below. Needs widths that are multiples of 32;
 //  - Avx512Bf16: hidden and output layers as bf16 dot products (vdpbf16ps)
 //    with fp32 accumulation; the first layer (16 inputs, 2 % of the FLOPs)
 //    stays fp32 so normals and view directions keep full precision;
@@ -20,10 +23,14 @@
 
 namespace transgi::shading {
 
-enum class FusedIsa { Scalar, Avx2, Avx512Bf16 };
+enum class FusedIsa { Scalar, Avx2, Avx512Bf16, Amx };
+
+// Whether a backend rounds weights and activations to bf16.
+constexpr bool is_bf16(FusedIsa isa) { return isa == FusedIsa::Avx512Bf16 || isa == FusedIsa::Amx; }
 
 // The fastest backend this CPU runs (or the TRANSGI_FUSED_ISA override).
 FusedIsa best_fused_isa();
+// For Amx this also asks Linux for the tile state (arch_prctl), once.
 bool cpu_supports(FusedIsa isa);
 const char* fused_isa_name(FusedIsa isa);
 

@@ -62,7 +62,8 @@ TRANSGI_AVX512BF16 inline void dot_light(__m512 y, const float* light, int o, fl
 
 // First layer, fp32: act[row][o0 .. o0 + NB*16) = relu(W x + b) as bf16.
 template <int NB>
-TRANSGI_AVX512BF16 void first_layer_group(const PackedLayer& L, int o0, Tile& t, int rows) {
+TRANSGI_AVX512BF16 void first_layer_group(const PackedLayer& L, int o0, const float* input, std::uint16_t* act,
+                                          int act_stride, int rows) {
   constexpr int gs = NB * kLanes, kRows = kRowsFor<NB>;
   const float* w = L.w_f32.data() + static_cast<std::size_t>(L.in) * o0;
   for (int r0 = 0; r0 < rows; r0 += kRows) {
@@ -79,7 +80,7 @@ TRANSGI_AVX512BF16 void first_layer_group(const PackedLayer& L, int o0, Tile& t,
       for (int j = 0; j < NB; ++j) wv[j] = _mm512_loadu_ps(w + k * gs + j * kLanes);
 #pragma GCC unroll 16
       for (int p = 0; p < kRows; ++p) {
-        const __m512 xv = _mm512_set1_ps(t.input[(r0 + p) * kMaxInputs + k]);
+        const __m512 xv = _mm512_set1_ps(input[(r0 + p) * kMaxInputs + k]);
 #pragma GCC unroll 16
         for (int j = 0; j < NB; ++j) acc[p][j] = _mm512_fmadd_ps(xv, wv[j], acc[p][j]);
       }
@@ -87,7 +88,7 @@ TRANSGI_AVX512BF16 void first_layer_group(const PackedLayer& L, int o0, Tile& t,
 #pragma GCC unroll 16
     for (int p = 0; p < kRows; ++p)
 #pragma GCC unroll 16
-      for (int j = 0; j < NB; ++j) store_bf16(t.act[0] + (r0 + p) * kMaxWidth + o0 + j * kLanes, acc[p][j], L.relu);
+      for (int j = 0; j < NB; ++j) store_bf16(act + (r0 + p) * act_stride + o0 + j * kLanes, acc[p][j], L.relu);
   }
 }
 
@@ -148,7 +149,10 @@ TRANSGI_AVX512BF16 void for_each_group(const PackedLayer& L, Args&&... args) {
 
 template <int NB>
 struct FirstLayer {
-  TRANSGI_AVX512BF16 static void run(const PackedLayer& L, int o0, Tile& t, int rows) { first_layer_group<NB>(L, o0, t, rows); }
+  TRANSGI_AVX512BF16 static void run(const PackedLayer& L, int o0, const float* input, std::uint16_t* act, int act_stride,
+                                     int rows) {
+    first_layer_group<NB>(L, o0, input, act, act_stride, rows);
+  }
 };
 template <int NB>
 struct HiddenLayer {
@@ -164,6 +168,11 @@ struct OutputLayer {
 };
 
 }  // namespace
+
+TRANSGI_AVX512BF16 void first_layer_avx512(const PackedLayer& L, const float* input, std::uint16_t* act, int act_stride,
+                                           int rows) {
+  for_each_group<FirstLayer>(L, input, act, act_stride, rows);
+}
 
 TRANSGI_AVX512BF16 void shade_tile_avx512bf16(const std::vector<PackedLayer>& layers, int inputs, const float* x,
                                               const float* light, int n, float* rgb, const float* light2, float* rgb2) {
@@ -186,7 +195,7 @@ TRANSGI_AVX512BF16 void shade_tile_avx512bf16(const std::vector<PackedLayer>& la
     }
     if (i < n) std::copy_n(x + static_cast<std::size_t>(i) * inputs, inputs, t.input + i * kMaxInputs);
   }
-  for_each_group<FirstLayer>(layers.front(), t, rows);
+  first_layer_avx512(layers.front(), t.input, t.act[0], kMaxWidth, rows);
   int src = 0;
   for (std::size_t l = 1; l + 1 < layers.size(); ++l, src = 1 - src) for_each_group<HiddenLayer>(layers[l], t, src, rows);
   for_each_group<OutputLayer>(layers.back(), t, src, rows);

@@ -11,13 +11,29 @@ namespace transgi::shading::detail {
 inline constexpr int kMaxInputs = 64;
 inline constexpr int kMaxWidth = 256;
 inline constexpr int kLightPadded = 80;  // 75 SH values, padded to whole vectors
+// The AMX output layer: 3 channels x 25 values, each channel padded to 32.
+inline constexpr int kAmxOutputs = 96;
 // Outputs per register block: 4 vectors of 16 (AVX-512) or of 8 (AVX2).
 inline constexpr int kGroupAvx512 = 64;
 inline constexpr int kGroupAvx2 = 32;
 
+// The fp32 first layer on AVX-512 FMA, shared by the bf16 and AMX backends:
+// act[r * act_stride + o] = bf16(relu(W input_r + b)) for rows r < rows (a
+// multiple of 16), inputs at input + r * kMaxInputs; L packed in groups of
+// kGroupAvx512 fp32 outputs.
+void first_layer_avx512(const PackedLayer& L, const float* input, std::uint16_t* act, int act_stride, int rows);
+
 // light2 / rgb2 may be null (one light).
 void shade_tile_avx512bf16(const std::vector<PackedLayer>& layers, int inputs, const float* x, const float* light, int n,
                            float* rgb, const float* light2, float* rgb2);
+// AMX: hidden and output layers as bf16 tile products; layers packed by
+// pack_layer_amx (outputs padded to 32, the output layer blocked by colour
+// channel: channel c's 25 values at columns c * 32 ..).
+void shade_tile_amx(const std::vector<PackedLayer>& layers, int inputs, const float* x, const float* light, int n,
+                    float* rgb, const float* light2, float* rgb2);
+// The tile unit's peak: `reps` x 4 independent tile products of 16,384 FLOP
+// each, no memory traffic. Only where cpu_supports(FusedIsa::Amx).
+double amx_peak_loop(long long reps);
 void shade_tile_avx2(const std::vector<PackedLayer>& layers, int inputs, const float* x, const float* light, int n,
                      float* rgb, const float* light2, float* rgb2);
 
