@@ -204,6 +204,10 @@ TEST(ProbeMap, UnsampledTexelsAreFilledNotBlack) {
   for (std::size_t t = 0; t < filled.size(); ++t) EXPECT_EQ(filled[t], glm::vec3(2.0f)) << "texel " << t;
 }
 
+// The history is stored at half precision: one rounding of a value near 1
+// (scale 1) is at most 2^-11.
+constexpr float kHalfRounding = 0x1p-11f;
+
 TEST(ProbeMap, HysteresisAdaptsOnlyToChangesBeyondTheNoise) {
   const MapLayout m{4, 2};
   ProbeMapState st;
@@ -216,17 +220,17 @@ TEST(ProbeMap, HysteresisAdaptsOnlyToChangesBeyondTheNoise) {
   // Steady light with +-10 % noise: slow blending throughout (h = 0.95).
   for (int i = 0; i < 40; ++i) {
     f.sum[0] = glm::vec3(i % 2 ? 1.1f : 0.9f);
-    const float before = st.radiance[0].r;
+    const float before = st.radiance_at(0).r;
     accumulate(st, f, settings);
     if (i > 0) {
-      EXPECT_NEAR(st.radiance[0].r, 0.95f * before + 0.05f * f.sum[0].r, 1e-6f) << "frame " << i;
+      EXPECT_NEAR(st.radiance_at(0).r, 0.95f * before + 0.05f * f.sum[0].r, kHalfRounding) << "frame " << i;
     }
   }
   // The light goes off: far beyond the noise, so the fast blend (h = 0.5) applies.
-  const float before = st.radiance[0].r;
+  const float before = st.radiance_at(0).r;
   f.sum[0] = glm::vec3(0.0f);
   accumulate(st, f, settings);
-  EXPECT_NEAR(st.radiance[0].r, 0.5f * before, 1e-6f);
+  EXPECT_NEAR(st.radiance_at(0).r, 0.5f * before, kHalfRounding);
 }
 
 TEST(ProbeMap, ColdStartRampsTheHysteresisUp) {
@@ -239,11 +243,64 @@ TEST(ProbeMap, ColdStartRampsTheHysteresisUp) {
   const AccumulationSettings s;  // ramp 0.5 -> 0.95 over 32 frames
   for (int frame = 0; frame < 40; ++frame) {
     f.sum[0] = glm::vec3(frame % 2 ? 1.05f : 0.95f);
-    const float before = st.radiance[0].r;
+    const float before = st.radiance_at(0).r;
     accumulate(st, f, s);
     if (frame == 0) continue;  // the first sample initialises the texel
     const float h = frame < 32 ? 0.5f + 0.45f * static_cast<float>(frame) / 32.0f : 0.95f;
-    EXPECT_NEAR(st.radiance[0].r, h * before + (1 - h) * f.sum[0].r, 1e-6f) << "frame " << frame;
+    EXPECT_NEAR(st.radiance_at(0).r, h * before + (1 - h) * f.sum[0].r, kHalfRounding) << "frame " << frame;
+  }
+}
+
+// The history is half precision in units of a power-of-two scale, so a steady
+// light is held to one ulp (2^-10 relative at most) whether it is a millionth
+// or a million times the level's, and the scale follows when the light
+// changes by that much.
+TEST(ProbeMap, HistoryHoldsASteadyLightToOneUlpAtAnyBrightness) {
+  const MapLayout m{4, 2};
+  for (float brightness : {1e-6f, 1.0f, 1e6f}) {
+    ProbeMapState st;
+    st.reset(m.texel_count());
+    FrameSamples f;
+    f.reset(m.texel_count());
+    f.count[0] = 1;
+    const glm::vec3 value = brightness * glm::vec3(1.0f, 0.37f, 0.011f);
+    f.sum[0] = value;
+    for (int i = 0; i < 50; ++i) accumulate(st, f, {});
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(st.radiance_at(0)[c], value[c], 0x1p-10f * value[c])
+          << "brightness " << brightness << " channel " << c << ": expected " << value[c] << ", got " << st.radiance_at(0)[c];
+    // The light jumps 1e6 times brighter: the scale follows, nothing saturates.
+    f.sum[0] = value * 1e6f;
+    for (int i = 0; i < 200; ++i) accumulate(st, f, {});
+    EXPECT_NEAR(st.radiance_at(0).r, value.r * 1e6f, 1e-3f * value.r * 1e6f) << "brightness " << brightness << " x 1e6";
+  }
+}
+
+// Depth is stored as half-precision mean and variance in units of the grid
+// spacing: at 1 mm and at 10 km grids they follow the exponential moments of
+// the distances (kept in double here) as closely as at 1 m.
+TEST(DepthMap, MeanAndVarianceFollowTheMomentsAtAnyScale) {
+  const MapLayout m{8, 4};
+  const glm::vec3 dir(0, 1, 0);
+  const AccumulationSettings settings;
+  for (float unit : {1e-3f, 1.0f, 1e4f}) {
+    ProbeMapState st;
+    st.reset(m.texel_count(), unit);
+    engine::math::Pcg32 rng(4, 4);
+    double m1 = 0, m2 = 0;
+    for (int frame = 0; frame < 300; ++frame) {
+      const float d = unit * (3.0f + 0.4f * (rng.next_float() - 0.5f));
+      update_own_depth(st, m, {{dir * d, glm::vec3(0.0f), dir, d, -dir}}, settings);
+      const double ramp = std::min(1.0, frame / static_cast<double>(settings.warmup_frames));
+      const double h = std::min<double>(settings.hysteresis, settings.fast_hysteresis + (settings.hysteresis - settings.fast_hysteresis) * ramp);
+      m1 = frame == 0 ? d : h * m1 + (1 - h) * d;
+      m2 = frame == 0 ? static_cast<double>(d) * d : h * m2 + (1 - h) * static_cast<double>(d) * d;
+    }
+    const auto t = static_cast<std::size_t>(m.texel_of(dir));
+    const double variance = m2 - m1 * m1;
+    EXPECT_NEAR(st.depth.mean(t), m1, 1e-3 * m1) << "unit " << unit;
+    EXPECT_NEAR(st.depth.variance(t), variance, 0.02 * variance) << "unit " << unit << ": expected variance " << variance << ", got "
+                                                                   << st.depth.variance(t);
   }
 }
 
@@ -302,8 +359,8 @@ TEST(Interpolation, OccludedProbeIsPrunedByChebyshev) {
   for (std::size_t i = 0; i < 8; ++i) (r.probes[i] == 0 ? w0 : w1) += r.weights[i];
   EXPECT_EQ(w1, 0.0f) << "probe 1 is occluded";
   EXPECT_NEAR(w0, 1.0f, 1e-6f);
-  EXPECT_NEAR(chebyshev_visibility(0.2f, 0.04f, 0.6f), 0.0f, 1e-3f);
-  EXPECT_EQ(chebyshev_visibility(0.2f, 0.04f, 0.1f), 1.0f) << "closer than the wall: visible";
+  EXPECT_NEAR(chebyshev_visibility(0.2f, 0.0f, 0.6f), 0.0f, 1e-3f);
+  EXPECT_EQ(chebyshev_visibility(0.2f, 0.0f, 0.1f), 1.0f) << "closer than the wall: visible";
 }
 
 TEST(Interpolation, AllPrunedFallsBackToDistanceAndCosineWeights) {

@@ -5,9 +5,9 @@
 
 namespace transgi::probes {
 
-float chebyshev_visibility(float mean, float mean_squared, float distance) {
+float chebyshev_visibility(float mean, float variance_in, float distance) {
   if (!std::isfinite(mean) || distance <= mean) return 1.0f;
-  const float variance = std::max(mean_squared - mean * mean, 1e-6f * mean * mean + 1e-8f);
+  const float variance = std::max(variance_in, 1e-6f * mean * mean + 1e-8f);
   const float d = distance - mean;
   return variance / (variance + d * d);
 }
@@ -38,8 +38,7 @@ InterpolationResult interpolate_probes(const ProbeGrid& grid, const MapLayout& l
       if (d > 1e-6f) {
         const auto t = static_cast<std::size_t>(layout.texel_of(from_probe / d));
         const ProbeMapState& st = states[static_cast<std::size_t>(q)];
-        const glm::vec2 m = st.depth.moments[t];
-        if (chebyshev_visibility(m.x, m.y, d) < s.visibility_threshold) keep = false;
+        if (chebyshev_visibility(st.depth.mean(t), st.depth.variance(t), d) < s.visibility_threshold) keep = false;
       }
     }
     if (!keep && cage.weights[i] > 0) ++r.pruned;

@@ -47,7 +47,7 @@ InterpolationResult interpolate_probes(const ProbeGrid& grid, const MapLayout& l
                                        std::span<const std::uint8_t> usable = {});
 
 // Chebyshev upper bound on the probability that the probe sees a point at
-// `distance`, from its mean and mean-squared hit distance in that direction.
-float chebyshev_visibility(float mean, float mean_squared, float distance);
+// `distance`, from the mean and variance of its hit distance in that direction.
+float chebyshev_visibility(float mean, float variance, float distance);
 
 }  // namespace transgi::probes

@@ -29,7 +29,7 @@ double ms_since(Clock::time_point t) { return std::chrono::duration<double, std:
 ProbeField::ProbeField(ProbeFieldSettings s)
     : settings_(s), grid_(s.grid), projector_(s.map), fibonacci_(spherical_fibonacci(s.rays_per_probe)) {
   states_.resize(static_cast<std::size_t>(s.grid.count()));
-  for (auto& st : states_) st.reset(s.map.texel_count());
+  for (auto& st : states_) st.reset(s.map.texel_count(), depth_unit());
   state_.assign(states_.size(), ProbeState::Active);
   usable_.assign(states_.size(), 1);
   sh_.assign(static_cast<std::size_t>(s.grid.count()) * 75, 0.0f);
@@ -83,8 +83,8 @@ std::size_t ProbeField::memory_bytes() const {
   std::size_t b = (sh_.size() + direct_mean_.size() + direct_sh_.size()) * sizeof(float) +
                   direct_frames_.size() * sizeof(std::uint32_t);
   for (const ProbeMapState& st : states_)
-    b += st.radiance.size() * sizeof(glm::vec3) +
-         st.sampled.size() * sizeof(std::uint8_t) + st.depth.moments.size() * sizeof(glm::vec2);
+    b += st.radiance.size() * sizeof(HalfRgb) + st.sampled.size() * sizeof(std::uint8_t) +
+         st.depth.texels.size() * sizeof(DepthMap::Texel);
   return b;
 }
 
@@ -134,7 +134,7 @@ void ProbeField::select_within_budget(std::vector<std::uint8_t>& traced) const {
 
 void ProbeField::forget_light(int probe) {
   const auto q = static_cast<std::size_t>(probe);
-  states_[q].reset(settings_.map.texel_count());
+  states_[q].reset(settings_.map.texel_count(), depth_unit());
   std::fill_n(sh_.data() + q * 75, 75, 0.0f);
   std::fill_n(direct_mean_.data() + q * 75, 75, 0.0f);
   std::fill_n(direct_sh_.data() + q * 75, 75, 0.0f);

@@ -205,6 +205,8 @@ class ProbeField {
   ProbeFieldSettings settings_;
   ProbeGrid grid_;  // settings_.grid, relocated
   MapProjector projector_;
+  // The length probe depths are stored in units of (ProbeMapState::reset).
+  [[nodiscard]] float depth_unit() const { return grid_.min_spacing() > 0 ? grid_.min_spacing() : 1.0f; }
   std::vector<ProbeMapState> states_;
   std::vector<ProbeState> state_;
   std::vector<std::uint8_t> usable_;  // 1 unless buried or far (read by interpolation)

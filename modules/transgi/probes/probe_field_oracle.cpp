@@ -24,7 +24,8 @@ void ProbeField::replace_with_oracle(const engine::rt::RtScene& scene, const eng
     bar.update(static_cast<std::uint64_t>(q));
     if (!usable_[static_cast<std::size_t>(q)]) continue;
     ProbeMapState& st = states_[static_cast<std::size_t>(q)];
-    st.reset(texels);
+    st.reset(texels, depth_unit());
+    std::vector<glm::vec3> radiance(static_cast<std::size_t>(texels));
     const glm::vec3 origin = grid_.position(q);
     jobs::parallel_for(0, texels, 16, [&](int b, int e) {
       for (int t = b; t < e; ++t) {
@@ -53,14 +54,20 @@ void ProbeField::replace_with_oracle(const engine::rt::RtScene& scene, const eng
           ++hits;
         }
         const int n = side * side;
-        st.radiance[static_cast<std::size_t>(t)] = glm::vec3(sum / static_cast<double>(n));
+        radiance[static_cast<std::size_t>(t)] = glm::vec3(sum / static_cast<double>(n));
         st.sampled[static_cast<std::size_t>(t)] = 1;
-        st.depth.moments[static_cast<std::size_t>(t)] =
-            hits > 0 ? glm::vec2(static_cast<float>(d1 / hits), static_cast<float>(d2 / hits)) : glm::vec2(std::numeric_limits<float>::quiet_NaN(), 0.0f);
+        if (hits > 0) {
+          const double mean = d1 / hits;
+          st.depth.set(static_cast<std::size_t>(t), static_cast<float>(mean), static_cast<float>(std::max(0.0, d2 / hits - mean * mean)));
+        }
       }
     });
     st.frames = 1;
-    projector_.project(st.radiance.data(), sh_.data() + static_cast<std::size_t>(q) * 75);
+    float peak = 0;
+    for (const glm::vec3& v : radiance) peak = std::max(peak, std::max(v.r, std::max(v.g, v.b)));
+    st.fit_radiance_scale(peak);
+    for (std::size_t t = 0; t < radiance.size(); ++t) st.set_radiance(t, radiance[t]);
+    projector_.project(radiance.data(), sh_.data() + static_cast<std::size_t>(q) * 75);
     if (settings_.window) apply_hanning_window(sh_.data() + static_cast<std::size_t>(q) * 75);
   }
   bar.finish();

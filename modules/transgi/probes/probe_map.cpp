@@ -6,17 +6,65 @@
 
 namespace transgi::probes {
 
-void ProbeMapState::reset(int texels) {
+void ProbeMapState::reset(int texels, float depth_unit) {
   const auto n = static_cast<std::size_t>(texels);
-  radiance.assign(n, glm::vec3(0.0f));
+  radiance.assign(n, HalfRgb{});
+  radiance_scale = 1.0f;
   sampled.assign(n, 0);
-  depth.moments.assign(n, glm::vec2(std::numeric_limits<float>::quiet_NaN(), 0.0f));
+  depth.reset(texels, depth_unit);
   noise_variance = 0.0f;
   noise_frames = 0;
   frames = 0;
   stable_frames = 0;
   depth_frames = 0;
   drift = 0.0f;
+}
+
+glm::vec3 ProbeMapState::radiance_at(std::size_t t) const {
+  const HalfRgb& h = radiance[t];
+  using engine::math::from_half;
+  return glm::vec3(from_half(h.r), from_half(h.g), from_half(h.b)) * radiance_scale;
+}
+
+namespace {
+std::uint16_t stored_half(float v, float scale) {
+  return engine::math::to_half(std::clamp(v / scale, 0.0f, engine::math::kHalfMax));
+}
+}  // namespace
+
+void ProbeMapState::set_radiance(std::size_t t, const glm::vec3& v) {
+  radiance[t] = {stored_half(v.r, radiance_scale), stored_half(v.g, radiance_scale), stored_half(v.b, radiance_scale)};
+}
+
+void ProbeMapState::blend_radiance(std::size_t t, float h, const glm::vec3& sample) {
+  const glm::vec3 old = radiance_at(t);
+  const glm::vec3 target = h * old + (1.0f - h) * sample;
+  std::uint16_t* bits[3] = {&radiance[t].r, &radiance[t].g, &radiance[t].b};
+  for (int c = 0; c < 3; ++c) {
+    const std::uint16_t rounded = stored_half(target[c], radiance_scale);
+    // A step under half an ulp would round back to the old value forever and
+    // leave the history up to (2^-12 / (1 - h)) off a steady light (0.5 % at
+    // h = 0.95); such a step moves one ulp instead. Values are non-negative
+    // halves, whose bit patterns order like their values.
+    if (rounded == *bits[c] && target[c] != old[c])
+      *bits[c] = target[c] > old[c] ? static_cast<std::uint16_t>(std::min(*bits[c] + 1, 0x7bff)) : static_cast<std::uint16_t>(std::max(*bits[c] - 1, 0));
+    else
+      *bits[c] = rounded;
+  }
+}
+
+void ProbeMapState::fit_radiance_scale(float peak) {
+  if (!(peak > 0) || !std::isfinite(peak)) return;
+  const float stored = peak / radiance_scale;
+  if (stored <= 16384.0f && stored >= 0.25f) return;
+  // New scale: the peak lands in (2^11, 2^12].
+  const float scale = std::ldexp(1.0f, std::ilogb(peak) + 1 - 12);
+  const float factor = radiance_scale / scale;
+  for (std::size_t t = 0; t < radiance.size(); ++t) {
+    const glm::vec3 u = radiance_at(t) / radiance_scale * factor;
+    radiance[t] = {engine::math::to_half(u.r), engine::math::to_half(u.g), engine::math::to_half(u.b)};
+  }
+  radiance_scale = scale;
 }
 
 namespace {
@@ -31,11 +79,20 @@ bool accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSett
   // low, per probe without the noise test 5 % high on a lit floor
   // (tests/transgi/probe_field_test.cpp).
   double old_sum = 0, new_sum = 0;
-  for (std::size_t t = 0; t < st.radiance.size(); ++t)
-    if (f.count[t] > 0 && st.sampled[t] > 0) {
-      old_sum += luminance(st.radiance[t]);
-      new_sum += luminance(f.sum[t] / f.count[t]);
+  float peak = 0;
+  for (std::size_t t = 0; t < st.radiance.size(); ++t) {
+    const glm::vec3 old = st.radiance_at(t);
+    peak = std::max(peak, std::max(old.r, std::max(old.g, old.b)));
+    if (f.count[t] > 0) {
+      const glm::vec3 mean = f.sum[t] / f.count[t];
+      peak = std::max(peak, std::max(mean.r, std::max(mean.g, mean.b)));
+      if (st.sampled[t] > 0) {
+        old_sum += luminance(old);
+        new_sum += luminance(mean);
+      }
     }
+  }
+  st.fit_radiance_scale(peak);
   bool changed = false, drifting = false;
   // The noise is only measured once the cold start is over: the warm-up's
   // large frame-to-frame changes are convergence, not noise, and counting
@@ -74,11 +131,11 @@ bool accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSett
     }
     const glm::vec3 mean = f.sum[t] / f.count[t];
     if (st.sampled[t] == 0) {
-      st.radiance[t] = mean;
+      st.set_radiance(t, mean);
       st.sampled[t] = 1;
       continue;
     }
-    st.radiance[t] = h * st.radiance[t] + (1.0f - h) * mean;
+    st.blend_radiance(t, h, mean);
   }
   return changed;
 }
@@ -94,18 +151,22 @@ void update_own_depth(ProbeMapState& st, const MapLayout& layout, const std::vec
   for (const ShadedPoint& p : own) {
     if (!std::isfinite(p.distance)) continue;
     const auto t = static_cast<std::size_t>(layout.texel_of(p.direction));
-    glm::vec2& m = st.depth.moments[t];
-    if (std::isnan(m.x)) {  // the texel's first own hit (distances are finite)
-      m = {p.distance, p.distance * p.distance};
+    const float mean = st.depth.mean(t);
+    if (std::isnan(mean)) {  // the texel's first own hit (distances are finite)
+      st.depth.set(t, p.distance, 0.0f);
     } else {
-      m.x = h * m.x + (1 - h) * p.distance;
-      m.y = h * m.y + (1 - h) * p.distance * p.distance;
+      // The exponential mean of the distance and of its square, written as
+      // mean and variance: var' = h var + h (1 - h) (d - mean)^2 is exactly
+      // M2' - mean'^2 for M2' = h M2 + (1 - h) d^2.
+      const float d = p.distance - mean;
+      st.depth.set(t, mean + (1 - h) * d, h * st.depth.variance(t) + h * (1 - h) * d * d);
     }
   }
 }
 
 std::vector<glm::vec3> filled_radiance(const ProbeMapState& st, const MapLayout& layout, int passes) {
-  std::vector<glm::vec3> r = st.radiance;
+  std::vector<glm::vec3> r(st.radiance.size());
+  for (std::size_t t = 0; t < r.size(); ++t) r[t] = st.radiance_at(t);
   std::vector<std::uint8_t> known = st.sampled;
   const int w = layout.width, h = layout.height;
   // Each pass fills the holes next to known texels from the state before the

@@ -37,10 +37,21 @@ struct AccumulationSettings {
   bool operator==(const AccumulationSettings&) const = default;
 };
 
+// One texel's radiance history: binary16 in units of the probe's scale.
+struct HalfRgb {
+  std::uint16_t r = 0, g = 0, b = 0;
+};
+
+// The probe state is what the field keeps per probe across frames, so it is
+// compact: 6 + 1 + 4 bytes a texel (radiance, flag, depth) instead of 21.
+// Half precision is enough for a history that blends 5 % of a noisy frame in:
+// one rounding is 2^-11 relative, far under the per-texel noise, and the
+// power-of-two scale keeps any emitter strength in range.
 struct ProbeMapState {
-  std::vector<glm::vec3> radiance;   // history, per texel
+  std::vector<HalfRgb> radiance;     // history, per texel, in units of radiance_scale
+  float radiance_scale = 1.0f;       // a power of two, fitted to the probe's brightest texel
   std::vector<std::uint8_t> sampled; // 0 until a texel receives its first sample (a flag: one byte)
-  DepthMap depth;                    // own hit distance moments (mean NaN = never hit)
+  DepthMap depth;                    // own hit distance mean and variance (mean NaN = never hit)
   float noise_variance = 0.0f;  // running mean of (relative frame change)^2 under steady light
   int noise_frames = 0;
   int frames = 0;  // frames accumulated since reset
@@ -48,7 +59,22 @@ struct ProbeMapState {
   int stable_frames = 0;  // (neither changed nor drifting)
   int depth_frames = 0;   // frames of own depth since reset or since the geometry last moved  // consecutive frames after the warm-up without a detected change
 
-  void reset(int texels);
+  // depth_unit: the length the depth is stored in units of (the grid's
+  // smallest spacing).
+  void reset(int texels, float depth_unit = 1.0f);
+  [[nodiscard]] glm::vec3 radiance_at(std::size_t texel) const;
+  // v in [0, 2^14 * radiance_scale] is stored to 11 significant bits; more is
+  // clamped to the half range (call fit_radiance_scale first), and negative
+  // values (radiance is never negative) to 0.
+  void set_radiance(std::size_t texel, const glm::vec3& v);
+  // history = h * history + (1 - h) * sample, stored so that a steady sample
+  // is reached to within one half-precision ulp (see the .cpp).
+  void blend_radiance(std::size_t texel, float h, const glm::vec3& sample);
+  // Changes the scale by a power of two (exact for the stored texels) when
+  // `peak` (the largest value the history holds or will receive) would not
+  // fit under 2^14 of it, or would sit below 1/4 of it where the bottom of the
+  // half range loses bits.
+  void fit_radiance_scale(float peak);
 };
 
 // Blends this frame's samples into the history. Returns whether the probe

@@ -1,11 +1,24 @@
 #include "probes/radiance_sharing.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 
 #include "engine/jobs/parallel_for.h"
 
 namespace transgi::probes {
+
+void DepthMap::reset(int count, float unit_length) {
+  texels.assign(static_cast<std::size_t>(count), Texel{});
+  unit = unit_length > 0 && std::isfinite(unit_length) ? unit_length : 1.0f;
+}
+
+void DepthMap::set(std::size_t texel, float m, float v) {
+  using engine::math::kHalfMax;
+  const float mu = m / unit, var = v / (unit * unit);
+  texels[texel].mean = engine::math::to_half(std::isnan(mu) ? mu : std::min(mu, kHalfMax));
+  texels[texel].variance = engine::math::to_half(std::clamp(std::isfinite(var) ? var : kHalfMax, 0.0f, kHalfMax));
+}
 
 SharingStats rasterize_shared(const ProbeGrid& grid, const MapLayout& layout,
                               const std::vector<std::vector<ShadedPoint>>& points, const std::vector<const DepthMap*>& own_depth,

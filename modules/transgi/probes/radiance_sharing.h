@@ -21,6 +21,7 @@
 
 #include <glm/glm.hpp>
 
+#include "engine/math/half.h"
 #include "probes/probe_grid.h"
 #include "probes/radiance_map.h"
 
@@ -60,13 +61,28 @@ struct FrameSamples {
   }
 };
 
-// Per texel, the mean own hit distance (x; NaN where the probe's own rays
-// never hit), which the sharing guard compares against, and the mean of its
-// square (y), for the Chebyshev visibility test. One interleaved array: a
+// Per texel, the mean own hit distance (NaN where the probe's own rays never
+// hit), which the sharing guard compares against, and its variance, for the
+// Chebyshev visibility test. Both binary16 in units of `unit` (the grid's
+// smallest spacing), so a scene's scale does not change their precision, and
+// the variance is stored itself rather than as a mean square, which would
+// cancel to nothing at half precision. 4 bytes a texel, interleaved: a
 // visibility lookup reads both from one cache line.
 struct DepthMap {
-  std::vector<glm::vec2> moments;
-  [[nodiscard]] float mean(std::size_t texel) const { return moments[texel].x; }
+  struct Texel {
+    std::uint16_t mean = 0x7e00;  // NaN
+    std::uint16_t variance = 0;
+  };
+  std::vector<Texel> texels;
+  float unit = 1.0f;
+
+  void reset(int count, float unit_length);
+  [[nodiscard]] float mean(std::size_t texel) const { return engine::math::from_half(texels[texel].mean) * unit; }
+  [[nodiscard]] float variance(std::size_t texel) const {
+    return engine::math::from_half(texels[texel].variance) * unit * unit;
+  }
+  // Clamped into the half range (a hit 65,504 grid spacings away reads as that far).
+  void set(std::size_t texel, float mean, float variance);
 };
 
 struct SharingStats {
