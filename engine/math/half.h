@@ -6,6 +6,7 @@
 // finite clamp to kHalfMax first). No F16C needed, so it runs on any x86-64
 // and gives the same bits everywhere.
 #include <bit>
+#include <cstddef>
 #include <cstdint>
 
 namespace engine::math {
@@ -46,5 +47,16 @@ inline float from_half(std::uint16_t h) {
   o |= static_cast<std::uint32_t>(h & 0x8000u) << 16;
   return std::bit_cast<float>(o);
 }
+
+}  // namespace engine::math
+
+namespace engine::math {
+
+// Bulk conversions, F16C where the CPU has it (8 values an instruction),
+// else the functions above; the results are the same bits either way, NaN
+// payloads aside
+// (tests/engine/half_test.cpp).
+void to_halves(const float* in, std::uint16_t* out, std::size_t n);
+void from_halves(const std::uint16_t* in, float* out, std::size_t n);
 
 }  // namespace engine::math

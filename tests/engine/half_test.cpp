@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 #include "engine/math/half.h"
 #include "engine/math/rng.h"
@@ -65,6 +66,23 @@ TEST(Half, MatchesF16cOnRandomFloats) {
       ASSERT_EQ(std::isnan(a), std::isnan(b)) << "half " << h;
     } else {
       ASSERT_EQ(a, b) << "half " << h;
+    }
+  }
+}
+
+// The bulk conversions (F16C where present) against the scalar ones, with
+// tails that are not whole vectors.
+TEST(Half, BulkConversionsEqualTheScalarOnes) {
+  engine::math::Pcg32 rng(8, 1);
+  for (std::size_t n : {0u, 1u, 7u, 8u, 29u, 1000u}) {
+    std::vector<float> f(n), back(n);
+    std::vector<std::uint16_t> h(n);
+    for (float& v : f) v = (2 * rng.next_float() - 1) * std::ldexp(1.0f, static_cast<int>(rng.next_float() * 40) - 26);
+    engine::math::to_halves(f.data(), h.data(), n);
+    engine::math::from_halves(h.data(), back.data(), n);
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(h[i], to_half(f[i])) << "n " << n << " value " << i << " (" << f[i] << ")";
+      ASSERT_EQ(back[i], from_half(h[i])) << "n " << n << " value " << i;
     }
   }
 }

@@ -36,29 +36,16 @@ void ProbeMapState::set_radiance(std::size_t t, const glm::vec3& v) {
   radiance[t] = {stored_half(v.r, radiance_scale), stored_half(v.g, radiance_scale), stored_half(v.b, radiance_scale)};
 }
 
-void ProbeMapState::blend_radiance(std::size_t t, float h, const glm::vec3& sample) {
-  const glm::vec3 old = radiance_at(t);
-  const glm::vec3 target = h * old + (1.0f - h) * sample;
-  std::uint16_t* bits[3] = {&radiance[t].r, &radiance[t].g, &radiance[t].b};
-  for (int c = 0; c < 3; ++c) {
-    const std::uint16_t rounded = stored_half(target[c], radiance_scale);
-    // A step under half an ulp would round back to the old value forever and
-    // leave the history up to (2^-12 / (1 - h)) off a steady light (0.5 % at
-    // h = 0.95); such a step moves one ulp instead. Values are non-negative
-    // halves, whose bit patterns order like their values.
-    if (rounded == *bits[c] && target[c] != old[c])
-      *bits[c] = target[c] > old[c] ? static_cast<std::uint16_t>(std::min(*bits[c] + 1, 0x7bff)) : static_cast<std::uint16_t>(std::max(*bits[c] - 1, 0));
-    else
-      *bits[c] = rounded;
-  }
+float fitted_scale(float scale, float peak) {
+  if (!(peak > 0) || !std::isfinite(peak)) return scale;
+  const float stored = peak / scale;
+  if (stored <= 16384.0f && stored >= 0.25f) return scale;
+  return std::ldexp(1.0f, std::ilogb(peak) + 1 - 12);  // the peak lands in [2^11, 2^12)
 }
 
 void ProbeMapState::fit_radiance_scale(float peak) {
-  if (!(peak > 0) || !std::isfinite(peak)) return;
-  const float stored = peak / radiance_scale;
-  if (stored <= 16384.0f && stored >= 0.25f) return;
-  // New scale: the peak lands in (2^11, 2^12].
-  const float scale = std::ldexp(1.0f, std::ilogb(peak) + 1 - 12);
+  const float scale = fitted_scale(radiance_scale, peak);
+  if (scale == radiance_scale) return;
   const float factor = radiance_scale / scale;
   for (std::size_t t = 0; t < radiance.size(); ++t) {
     const glm::vec3 u = radiance_at(t) / radiance_scale * factor;
@@ -71,7 +58,46 @@ namespace {
 float luminance(const glm::vec3& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
 }  // namespace
 
+namespace {
+
+// The history as floats in real units (one bulk conversion).
+void load_history(const ProbeMapState& st, std::vector<glm::vec3>& out) {
+  out.resize(st.radiance.size());
+  engine::math::from_halves(&st.radiance.data()->r, &out.data()->x, 3 * out.size());
+  for (glm::vec3& v : out) v *= st.radiance_scale;
+}
+
+// Stores `next` as the history. A blend step under half an ulp would round
+// back to the old value forever and leave the history up to
+// 2^-12 / (1 - h) off a steady light (0.5 % at h = 0.95); such a step moves
+// one ulp instead. Values are non-negative halves, whose bit patterns order
+// like their values. `old` is the history before the step, at the same scale.
+void store_history(ProbeMapState& st, std::vector<glm::vec3>& next, const std::vector<glm::vec3>* old) {
+  const float inv = 1.0f / st.radiance_scale;
+  for (glm::vec3& v : next) v = glm::clamp(v * inv, glm::vec3(0.0f), glm::vec3(engine::math::kHalfMax));
+  thread_local std::vector<HalfRgb> bits;
+  bits.resize(next.size());
+  engine::math::to_halves(&next.data()->x, &bits.data()->r, 3 * next.size());
+  if (old) {
+    const float* target = &next.data()->x;
+    const float* before = &old->data()->x;
+    const std::uint16_t* was = &st.radiance.data()->r;
+    std::uint16_t* now = &bits.data()->r;
+    for (std::size_t i = 0; i < 3 * next.size(); ++i) {
+      const float b = before[i] * inv;
+      if (now[i] == was[i] && target[i] != b)
+        now[i] = target[i] > b ? static_cast<std::uint16_t>(std::min(now[i] + 1, 0x7bff))
+                               : static_cast<std::uint16_t>(std::max(now[i] - 1, 0));
+    }
+  }
+  st.radiance.swap(bits);
+}
+
+}  // namespace
+
 bool accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSettings& s) {
+  thread_local std::vector<glm::vec3> history, next;
+  load_history(st, history);
   // "The lighting changed" is decided once per probe, from the mean over
   // every texel sampled this frame, and only when the change is far outside
   // the probe's own frame-to-frame noise. A blend weight that depends on the
@@ -80,8 +106,8 @@ bool accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSett
   // (tests/transgi/probe_field_test.cpp).
   double old_sum = 0, new_sum = 0;
   float peak = 0;
-  for (std::size_t t = 0; t < st.radiance.size(); ++t) {
-    const glm::vec3 old = st.radiance_at(t);
+  for (std::size_t t = 0; t < history.size(); ++t) {
+    const glm::vec3& old = history[t];
     peak = std::max(peak, std::max(old.r, std::max(old.g, old.b)));
     if (f.count[t] > 0) {
       const glm::vec3 mean = f.sum[t] / f.count[t];
@@ -92,7 +118,6 @@ bool accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSett
       }
     }
   }
-  st.fit_radiance_scale(peak);
   bool changed = false, drifting = false;
   // The noise is only measured once the cold start is over: the warm-up's
   // large frame-to-frame changes are convergence, not noise, and counting
@@ -121,7 +146,8 @@ bool accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSett
   }
   st.stable_frames = (changed || drifting || st.frames < s.warmup_frames) ? 0 : st.stable_frames + 1;
   ++st.frames;
-  for (std::size_t t = 0; t < st.radiance.size(); ++t) {
+  next = history;
+  for (std::size_t t = 0; t < next.size(); ++t) {
     if (f.count[t] <= 0) {
       // Nothing new: keep the history, unless the lighting just changed, in
       // which case the history is wrong and the texel is refilled from
@@ -131,12 +157,17 @@ bool accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSett
     }
     const glm::vec3 mean = f.sum[t] / f.count[t];
     if (st.sampled[t] == 0) {
-      st.set_radiance(t, mean);
+      next[t] = mean;
       st.sampled[t] = 1;
       continue;
     }
-    st.blend_radiance(t, h, mean);
+    next[t] = h * history[t] + (1.0f - h) * mean;
   }
+  // A new scale (a power of two: the old texels convert exactly) rewrites
+  // every texel, so the ulp step is judged at the next frame.
+  const float old_scale = st.radiance_scale;
+  st.radiance_scale = fitted_scale(old_scale, peak);
+  store_history(st, next, st.radiance_scale == old_scale ? &history : nullptr);
   return changed;
 }
 
@@ -165,8 +196,8 @@ void update_own_depth(ProbeMapState& st, const MapLayout& layout, const std::vec
 }
 
 std::vector<glm::vec3> filled_radiance(const ProbeMapState& st, const MapLayout& layout, int passes) {
-  std::vector<glm::vec3> r(st.radiance.size());
-  for (std::size_t t = 0; t < r.size(); ++t) r[t] = st.radiance_at(t);
+  std::vector<glm::vec3> r;
+  load_history(st, r);
   std::vector<std::uint8_t> known = st.sampled;
   const int w = layout.width, h = layout.height;
   // Each pass fills the holes next to known texels from the state before the

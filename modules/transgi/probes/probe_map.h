@@ -67,15 +67,15 @@ struct ProbeMapState {
   // clamped to the half range (call fit_radiance_scale first), and negative
   // values (radiance is never negative) to 0.
   void set_radiance(std::size_t texel, const glm::vec3& v);
-  // history = h * history + (1 - h) * sample, stored so that a steady sample
-  // is reached to within one half-precision ulp (see the .cpp).
-  void blend_radiance(std::size_t texel, float h, const glm::vec3& sample);
   // Changes the scale by a power of two (exact for the stored texels) when
   // `peak` (the largest value the history holds or will receive) would not
   // fit under 2^14 of it, or would sit below 1/4 of it where the bottom of the
   // half range loses bits.
   void fit_radiance_scale(float peak);
 };
+
+// The power-of-two scale fit_radiance_scale would choose for `peak`.
+float fitted_scale(float scale, float peak);
 
 // Blends this frame's samples into the history. Returns whether the probe
 // detected a lighting change this frame.
