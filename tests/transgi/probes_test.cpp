@@ -143,9 +143,21 @@ TEST(ProbeGrid, CageWeightsReproduceLinearFunctions) {
     for (int k = 0; k < 8; ++k) {
       wsum += c.weights[static_cast<std::size_t>(k)];
       interp += c.weights[static_cast<std::size_t>(k)] * g.position(c.probes[static_cast<std::size_t>(k)]);
+      ASSERT_EQ(c.positions[static_cast<std::size_t>(k)], g.position(c.probes[static_cast<std::size_t>(k)])) << "corner " << k;
     }
     EXPECT_NEAR(wsum, 1.0f, 1e-5f);
     EXPECT_NEAR(glm::length(interp - p), 0.0f, 1e-4f) << "trilinear weights reproduce the position itself";
+  }
+}
+
+TEST(ProbeGrid, CagePositionsIncludeRelocationOffsets) {
+  ProbeGrid g{{-1, 0, -2}, {3, 2, 2}, {5, 3, 4}};
+  g.offsets.resize(static_cast<std::size_t>(g.count()));
+  for (int i = 0; i < g.count(); ++i) g.offsets[static_cast<std::size_t>(i)] = glm::vec3(0.01f * i, -0.02f * (i % 3), 0.03f);
+  const auto c = g.cage({0.3f, 1.1f, 0.7f});
+  for (std::size_t k = 0; k < 8; ++k) {
+    EXPECT_EQ(c.positions[k], g.position(c.probes[k])) << "corner " << k;
+    EXPECT_NE(c.positions[k], g.grid_point(c.probes[k])) << "corner " << k << ": the offset was left out";
   }
 }
 

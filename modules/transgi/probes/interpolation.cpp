@@ -20,26 +20,39 @@ InterpolationResult interpolate_probes(const ProbeGrid& grid, const MapLayout& l
   r.probes = cage.probes;
   const float bias = s.normal_bias * grid.min_spacing();
   const glm::vec3 biased = p + n * bias;
+  // Two passes: first every probe's geometry and its depth texel's address,
+  // then the loads together, so the eight (often cache-missing) depth reads
+  // overlap instead of waiting one after another behind each probe's math.
+  std::array<float, 8> facing{}, dist{}, from_dist{};
+  std::array<const DepthMap::Texel*, 8> texel{};
+  for (std::size_t i = 0; i < 8; ++i) {
+    const int q = cage.probes[i];
+    const glm::vec3& at = cage.positions[i];
+    const glm::vec3 to_probe = at - p;
+    dist[i] = glm::length(to_probe);
+    facing[i] = dist[i] > 1e-6f ? glm::dot(to_probe / dist[i], n) : 1.0f;  // dir = n when the point is at the probe
+    const glm::vec3 from_probe = biased - at;
+    from_dist[i] = glm::length(from_probe);
+    texel[i] = s.prune_occluded && from_dist[i] > 1e-6f ? &states[static_cast<std::size_t>(q)].depth.texels[static_cast<std::size_t>(layout.texel_of(from_probe / from_dist[i]))]
+                                    : nullptr;
+  }
+  std::array<DepthMap::Texel, 8> depth{};
+  for (std::size_t i = 0; i < 8; ++i)
+    if (texel[i]) depth[i] = *texel[i];
   float sum = 0;
   std::array<float, 8> fallback{};
   for (std::size_t i = 0; i < 8; ++i) {
     const int q = cage.probes[i];
-    const glm::vec3 to_probe = grid.position(q) - p;
-    const float dist = glm::length(to_probe);
-    const glm::vec3 dir = dist > 1e-6f ? to_probe / dist : n;
     // Fallback weight: nearer and more in front of the surface counts more.
     const bool holds_light = usable.empty() || usable[static_cast<std::size_t>(q)] != 0;
-    fallback[i] = holds_light ? std::max(0.05f, 0.5f * (glm::dot(dir, n) + 1.0f)) / (dist * dist + 1e-4f) : 0.0f;
+    fallback[i] = holds_light ? std::max(0.05f, 0.5f * (facing[i] + 1.0f)) / (dist[i] * dist[i] + 1e-4f) : 0.0f;
     bool keep = cage.weights[i] > 0 && holds_light;
-    if (keep && s.prune_back_facing && glm::dot(dir, n) < 0) keep = false;
-    if (keep && s.prune_occluded) {
-      const glm::vec3 from_probe = biased - grid.position(q);
-      const float d = glm::length(from_probe);
-      if (d > 1e-6f) {
-        const auto t = static_cast<std::size_t>(layout.texel_of(from_probe / d));
-        const ProbeMapState& st = states[static_cast<std::size_t>(q)];
-        if (chebyshev_visibility(st.depth.mean(t), st.depth.variance(t), d) < s.visibility_threshold) keep = false;
-      }
+    if (keep && s.prune_back_facing && facing[i] < 0) keep = false;
+    if (keep && s.prune_occluded && texel[i]) {
+      const DepthMap& dm = states[static_cast<std::size_t>(q)].depth;
+      const float mean = engine::math::from_half(depth[i].mean) * dm.unit;
+      const float variance = engine::math::from_half(depth[i].variance) * dm.unit * dm.unit;
+      if (chebyshev_visibility(mean, variance, from_dist[i]) < s.visibility_threshold) keep = false;
     }
     if (!keep && cage.weights[i] > 0) ++r.pruned;
     r.weights[i] = keep ? cage.weights[i] : 0.0f;

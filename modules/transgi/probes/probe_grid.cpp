@@ -25,8 +25,11 @@ ProbeGrid::Cage ProbeGrid::cage(const glm::vec3& p) const {
   for (int i = 0; i < 8; ++i) {
     const glm::ivec3 o((i >> 0) & 1, (i >> 1) & 1, (i >> 2) & 1);
     const glm::ivec3 q = glm::min(base + o, dims - 1);
-    c.probes[static_cast<std::size_t>(i)] = index(q);
+    const int at = index(q);
+    c.probes[static_cast<std::size_t>(i)] = at;
     c.weights[static_cast<std::size_t>(i)] = (o.x ? f.x : 1 - f.x) * (o.y ? f.y : 1 - f.y) * (o.z ? f.z : 1 - f.z);
+    c.positions[static_cast<std::size_t>(i)] =
+        min + glm::vec3(q) * s + (offsets.empty() ? glm::vec3(0.0f) : offsets[static_cast<std::size_t>(at)]);
   }
   return c;
 }

@@ -42,6 +42,7 @@ struct ProbeGrid {
   struct Cage {
     std::array<int, 8> probes{};
     std::array<float, 8> weights{};
+    std::array<glm::vec3, 8> positions{};  // position(probes[i]), without its divisions
   };
   [[nodiscard]] Cage cage(const glm::vec3& p) const;
 
