@@ -29,7 +29,14 @@ void write_file_atomically(const std::filesystem::path& path, std::span<const st
   if (fs::is_directory(path, ec)) throw IoError(path.string() + ": is a directory");
 
   std::random_device rd;
-  const fs::path tmp = dir / ("." + path.filename().string() + "." + std::to_string(rd()) + ".tmp");
+  // Built by appending: GCC 12 at -O3 warns falsely (-Wrestrict, its bug
+  // 105329) on "." + std::string&&.
+  std::string name = ".";
+  name += path.filename().string();
+  name += '.';
+  name += std::to_string(rd());
+  name += ".tmp";
+  const fs::path tmp = dir / name;
   {
     Fd f{::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644)};
     if (f.fd < 0) throw IoError(path.string() + ": cannot create temporary file " + tmp.string() + ": " + errno_text());
