@@ -25,6 +25,15 @@ TEST(RadianceMap, SolidAnglesSumToTheSphereAndTexelsRoundTrip) {
   EXPECT_NEAR(total, 4 * engine::math::kPi, 1e-9);
 }
 
+TEST(RadianceMap, FastAtan2KeepsTheSignedZeroConventions) {
+  for (float y : {0.0f, -0.0f, 1.0f, -1.0f})
+    for (float x : {0.0f, -0.0f, 1.0f, -1.0f}) {
+      const float expected = std::atan2(y, x), got = fast_atan2(y, x);
+      EXPECT_NEAR(got, expected, 2e-5f) << "atan2(" << y << ", " << x << ")";  // the polynomial's bound
+      EXPECT_EQ(std::signbit(got), std::signbit(expected)) << "atan2(" << y << ", " << x << ")";
+    }
+}
+
 TEST(RadianceMap, FastTexelLookupMatchesTheReferenceAwayFromBorders) {
   // texel_of uses polynomial atan2/acos; texel_of_reference the library
   // ones. They may disagree only for directions within 1e-4 rad of a texel
@@ -327,6 +336,40 @@ std::vector<ProbeMapState> open_space_states(const ProbeGrid& g, const MapLayout
   return s;
 }
 }  // namespace
+
+// interpolate_probes computes the cage's geometry as 8-lane vectors; the
+// reference one corner at a time. Same arithmetic, no contraction: the same
+// bits, on relocated probes with depth that occludes some corners, at points
+// on and off the probes.
+TEST(Interpolation, VectorisedGeometryEqualsTheReferenceBitForBit) {
+  ProbeGrid g{{-2, 0, -2}, {2, 3, 2}, {5, 4, 5}};
+  g.offsets.resize(static_cast<std::size_t>(g.count()));
+  engine::math::Pcg32 rng(12, 3);
+  for (glm::vec3& o : g.offsets) o = 0.2f * glm::vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f);
+  const MapLayout m{50, 25};
+  std::vector<ProbeMapState> states(static_cast<std::size_t>(g.count()));
+  for (auto& st : states) {
+    st.reset(m.texel_count());
+    for (int t = 0; t < m.texel_count(); ++t)
+      if (rng.next_float() < 0.7f) st.depth.set(static_cast<std::size_t>(t), 0.2f + 1.5f * rng.next_float(), 0.05f * rng.next_float());
+  }
+  const InterpolationSettings settings;
+  int pruned = 0, compared = 0;
+  for (int i = 0; i < 20000; ++i) {
+    glm::vec3 p = g.min + (g.max - g.min) * glm::vec3(rng.next_float(), rng.next_float(), rng.next_float());
+    if (i % 100 == 0) p = g.position(i % g.count());  // exactly on a probe
+    const glm::vec3 n = engine::math::sample_uniform_sphere({rng.next_float(), rng.next_float()});
+    const InterpolationResult fast = interpolate_probes(g, m, states, p, n, settings);
+    const InterpolationResult ref = interpolate_probes_reference(g, m, states, p, n, settings);
+    ASSERT_EQ(fast.probes, ref.probes) << "point " << i;
+    ASSERT_EQ(fast.weights, ref.weights) << "point " << i;
+    ASSERT_EQ(fast.pruned, ref.pruned) << "point " << i;
+    ASSERT_EQ(fast.fallback, ref.fallback) << "point " << i;
+    pruned += ref.pruned;
+    ++compared;
+  }
+  EXPECT_GT(pruned, compared) << "the depth must prune some corners, or the visibility path went untested";
+}
 
 TEST(Interpolation, UnprunedWeightsAreTrilinear) {
   const ProbeGrid g{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}};

@@ -46,6 +46,13 @@ InterpolationResult interpolate_probes(const ProbeGrid& grid, const MapLayout& l
                                        const glm::vec3& normal, const InterpolationSettings& settings,
                                        std::span<const std::uint8_t> usable = {});
 
+// The same, one cage corner at a time: the plain statement that
+// interpolate_probes' vectorised corner geometry is tested against.
+InterpolationResult interpolate_probes_reference(const ProbeGrid& grid, const MapLayout& layout,
+                                                 const std::vector<ProbeMapState>& states, const glm::vec3& position,
+                                                 const glm::vec3& normal, const InterpolationSettings& settings,
+                                                 std::span<const std::uint8_t> usable = {});
+
 // Chebyshev upper bound on the probability that the probe sees a point at
 // `distance`, from the mean and variance of its hit distance in that direction.
 float chebyshev_visibility(float mean, float variance, float distance);

@@ -14,17 +14,17 @@
 
 namespace transgi::probes {
 
-// atan2 and acos to about 1e-5 rad, branch-light and inlinable.
+// atan2 and acos to about 1e-5 rad, branch-free and inlinable, so loops of
+// them vectorise. Signed zeros follow std::atan2 (atan2(+-0, -0) = +-pi).
 inline float fast_atan2(float y, float x) {
   const float ax = std::abs(x), ay = std::abs(y);
   const float hi = std::max(ax, ay), lo = std::min(ax, ay);
-  if (!(hi > 0)) return std::signbit(x) ? std::copysign(3.14159265f, y) : std::copysign(0.0f, y);  // as std::atan2
-  const float z = lo / hi, z2 = z * z;
+  const float z = hi > 0 ? lo / hi : 0.0f, z2 = z * z;
   // Minimax odd polynomial for atan on [0, 1].
   float a = z * (0.99997726f + z2 * (-0.33262347f + z2 * (0.19354346f + z2 * (-0.11643287f + z2 * (0.05265332f + z2 * -0.01172120f)))));
-  if (ay > ax) a = 1.57079633f - a;
-  if (x < 0) a = 3.14159265f - a;
-  return y < 0 ? -a : a;
+  a = ay > ax ? 1.57079633f - a : a;
+  a = std::signbit(x) ? 3.14159265f - a : a;
+  return std::signbit(y) ? -a : a;
 }
 inline float fast_acos(float x) {
   // Abramowitz and Stegun 4.4.46 (error 2e-8 on [0, 1]), mirrored for x < 0.
