@@ -29,6 +29,7 @@ struct Upsampling {
   int grid_w = 0, grid_h = 0;
   float sx = 1, sy = 1;                   // output pixels per cell
   std::vector<std::size_t> cell_pixel;    // per cell: the pixel it decodes
+  std::vector<glm::vec4> cell_guide;      // per cell: its pixel's guide, read in order rather than through cell_pixel
   enum : std::uint8_t { kUpsampled = 0, kOwn = 1, kMiss = 2 };
   std::vector<std::uint8_t> kind;         // per pixel
   // Per upsampled pixel: its four grid cells and normalised weights (32
@@ -52,7 +53,7 @@ struct RawTaps {
 
 struct RealtimeGiScratch::Impl {
   Upsampling up;
-  std::vector<std::size_t> decode, slot_of_pixel;
+  std::vector<std::size_t> decode, slot_of_pixel, cell_slot;
   std::vector<glm::vec3> value, value_direct, shaded, shaded_direct;
   std::vector<TransferQuery> queries;
 };
@@ -87,7 +88,7 @@ RawTaps taps_of(int x, int y, const std::vector<glm::vec4>& guide, const Upsampl
     const int i = std::clamp(i0 + (k & 1), 0, u.grid_w - 1), j = std::clamp(j0 + (k >> 1), 0, u.grid_h - 1);
     const float bilinear = ((k & 1) ? tx : 1 - tx) * ((k >> 1) ? ty : 1 - ty);
     const std::size_t cell = static_cast<std::size_t>(j) * u.grid_w + i;
-    const float w = bilinear * similarity(gp, guide[u.cell_pixel[cell]], s);
+    const float w = bilinear * similarity(gp, u.cell_guide[cell], s);
     t.cell[static_cast<std::size_t>(k)] = cell;
     t.weight[static_cast<std::size_t>(k)] = w;
     t.total += w;
@@ -108,6 +109,8 @@ void plan_upsampling(const GBuffer& g, const std::vector<glm::vec4>& guide, cons
       const int y = std::min(g.height - 1, static_cast<int>((static_cast<float>(j) + 0.5f) * u.sy));
       u.cell_pixel[static_cast<std::size_t>(j) * u.grid_w + i] = static_cast<std::size_t>(y) * g.width + x;
     }
+  u.cell_guide.resize(u.cell_pixel.size());
+  for (std::size_t c = 0; c < u.cell_pixel.size(); ++c) u.cell_guide[c] = guide[u.cell_pixel[c]];
   u.kind.resize(g.samples.size());
   u.taps.resize(g.samples.size());
   engine::jobs::parallel_for(0, g.height, 8, [&](int y0, int y1) {
@@ -365,6 +368,11 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   stats.diffuse = diffuse.size();
 
   t0 = Clock::now();
+  // Each cell's slot in `value`, so the composite reads one index per tap
+  // (a miss cell has none; its taps have zero weight and are skipped).
+  std::vector<std::size_t>& cell_slot = sc.cell_slot;
+  cell_slot.resize(up.cell_pixel.size());
+  for (std::size_t c = 0; c < cell_slot.size(); ++c) cell_slot[c] = slot_of_pixel[up.cell_pixel[c]];
   engine::jobs::parallel_for(0, g.height, 8, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < g.width; ++x) {
@@ -380,7 +388,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
         for (std::size_t k = 0; k < 4; ++k) {
           if (!(t.weight[k] > 0)) continue;
           const float w = t.weight[k];
-          const std::size_t slot = slot_of_pixel[up.cell_pixel[t.cell[k]]];
+          const std::size_t slot = cell_slot[t.cell[k]];
           sum += w * value[slot];
           if (with_direct) sum_direct += w * value_direct[slot];
         }
