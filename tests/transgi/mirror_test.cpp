@@ -111,4 +111,16 @@ TEST(MirrorPath, AFlatMirrorUnderALitCeilingShowsTheCeilingsRadiance) {
   for (int y = 14; y < 18; ++y)
     for (int x = 14; x < 18; ++x)
       EXPECT_NEAR(realtime.at(x, y).g, expected, 1e-4f * expected) << "real-time path, pixel (" << x << ", " << y << ")";
+
+  // The mirror pass finds its pixels through the G-buffer's metal_roughness:
+  // exactly the pixels is_mirror() picks from the full samples.
+  const shading::MirrorRay mirror_ray;
+  int mirrors = 0;
+  ASSERT_EQ(g.metal_roughness.size(), g.samples.size());
+  for (std::size_t p = 0; p < g.samples.size(); ++p) {
+    const bool by_sample = g.samples[p].hit && shading::is_mirror(g.samples[p].brdf, mirror_ray);
+    EXPECT_EQ(g.metal_roughness[p] <= mirror_ray.max_roughness, by_sample) << "pixel " << p;
+    mirrors += by_sample;
+  }
+  EXPECT_GT(mirrors, 0) << "the scene must show its mirror";
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
+#include <limits>
 #include <map>
 #include <unordered_map>
 
@@ -204,6 +205,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
   g.height = height;
   g.samples.resize(static_cast<std::size_t>(width) * height);
   g.guide.resize(g.samples.size());
+  g.metal_roughness.resize(g.samples.size());
   // 4x4 pixel tiles as one Embree packet: neighbouring camera rays share
   // their traversal.
   const int tiles_x = (width + 3) / 4, tiles_y = (height + 3) / 4;
@@ -225,6 +227,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
       for (int i = 0; i < n; ++i) {
         const GSample& s = g.samples[pixel[i]] = make_gsample(scene, assets, rays[i], found[i] ? &hits[i] : nullptr, nullptr, spread);
         g.guide[pixel[i]] = s.hit ? glm::vec4(s.normal_world, std::max(s.depth, 1e-30f)) : glm::vec4(0.0f);
+        g.metal_roughness[pixel[i]] = s.hit && s.brdf.metallic >= 0.5f ? s.brdf.roughness : std::numeric_limits<float>::infinity();
       }
     }
   });
@@ -402,10 +405,13 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   if (mirror.max_roughness >= 0) {
     t0 = Clock::now();
     const LightAt light_at = [&](const glm::vec3& p, const glm::vec3& n, float* out) { field_holding(fields, p)->interpolate(p, n, out); };
+    const bool by_roughness = g.metal_roughness.size() == g.samples.size();
     engine::jobs::parallel_for<std::size_t>(0, g.samples.size(), 1024, [&](std::size_t b, std::size_t e) {
       for (std::size_t p = b; p < e; ++p) {
+        // metal_roughness <= max_roughness is is_mirror() on the pixel's material.
+        if (by_roughness ? !(g.metal_roughness[p] <= mirror.max_roughness) : !g.samples[p].hit || !is_mirror(g.samples[p].brdf, mirror))
+          continue;
         const GSample& s = g.samples[p];
-        if (!s.hit || !is_mirror(s.brdf, mirror)) continue;
         engine::math::Pcg32 rng = engine::math::make_rng(0x4D1Bull, p, 0);  // fixed: the real-time image has no seed
         image.pixels[p] = shade_mirror_gi(scene, s, light_at, mirror_lights, mirror, rng);
       }

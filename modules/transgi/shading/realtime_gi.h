@@ -56,6 +56,10 @@ struct GBuffer {
   // upsampling compares; written by trace_gbuffer. 16 bytes a pixel instead
   // of a whole GSample keeps those passes in cache.
   std::vector<glm::vec4> guide;
+  // Per pixel: the surface's roughness where it is metallic (>= 0.5), else
+  // infinity (misses too), so the mirror pass finds its pixels in 4 bytes a
+  // pixel rather than reading every GSample's material; written by trace_gbuffer.
+  std::vector<float> metal_roughness;
 };
 
 // One ray through each pixel centre, in parallel over rows.
