@@ -65,7 +65,7 @@ void ProbeField::replace_with_oracle(const engine::rt::RtScene& scene, const eng
     st.frames = 1;
     float peak = 0;
     for (const glm::vec3& v : radiance) peak = std::max(peak, std::max(v.r, std::max(v.g, v.b)));
-    st.fit_radiance_scale(peak);
+    st.radiance_scale = fitted_scale(st.radiance_scale, peak);  // the state was just reset: nothing to rescale
     for (std::size_t t = 0; t < radiance.size(); ++t) st.set_radiance(t, radiance[t]);
     projector_.project(radiance.data(), sh_.data() + static_cast<std::size_t>(q) * 75);
     if (settings_.window) apply_hanning_window(sh_.data() + static_cast<std::size_t>(q) * 75);

@@ -43,17 +43,6 @@ float fitted_scale(float scale, float peak) {
   return std::ldexp(1.0f, std::ilogb(peak) + 1 - 12);  // the peak lands in [2^11, 2^12)
 }
 
-void ProbeMapState::fit_radiance_scale(float peak) {
-  const float scale = fitted_scale(radiance_scale, peak);
-  if (scale == radiance_scale) return;
-  const float factor = radiance_scale / scale;
-  for (std::size_t t = 0; t < radiance.size(); ++t) {
-    const glm::vec3 u = radiance_at(t) / radiance_scale * factor;
-    radiance[t] = {engine::math::to_half(u.r), engine::math::to_half(u.g), engine::math::to_half(u.b)};
-  }
-  radiance_scale = scale;
-}
-
 namespace {
 float luminance(const glm::vec3& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
 }  // namespace

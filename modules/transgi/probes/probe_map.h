@@ -64,17 +64,15 @@ struct ProbeMapState {
   void reset(int texels, float depth_unit = 1.0f);
   [[nodiscard]] glm::vec3 radiance_at(std::size_t texel) const;
   // v in [0, 2^14 * radiance_scale] is stored to 11 significant bits; more is
-  // clamped to the half range (call fit_radiance_scale first), and negative
-  // values (radiance is never negative) to 0.
+  // clamped to the half range (choose the scale with fitted_scale first),
+  // and negative values (radiance is never negative) to 0.
   void set_radiance(std::size_t texel, const glm::vec3& v);
-  // Changes the scale by a power of two (exact for the stored texels) when
-  // `peak` (the largest value the history holds or will receive) would not
-  // fit under 2^14 of it, or would sit below 1/4 of it where the bottom of the
-  // half range loses bits.
-  void fit_radiance_scale(float peak);
 };
 
-// The power-of-two scale fit_radiance_scale would choose for `peak`.
+// The radiance scale for a history whose largest value (held or about to be
+// stored) is `peak`: `scale` itself while the peak lies in [1/4, 2^14] of it,
+// else the power of two that puts the peak in [2^11, 2^12), so the texels
+// convert exactly and the bottom of the half range keeps its bits.
 float fitted_scale(float scale, float peak);
 
 // Blends this frame's samples into the history. Returns whether the probe

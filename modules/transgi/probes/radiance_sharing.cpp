@@ -69,24 +69,35 @@ __attribute__((target_clones("default", "avx2", "arch=x86-64-v4"))) void point_g
   }
 }
 
-}  // namespace
+// The reference's geometry: one point at a time through glm and
+// MapLayout::texel_of (points at the origin keep dist only; they are skipped).
+void point_geometry_reference(const std::vector<ShadedPoint>& pts, const glm::vec3& origin, const MapLayout& layout,
+                              float* dist_out, int* texel_out, float* facing_out) {
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    glm::vec3 d = pts[i].position - origin;
+    dist_out[i] = glm::length(d);
+    if (!(dist_out[i] > 1e-6f)) continue;
+    d /= dist_out[i];
+    texel_out[i] = layout.texel_of(d);
+    facing_out[i] = glm::dot(pts[i].normal, d);
+  }
+}
 
-SharingStats rasterize_shared(const ProbeGrid& grid, const MapLayout& layout,
-                              const std::vector<std::vector<ShadedPoint>>& points, const std::vector<const DepthMap*>& own_depth,
-                              const SharingSettings& s, std::vector<FrameSamples>& out,
-                              std::span<const std::uint8_t> targets) {
+// Gathers each target's frame samples from its neighbourhood; `geometry(q,
+// origin, dist, texel, facing)` fills, for each of probe q's points, its
+// distance from the target at `origin`, its texel and the cosine between its
+// normal and the direction from the target (> 0: seen from behind).
+template <class Geometry>
+SharingStats rasterize(const ProbeGrid& grid, const MapLayout& layout, const std::vector<std::vector<ShadedPoint>>& points,
+                       const std::vector<const DepthMap*>& own_depth, const SharingSettings& s,
+                       std::vector<FrameSamples>& out, std::span<const std::uint8_t> targets, const Geometry& geometry) {
   const int n = grid.count();
   out.resize(static_cast<std::size_t>(n));
-  std::vector<PointColumns> columns(points.size());
-  engine::jobs::parallel_for(0, static_cast<int>(points.size()), 16, [&](int b, int e) {
-    for (int q = b; q < e; ++q) columns[static_cast<std::size_t>(q)].fill(points[static_cast<std::size_t>(q)]);
-  });
   std::atomic<std::size_t> accepted{0}, rejected{0};
   engine::jobs::parallel_for(0, n, 8, [&](int b, int e) {
     std::size_t acc = 0, rej = 0;
-    std::vector<float> dist;
+    std::vector<float> dist, facing;
     std::vector<int> texel;
-    std::vector<float> facing;
     for (int p = b; p < e; ++p) {
       if (!targets.empty() && !targets[static_cast<std::size_t>(p)]) continue;
       FrameSamples& fs = out[static_cast<std::size_t>(p)];
@@ -98,7 +109,7 @@ SharingStats rasterize_shared(const ProbeGrid& grid, const MapLayout& layout,
         dist.resize(pts.size());
         texel.resize(pts.size());
         facing.resize(pts.size());
-        point_geometry(columns[static_cast<std::size_t>(q)], origin, layout, dist.data(), texel.data(), facing.data());
+        geometry(q, origin, dist.data(), texel.data(), facing.data());
         for (std::size_t i = 0; i < pts.size(); ++i) {
           const ShadedPoint& pt = pts[i];
           if (!std::isfinite(pt.distance)) {
@@ -133,56 +144,30 @@ SharingStats rasterize_shared(const ProbeGrid& grid, const MapLayout& layout,
   return {accepted.load(), rejected.load()};
 }
 
-SharingStats rasterize_shared_reference(const ProbeGrid& grid, const MapLayout& layout,
+}  // namespace
+
+SharingStats rasterize_shared(const ProbeGrid& grid, const MapLayout& layout,
                               const std::vector<std::vector<ShadedPoint>>& points, const std::vector<const DepthMap*>& own_depth,
                               const SharingSettings& s, std::vector<FrameSamples>& out,
                               std::span<const std::uint8_t> targets) {
-  const int n = grid.count();
-  out.resize(static_cast<std::size_t>(n));
-  std::atomic<std::size_t> accepted{0}, rejected{0};
-  engine::jobs::parallel_for(0, n, 8, [&](int b, int e) {
-    std::size_t acc = 0, rej = 0;
-    for (int p = b; p < e; ++p) {
-      if (!targets.empty() && !targets[static_cast<std::size_t>(p)]) continue;
-      FrameSamples& fs = out[static_cast<std::size_t>(p)];
-      fs.reset(layout.texel_count());
-      const glm::vec3 origin = grid.position(p);
-      const DepthMap* depth = own_depth.empty() ? nullptr : own_depth[static_cast<std::size_t>(p)];
-      grid.for_each_neighbour(p, [&](int q) {
-        for (const ShadedPoint& pt : points[static_cast<std::size_t>(q)]) {
-          if (!std::isfinite(pt.distance)) {
-            if (q != p) continue;  // an escaped ray has no position to share
-            const int t = layout.texel_of(pt.direction);
-            fs.count[static_cast<std::size_t>(t)] += 1.0f;  // a zero sample: the probes hold indirect light only
-            ++acc;
-            continue;
-          }
-          glm::vec3 d = pt.position - origin;
-          const float dist = glm::length(d);
-          if (!(dist > 1e-6f)) continue;
-          d /= dist;
-          const int t = layout.texel_of(d);
-          if (q != p && s.mode == SharingMode::DepthGuard && s.same_side && glm::dot(pt.normal, d) > 0) {
-            ++rej;  // the target sees the point's surface from behind
-            continue;
-          }
-          if (q != p && s.mode == SharingMode::DepthGuard && depth) {
-            const float own = depth->mean(static_cast<std::size_t>(t));
-            if (std::isfinite(own) && dist > own * (1.0f + s.relative_tolerance) + s.absolute_tolerance) {
-              ++rej;
-              continue;
-            }
-          }
-          fs.sum[static_cast<std::size_t>(t)] += pt.radiance;
-          fs.count[static_cast<std::size_t>(t)] += 1.0f;
-          ++acc;
-        }
-      });
-    }
-    accepted += acc;
-    rejected += rej;
+  std::vector<PointColumns> columns(points.size());
+  engine::jobs::parallel_for(0, static_cast<int>(points.size()), 16, [&](int b, int e) {
+    for (int q = b; q < e; ++q) columns[static_cast<std::size_t>(q)].fill(points[static_cast<std::size_t>(q)]);
   });
-  return {accepted.load(), rejected.load()};
+  return rasterize(grid, layout, points, own_depth, s, out, targets,
+                   [&](int q, const glm::vec3& origin, float* dist, int* texel, float* facing) {
+                     point_geometry(columns[static_cast<std::size_t>(q)], origin, layout, dist, texel, facing);
+                   });
+}
+
+SharingStats rasterize_shared_reference(const ProbeGrid& grid, const MapLayout& layout,
+                                        const std::vector<std::vector<ShadedPoint>>& points,
+                                        const std::vector<const DepthMap*>& own_depth, const SharingSettings& s,
+                                        std::vector<FrameSamples>& out, std::span<const std::uint8_t> targets) {
+  return rasterize(grid, layout, points, own_depth, s, out, targets,
+                   [&](int q, const glm::vec3& origin, float* dist, int* texel, float* facing) {
+                     point_geometry_reference(points[static_cast<std::size_t>(q)], origin, layout, dist, texel, facing);
+                   });
 }
 
 }  // namespace transgi::probes

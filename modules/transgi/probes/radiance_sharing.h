@@ -98,8 +98,9 @@ SharingStats rasterize_shared(const ProbeGrid& grid, const MapLayout& layout,
                               const std::vector<std::vector<ShadedPoint>>& points, const std::vector<const DepthMap*>& own_depth,
                               const SharingSettings& settings, std::vector<FrameSamples>& out,
                               std::span<const std::uint8_t> targets = {});
-// The same, one point at a time: the plain statement that rasterize_shared's
-// vectorised point geometry is tested against (bit-identical results).
+// The same with each point's geometry (distance, texel, facing) computed one
+// point at a time: the plain statement that rasterize_shared's vectorised
+// point geometry is tested against (bit-identical results).
 SharingStats rasterize_shared_reference(const ProbeGrid& grid, const MapLayout& layout,
                                         const std::vector<std::vector<ShadedPoint>>& points,
                                         const std::vector<const DepthMap*>& own_depth, const SharingSettings& settings,

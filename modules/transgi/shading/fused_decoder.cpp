@@ -97,46 +97,40 @@ int round_up(int x, int m) { return (x + m - 1) / m * m; }
 // blocks of 32 outputs.
 bool amx_layout_ok(const model::MlpLayout& l) { return simd_layout_ok(l) && l.width % 32 == 0; }
 
-// Weights as [k / 2][output][k % 2] over all outputs (one AMX weight tile is
-// 16 k-pairs of 16 outputs, rows out_padded * 4 bytes apart). The output
-// layer's columns are blocked by colour channel, c * 32 + k for k < 25.
-PackedLayer pack_layer_amx(const model::Mlp& mlp, int layer) {
-  const model::MlpLayout& lay = mlp.layout();
-  const float* w = mlp.params().data() + lay.weight_offset(layer);  // [out][in]
-  const float* b = mlp.params().data() + lay.bias_offset(layer);
-  PackedLayer p;
-  p.in = lay.in_of(layer);
-  p.out = lay.out_of(layer);
-  p.relu = layer < lay.hidden_layers;
-  p.bf16 = true;
-  const bool output = layer == lay.hidden_layers;
-  p.out_padded = output ? detail::kAmxOutputs : round_up(p.out, 32);
-  auto source = [&](int column) { return output ? (column % 32 < 25 ? column / 32 * 25 + column % 32 : -1) : column; };
-  p.bias.assign(static_cast<std::size_t>(p.out_padded), 0.0f);
-  p.w_bf16.assign(static_cast<std::size_t>(p.in) * p.out_padded, 0);
-  for (int col = 0; col < p.out_padded; ++col) {
-    const int o = source(col);
-    if (o < 0 || o >= p.out) continue;
-    p.bias[static_cast<std::size_t>(col)] = b[o];
-    for (int k = 0; k < p.in; ++k)
-      p.w_bf16[(static_cast<std::size_t>(k / 2) * p.out_padded + col) * 2 + k % 2] = to_bf16(w[static_cast<std::size_t>(o) * p.in + k]);
-  }
-  return p;
-}
+int same_output(int column) { return column; }
 
-PackedLayer pack_layer(const model::Mlp& mlp, int layer, int lane, int group, bool bf16) {
+// The AMX output layer's columns blocked by colour channel: channel c's 25
+// values at columns c * 32 .. c * 32 + 24, the rest padding (-1).
+int channel_blocked_output(int column) { return column % 32 < 25 ? column / 32 * 25 + column % 32 : -1; }
+
+// One layer packed for the kernels: out_padded columns, output_of(column) the
+// decoder output a column holds (-1 or past the outputs: zero padding).
+// Columns are split into groups of `group` (the register block); within a
+// group the layout is [k][column] for fp32 and [k / 2][column][k % 2] for
+// bf16. With one group of all columns, the bf16 layout is what an AMX weight
+// tile reads: 16 k-pairs of 16 columns, rows out_padded * 4 bytes apart.
+PackedLayer pack_layer(const model::Mlp& mlp, int layer, int out_padded, int group, bool bf16,
+                       int (*output_of)(int) = same_output) {
   const model::MlpLayout& lay = mlp.layout();
   const float* w = mlp.params().data() + lay.weight_offset(layer);  // [out][in]
   const float* b = mlp.params().data() + lay.bias_offset(layer);
   PackedLayer p;
   p.in = lay.in_of(layer);
   p.out = lay.out_of(layer);
-  p.out_padded = round_up(p.out, lane);
+  p.out_padded = out_padded;
   p.relu = layer < lay.hidden_layers;
   p.bf16 = bf16;
+  auto output = [&](int column) {
+    const int o = output_of(column);
+    return o >= 0 && o < p.out ? o : -1;
+  };
+  auto weight = [&](int column, int i) {
+    const int o = output(column);
+    return o >= 0 && i < p.in ? w[static_cast<std::size_t>(o) * p.in + i] : 0.0f;
+  };
   p.bias.assign(static_cast<std::size_t>(p.out_padded), 0.0f);
-  std::copy(b, b + p.out, p.bias.begin());
-  auto weight = [&](int o, int i) { return o < p.out && i < p.in ? w[static_cast<std::size_t>(o) * p.in + i] : 0.0f; };
+  for (int col = 0; col < p.out_padded; ++col)
+    if (output(col) >= 0) p.bias[static_cast<std::size_t>(col)] = b[output(col)];
   if (bf16) {
     const int in2 = round_up(p.in, 2);
     p.w_bf16.assign(static_cast<std::size_t>(in2) * p.out_padded, 0);
@@ -170,14 +164,19 @@ FusedDecoder::FusedDecoder(const model::Mlp& mlp, FusedIsa isa) : layout_(mlp.la
   if (isa_ != FusedIsa::Scalar && !simd_layout_ok(layout_)) isa_ = FusedIsa::Scalar;
   if (isa_ == FusedIsa::Scalar) return;
   if (isa_ == FusedIsa::Amx) {
-    layers_.push_back(pack_layer(mlp, 0, 16, detail::kGroupAvx512, false));
-    for (int l = 1; l < layout_.layer_count(); ++l) layers_.push_back(pack_layer_amx(mlp, l));
+    layers_.push_back(pack_layer(mlp, 0, round_up(layout_.out_of(0), 16), detail::kGroupAvx512, false));
+    for (int l = 1; l < layout_.hidden_layers; ++l) {
+      const int columns = round_up(layout_.out_of(l), 32);
+      layers_.push_back(pack_layer(mlp, l, columns, columns, true));
+    }
+    layers_.push_back(pack_layer(mlp, layout_.hidden_layers, detail::kAmxOutputs, detail::kAmxOutputs, true, channel_blocked_output));
     return;
   }
   const bool avx512 = isa_ == FusedIsa::Avx512Bf16;
   const int lane = avx512 ? 16 : 8;
   const int group = avx512 ? detail::kGroupAvx512 : detail::kGroupAvx2;
-  for (int l = 0; l < layout_.layer_count(); ++l) layers_.push_back(pack_layer(mlp, l, lane, group, avx512 && l > 0));
+  for (int l = 0; l < layout_.layer_count(); ++l)
+    layers_.push_back(pack_layer(mlp, l, round_up(layout_.out_of(l), lane), group, avx512 && l > 0));
 }
 
 void FusedDecoder::shade_tile(const float* inputs, const float* light, int n, float* rgb, const float* light2,
