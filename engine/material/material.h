@@ -33,6 +33,10 @@ struct Material {
     const glm::vec3 e = emission();
     return e.r > 0 || e.g > 0 || e.b > 0;
   }
+  // Whether any texture is read; if not, a texture footprint changes nothing.
+  [[nodiscard]] bool is_textured() const {
+    return base_color_texture != kNoTexture || metallic_roughness_texture != kNoTexture || emissive_texture != kNoTexture;
+  }
 };
 
 }  // namespace engine::material

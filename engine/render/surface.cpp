@@ -58,7 +58,7 @@ glm::vec3 evaluate_emission(const scene::SceneAssets& assets, std::uint32_t inde
 }
 
 Surface make_surface(const rt::RtScene& scene, const rt::Hit& hit, const glm::vec3& incoming_dir) {
-  const rt::InstanceRecord& inst = *scene.instance_of(hit.entity);
+  const rt::InstanceRecord& inst = *scene.instance_of(hit);
   const scene::SceneAssets& assets = *scene.assets();
   const scene::MeshAsset& mesh = *assets.meshes[hit.mesh];
   const glm::uvec3 t = mesh.triangles[hit.primitive];

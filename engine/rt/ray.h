@@ -23,6 +23,11 @@ struct Hit {
   std::uint32_t primitive = 0;  // triangle index in the mesh
   glm::vec2 barycentric{0.0f};
   float t = std::numeric_limits<float>::infinity();
+  // The RtScene instance that was hit, so consumers index its record instead
+  // of hashing `entity` once per hit (RtScene::instance_of(const Hit&)).
+  // kUnknownInstance for hits made by hand.
+  static constexpr std::uint32_t kUnknownInstance = 0xffffffffu;
+  std::uint32_t instance = kUnknownInstance;
 };
 
 // Offsets a ray origin off a surface along its geometric normal, scaled to

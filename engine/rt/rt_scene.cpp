@@ -270,6 +270,7 @@ bool RtScene::intersect(const Ray& ray, Hit& hit) const {
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   const InstanceRecord& inst = instances_[rh.hit.instID[0]];
   hit.entity = inst.entity;
+  hit.instance = rh.hit.instID[0];
   hit.mesh = inst.mesh;
   hit.primitive = rh.hit.primID;
   hit.barycentric = {rh.hit.u, rh.hit.v};
@@ -346,6 +347,7 @@ void RtScene::intersect16(const Ray* rays, int n, Hit* hits, bool* found) const 
     if (!found[i]) continue;
     const InstanceRecord& inst = instances_[rh.hit.instID[0][i]];
     hits[i].entity = inst.entity;
+    hits[i].instance = rh.hit.instID[0][i];
     hits[i].mesh = inst.mesh;
     hits[i].primitive = rh.hit.primID[i];
     hits[i].barycentric = {rh.hit.u[i], rh.hit.v[i]};
@@ -366,6 +368,12 @@ void RtScene::occluded16(const Ray* rays, int n, bool* blocked) const {
 
 const InstanceRecord* RtScene::instance(std::uint32_t id) const {
   return id < instances_.size() && instances_[id].active ? &instances_[id] : nullptr;
+}
+
+const InstanceRecord* RtScene::instance_of(const Hit& hit) const {
+  if (hit.instance < instances_.size() && instances_[hit.instance].active && instances_[hit.instance].entity == hit.entity)
+    return &instances_[hit.instance];
+  return instance_of(hit.entity);
 }
 
 const InstanceRecord* RtScene::instance_of(ecs::Entity e) const {

@@ -79,6 +79,9 @@ class RtScene {
       if (r.active) fn(r);
   }
   [[nodiscard]] const InstanceRecord* instance_of(ecs::Entity e) const;
+  // The record of the instance a query hit: by its index when the hit carries
+  // one (no hashing), else by entity.
+  [[nodiscard]] const InstanceRecord* instance_of(const Hit& hit) const;
   [[nodiscard]] const scene::SceneAssets* assets() const { return assets_; }
   [[nodiscard]] const RtStats& stats() const { return stats_; }
   [[nodiscard]] std::uint64_t rejected_rays() const { return rejected_.load(std::memory_order_relaxed); }

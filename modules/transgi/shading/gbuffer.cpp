@@ -23,7 +23,7 @@ GSample make_gsample(const engine::rt::RtScene& scene, const engine::scene::Scen
     return out;
   }
   const rt::Hit& hit = *found;
-  const rt::InstanceRecord& inst = *scene.instance_of(hit.entity);
+  const rt::InstanceRecord& inst = *scene.instance_of(hit);
   const scene::MeshAsset& mesh = *assets.meshes[hit.mesh];
   const glm::uvec3 t = mesh.triangles[hit.primitive];
   const float b1 = hit.barycentric.x, b2 = hit.barycentric.y, b0 = 1 - b1 - b2;
@@ -46,8 +46,9 @@ GSample make_gsample(const engine::rt::RtScene& scene, const engine::scene::Scen
   out.wo_world = glm::normalize(-ray.direction);
   glm::vec3 ng = glm::cross(mesh.positions[t.y] - mesh.positions[t.x], mesh.positions[t.z] - mesh.positions[t.x]);
   ng = glm::length(ng) > 0 ? glm::normalize(inst.to_world.apply_direction(glm::normalize(ng))) : out.normal_world;
-  const float footprint =
-      spread > 0 ? render::uv_footprint(mesh, hit.primitive, inst.to_world.scale, hit.t * spread, glm::dot(ng, out.wo_world)) : 0.0f;
+  const float footprint = spread > 0 && assets.materials[material].is_textured()
+                              ? render::uv_footprint(mesh, hit.primitive, inst.to_world.scale, hit.t * spread, glm::dot(ng, out.wo_world))
+                              : 0.0f;
   out.brdf = render::evaluate_material(assets, material, uv, footprint);
   out.albedo = out.brdf.base_color;  // the network's input
   out.diffuse = material::diffuse_albedo(out.brdf);

@@ -14,6 +14,7 @@
 #include "engine/math/sampling.h"
 #include "shading/sh_light.h"
 #include "shading/transfer_inference.h"
+#include "shading/upsampling.h"
 
 namespace transgi::shading {
 
@@ -24,36 +25,10 @@ double ms_since(Clock::time_point t) { return std::chrono::duration<double, std:
 
 constexpr std::size_t kNone = SIZE_MAX;
 
-// The cell grid and, for each output pixel, whether it is upsampled from
-// the grid, decoded on its own, or empty.
-struct Upsampling {
-  int grid_w = 0, grid_h = 0;
-  float sx = 1, sy = 1;                   // output pixels per cell
-  std::vector<std::size_t> cell_pixel;    // per cell: the pixel it decodes
-  std::vector<glm::vec4> cell_guide;      // per cell: its pixel's guide, read in order rather than through cell_pixel
-  enum : std::uint8_t { kUpsampled = 0, kOwn = 1, kMiss = 2 };
-  std::vector<std::uint8_t> kind;         // per pixel
-  // Per upsampled pixel: its four grid cells and normalised weights (32
-  // bytes; the composite reads them back rather than recomputing them).
-  struct Taps {
-    std::array<std::uint32_t, 4> cell{};
-    std::array<float, 4> weight{};
-  };
-  std::vector<Taps> taps;
-};
-
-// The four grid samples standing for a pixel and their unnormalised
-// weights, as computed (Upsampling::Taps is the stored, normalised form).
-struct RawTaps {
-  std::array<std::size_t, 4> cell{kNone, kNone, kNone, kNone};
-  std::array<float, 4> weight{};
-  float total = 0;
-};
-
 }  // namespace
 
 struct RealtimeGiScratch::Impl {
-  Upsampling up;
+  UpsamplingPlan up;
   std::vector<std::size_t> decode, slot_of_pixel, cell_slot;
   std::vector<glm::vec3> value, value_direct, shaded, shaded_direct;
   std::vector<TransferQuery> queries;
@@ -64,78 +39,6 @@ RealtimeGiScratch::RealtimeGiScratch(RealtimeGiScratch&&) noexcept = default;
 RealtimeGiScratch& RealtimeGiScratch::operator=(RealtimeGiScratch&&) noexcept = default;
 
 namespace {
-
-// guide: world normal (xyz), depth (w; 0 = miss).
-float similarity(const glm::vec4& p, const glm::vec4& q, const RealtimeGiSettings& s) {
-  if (!(q.w > 0)) return 0.0f;
-  if (!s.edge_aware) return 1.0f;
-  const float dz = (q.w - p.w) / (s.depth_tolerance * std::max(p.w, 1e-6f));
-  const float depth = std::max(0.0f, 1.0f - dz * dz);  // zero beyond the tolerance: silhouettes cut hard
-  float n = std::max(0.0f, p.x * q.x + p.y * q.y + p.z * q.z), normal = 1.0f;
-  for (int e = s.normal_power; e > 0; e >>= 1, n *= n)  // n^power by squaring
-    if (e & 1) normal *= n;
-  return depth * normal;
-}
-
-// Bilinear weights times similarity, for pixel (x, y).
-RawTaps taps_of(int x, int y, const std::vector<glm::vec4>& guide, const Upsampling& u, const RealtimeGiSettings& s, int width) {
-  RawTaps t;
-  const glm::vec4& gp = guide[static_cast<std::size_t>(y) * width + x];
-  // Position in cell coordinates, cell centres at integers.
-  const float fx = (static_cast<float>(x) + 0.5f) / u.sx - 0.5f, fy = (static_cast<float>(y) + 0.5f) / u.sy - 0.5f;
-  const int i0 = static_cast<int>(std::floor(fx)), j0 = static_cast<int>(std::floor(fy));
-  const float tx = fx - static_cast<float>(i0), ty = fy - static_cast<float>(j0);
-  for (int k = 0; k < 4; ++k) {
-    const int i = std::clamp(i0 + (k & 1), 0, u.grid_w - 1), j = std::clamp(j0 + (k >> 1), 0, u.grid_h - 1);
-    const float bilinear = ((k & 1) ? tx : 1 - tx) * ((k >> 1) ? ty : 1 - ty);
-    const std::size_t cell = static_cast<std::size_t>(j) * u.grid_w + i;
-    const float w = bilinear * similarity(gp, u.cell_guide[cell], s);
-    t.cell[static_cast<std::size_t>(k)] = cell;
-    t.weight[static_cast<std::size_t>(k)] = w;
-    t.total += w;
-  }
-  return t;
-}
-
-void plan_upsampling(const GBuffer& g, const std::vector<glm::vec4>& guide, const RealtimeGiSettings& s, Upsampling& u) {
-  const float scale = std::clamp(s.resolution_scale, 1e-3f, 1.0f);
-  u.grid_w = std::max(1, static_cast<int>(std::lround(static_cast<float>(g.width) * scale)));
-  u.grid_h = std::max(1, static_cast<int>(std::lround(static_cast<float>(g.height) * scale)));
-  u.sx = static_cast<float>(g.width) / static_cast<float>(u.grid_w);
-  u.sy = static_cast<float>(g.height) / static_cast<float>(u.grid_h);
-  u.cell_pixel.resize(static_cast<std::size_t>(u.grid_w) * u.grid_h);
-  for (int j = 0; j < u.grid_h; ++j)
-    for (int i = 0; i < u.grid_w; ++i) {
-      const int x = std::min(g.width - 1, static_cast<int>((static_cast<float>(i) + 0.5f) * u.sx));
-      const int y = std::min(g.height - 1, static_cast<int>((static_cast<float>(j) + 0.5f) * u.sy));
-      u.cell_pixel[static_cast<std::size_t>(j) * u.grid_w + i] = static_cast<std::size_t>(y) * g.width + x;
-    }
-  u.cell_guide.resize(u.cell_pixel.size());
-  for (std::size_t c = 0; c < u.cell_pixel.size(); ++c) u.cell_guide[c] = guide[u.cell_pixel[c]];
-  u.kind.resize(g.samples.size());
-  u.taps.resize(g.samples.size());
-  engine::jobs::parallel_for(0, g.height, 8, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < g.width; ++x) {
-        const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
-        if (!(guide[p].w > 0)) {
-          u.kind[p] = Upsampling::kMiss;
-          continue;
-        }
-        const RawTaps t = taps_of(x, y, guide, u, s, g.width);
-        if (t.total < s.min_weight) {
-          u.kind[p] = Upsampling::kOwn;
-          continue;
-        }
-        u.kind[p] = Upsampling::kUpsampled;
-        Upsampling::Taps& stored = u.taps[p];
-        for (std::size_t k = 0; k < 4; ++k) {
-          stored.cell[k] = static_cast<std::uint32_t>(t.cell[k]);
-          stored.weight[k] = t.weight[k] / t.total;
-        }
-      }
-  });
-}
 
 // Probe SH rotated into object frames, one copy per distinct rotation and
 // field; identity rotations read the field's own SH.
@@ -206,6 +109,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
   g.samples.resize(static_cast<std::size_t>(width) * height);
   g.guide.resize(g.samples.size());
   g.metal_roughness.resize(g.samples.size());
+  g.entity.resize(g.samples.size());
   // 4x4 pixel tiles as one Embree packet: neighbouring camera rays share
   // their traversal.
   const int tiles_x = (width + 3) / 4, tiles_y = (height + 3) / 4;
@@ -228,6 +132,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
         const GSample& s = g.samples[pixel[i]] = make_gsample(scene, assets, rays[i], found[i] ? &hits[i] : nullptr, nullptr, spread);
         g.guide[pixel[i]] = s.hit ? glm::vec4(s.normal_world, std::max(s.depth, 1e-30f)) : glm::vec4(0.0f);
         g.metal_roughness[pixel[i]] = s.hit && s.brdf.metallic >= 0.5f ? s.brdf.roughness : std::numeric_limits<float>::infinity();
+        g.entity[pixel[i]] = s.entity;
       }
     }
   });
@@ -254,23 +159,24 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   if (g.guide.size() != g.samples.size())
     throw std::invalid_argument("shade_gi_realtime: the G-buffer has no guide; make it with trace_gbuffer");
   const std::vector<glm::vec4>& guide = g.guide;
-  plan_upsampling(g, guide, settings, sc.up);
-  const Upsampling& up = sc.up;
+  plan_upsampling(guide, g.width, g.height, settings, sc.up);
+  const UpsamplingPlan& up = sc.up;
 
   // The pixels to decode: grid cells that hit, then pixels on their own.
   std::vector<std::size_t>& decode = sc.decode;
   decode.clear();
   std::vector<std::size_t>& slot_of_pixel = sc.slot_of_pixel;
   slot_of_pixel.assign(g.samples.size(), kNone);
+  // guide[p].w > 0 is samples[p].hit, read from 16 bytes a pixel instead of a GSample.
   auto want = [&](std::size_t p) {
-    if (slot_of_pixel[p] != kNone || !g.samples[p].hit) return;
+    if (slot_of_pixel[p] != kNone || !(guide[p].w > 0)) return;
     slot_of_pixel[p] = decode.size();
     decode.push_back(p);
   };
   for (std::size_t p : up.cell_pixel) want(p);
   stats.grid_samples = decode.size();
   for (std::size_t p = 0; p < g.samples.size(); ++p)
-    if (up.kind[p] == Upsampling::kOwn) want(p);
+    if (up.kind[p] == UpsamplingPlan::kOwn) want(p);
   stats.edge_samples = decode.size() - stats.grid_samples;
   double plan_ms = ms_since(t0);
 
@@ -281,16 +187,24 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   RotatedProbes rotated(fields);
   {
     std::unordered_map<engine::ecs::Entity, std::pair<bool, int>> per_entity;
+    // Neighbouring samples mostly lie on one entity: look it up only when it changes.
+    engine::ecs::Entity last{};
+    std::pair<bool, int> last_route{false, -1};
+    const bool by_entity = g.entity.size() == g.samples.size();
     for (std::size_t i = 0; i < decode.size(); ++i) {
-      const GSample& s = g.samples[decode[i]];
-      auto [it, inserted] = per_entity.try_emplace(s.entity, false, -1);
-      if (inserted) {
-        it->second.first = model && decoder && (!has_transfer || has_transfer(s.entity));
-        if (it->second.first) it->second.second = rotated.add(scene.instance_of(s.entity)->to_world.rotation);
+      const engine::ecs::Entity e = by_entity ? g.entity[decode[i]] : g.samples[decode[i]].entity;
+      if (i == 0 || !(e == last)) {
+        auto [it, inserted] = per_entity.try_emplace(e, false, -1);
+        if (inserted) {
+          it->second.first = model && decoder && (!has_transfer || has_transfer(e));
+          if (it->second.first) it->second.second = rotated.add(scene.instance_of(e)->to_world.rotation);
+        }
+        last = e;
+        last_route = it->second;
       }
-      if (it->second.first) {
+      if (last_route.first) {
         net.push_back(i);
-        rotation_of.push_back(it->second.second);
+        rotation_of.push_back(last_route.second);
       } else {
         diffuse.push_back(i);
       }
@@ -380,18 +294,17 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < g.width; ++x) {
         const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
-        if (up.kind[p] == Upsampling::kMiss) continue;
-        if (up.kind[p] == Upsampling::kOwn) {
+        if (up.kind[p] == UpsamplingPlan::kMiss) continue;
+        if (up.kind[p] == UpsamplingPlan::kOwn) {
           image.pixels[p] = value[slot_of_pixel[p]];
           if (with_direct) direct_out->pixels[p] = value_direct[slot_of_pixel[p]];
           continue;
         }
-        const Upsampling::Taps& t = up.taps[p];
         glm::vec3 sum(0.0f), sum_direct(0.0f);
-        for (std::size_t k = 0; k < 4; ++k) {
-          if (!(t.weight[k] > 0)) continue;
-          const float w = t.weight[k];
-          const std::size_t slot = cell_slot[t.cell[k]];
+        for (int k = 0; k < 4; ++k) {
+          const float w = up.weight[static_cast<std::size_t>(k)][p];
+          if (!(w > 0)) continue;
+          const std::size_t slot = cell_slot[up.cell(k, x, y)];
           sum += w * value[slot];
           if (with_direct) sum_direct += w * value_direct[slot];
         }

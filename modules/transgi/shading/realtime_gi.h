@@ -60,6 +60,9 @@ struct GBuffer {
   // infinity (misses too), so the mirror pass finds its pixels in 4 bytes a
   // pixel rather than reading every GSample's material; written by trace_gbuffer.
   std::vector<float> metal_roughness;
+  // Per pixel: the entity hit (null for a miss), so routing samples by object
+  // reads 8 bytes a pixel rather than a GSample; written by trace_gbuffer.
+  std::vector<engine::ecs::Entity> entity;
 };
 
 // One ray through each pixel centre, in parallel over rows.
