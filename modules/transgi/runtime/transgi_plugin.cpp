@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "engine/jobs/parallel_for.h"
 #include "engine/render/camera_rays.h"
 #include "engine/render/light_plugin.h"
 #include "engine/render/path_tracer.h"
@@ -88,8 +89,10 @@ void add_stochastic_direct(const rt::RtScene& rt, const render::LightSet& lights
 }
 
 void compose_full(GiFrame& frame) {
-  frame.full = frame.gi;
-  for (std::size_t i = 0; i < frame.full.size(); ++i) frame.full.pixels[i] += frame.direct.pixels[i];
+  if (frame.full.width != frame.gi.width || frame.full.height != frame.gi.height) frame.full = image::ImageRGB(frame.gi.width, frame.gi.height);
+  jobs::parallel_for<std::size_t>(0, frame.full.size(), 16384, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) frame.full.pixels[i] = frame.gi.pixels[i] + frame.direct.pixels[i];
+  });
 }
 
 // The decoder packed for the fused kernel, repacked only when the model
@@ -131,8 +134,7 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
 
   if (deterministic) {
     t0 = std::chrono::steady_clock::now();
-    frame.direct = shading::shade_direct_realtime(g, rt, lights, rays, &frame.direct_stats);
-    for (std::size_t i = 0; i < frame.direct.size(); ++i) frame.direct.pixels[i] += probe_direct.pixels[i];
+    frame.direct = shading::shade_direct_realtime(g, rt, lights, rays, &frame.direct_stats, &probe_direct);
     t.direct = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   } else {
     add_stochastic_direct(rt, lights, rays, settings.direct_spp, seed, frame);

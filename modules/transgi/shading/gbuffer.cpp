@@ -16,11 +16,18 @@ GSample trace_gsample(const engine::rt::RtScene& scene, const engine::scene::Sce
 GSample make_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                      const engine::rt::Ray& ray, const engine::rt::Hit* found, const engine::scene::Environment* background,
                      float spread) {
-  using namespace engine;
   GSample out;
+  make_gsample(scene, assets, ray, found, background, spread, out);
+  return out;
+}
+
+void make_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets, const engine::rt::Ray& ray,
+                  const engine::rt::Hit* found, const engine::scene::Environment* background, float spread, GSample& out) {
+  using namespace engine;
   if (!found) {
+    out = GSample{};
     if (background) out.background = background->radiance(ray.direction);
-    return out;
+    return;
   }
   const rt::Hit& hit = *found;
   const rt::InstanceRecord& inst = *scene.instance_of(hit);
@@ -34,6 +41,7 @@ GSample make_gsample(const engine::rt::RtScene& scene, const engine::scene::Scen
   glm::vec2 uv(0.0f);
   if (!mesh.uvs.empty()) uv = b0 * mesh.uvs[t.x] + b1 * mesh.uvs[t.y] + b2 * mesh.uvs[t.z];
   out.hit = true;
+  out.background = glm::vec3(0.0f);
   out.entity = hit.entity;
   out.mesh = hit.mesh;
   out.triangle = hit.primitive;
@@ -55,7 +63,6 @@ GSample make_gsample(const engine::rt::RtScene& scene, const engine::scene::Scen
   out.emission = render::evaluate_emission(assets, material, uv, footprint);
   out.geometric_normal = glm::dot(ng, out.wo_world) < 0 ? -ng : ng;
   out.depth = hit.t;
-  return out;
 }
 
 }  // namespace transgi::shading

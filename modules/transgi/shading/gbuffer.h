@@ -37,5 +37,9 @@ GSample trace_gsample(const engine::rt::RtScene& scene, const engine::scene::Sce
 GSample make_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                      const engine::rt::Ray& ray, const engine::rt::Hit* hit, const engine::scene::Environment* background,
                      float spread = 0);
+// The same, written over `out` in place (every field; a G-buffer of 200-byte
+// samples need not copy each one).
+void make_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets, const engine::rt::Ray& ray,
+                  const engine::rt::Hit* hit, const engine::scene::Environment* background, float spread, GSample& out);
 
 }  // namespace transgi::shading

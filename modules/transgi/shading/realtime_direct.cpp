@@ -23,7 +23,8 @@ glm::vec2 disk_pattern(int x, int y) {
 
 engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
                                               const engine::render::LightSet& lights,
-                                              const engine::render::CameraRays& camera, RealtimeDirectStats* stats) {
+                                              const engine::render::CameraRays& camera, RealtimeDirectStats* stats,
+                                              const engine::image::ImageRGB* plus) {
   using namespace engine;
   image::ImageRGB out(g.width, g.height);
   const std::size_t n_lights = lights.punctual_count();
@@ -87,6 +88,12 @@ engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt
         for (int i = 0; i < n; ++i)
           if (!blocked[i]) out.pixels[pixel[i]] += contribution[i];
       }
+      if (plus)
+        for (int y = ty; y < std::min(ty + 4, g.height); ++y)
+          for (int x = tx; x < std::min(tx + 4, g.width); ++x) {
+            const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
+            out.pixels[p] += plus->pixels[p];
+          }
     }
     rays_traced.fetch_add(traced, std::memory_order_relaxed);
   });

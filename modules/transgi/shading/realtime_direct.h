@@ -9,7 +9,8 @@
 //    a stable dither, not noise.
 // The rest of the direct light, the residual sky and emissive meshes, comes
 // from the probes' direct SH through the transfer (shade_gi_realtime's
-// direct_out). The reference is the path tracer's direct pass.
+// direct_out); pass that image as `plus` and it is added in the same pass.
+// The reference is the path tracer's direct pass.
 #include "engine/image/image.h"
 #include "engine/render/camera_rays.h"
 #include "engine/render/light_set.h"
@@ -25,7 +26,8 @@ struct RealtimeDirectStats {
 engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
                                               const engine::render::LightSet& lights,
                                               const engine::render::CameraRays& camera,
-                                              RealtimeDirectStats* stats = nullptr);
+                                              RealtimeDirectStats* stats = nullptr,
+                                              const engine::image::ImageRGB* plus = nullptr);
 
 // The fixed point on [0, 1)^2 that pixel (x, y) uses for disk lights: an
 // R2 low-discrepancy sequence over each 8x8 block.

@@ -88,6 +88,7 @@ class RotatedProbes {
 }  // namespace
 
 const probes::ProbeField* field_holding(std::span<const probes::ProbeField* const> fields, const glm::vec3& p) {
+  if (fields.size() == 1) return fields.front();  // the usual case, asked once per decoded pixel
   for (const probes::ProbeField* f : fields) {
     const auto& grid = f->grid();
     if (glm::all(glm::greaterThanEqual(p, grid.min)) && glm::all(glm::lessThanEqual(p, grid.max))) return f;
@@ -129,7 +130,8 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
         }
       scene.intersect16(rays, n, hits, found);
       for (int i = 0; i < n; ++i) {
-        const GSample& s = g.samples[pixel[i]] = make_gsample(scene, assets, rays[i], found[i] ? &hits[i] : nullptr, nullptr, spread);
+        GSample& s = g.samples[pixel[i]];
+        make_gsample(scene, assets, rays[i], found[i] ? &hits[i] : nullptr, nullptr, spread, s);
         g.guide[pixel[i]] = s.hit ? glm::vec4(s.normal_world, std::max(s.depth, 1e-30f)) : glm::vec4(0.0f);
         g.metal_roughness[pixel[i]] = s.hit && s.brdf.metallic >= 0.5f ? s.brdf.roughness : std::numeric_limits<float>::infinity();
         g.entity[pixel[i]] = s.entity;
