@@ -32,6 +32,9 @@ struct RealtimeGiScratch::Impl {
   std::vector<std::size_t> decode, slot_of_pixel, cell_slot;
   std::vector<glm::vec3> value, value_direct, shaded, shaded_direct;
   std::vector<TransferQuery> queries;
+  // Per network sample: where it is and its world normal, copied while its
+  // GSample is in cache so the light fill does not miss on it a second time.
+  std::vector<glm::vec3> net_position, net_normal;
 };
 RealtimeGiScratch::RealtimeGiScratch() : impl(std::make_unique<Impl>()) {}
 RealtimeGiScratch::~RealtimeGiScratch() = default;
@@ -230,10 +233,14 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   value.resize(decode.size());
   value_direct.resize(with_direct ? decode.size() : 0);
   queries.resize(net.size());
+  sc.net_position.resize(net.size());
+  sc.net_normal.resize(net.size());
   engine::jobs::parallel_for<std::size_t>(0, net.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       const GSample& s = g.samples[decode[net[k]]];
       queries[k] = {s.mesh, s.triangle, s.bary, s.albedo, s.normal_obj, s.wo_obj};
+      sc.net_position[k] = s.position;
+      sc.net_normal[k] = s.normal_world;
     }
   });
   engine::jobs::parallel_for<std::size_t>(0, diffuse.size(), 256, [&](std::size_t b, std::size_t e) {
@@ -260,14 +267,15 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     shaded_direct.resize(with_direct ? net.size() : 0);
     const auto fill = [&](std::size_t b, std::size_t e, float* light, float* light_direct) {
       for (std::size_t k = b; k < e; ++k) {
-        const GSample& s = g.samples[decode[net[k]]];
-        const probes::ProbeField* f = field_holding(fields, s.position);
+        const glm::vec3& position = sc.net_position[k];
+        const glm::vec3& normal = sc.net_normal[k];
+        const probes::ProbeField* f = field_holding(fields, position);
         float* l = light + (k - b) * 75;
         if (light_direct)
-          f->interpolate(s.position, s.normal_world, rotated.sh(rotation_of[k], f), l, rotated.sh(rotation_of[k], f, true),
+          f->interpolate(position, normal, rotated.sh(rotation_of[k], f), l, rotated.sh(rotation_of[k], f, true),
                          light_direct + (k - b) * 75);
         else
-          f->interpolate(s.position, s.normal_world, rotated.sh(rotation_of[k], f), l);
+          f->interpolate(position, normal, rotated.sh(rotation_of[k], f), l);
       }
     };
     fill_seconds = shade_transfer_fused(*decoder, *model, assets, queries, fill, shaded.data(),
