@@ -13,6 +13,7 @@
 #include "engine/render/path_tracer.h"
 #include "engine/scene/procedural.h"
 #include "runtime/transgi_plugin.h"
+#include "shading/realtime_direct.h"
 
 using namespace transgi;
 using namespace engine;
@@ -132,4 +133,31 @@ TEST(RealtimeDirect, FullImageIsIdenticalAcrossSeedsAndThreadCounts) {
                                           << ", seed 12345 on 1 thread gave " << fb.pixels[i].g;
   }
   EXPECT_GT(mean, 0.0) << "the image must not be trivially black";
+}
+
+TEST(RealtimeDirect, ShadedInsideTheGBufferLoopEqualsTheStandalonePass) {
+  SunLevel level(small_realtime(0, 1), 2);
+  const int w = 37, h = 29;  // tiles cut by both edges
+  level.run(2, w, h);
+  auto& world = level.app.world();
+  const auto& lights = world.resource<render::SceneLights>();
+  const auto& rt = world.resource<rt::RtScene>();
+  const auto& assets = world.resource<scene::SceneAssets>();
+  const render::CameraRays rays(world.get<scene::Camera>(level.camera), world.get<transform::WorldTransform>(level.camera), w, h);
+  shading::GBuffer separate, fused;
+  shading::RealtimeDirectStats separate_stats, fused_stats;
+  image::ImageRGB want, got;
+  level.app.jobs().run([&] {
+    shading::trace_gbuffer(rt, assets, rays, w, h, separate);
+    want = shading::shade_direct_realtime(separate, rt, lights.set, rays, &separate_stats);
+    shading::DirectTileShader shader(rt, lights.set, rays, w, h);
+    shading::trace_gbuffer(rt, assets, rays, w, h, fused, &shader);
+    got = shader.take(&fused_stats);
+  });
+  EXPECT_GT(separate_stats.shadow_rays, 0u);
+  EXPECT_EQ(fused_stats.shadow_rays, separate_stats.shadow_rays);
+  ASSERT_EQ(got.pixels.size(), want.pixels.size());
+  for (std::size_t i = 0; i < got.pixels.size(); ++i)
+    ASSERT_EQ(got.pixels[i], want.pixels[i]) << "pixel " << i << ": inside the G-buffer loop " << got.pixels[i].r << ", standalone "
+                                             << want.pixels[i].r;
 }

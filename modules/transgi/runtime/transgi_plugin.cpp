@@ -1,6 +1,7 @@
 #include "runtime/transgi_plugin.h"
 
 #include <chrono>
+#include <optional>
 
 #include "engine/jobs/parallel_for.h"
 #include "engine/render/camera_rays.h"
@@ -115,10 +116,14 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
     packed.model = model;
   }
   auto t0 = std::chrono::steady_clock::now();
-  shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, packed.gbuffer);
+  const bool deterministic = deterministic_direct(settings);
+  // The deterministic direct light is shaded tile by tile inside the
+  // G-buffer's loop, while each tile is in cache; its time counts there.
+  std::optional<shading::DirectTileShader> direct;
+  if (deterministic) direct.emplace(rt, lights, rays, frame.width, frame.height);
+  shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, packed.gbuffer, direct ? &*direct : nullptr);
   const shading::GBuffer& g = packed.gbuffer;
   frame.times.gbuffer = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  const bool deterministic = deterministic_direct(settings);
   shading::RealtimeGiStats st;
   image::ImageRGB probe_direct;
   frame.gi = shading::shade_gi_realtime(g, rt, assets, model.get(), model ? packed.decoder.get() : nullptr, has_transfer, fields,
@@ -134,7 +139,8 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
 
   if (deterministic) {
     t0 = std::chrono::steady_clock::now();
-    frame.direct = shading::shade_direct_realtime(g, rt, lights, rays, &frame.direct_stats, &probe_direct);
+    frame.direct = direct->take(&frame.direct_stats);
+    shading::add_image(frame.direct, probe_direct);
     t.direct = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   } else {
     add_stochastic_direct(rt, lights, rays, settings.direct_spp, seed, frame);

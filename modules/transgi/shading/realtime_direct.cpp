@@ -21,87 +21,98 @@ glm::vec2 disk_pattern(int x, int y) {
   return {std::fmod(0.5f + a1 * k, 1.0f), std::fmod(0.5f + a2 * k, 1.0f)};
 }
 
+DirectTileShader::DirectTileShader(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                                   const engine::render::CameraRays& camera, int width, int height)
+    : scene_(scene), lights_(lights), camera_(camera), out_(width, height), n_lights_(lights.punctual_count()) {
+  using namespace engine;
+  // A directional light's sample does not depend on the point: its 64
+  // pattern directions are computed once per frame, not per pixel.
+  directional_.resize(n_lights_);
+  is_directional_.assign(n_lights_, 0);
+  for (std::size_t l = 0; l < n_lights_; ++l) {
+    if (lights.punctual_lights()[l].light.type != scene::PunctualLight::Type::Directional) continue;
+    is_directional_[l] = 1;
+    for (int i = 0; i < 64; ++i) lights.sample_punctual(l, glm::vec3(0.0f), disk_pattern(i & 7, i >> 3), directional_[l][static_cast<std::size_t>(i)]);
+  }
+}
+
+void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
+  using namespace engine;
+  rt::Ray rays[16];
+  bool blocked[16];
+  std::size_t pixel[16];
+  glm::vec3 contribution[16];
+  std::size_t traced = 0;
+  const scene::Environment* background = lights_.background();
+  // Emission and background first.
+  for (int y = ty; y < std::min(ty + 4, g.height); ++y)
+    for (int x = tx; x < std::min(tx + 4, g.width); ++x) {
+      const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
+      const GSample& s = g.samples[p];
+      if (s.hit)
+        out_.pixels[p] = s.emission;
+      else if (background)
+        out_.pixels[p] = background->radiance(camera_.generate({static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f}).direction);
+    }
+  for (std::size_t l = 0; l < n_lights_; ++l) {
+    int n = 0;
+    for (int y = ty; y < std::min(ty + 4, g.height); ++y)
+      for (int x = tx; x < std::min(tx + 4, g.width); ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
+        const GSample& s = g.samples[p];
+        if (!s.hit) continue;
+        render::LightSample ls;
+        if (is_directional_[l])
+          ls = directional_[l][static_cast<std::size_t>((x & 7) | ((y & 7) << 3))];
+        else if (!lights_.sample_punctual(l, s.position, disk_pattern(x, y), ls))
+          continue;
+        if (glm::dot(ls.direction, s.geometric_normal) <= 0) continue;
+        const math::Frame frame = math::Frame::from_normal(s.normal_world);
+        const glm::vec3 wo = frame.to_local(s.wo_world), wi = frame.to_local(ls.direction);
+        if (wo.z <= 0 || wi.z <= 0) continue;
+        const glm::vec3 c = material::brdf_eval(s.brdf, wo, wi) * wi.z * ls.radiance;
+        if (!(c.r > 0 || c.g > 0 || c.b > 0)) continue;
+        const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
+        rays[n] = rt::Ray{rt::offset_ray_origin(s.position, s.geometric_normal, scene_.offset_scale()), ls.direction, 0.0f, tmax};
+        pixel[n] = p;
+        contribution[n] = c;
+        ++n;
+      }
+    if (n == 0) continue;
+    scene_.occluded16(rays, n, blocked);
+    traced += static_cast<std::size_t>(n);
+    for (int i = 0; i < n; ++i)
+      if (!blocked[i]) out_.pixels[pixel[i]] += contribution[i];
+  }
+  rays_traced_.fetch_add(traced, std::memory_order_relaxed);
+}
+
+engine::image::ImageRGB DirectTileShader::take(RealtimeDirectStats* stats) {
+  if (stats) {
+    stats->shadow_rays = rays_traced_.load();
+    stats->lights = n_lights_;
+  }
+  return std::move(out_);
+}
+
 engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
                                               const engine::render::LightSet& lights,
                                               const engine::render::CameraRays& camera, RealtimeDirectStats* stats,
                                               const engine::image::ImageRGB* plus) {
-  using namespace engine;
-  image::ImageRGB out(g.width, g.height);
-  const std::size_t n_lights = lights.punctual_count();
-  const scene::Environment* background = lights.background();
-  std::atomic<std::size_t> rays_traced{0};
-  // A directional light's sample does not depend on the point: its 64
-  // pattern directions are computed once per frame, not per pixel.
-  std::vector<std::array<render::LightSample, 64>> directional(n_lights);
-  std::vector<std::uint8_t> is_directional(n_lights, 0);
-  for (std::size_t l = 0; l < n_lights; ++l) {
-    if (lights.punctual_lights()[l].light.type != scene::PunctualLight::Type::Directional) continue;
-    is_directional[l] = 1;
-    for (int i = 0; i < 64; ++i) lights.sample_punctual(l, glm::vec3(0.0f), disk_pattern(i & 7, i >> 3), directional[l][static_cast<std::size_t>(i)]);
-  }
+  DirectTileShader shader(scene, lights, camera, g.width, g.height);
   const int tiles_x = (g.width + 3) / 4, tiles_y = (g.height + 3) / 4;
-  jobs::parallel_for(0, tiles_x * tiles_y, 16, [&](int t0, int t1) {
-    rt::Ray rays[16];
-    bool blocked[16];
-    std::size_t pixel[16];
-    glm::vec3 contribution[16];
-    std::size_t traced = 0;
-    for (int t = t0; t < t1; ++t) {
-      const int tx = t % tiles_x * 4, ty = t / tiles_x * 4;
-      // Emission and background first.
-      for (int y = ty; y < std::min(ty + 4, g.height); ++y)
-        for (int x = tx; x < std::min(tx + 4, g.width); ++x) {
-          const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
-          const GSample& s = g.samples[p];
-          if (s.hit)
-            out.pixels[p] = s.emission;
-          else if (background)
-            out.pixels[p] = background->radiance(camera.generate({static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f}).direction);
-        }
-      for (std::size_t l = 0; l < n_lights; ++l) {
-        int n = 0;
-        for (int y = ty; y < std::min(ty + 4, g.height); ++y)
-          for (int x = tx; x < std::min(tx + 4, g.width); ++x) {
-            const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
-            const GSample& s = g.samples[p];
-            if (!s.hit) continue;
-            render::LightSample ls;
-            if (is_directional[l])
-              ls = directional[l][static_cast<std::size_t>((x & 7) | ((y & 7) << 3))];
-            else if (!lights.sample_punctual(l, s.position, disk_pattern(x, y), ls))
-              continue;
-            if (glm::dot(ls.direction, s.geometric_normal) <= 0) continue;
-            const math::Frame frame = math::Frame::from_normal(s.normal_world);
-            const glm::vec3 wo = frame.to_local(s.wo_world), wi = frame.to_local(ls.direction);
-            if (wo.z <= 0 || wi.z <= 0) continue;
-            const glm::vec3 c = material::brdf_eval(s.brdf, wo, wi) * wi.z * ls.radiance;
-            if (!(c.r > 0 || c.g > 0 || c.b > 0)) continue;
-            const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
-            rays[n] = rt::Ray{rt::offset_ray_origin(s.position, s.geometric_normal, scene.offset_scale()), ls.direction, 0.0f, tmax};
-            pixel[n] = p;
-            contribution[n] = c;
-            ++n;
-          }
-        if (n == 0) continue;
-        scene.occluded16(rays, n, blocked);
-        traced += static_cast<std::size_t>(n);
-        for (int i = 0; i < n; ++i)
-          if (!blocked[i]) out.pixels[pixel[i]] += contribution[i];
-      }
-      if (plus)
-        for (int y = ty; y < std::min(ty + 4, g.height); ++y)
-          for (int x = tx; x < std::min(tx + 4, g.width); ++x) {
-            const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
-            out.pixels[p] += plus->pixels[p];
-          }
-    }
-    rays_traced.fetch_add(traced, std::memory_order_relaxed);
+  engine::jobs::parallel_for(0, tiles_x * tiles_y, 16, [&](int t0, int t1) {
+    for (int t = t0; t < t1; ++t) shader.shade_tile(g, t % tiles_x * 4, t / tiles_x * 4);
   });
-  if (stats) {
-    stats->shadow_rays = rays_traced.load();
-    stats->lights = n_lights;
-  }
+  engine::image::ImageRGB out = shader.take(stats);
+  if (plus) add_image(out, *plus);
   return out;
+}
+
+void add_image(engine::image::ImageRGB& to, const engine::image::ImageRGB& from) {
+  engine::jobs::parallel_for<std::size_t>(0, to.size(), 16384, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) to.pixels[i] += from.pixels[i];
+  });
 }
 
 }  // namespace transgi::shading

@@ -9,8 +9,12 @@
 //    a stable dither, not noise.
 // The rest of the direct light, the residual sky and emissive meshes, comes
 // from the probes' direct SH through the transfer (shade_gi_realtime's
-// direct_out); pass that image as `plus` and it is added in the same pass.
+// direct_out); pass that image as `plus` and it is added to the result.
 // The reference is the path tracer's direct pass.
+#include <array>
+#include <atomic>
+#include <vector>
+
 #include "engine/image/image.h"
 #include "engine/render/camera_rays.h"
 #include "engine/render/light_set.h"
@@ -22,6 +26,34 @@ struct RealtimeDirectStats {
   std::size_t shadow_rays = 0;
   std::size_t lights = 0;  // punctual lights shaded (the split sun included)
 };
+
+// The pass one 4x4 tile at a time: shade_direct_realtime runs it over the
+// whole G-buffer, and the real-time frame runs it inside the G-buffer's own
+// tile loop (trace_gbuffer's `direct`), while the tile's samples are still in
+// cache; the image is the same either way. shade_tile may run on several
+// threads at once for different tiles.
+class DirectTileShader {
+ public:
+  DirectTileShader(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                   const engine::render::CameraRays& camera, int width, int height);
+  // Pixels [tx, tx + 4) x [ty, ty + 4) of `g`, which must already hold them.
+  void shade_tile(const GBuffer& g, int tx, int ty);
+  // The image, once every tile is shaded.
+  engine::image::ImageRGB take(RealtimeDirectStats* stats = nullptr);
+
+ private:
+  const engine::rt::RtScene& scene_;
+  const engine::render::LightSet& lights_;
+  const engine::render::CameraRays& camera_;
+  engine::image::ImageRGB out_;
+  std::size_t n_lights_ = 0;
+  std::vector<std::array<engine::render::LightSample, 64>> directional_;
+  std::vector<std::uint8_t> is_directional_;
+  std::atomic<std::size_t> rays_traced_{0};
+};
+
+// to += from, pixel by pixel (same size), in parallel.
+void add_image(engine::image::ImageRGB& to, const engine::image::ImageRGB& from);
 
 engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
                                               const engine::render::LightSet& lights,

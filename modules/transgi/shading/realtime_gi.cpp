@@ -12,6 +12,7 @@
 
 #include "engine/jobs/parallel_for.h"
 #include "engine/math/sampling.h"
+#include "shading/realtime_direct.h"
 #include "shading/sh_light.h"
 #include "shading/transfer_inference.h"
 #include "shading/upsampling.h"
@@ -107,7 +108,7 @@ GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::Sce
 }
 
 void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
-                   const engine::render::CameraRays& camera, int width, int height, GBuffer& g) {
+                   const engine::render::CameraRays& camera, int width, int height, GBuffer& g, DirectTileShader* direct) {
   g.width = width;
   g.height = height;
   g.samples.resize(static_cast<std::size_t>(width) * height);
@@ -139,6 +140,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
         g.metal_roughness[pixel[i]] = s.hit && s.brdf.metallic >= 0.5f ? s.brdf.roughness : std::numeric_limits<float>::infinity();
         g.entity[pixel[i]] = s.entity;
       }
+      if (direct) direct->shade_tile(g, tx, ty);
     }
   });
 }

@@ -27,6 +27,8 @@
 
 namespace transgi::shading {
 
+class DirectTileShader;
+
 struct RealtimeGiSettings {
   // GI is decoded on a grid this fraction of the output size per axis.
   // Higher = finer GI detail inside surfaces, at the cost of inference time
@@ -69,9 +71,12 @@ struct GBuffer {
 GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                       const engine::render::CameraRays& camera, int width, int height);
 // The same into `g`, reusing its storage (a frame loop keeps one G-buffer:
-// 230,400 samples are tens of MB to fault in afresh every frame).
+// 230,400 samples are tens of MB to fault in afresh every frame). With
+// `direct`, each 4x4 tile is also shaded by it as soon as it is traced, while
+// its samples are in cache (realtime_direct.h).
 void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
-                   const engine::render::CameraRays& camera, int width, int height, GBuffer& g);
+                   const engine::render::CameraRays& camera, int width, int height, GBuffer& g,
+                   DirectTileShader* direct = nullptr);
 
 // Buffers the real-time path keeps from frame to frame: at 640x360 they are
 // tens of MB that would otherwise be faulted in and zeroed every frame.
