@@ -41,7 +41,9 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
   rt::Ray rays[16];
   bool blocked[16];
   std::size_t pixel[16];
-  glm::vec3 contribution[16];
+  const GSample* samples[16];
+  std::array<glm::vec3, 2> local[16];  // wo, wi in the shading frame
+  glm::vec3 light[16];
   std::size_t traced = 0;
   const scene::Environment* background = lights_.background();
   // Emission and background first.
@@ -69,20 +71,25 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
         if (glm::dot(ls.direction, s.geometric_normal) <= 0) continue;
         const math::Frame frame = math::Frame::from_normal(s.normal_world);
         const glm::vec3 wo = frame.to_local(s.wo_world), wi = frame.to_local(ls.direction);
-        if (wo.z <= 0 || wi.z <= 0) continue;
-        const glm::vec3 c = material::brdf_eval(s.brdf, wo, wi) * wi.z * ls.radiance;
-        if (!(c.r > 0 || c.g > 0 || c.b > 0)) continue;
+        if (wo.z <= 0 || wi.z <= 0 || ls.radiance == glm::vec3(0.0f)) continue;
         const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
         rays[n] = rt::Ray{rt::offset_ray_origin(s.position, s.geometric_normal, scene_.offset_scale()), ls.direction, 0.0f, tmax};
         pixel[n] = p;
-        contribution[n] = c;
+        samples[n] = &s;
+        local[n] = {wo, wi};
+        light[n] = ls.radiance;
         ++n;
       }
     if (n == 0) continue;
     scene_.occluded16(rays, n, blocked);
     traced += static_cast<std::size_t>(n);
-    for (int i = 0; i < n; ++i)
-      if (!blocked[i]) out_.pixels[pixel[i]] += contribution[i];
+    // The BRDF only where the light arrives: most of a room's pixels that face
+    // the sun are in shadow.
+    for (int i = 0; i < n; ++i) {
+      if (blocked[i]) continue;
+      const glm::vec3 c = material::brdf_eval(samples[i]->brdf, local[i][0], local[i][1]) * local[i][1].z * light[i];
+      if (c.r > 0 || c.g > 0 || c.b > 0) out_.pixels[pixel[i]] += c;
+    }
   }
   rays_traced_.fetch_add(traced, std::memory_order_relaxed);
 }
