@@ -38,8 +38,8 @@ int run_transfer_study(const std::vector<std::string>& argv) {
   const int per_mesh = std::max(1, points / static_cast<int>(jobs_list.size()));
   double seconds_mix[4] = {}, seconds_cos[4] = {};
   jobs.run([&] {
-    for (auto [m, unused] : jobs_list) {
-      (void)unused;
+    for (const auto& job : jobs_list) {
+      const auto m = job.first;  // a plain variable: clang 14 cannot capture a structured binding
       const auto tracer = bake::make_object_tracer(assets, m);
       const bake::MeshTransfer mt(*tracer, *assets.meshes[m], assets, bake::default_visibility_distance(*assets.meshes[m]));
       std::vector<std::vector<double>> local(counts.size() * 2, std::vector<double>(2, 0.0));
