@@ -188,7 +188,7 @@ TEST(Stress, AGridOneProbeThickStaysFinite) {
   Room room(RoomCase{.point_light = 3.0f, .dims = {4, 1, 4}});
   room.run(kFrames);
   EXPECT_EQ(room.non_finite(), 0u);
-  std::printf("[ measured ] one probe thick: GI mean %.6g, %zu probes traced last frame\n", room.mean(room.frame().gi),
+  std::printf("[ measured ] one probe thick: GI mean %.6g, %d probes traced last frame\n", room.mean(room.frame().gi),
               room.frame().probe_stats.traced);
   EXPECT_GT(room.mean(room.frame().gi), 0.0);
 }

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include <glm/gtc/quaternion.hpp>
 
@@ -355,4 +356,49 @@ TEST(RuntimeDynamics, MovedObjectGiConvergesToTheReferenceOfTheMovedScene) {
   EXPECT_LT(rmse_after, 0.015) << "GI of the moved scene vs the path tracer (reference mean " << mean_luminance(ref_after) << ")";
   EXPECT_LT(rmse_after, 0.5 * rmse_stale) << "the GI must follow the cube, not keep the old image";
   EXPECT_LT(probe_rel, 0.05) << "moved probes must re-converge to what fresh probes hold";
+}
+
+// Issue 13, item 3: a non-finite value put into one stage at a time (the
+// decoder's output layer, the latents, an emitter's strength) is replaced at
+// that stage's boundary and counted; no pixel of gi, direct or full is
+// non-finite, and the rest of the image is still lit. A NaN latent never
+// leaves the network: the kernels' ReLU (max(x, 0) with x second-operand
+// NaN rules) turns it into zero in the first hidden layer, so that stage has
+// nothing to count.
+TEST(NanContainment, EachStageReplacesAndCountsWhatIsNotFinite) {
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  for (int stage = 0; stage < 3; ++stage) {
+    runtime::TransGISettings s = runtime::realtime_preset();
+    s.probes.map = probes::MapLayout{16, 8};
+    Level level(s);
+    auto& w = level.app.world();
+    if (stage == 2) {
+      engine::material::Material& m = w.resource<scene::SceneAssets>().materials[1];  // the cube glows infinitely
+      m.emissive_factor = glm::vec3(1.0f);
+      m.emissive_strength = inf;
+    }
+    math::Pcg32 rng(3, 1);
+    model::TransferModel m = random_model(w.resource<scene::SceneAssets>(), 32, rng);
+    if (stage == 0) m.decoder.params().back() = nan;      // an output bias: every decoded sample
+    if (stage == 1) m.meshes[1].latents.values[0] = nan;  // one vertex of the cube
+    level.model = std::make_shared<const model::TransferModel>(std::move(m));
+    runtime::attach_latent_meshes(w, level.model);
+    level.run(6, 32, 24);
+    const runtime::GiFrame& f = level.frame();
+    std::size_t bad = 0;
+    for (const image::ImageRGB* img : {&f.gi, &f.direct, &f.full})
+      for (const glm::vec3& p : img->pixels) bad += !(std::isfinite(p.r) && std::isfinite(p.g) && std::isfinite(p.b));
+    std::printf("[ measured ] stage %d: %zu decoded samples, %zu direct pixels, %zu probe rays replaced, %d probes restarted\n",
+                stage, f.realtime.nonfinite_samples, f.direct_stats.nonfinite_pixels, f.probe_stats.nonfinite_rays,
+                f.probe_stats.nonfinite_probes);
+    EXPECT_EQ(bad, 0u) << "stage " << stage << ": non-finite pixels reached the image";
+    if (stage == 0) {
+      EXPECT_GT(f.realtime.nonfinite_samples, 0u) << "the network's boundary must count it";
+    }
+    if (stage == 2) {
+      EXPECT_GT(f.direct_stats.nonfinite_pixels, 0u) << "the camera sees the infinite emitter: the direct pass must count it";
+      EXPECT_GT(f.probe_stats.nonfinite_rays, 0u) << "probe rays reach the infinite emitter: their boundary must count it";
+    }
+    EXPECT_GT(mean_luminance(f.full), 0.0) << "stage " << stage << ": the rest must still be lit";
+  }
 }

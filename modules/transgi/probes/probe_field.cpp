@@ -167,7 +167,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   std::vector<int> backfaces(static_cast<std::size_t>(probes), 0);
   saw_light_.resize(static_cast<std::size_t>(probes), 0);
   std::vector<float> nearest(static_cast<std::size_t>(probes), std::numeric_limits<float>::infinity());
-  std::atomic<std::size_t> hits{0};
+  std::atomic<std::size_t> hits{0}, nonfinite_rays{0};
   std::vector<float> direct_frame(static_cast<std::size_t>(probes) * 75, 0.0f);
   jobs::parallel_for(0, probes, 1, [&](int b, int e) {
     for (int q = b; q < e; ++q) {
@@ -197,6 +197,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
         sp.position = h.position;
         sp.radiance = h.radiance;
         sp.normal = h.normal;
+        if (h.replaced_non_finite) nonfinite_rays.fetch_add(1, std::memory_order_relaxed);
         if (h.hit) {
           hits.fetch_add(1, std::memory_order_relaxed);
           backfaces[static_cast<std::size_t>(q)] += h.back_face ? 1 : 0;
@@ -211,6 +212,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   for (std::uint8_t t : traced) stats.traced += t;
   stats.rays = static_cast<std::size_t>(stats.traced) * static_cast<std::size_t>(M);
   stats.hits = hits.load();
+  stats.nonfinite_rays = nonfinite_rays.load();
   std::vector<std::uint8_t> skip_this_frame(static_cast<std::size_t>(probes), 0);  // relocated probes
   if (classify || budgeted) {
     const float far = settings_.skip.far_cells * glm::length(grid.spacing());
@@ -273,6 +275,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
 
   // 3. Accumulate, fill, project.
   t0 = Clock::now();
+  std::atomic<int> bad_probes{0};
   jobs::parallel_for(0, probes, 1, [&](int b, int e) {
     for (int q = b; q < e; ++q) {
       if (!updates(q)) continue;
@@ -291,8 +294,18 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
       float* out = sh_.data() + static_cast<std::size_t>(q) * 75;
       projector_.project(filled.data(), out);
       if (settings_.window) apply_hanning_window(out);
+      bool finite = true;
+      for (int k = 0; k < 75; ++k)
+        finite = finite && std::isfinite(out[k]) && std::isfinite(direct_sh_[at + k]) && std::isfinite(direct_mean_[at + k]);
+      if (!finite) {
+        // A value that got past the ray guards (an overflowing sum): this
+        // probe's light is unusable, so it starts afresh rather than spread it.
+        forget_light(q);
+        bad_probes.fetch_add(1, std::memory_order_relaxed);
+      }
     }
   });
+  stats.nonfinite_probes = bad_probes.load();
   stats.project_ms = ms_since(t0);
   for (std::size_t q = 0; q < state_.size(); ++q) {
     stats.active += state_[q] == ProbeState::Active;

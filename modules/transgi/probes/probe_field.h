@@ -118,6 +118,11 @@ struct ProbeFrameStats {
   int active = 0, converged = 0, buried = 0, far = 0;
   int relocated = 0;  // probes standing off their grid points
   bool classified = false;  // this frame traced every probe to classify them
+  // Non-finite values replaced at the probes' boundaries this frame: ray
+  // radiance or emission set to zero, and probes whose projected SH came out
+  // non-finite, emptied and started afresh (issue 13's NaN containment).
+  std::size_t nonfinite_rays = 0;
+  int nonfinite_probes = 0;
   double scatter_ms = 0, raster_ms = 0, project_ms = 0;
 
   // Sums over volumes (counts and times add; `classified` if any was).
@@ -133,6 +138,8 @@ struct ProbeFrameStats {
     far += o.far;
     relocated += o.relocated;
     classified = classified || o.classified;
+    nonfinite_rays += o.nonfinite_rays;
+    nonfinite_probes += o.nonfinite_probes;
     scatter_ms += o.scatter_ms;
     raster_ms += o.raster_ms;
     project_ms += o.project_ms;

@@ -37,6 +37,9 @@ struct ProbeRayHit {
   // not part of `radiance`, which is indirect light only; the probes keep it
   // apart as the real-time path's direct sky and emitter light.
   glm::vec3 emitted{0.0f};
+  // A non-finite radiance or emission (an overflowing light, a NaN material)
+  // was replaced by zero here, at the probe rays' boundary; callers count it.
+  bool replaced_non_finite = false;
 };
 
 // Traces one probe ray. At a hit that is not an emitter and faces the ray,
@@ -53,13 +56,19 @@ ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::rend
   rt::Hit hit;
   if (!scene.intersect(rt::Ray{origin, dir}, hit)) {
     if (const scene::Environment* env = lights.environment()) r.emitted = env->radiance(dir);
-    if (!std::isfinite(r.emitted.r + r.emitted.g + r.emitted.b)) r.emitted = glm::vec3(0.0f);
+    if (!std::isfinite(r.emitted.r + r.emitted.g + r.emitted.b)) {
+      r.emitted = glm::vec3(0.0f);
+      r.replaced_non_finite = true;
+    }
     r.saw_light = true;
     return r;
   }
   const render::Surface s = render::make_surface(scene, hit, dir);
   r.emitted = s.emission;
-  if (!std::isfinite(r.emitted.r + r.emitted.g + r.emitted.b)) r.emitted = glm::vec3(0.0f);
+  if (!std::isfinite(r.emitted.r + r.emitted.g + r.emitted.b)) {
+    r.emitted = glm::vec3(0.0f);
+    r.replaced_non_finite = true;
+  }
   r.hit = true;
   r.back_face = s.back_face;
   r.distance = hit.t;
@@ -85,7 +94,10 @@ ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::rend
     }
   }
   r.radiance += material::diffuse_albedo(s.brdf) * math::kInvPi * feedback(s.position, s.shading_normal, -dir);
-  if (!std::isfinite(r.radiance.r + r.radiance.g + r.radiance.b)) r.radiance = glm::vec3(0.0f);
+  if (!std::isfinite(r.radiance.r + r.radiance.g + r.radiance.b)) {
+    r.radiance = glm::vec3(0.0f);
+    r.replaced_non_finite = true;
+  }
   return r;
 }
 

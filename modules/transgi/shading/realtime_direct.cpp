@@ -91,6 +91,16 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
       if (c.r > 0 || c.g > 0 || c.b > 0) out_.pixels[pixel[i]] += c;
     }
   }
+  // The pass's boundary: an infinite emitter or light leaves no non-finite pixel.
+  std::size_t bad = 0;
+  for (int y = ty; y < std::min(ty + 4, g.height); ++y)
+    for (int x = tx; x < std::min(tx + 4, g.width); ++x) {
+      glm::vec3& v = out_.pixels[static_cast<std::size_t>(y) * g.width + x];
+      if (std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b)) continue;
+      v = glm::vec3(0.0f);
+      ++bad;
+    }
+  if (bad) nonfinite_.fetch_add(bad, std::memory_order_relaxed);
   rays_traced_.fetch_add(traced, std::memory_order_relaxed);
 }
 
@@ -98,6 +108,7 @@ engine::image::ImageRGB DirectTileShader::take(RealtimeDirectStats* stats) {
   if (stats) {
     stats->shadow_rays = rays_traced_.load();
     stats->lights = n_lights_;
+    stats->nonfinite_pixels = nonfinite_.load();
   }
   return std::move(out_);
 }

@@ -25,6 +25,9 @@ namespace transgi::shading {
 struct RealtimeDirectStats {
   std::size_t shadow_rays = 0;
   std::size_t lights = 0;  // punctual lights shaded (the split sun included)
+  // Pixels whose seen emission, background or light came out non-finite and
+  // were set to zero (issue 13's NaN containment).
+  std::size_t nonfinite_pixels = 0;
 };
 
 // The pass one 4x4 tile at a time: shade_direct_realtime runs it over the
@@ -49,7 +52,7 @@ class DirectTileShader {
   std::size_t n_lights_ = 0;
   std::vector<std::array<engine::render::LightSample, 64>> directional_;
   std::vector<std::uint8_t> is_directional_;
-  std::atomic<std::size_t> rays_traced_{0};
+  std::atomic<std::size_t> rays_traced_{0}, nonfinite_{0};
 };
 
 // to += from, pixel by pixel (same size), in parallel.

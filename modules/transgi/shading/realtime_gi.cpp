@@ -295,6 +295,15 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
 
   stats.inferred = net.size();
   stats.diffuse = diffuse.size();
+  // The decoded values' boundary: nothing non-finite reaches the upsampling.
+  const auto finite = [](const glm::vec3& v) { return std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b); };
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    const bool ok = finite(value[i]) && (!with_direct || finite(value_direct[i]));
+    if (ok) continue;
+    value[i] = glm::vec3(0.0f);
+    if (with_direct) value_direct[i] = glm::vec3(0.0f);
+    ++stats.nonfinite_samples;
+  }
 
   t0 = Clock::now();
   // Each cell's slot in `value`, so the composite reads one index per tap

@@ -101,6 +101,9 @@ struct RealtimeGiStats {
   std::size_t grid_samples = 0, edge_samples = 0;  // decoded: on the grid, on their own
   std::size_t inferred = 0, diffuse = 0;           // of those: through the network, diffuse fallback
   std::size_t rotations = 0;                        // distinct object rotations this frame
+  // Decoded samples whose GI came out non-finite (a NaN latent or weight, an
+  // overflowing light) and were set to zero before upsampling.
+  std::size_t nonfinite_samples = 0;
 };
 
 // The GI image (output size = g's) from the probes of `fields` (a point
