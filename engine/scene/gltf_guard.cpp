@@ -195,6 +195,72 @@ std::string check_external_uris(std::string_view json_text, const FileAccess& ac
   return {};
 }
 
+namespace {
+
+// The bytes buffers[b] really has, or -1 when that cannot be told here
+// (tinygltf then reports the buffer itself).
+long long real_buffer_bytes(const nlohmann::json& buffer, std::size_t index, const FileAccess& access, std::size_t bin_length) {
+  if (!buffer.is_object()) return -1;
+  if (!buffer.contains("uri")) return index == 0 ? static_cast<long long>(bin_length) : 0;  // only buffer 0 may be the BIN chunk
+  if (!buffer["uri"].is_string()) return -1;
+  const std::string uri = buffer["uri"].get<std::string>();
+  if (uri.rfind("data:", 0) == 0) {
+    const std::size_t comma = uri.find(',');
+    if (comma == std::string::npos) return 0;
+    const std::size_t n = uri.size() - comma - 1;
+    std::size_t pad = 0;
+    while (pad < 2 && pad < n && uri[uri.size() - 1 - pad] == '=') ++pad;
+    return static_cast<long long>((n - pad) * 3 / 4);  // base64: 3 bytes per 4 significant characters
+  }
+  std::string why;
+  const std::filesystem::path file = resolve_inside_root(access, access.root / percent_decode(uri), why);
+  std::error_code ec;
+  const auto size = file.empty() ? 0 : std::filesystem::file_size(file, ec);
+  return file.empty() || ec ? -1 : static_cast<long long>(size);
+}
+
+// A non-negative integer member, or `fallback` when absent; -1 when it is
+// present but not one.
+long long index_member(const nlohmann::json& o, const char* name, long long fallback) {
+  if (!o.contains(name)) return fallback;
+  const auto& v = o[name];
+  if (v.is_number_unsigned()) return v.get<unsigned long long>() > (1ull << 62) ? -1 : static_cast<long long>(v.get<unsigned long long>());
+  if (v.is_number_integer()) return v.get<long long>() < 0 ? -1 : v.get<long long>();
+  return -1;
+}
+
+}  // namespace
+
+std::string check_image_buffer_views(std::string_view json_text, const FileAccess& access, std::size_t bin_length) {
+  const auto j = nlohmann::json::parse(json_text, nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded() || !j.is_object()) return {};
+  const auto images = j.find("images");
+  if (images == j.end() || !images->is_array()) return {};
+  const auto views = j.find("bufferViews");
+  const auto buffers = j.find("buffers");
+  for (std::size_t i = 0; i < images->size(); ++i) {
+    const auto& image = (*images)[i];
+    if (!image.is_object() || !image.contains("bufferView")) continue;
+    const std::string field = "images[" + std::to_string(i) + "].bufferView";
+    const long long v = index_member(image, "bufferView", -1);
+    if (v < 0 || views == j.end() || !views->is_array() || static_cast<std::size_t>(v) >= views->size())
+      return field + ": not the index of a bufferView";
+    const auto& view = (*views)[static_cast<std::size_t>(v)];
+    const std::string vfield = "bufferViews[" + std::to_string(v) + "]";
+    if (!view.is_object()) return vfield + ": must be an object";
+    const long long b = index_member(view, "buffer", -1), offset = index_member(view, "byteOffset", 0),
+                    length = index_member(view, "byteLength", -1);
+    if (b < 0 || buffers == j.end() || !buffers->is_array() || static_cast<std::size_t>(b) >= buffers->size())
+      return vfield + ".buffer: not the index of a buffer";
+    if (offset < 0 || length < 0) return vfield + ": byteOffset and byteLength must be non-negative integers";
+    const long long have = real_buffer_bytes((*buffers)[static_cast<std::size_t>(b)], static_cast<std::size_t>(b), access, bin_length);
+    if (have >= 0 && offset + length > have)
+      return vfield + ": bytes [" + std::to_string(offset) + ", " + std::to_string(offset + length) + ") lie outside buffers[" +
+             std::to_string(b) + "], which holds " + std::to_string(have) + " bytes (used by images[" + std::to_string(i) + "])";
+  }
+  return {};
+}
+
 tinygltf::FsCallbacks make_fs_callbacks(FileAccess* access) {
   tinygltf::FsCallbacks cb{};
   cb.FileExists = fs_file_exists;

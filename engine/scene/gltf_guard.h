@@ -45,6 +45,14 @@ tinygltf::FsCallbacks make_fs_callbacks(FileAccess* access);
 // bad one, or an empty string. The JSON must already have passed json_depth.
 std::string check_external_uris(std::string_view json, const FileAccess& access);
 
+// Checks that every images[i].bufferView lies inside the bytes its buffer
+// really has (the GLB BIN chunk, a data: URI's decoded length or the file's
+// size), as the declared byteLength alone does not: tinygltf hands the image
+// decoder a pointer to bufferView.byteOffset without checking it. Returns
+// "field: reason" for the first bad one, or an empty string. bin_length: the
+// GLB's BIN chunk length (0 for .gltf).
+std::string check_image_buffer_views(std::string_view json, const FileAccess& access, std::size_t bin_length);
+
 struct ImageLimits {
   int max_dimension = 16384;
 };

@@ -398,9 +398,12 @@ GltfLoadResult load_gltf(ecs::World& world, const fs::path& path, const GltfLoad
 
   const bool glb = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
   std::string_view json;
+  std::size_t bin_length = 0;
   if (glb) {
     try {
-      json = parse_glb(bytes).json;
+      const GlbChunks chunks = parse_glb(bytes);
+      json = chunks.json;
+      bin_length = chunks.bin_length;
     } catch (const std::exception& e) {
       throw GltfError(file + ": " + e.what());
     }
@@ -412,6 +415,7 @@ GltfLoadResult load_gltf(ecs::World& world, const fs::path& path, const GltfLoad
                     std::to_string(options.max_json_depth));
 
   if (const std::string bad = check_external_uris(json, access); !bad.empty()) throw GltfError(file + ": " + bad);
+  if (const std::string bad = check_image_buffer_views(json, access, bin_length); !bad.empty()) throw GltfError(file + ": " + bad);
 
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks(make_fs_callbacks(&access));

@@ -241,6 +241,17 @@ TEST(GltfLoaderBadInput, BufferViewPastItsBuffer) {
   expect_rejected(write_scene(d, j), {"bufferViews[3]", "runs past the end of buffers[0]"});
 }
 
+// Found by the gltf fuzzer (tests/fuzz/corpus/gltf/crash-image-buffer-view-past-bin-chunk.glb):
+// tinygltf hands the image decoder a pointer at bufferView.byteOffset without
+// checking it against the buffer, which read freed memory under ASan.
+TEST(GltfLoaderBadInput, ImageBufferViewPastItsBuffer) {
+  TempDir d;
+  json j = quad_gltf();
+  j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 92768}, {"byteLength", 2176}});
+  j["images"] = json::array({{{"bufferView", j["bufferViews"].size() - 1}, {"mimeType", "image/png"}}});
+  expect_rejected(write_scene(d, j), {"bufferViews[", "lie outside buffers[0], which holds 140 bytes", "images[0]"});
+}
+
 TEST(GltfLoaderBadInput, IndexBeyondVertexCount) {
   TempDir d;
   auto bin = quad_bin();
