@@ -11,6 +11,11 @@ packages=(
   liblua5.4-dev libglfw3-dev libimgui-dev libgl-dev libgl1-mesa-dri
   xvfb xauth ffmpeg
 )
+# --fuzz: also the compiler of the `fuzz` preset (clang 14 with libFuzzer and
+# its sanitizer runtimes; tests/fuzz/README.md). The test suite does not need it.
+if [[ "${1:-}" == "--fuzz" ]]; then
+  packages+=(clang-14 libclang-rt-14-dev)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

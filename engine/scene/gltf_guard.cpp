@@ -271,6 +271,29 @@ tinygltf::FsCallbacks make_fs_callbacks(FileAccess* access) {
   return cb;
 }
 
+namespace {
+
+// Walks a PNG's chunk list and checks that each chunk's declared length fits
+// in the bytes left. stb_image grows its IDAT buffer to a chunk's declared
+// length before reading it, so a 489-byte PNG claiming a 2 GB IDAT chunk
+// made it allocate 2 GB (found by the image fuzzer).
+std::string png_chunk_lengths_fit(const unsigned char* bytes, std::size_t size) {
+  std::size_t at = 8;  // after the signature
+  for (int chunk = 0; at + 8 <= size; ++chunk) {
+    const std::uint32_t length = (std::uint32_t{bytes[at]} << 24) | (std::uint32_t{bytes[at + 1]} << 16) |
+                                 (std::uint32_t{bytes[at + 2]} << 8) | std::uint32_t{bytes[at + 3]};
+    const std::size_t left = size - at - 8;
+    if (length > left)
+      return "PNG chunk " + std::to_string(chunk) + " declares " + std::to_string(length) + " bytes but only " +
+             std::to_string(left) + " follow (truncated or malformed PNG)";
+    if (std::memcmp(bytes + at + 4, "IEND", 4) == 0) return {};
+    at += 8 + static_cast<std::size_t>(length) + std::min<std::size_t>(4, left - length);  // + CRC
+  }
+  return {};
+}
+
+}  // namespace
+
 bool load_image_checked(tinygltf::Image* image, int index, std::string* err, std::string*, int, int,
                         const unsigned char* bytes, int size, void* user) {
   const auto* limits = static_cast<const ImageLimits*>(user);
@@ -284,6 +307,8 @@ bool load_image_checked(tinygltf::Image* image, int index, std::string* err, std
   const bool png = size >= 8 && std::memcmp(bytes, kPng, 8) == 0;
   const bool jpeg = size >= 3 && std::memcmp(bytes, kJpeg, 3) == 0;
   if (!png && !jpeg) return fail("not a PNG or JPEG image (unrecognised magic bytes)");
+  if (png)
+    if (const std::string bad = png_chunk_lengths_fit(bytes, static_cast<std::size_t>(size)); !bad.empty()) return fail(bad);
   int w = 0, h = 0, comp = 0;
   if (!stbi_info_from_memory(bytes, size, &w, &h, &comp))
     return fail(std::string("malformed ") + (png ? "PNG" : "JPEG") + " header: " + stbi_failure_reason());

@@ -252,6 +252,21 @@ TEST(GltfLoaderBadInput, ImageBufferViewPastItsBuffer) {
   expect_rejected(write_scene(d, j), {"bufferViews[", "lie outside buffers[0], which holds 140 bytes", "images[0]"});
 }
 
+// Found by the image fuzzer (tests/fuzz/corpus/image/oom-png-chunk-claims-2gb.png):
+// stb_image sized its IDAT buffer from the chunk's declared length, so a
+// 489-byte PNG claiming 1.75 GB made it allocate that much.
+TEST(GltfLoaderBadInput, PngChunkLongerThanTheFile) {
+  TempDir d;
+  const unsigned char png[] = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A,                      // signature
+                               0, 0, 0, 13, 'I', 'H', 'D', 'R', 0, 0, 0, 64, 0, 0, 0, 64, 8, 2, 0, 0, 0,
+                               0x25, 0x0b, 0xe6, 0x89,                                         // IHDR + CRC
+                               0x68, 0x65, 0x0a, 0x85, 'I', 'D', 'A', 'T', 1, 2, 3, 4, 5, 6};  // IDAT "1,751,452,293 bytes"
+  std::ofstream(d.path / "bomb.png", std::ios::binary).write(reinterpret_cast<const char*>(png), sizeof png);
+  json j = quad_gltf();
+  j["images"] = json::array({{{"uri", "bomb.png"}}});
+  expect_rejected(write_scene(d, j), {"images[0]", "PNG chunk 1 declares 1751452293 bytes but only 6 follow"});
+}
+
 TEST(GltfLoaderBadInput, IndexBeyondVertexCount) {
   TempDir d;
   auto bin = quad_bin();
