@@ -160,6 +160,10 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   if (!csv.empty()) std::printf("per-frame CSV: %s\n", csv.c_str());
   std::printf("direct light, last frame: %zu shadow rays to %zu punctual lights\n", frame.direct_stats.shadow_rays,
               frame.direct_stats.lights);
+  // The NaN guards (docs/reliability.md): what each stage's boundary replaced in the last frame.
+  std::printf("non-finite values replaced, last frame: %zu decoded samples, %zu direct pixels, %zu probe rays, %d probes restarted\n",
+              frame.realtime.nonfinite_samples, frame.direct_stats.nonfinite_pixels, frame.probe_stats.nonfinite_rays,
+              frame.probe_stats.nonfinite_probes);
 
   // Accuracy with the object moving: the last frame's GI, and the path
   // tracer's GI pass of the scene exactly as it stands after that frame.
