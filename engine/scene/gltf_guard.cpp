@@ -171,11 +171,8 @@ std::string percent_decode(const std::string& s) {
   }
   return out;
 }
-}  // namespace
 
-std::string check_external_uris(std::string_view json_text, const FileAccess& access) {
-  const auto j = nlohmann::json::parse(json_text, nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded() || !j.is_object()) return {};  // tinygltf reports the syntax error itself
+std::string check_external_uris(const nlohmann::json& j, const FileAccess& access) {
   for (const char* array : {"buffers", "images"}) {
     const auto it = j.find(array);
     if (it == j.end() || !it->is_array()) continue;
@@ -194,8 +191,6 @@ std::string check_external_uris(std::string_view json_text, const FileAccess& ac
   }
   return {};
 }
-
-namespace {
 
 // The bytes buffers[b] really has, or -1 when that cannot be told here
 // (tinygltf then reports the buffer itself).
@@ -229,11 +224,7 @@ long long index_member(const nlohmann::json& o, const char* name, long long fall
   return -1;
 }
 
-}  // namespace
-
-std::string check_image_buffer_views(std::string_view json_text, const FileAccess& access, std::size_t bin_length) {
-  const auto j = nlohmann::json::parse(json_text, nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded() || !j.is_object()) return {};
+std::string check_image_buffer_views(const nlohmann::json& j, const FileAccess& access, std::size_t bin_length) {
   const auto images = j.find("images");
   if (images == j.end() || !images->is_array()) return {};
   const auto views = j.find("bufferViews");
@@ -259,6 +250,15 @@ std::string check_image_buffer_views(std::string_view json_text, const FileAcces
              std::to_string(b) + "], which holds " + std::to_string(have) + " bytes (used by images[" + std::to_string(i) + "])";
   }
   return {};
+}
+
+}  // namespace
+
+std::string check_references(std::string_view json_text, const FileAccess& access, std::size_t bin_length) {
+  const auto j = nlohmann::json::parse(json_text, nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded() || !j.is_object()) return {};  // tinygltf reports the syntax error itself
+  if (std::string bad = check_external_uris(j, access); !bad.empty()) return bad;
+  return check_image_buffer_views(j, access, bin_length);
 }
 
 tinygltf::FsCallbacks make_fs_callbacks(FileAccess* access) {

@@ -40,18 +40,17 @@ bool read_file_capped(const std::filesystem::path& path, std::uint64_t max_bytes
 
 tinygltf::FsCallbacks make_fs_callbacks(FileAccess* access);
 
-// Checks every external buffers[i].uri and images[i].uri (data: URIs are
-// skipped) before tinygltf sees them; returns "field: reason" for the first
-// bad one, or an empty string. The JSON must already have passed json_depth.
-std::string check_external_uris(std::string_view json, const FileAccess& access);
-
-// Checks that every images[i].bufferView lies inside the bytes its buffer
-// really has (the GLB BIN chunk, a data: URI's decoded length or the file's
-// size), as the declared byteLength alone does not: tinygltf hands the image
-// decoder a pointer to bufferView.byteOffset without checking it. Returns
-// "field: reason" for the first bad one, or an empty string. bin_length: the
-// GLB's BIN chunk length (0 for .gltf).
-std::string check_image_buffer_views(std::string_view json, const FileAccess& access, std::size_t bin_length);
+// Checks, on one parse of the JSON, before tinygltf sees it:
+//  - every external buffers[i].uri and images[i].uri (data: URIs are
+//    skipped) names a regular file inside the scene's folder;
+//  - every images[i].bufferView lies inside the bytes its buffer really has
+//    (the GLB BIN chunk, a data: URI's decoded length or the file's size), as
+//    the declared byteLength alone does not: tinygltf hands the image decoder
+//    a pointer to bufferView.byteOffset without checking it.
+// Returns "field: reason" for the first bad one, or an empty string. The JSON
+// must already have passed json_depth. bin_length: the GLB's BIN chunk length
+// (0 for .gltf).
+std::string check_references(std::string_view json, const FileAccess& access, std::size_t bin_length);
 
 struct ImageLimits {
   int max_dimension = 16384;

@@ -414,8 +414,7 @@ GltfLoadResult load_gltf(ecs::World& world, const fs::path& path, const GltfLoad
     throw GltfError(file + ": JSON nesting depth " + std::to_string(depth) + " exceeds the limit of " +
                     std::to_string(options.max_json_depth));
 
-  if (const std::string bad = check_external_uris(json, access); !bad.empty()) throw GltfError(file + ": " + bad);
-  if (const std::string bad = check_image_buffer_views(json, access, bin_length); !bad.empty()) throw GltfError(file + ": " + bad);
+  if (const std::string bad = check_references(json, access, bin_length); !bad.empty()) throw GltfError(file + ": " + bad);
 
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks(make_fs_callbacks(&access));
