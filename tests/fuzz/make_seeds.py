@@ -1,20 +1,20 @@
 #!/usr/bin/env python3
-"""Writes the fuzz harnesses' seed corpora (tests/fuzz/corpus/<harness>/) from
-the bundled content, so every seed is a real input the engine loads, then
-small edge cases by hand. Run from the repository root:
+"""Writes the fuzz seeds that must be derived from the bundled content (test
+scenes repacked as .glb or with data: URIs) or made by hand (a tiny HDR,
+command lines), into tests/fuzz/corpus/<harness>/. Bundled files that are
+seeds as they stand (environment maps, PNG textures, the level's Lua scripts)
+are not copied: tests/fuzz/CMakeLists.txt and README.md pass them as extra
+corpus paths. Run from the repository root:
 
-    python3 tests/fuzz/make_seeds.py [path/to/tiny.tgm]
+    python3 tests/fuzz/make_seeds.py
 
-The .tgm seed is a model baked small enough to fuzz quickly
-(tests/fuzz/README.md gives the bake command); without it that seed is kept.
-Crashes found by fuzzing are added next to the seeds by hand, named
-crash-<what>, so the replay tests keep them fixed.
+tiny.jpg and tiny.tgm in the corpus are kept as they are (README.md says how
+they were made), as are the crash-<what> inputs that fuzzing found.
 """
 import base64
 import json
 import os
 import struct
-import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CORPUS = os.path.join(ROOT, "tests", "fuzz", "corpus")
@@ -93,21 +93,8 @@ def main():
     }
     out("gltf", "triangle_textured.gltf", json.dumps(doc, separators=(",", ":")).encode())
 
-    # EXR and HDR: the bundled environment maps, and a 2x1 Radiance HDR.
-    out("exr", "sky.exr", read(SCENES, "thick_room", "sky.exr"))
-    out("exr", "studio.exr", read(SCENES, "object_textured", "studio.exr"))
+    # A 2x1 Radiance HDR (the EXR seeds are the bundled environment maps).
     out("exr", "tiny.hdr", b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 2\n" + bytes([128, 64, 32, 129, 1, 2, 3, 120]))
-
-    # PNG and JPEG: the bundled textures and an 8x8 baseline JPEG.
-    out("image", "checker.png", read(SCENES, "object_textured", "checker.png"))
-    out("image", "wallpaper.png", read(SCENES, "thick_room", "wallpaper.png"))
-    out("image", "tiny.jpg", read(ROOT, "tests", "fuzz", "seed_inputs", "tiny.jpg"))
-
-    # .tgm: a tiny bake of the textured object (see the docstring).
-    if len(sys.argv) > 1:
-        out("model", "tiny.tgm", read(sys.argv[1]))
-    else:
-        out("model", "tiny.tgm", read(ROOT, "tests", "fuzz", "seed_inputs", "tiny.tgm"))
 
     # Command lines, one token per line.
     for name, argv in {
@@ -117,11 +104,6 @@ def main():
         "bad_values": ["--width", "1e9", "--map-width", "3", "--direct", "maybe", "--width"],
     }.items():
         out("args", name, "\n".join(argv).encode())
-
-    # Lua: the sample level's gameplay scripts.
-    scripts = os.path.join(ROOT, "content", "levels", "living_room", "scripts")
-    for f in sorted(os.listdir(scripts)):
-        out("lua", f, read(scripts, f))
 
 
 if __name__ == "__main__":
