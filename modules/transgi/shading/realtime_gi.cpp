@@ -163,8 +163,8 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   auto t0 = Clock::now();
   RealtimeGiScratch local;
   RealtimeGiScratch::Impl& sc = *(scratch ? scratch : &local)->impl;
-  if (g.guide.size() != g.samples.size())
-    throw std::invalid_argument("shade_gi_realtime: the G-buffer has no guide; make it with trace_gbuffer");
+  if (g.guide.size() != g.samples.size() || g.entity.size() != g.samples.size() || g.metal_roughness.size() != g.samples.size())
+    throw std::invalid_argument("shade_gi_realtime: the G-buffer lacks its per-pixel arrays; make it with trace_gbuffer");
   const std::vector<glm::vec4>& guide = g.guide;
   plan_upsampling(guide, g.width, g.height, settings, sc.up);
   const UpsamplingPlan& up = sc.up;
@@ -197,9 +197,8 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     // Neighbouring samples mostly lie on one entity: look it up only when it changes.
     engine::ecs::Entity last{};
     std::pair<bool, int> last_route{false, -1};
-    const bool by_entity = g.entity.size() == g.samples.size();
     for (std::size_t i = 0; i < decode.size(); ++i) {
-      const engine::ecs::Entity e = by_entity ? g.entity[decode[i]] : g.samples[decode[i]].entity;
+      const engine::ecs::Entity e = g.entity[decode[i]];
       if (i == 0 || !(e == last)) {
         auto [it, inserted] = per_entity.try_emplace(e, false, -1);
         if (inserted) {
@@ -339,12 +338,10 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   if (mirror.max_roughness >= 0) {
     t0 = Clock::now();
     const LightAt light_at = [&](const glm::vec3& p, const glm::vec3& n, float* out) { field_holding(fields, p)->interpolate(p, n, out); };
-    const bool by_roughness = g.metal_roughness.size() == g.samples.size();
     engine::jobs::parallel_for<std::size_t>(0, g.samples.size(), 1024, [&](std::size_t b, std::size_t e) {
       for (std::size_t p = b; p < e; ++p) {
         // metal_roughness <= max_roughness is is_mirror() on the pixel's material.
-        if (by_roughness ? !(g.metal_roughness[p] <= mirror.max_roughness) : !g.samples[p].hit || !is_mirror(g.samples[p].brdf, mirror))
-          continue;
+        if (!(g.metal_roughness[p] <= mirror.max_roughness)) continue;
         const GSample& s = g.samples[p];
         engine::math::Pcg32 rng = engine::math::make_rng(0x4D1Bull, p, 0);  // fixed: the real-time image has no seed
         image.pixels[p] = shade_mirror_gi(scene, s, light_at, mirror_lights, mirror, rng);
