@@ -115,16 +115,13 @@ engine::image::ImageRGB DirectTileShader::take(RealtimeDirectStats* stats) {
 
 engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
                                               const engine::render::LightSet& lights,
-                                              const engine::render::CameraRays& camera, RealtimeDirectStats* stats,
-                                              const engine::image::ImageRGB* plus) {
+                                              const engine::render::CameraRays& camera, RealtimeDirectStats* stats) {
   DirectTileShader shader(scene, lights, camera, g.width, g.height);
   const int tiles_x = (g.width + 3) / 4, tiles_y = (g.height + 3) / 4;
   engine::jobs::parallel_for(0, tiles_x * tiles_y, 16, [&](int t0, int t1) {
     for (int t = t0; t < t1; ++t) shader.shade_tile(g, t % tiles_x * 4, t / tiles_x * 4);
   });
-  engine::image::ImageRGB out = shader.take(stats);
-  if (plus) add_image(out, *plus);
-  return out;
+  return shader.take(stats);
 }
 
 void add_image(engine::image::ImageRGB& to, const engine::image::ImageRGB& from) {

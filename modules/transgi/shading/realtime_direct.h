@@ -9,7 +9,7 @@
 //    a stable dither, not noise.
 // The rest of the direct light, the residual sky and emissive meshes, comes
 // from the probes' direct SH through the transfer (shade_gi_realtime's
-// direct_out); pass that image as `plus` and it is added to the result.
+// direct_out), which the frame adds with add_image.
 // The reference is the path tracer's direct pass.
 #include <array>
 #include <atomic>
@@ -61,8 +61,7 @@ void add_image(engine::image::ImageRGB& to, const engine::image::ImageRGB& from)
 engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
                                               const engine::render::LightSet& lights,
                                               const engine::render::CameraRays& camera,
-                                              RealtimeDirectStats* stats = nullptr,
-                                              const engine::image::ImageRGB* plus = nullptr);
+                                              RealtimeDirectStats* stats = nullptr);
 
 // The fixed point on [0, 1)^2 that pixel (x, y) uses for disk lights: an
 // R2 low-discrepancy sequence over each 8x8 block.
