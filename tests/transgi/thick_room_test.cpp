@@ -37,7 +37,7 @@ TEST(ThickRoom, BothProbeMethodsMeanGiIsWithinTenPercentOfTheReference) {
 
   eval::TransgiRunOptions t;
   t.frames = 96;
-  t.probe_grid = 6;
+  t.placement.scene_dims = glm::ivec3(6);
   t.progress = false;
   t.settings.direct_spp = 0;
   eval::LoadedScene ts = eval::load_scene(kScene, "", 2);

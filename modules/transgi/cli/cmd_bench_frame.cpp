@@ -75,7 +75,9 @@ ecs::Entity pick_moving_object(ecs::World& world, const std::string& name) {
 int run_bench_frame(const std::vector<std::string>& argv) {
   const Args args("bench-frame", argv,
                   {"scene", "model", "width", "height", "frames", "warmup", "preset", "csv", "object", "threads", "camera",
-                   "direct-spp", "gi-scale", "probe-budget", "direct", "gi-out", "reference-out", "reference-spp", "map-width"});
+                   "direct-spp", "gi-scale", "probe-budget", "direct", "gi-out", "reference-out", "reference-spp", "map-width",
+                   "probe-volume", "probe-grid", "cascades", "cascade-cell", "cascade-look-ahead"},
+                  {"allow-unbaked"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const int width = static_cast<int>(args.integer("width", 16, 8192, 640));
   const int height = static_cast<int>(args.integer("height", 16, 8192, 360));
@@ -88,12 +90,13 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   eval::LoadedScene scene = eval::load_scene(scene_path, args.str("camera", std::string()), threads);
   ecs::World& world = scene.app->world();
   auto model = model::load_model(model_path);
-  model::validate_model(model, world.resource<scene::SceneAssets>(), model_path);
+  model::validate_model(model, world.resource<scene::SceneAssets>(), model_path, args.has("allow-unbaked"));
   runtime::TransGISettings settings = runtime_settings_from(args, "realtime");
   settings.direct_spp = static_cast<int>(args.integer("direct-spp", 0, 100000, settings.direct_spp));
   scene.app->add_plugin<runtime::TransGIPlugin>(settings);
   runtime::attach_latent_meshes(world, std::make_shared<const model::TransferModel>(std::move(model)));
-  world.emplace<runtime::ProbeVolume>(world.spawn(), runtime::ProbeVolume{});
+  const runtime::ProbePlacement placement = probe_placement_from(args, runtime::ProbeVolumeMode::Scene);
+  runtime::spawn_probes(world, placement);
 
   const ecs::Entity mover = pick_moving_object(world, args.str("object", std::string()));
   const transform::Transform start = world.get<transform::Transform>(mover);
@@ -157,6 +160,12 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   std::printf("last frame: %zu pixels decoded (%zu grid, %zu edge), %zu rotations, %d probes traced\n",
               frame.realtime.grid_samples + frame.realtime.edge_samples, frame.realtime.grid_samples,
               frame.realtime.edge_samples, frame.realtime.rotations, frame.probe_stats.traced);
+  for (std::size_t k = 0; k < frame.cascade_stats.size(); ++k) {
+    const probes::ProbeFrameStats& c = frame.cascade_stats[k];
+    std::printf("cascade %zu (%.2f m cells): %d traced, %d active, %d converged, %d buried, %d far\n", k,
+                static_cast<double>(probes::cascade_cell(placement.cascades, static_cast<int>(k))), c.traced, c.active,
+                c.converged, c.buried, c.far);
+  }
   if (!csv.empty()) std::printf("per-frame CSV: %s\n", csv.c_str());
   std::printf("direct light, last frame: %zu shadow rays to %zu punctual lights\n", frame.direct_stats.shadow_rays,
               frame.direct_stats.lights);

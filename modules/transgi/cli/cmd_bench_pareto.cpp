@@ -112,7 +112,7 @@ int run_bench_pareto(const std::vector<std::string>& argv) {
     eval::TransgiRunOptions t;
     t.frames = frames;
     t.timing_frames = timing;
-    t.probe_grid = grid;
+    t.placement.scene_dims = glm::ivec3(grid);
     t.progress = false;
     t.settings.direct_spp = 0;
     t.settings.seed = seed;

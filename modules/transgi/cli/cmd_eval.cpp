@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "cli/args.h"
+#include "cli/runtime_options.h"
 #include "cli/commands.h"
 #include "engine/image/exr.h"
 #include "engine/image/png.h"
@@ -38,8 +39,9 @@ void write_image(const std::filesystem::path& dir, const std::string& name, cons
 int run_eval(const std::vector<std::string>& argv) {
   const Args args("eval", argv,
                   {"scene", "model", "out", "width", "height", "spp", "frames", "ddgi-frames", "ddgi-warmup", "probe-grid",
-                   "gbuffer-spp", "camera", "threads", "cache", "seed", "reference-error", "temporal"},
-                  {"decompose"});
+                   "gbuffer-spp", "camera", "threads", "cache", "seed", "reference-error", "temporal", "probe-volume", "cascades",
+                   "cascade-cell", "cascade-look-ahead"},
+                  {"decompose", "allow-unbaked"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const std::filesystem::path out = args.str("out");
   const int width = static_cast<int>(args.integer("width", 16, 8192, 320));
@@ -53,7 +55,7 @@ int run_eval(const std::vector<std::string>& argv) {
 
   eval::TransgiRunOptions t;
   t.frames = static_cast<int>(args.integer("frames", 1, 100000, 160));
-  t.probe_grid = static_cast<int>(args.integer("probe-grid", 1, 64, 8));
+  t.placement = probe_placement_from(args, runtime::ProbeVolumeMode::Scene);
   t.settings.gbuffer_spp = static_cast<int>(args.integer("gbuffer-spp", 1, 64, 1));
   t.settings.direct_spp = 0;  // both setups take direct light from the reference
   t.settings.seed = seed;
@@ -66,7 +68,7 @@ int run_eval(const std::vector<std::string>& argv) {
   eval::DdgiRunOptions d;
   d.frames = static_cast<int>(args.integer("ddgi-frames", 1, 100000, 200));
   d.settings.warmup_frames = static_cast<int>(args.integer("ddgi-warmup", 0, 100000, 64));
-  d.probe_grid = t.probe_grid;
+  d.probe_grid = t.placement.scene_dims.x;
   d.render.gbuffer_spp = t.settings.gbuffer_spp;
   d.render.direct_spp = 0;
   d.render.seed = seed;
@@ -77,7 +79,7 @@ int run_eval(const std::vector<std::string>& argv) {
   // Fail on a bad model before minutes of reference rendering.
   auto model = model::load_model(model_path);
   eval::LoadedScene reference_scene = eval::load_scene(scene_path, camera, threads);
-  model::validate_model(model, reference_scene.app->world().resource<scene::SceneAssets>(), model_path);
+  model::validate_model(model, reference_scene.app->world().resource<scene::SceneAssets>(), model_path, args.has("allow-unbaked"));
   std::filesystem::create_directories(out / "images");
   std::filesystem::create_directories(out / "heat");
 

@@ -108,7 +108,8 @@ int render_transgi(const Args& args, eval::LoadedScene& scene, int width, int he
     throw std::runtime_error("--lighting environment needs an environment light in the scene (scenes[0].extras.environment)");
   auto model = transgi::model::load_model(model_path);
   const std::string transfer = args.choice("transfer", {"network", "ground-truth"}, "network");
-  if (transfer == "network") transgi::model::validate_model(model, scene.app->world().resource<scene::SceneAssets>(), model_path);
+  if (transfer == "network")
+    transgi::model::validate_model(model, scene.app->world().resource<scene::SceneAssets>(), model_path, args.has("allow-unbaked"));
   if (lighting == "environment") return render_object_scale(args, scene, std::move(model), width, height, o);
   if (transfer != "network") throw std::runtime_error("--transfer ground-truth needs --lighting environment");
   if (args.has("coefficient-maps")) throw std::runtime_error("--coefficient-maps needs --lighting environment");
@@ -127,7 +128,7 @@ int render_transgi(const Args& args, eval::LoadedScene& scene, int width, int he
                                        : transgi::probes::SharingMode::DepthGuard;
   t.frames = static_cast<int>(args.integer("frames", 1, 100000, 32));
   t.timing_frames = static_cast<int>(args.integer("timing-frames", 1, 1000, 3));
-  t.probe_grid = static_cast<int>(args.integer("probe-grid", 1, 64, 8));
+  t.placement = probe_placement_from(args, runtime::ProbeVolumeMode::Scene);
   t.no_latent = split_names(args.str("no-latent", std::string()));
   const auto shared = std::make_shared<const transgi::model::TransferModel>(std::move(model));
   const eval::MethodRun r = eval::run_transgi(scene, shared, width, height, t);
@@ -195,7 +196,9 @@ int run_render(const std::vector<std::string>& argv) {
   const Args args("render", argv,
                   {"scene", "method", "pass", "spp", "width", "height", "out", "camera", "seed", "threads", "png", "exposure",
                    "model", "transfer", "gt-rays", "coefficient-maps", "lighting", "frames", "probe-grid", "probe-rays",
-                   "direct-spp", "probe-skip", "sharing", "no-latent", "timing-frames", "map-width", "hysteresis", "irradiance-gamma", "warmup-frames", "brightness-threshold", "preset", "gi-scale", "probe-budget", "direct"});
+                   "direct-spp", "probe-skip", "sharing", "no-latent", "timing-frames", "map-width", "hysteresis", "irradiance-gamma", "warmup-frames", "brightness-threshold", "preset", "gi-scale", "probe-budget", "direct",
+                   "probe-volume", "cascades", "cascade-cell", "cascade-look-ahead"},
+                  {"allow-unbaked"});
   const std::string scene_path = args.str("scene");
   const std::string method = args.choice("method", {"reference", "transgi", "ddgi"}, "reference");
   Outputs o;

@@ -107,8 +107,7 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
     if (matches.empty()) throw std::runtime_error("--no-latent: no mesh node named '" + name + "'");
     for (ecs::Entity e : matches) world.remove<runtime::LatentMesh>(e);
   }
-  const ecs::Entity volume = world.spawn();
-  world.emplace<runtime::ProbeVolume>(volume, runtime::ProbeVolume{.dims = glm::ivec3(o.probe_grid)});
+  runtime::spawn_probes(world, o.placement);
 
   auto& frame = world.resource<runtime::GiFrame>();
   frame.camera = scene.camera;
@@ -134,11 +133,27 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
   world.view<const runtime::ProbeVolume>().each([&](const runtime::ProbeVolume& v) {
     if (v.field) r.probe_bytes += v.field->memory_bytes();
   });
+  world.view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& c) {
+    for (const auto& f : c.fields)
+      if (f) r.probe_bytes += f->memory_bytes();
+  });
   const auto& st = frame.probe_stats;
   char line[256];
-  std::snprintf(line, sizeof(line), "%d^3 probes, %d frames; last frame %d active, %d converged, %d buried, %d far; %.1f traced per frame",
-                o.probe_grid, o.frames, st.active, st.converged, st.buried, st.far, static_cast<double>(traced) / o.frames);
+  if (o.placement.mode == runtime::ProbeVolumeMode::Scene)
+    std::snprintf(line, sizeof(line), "%d^3 probes over the scene's bounds", o.placement.scene_dims.x);
+  else
+    std::snprintf(line, sizeof(line), "%d cascades of %dx%dx%d probes, %.2f m finest cells", o.placement.cascades.count,
+                  o.placement.cascades.dims.x, o.placement.cascades.dims.y, o.placement.cascades.dims.z,
+                  static_cast<double>(o.placement.cascades.finest_cell));
   r.probe_summary = line;
+  std::snprintf(line, sizeof(line), ", %d frames; last frame %d active, %d converged, %d buried, %d far; %.1f traced per frame",
+                o.frames, st.active, st.converged, st.buried, st.far, static_cast<double>(traced) / o.frames);
+  r.probe_summary += line;
+  for (std::size_t k = 0; k < frame.cascade_stats.size(); ++k) {
+    const auto& c = frame.cascade_stats[k];
+    std::snprintf(line, sizeof(line), "; cascade %zu: %d active, %d buried, %d far", k, c.active, c.buried, c.far);
+    r.probe_summary += line;
+  }
   std::snprintf(line, sizeof(line), "; probe state %.1f MB", static_cast<double>(r.probe_bytes) / (1024.0 * 1024.0));
   r.probe_summary += line;
   // Say when the sun was taken out of the sky: a user comparing direct

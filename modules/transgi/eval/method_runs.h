@@ -11,6 +11,7 @@
 #include "ddgi/ddgi_plugin.h"
 #include "engine/app/app.h"
 #include "engine/image/image.h"
+#include "runtime/probe_placement.h"
 #include "runtime/transgi_plugin.h"
 
 namespace transgi::eval {
@@ -43,7 +44,7 @@ struct TransgiRunOptions {
   runtime::TransGISettings settings;
   int frames = 160;
   int timing_frames = 3;
-  int probe_grid = 8;
+  runtime::ProbePlacement placement{.mode = runtime::ProbeVolumeMode::Scene};
   std::vector<std::string> no_latent;  // node names whose LatentMesh is removed
   bool progress = true;
 };

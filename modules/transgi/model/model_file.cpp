@@ -181,18 +181,24 @@ TransferModel load_model(const std::filesystem::path& path) {
   return model;
 }
 
-void validate_model(const TransferModel& model, const engine::scene::SceneAssets& assets,
-                    const std::filesystem::path& model_path) {
+std::size_t validate_model(const TransferModel& model, const engine::scene::SceneAssets& assets,
+                           const std::filesystem::path& model_path, bool allow_unbaked) {
   const std::string hint = "; re-bake it with: transgi bake --scene " + assets.source.string() + " --out " + model_path.string();
-  if (model.meshes.size() != assets.meshes.size())
+  const bool extra_allowed = allow_unbaked && model.meshes.size() < assets.meshes.size();
+  if (model.meshes.size() != assets.meshes.size() && !extra_allowed)
     throw ModelFileError(model_path.string() + ": stale model: it has " + std::to_string(model.meshes.size()) +
-                         " meshes, the scene has " + std::to_string(assets.meshes.size()) + hint);
-  for (std::uint32_t i = 0; i < assets.meshes.size(); ++i) {
+                         " meshes, the scene has " + std::to_string(assets.meshes.size()) + hint +
+                         (model.meshes.size() < assets.meshes.size() ? " (or pass --allow-unbaked to shade the scene's last " +
+                                                                          std::to_string(assets.meshes.size() - model.meshes.size()) +
+                                                                          " meshes diffusely)"
+                                                                    : ""));
+  for (std::uint32_t i = 0; i < model.meshes.size(); ++i) {
     const MeshLatents& m = model.meshes[i];
     if (m.content_hash != mesh_content_hash(assets, i) || m.latents.vertex_to_latent.size() != assets.meshes[i]->vertex_count())
       throw ModelFileError(model_path.string() + ": stale model: mesh " + std::to_string(i) + " '" + assets.meshes[i]->name +
                            "' changed since the bake (content hash differs)" + hint);
   }
+  return assets.meshes.size() - model.meshes.size();
 }
 
 }  // namespace transgi::model

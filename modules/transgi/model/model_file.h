@@ -30,7 +30,11 @@ TransferModel load_model(const std::filesystem::path& path);
 
 // Throws ModelFileError if the model does not belong to these assets (mesh
 // count, names or content hashes differ), naming the first stale mesh.
-void validate_model(const TransferModel& model, const engine::scene::SceneAssets& assets,
-                    const std::filesystem::path& model_path);
+// allow_unbaked: the scene may have meshes after the model's last one (a
+// ground plane or props added since the bake); those get no latents and are
+// shaded diffusely from the probes. The meshes the model has must still match.
+// Returns how many of the scene's meshes have no latents.
+std::size_t validate_model(const TransferModel& model, const engine::scene::SceneAssets& assets,
+                           const std::filesystem::path& model_path, bool allow_unbaked = false);
 
 }  // namespace transgi::model

@@ -38,16 +38,19 @@ ProbeField::ProbeField(ProbeFieldSettings s)
   direct_frames_.assign(states_.size(), 0);
 }
 
-void ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, float* out) const { interpolate(p, n, sh_.data(), out); }
+bool ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, float* out) const { return interpolate(p, n, sh_.data(), out); }
 
-void ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float* probe_sh, float* out) const {
+bool ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float* probe_sh, float* out) const {
   const InterpolationResult r = interpolate_probes(grid_, settings_.map, states_, p, n, settings_.interpolation, usable_);
   for (int k = 0; k < 75; ++k) out[k] = 0.0f;
+  bool lit = false;
   for (std::size_t i = 0; i < 8; ++i) {
     if (r.weights[i] == 0.0f) continue;
+    lit = true;
     const float* L = probe_sh + static_cast<std::size_t>(r.probes[i]) * 75;
     for (int k = 0; k < 75; ++k) out[k] += r.weights[i] * L[k];
   }
+  return lit;
 }
 
 namespace {
@@ -67,10 +70,13 @@ __attribute__((target_clones("default", "avx2", "arch=x86-64-v4"))) void blend_t
 }
 }  // namespace
 
-void ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float* sh_a, float* out_a, const float* sh_b,
+bool ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float* sh_a, float* out_a, const float* sh_b,
                              float* out_b) const {
-  blend_two(interpolate_probes(grid_, settings_.map, states_, p, n, settings_.interpolation, usable_), sh_a, out_a,
-            sh_b, out_b);
+  const InterpolationResult r = interpolate_probes(grid_, settings_.map, states_, p, n, settings_.interpolation, usable_);
+  blend_two(r, sh_a, out_a, sh_b, out_b);
+  for (float w : r.weights)
+    if (w != 0.0f) return true;
+  return false;
 }
 
 glm::vec3 ProbeField::irradiance(const glm::vec3& p, const glm::vec3& n) const {
@@ -120,16 +126,19 @@ void ProbeField::select_within_budget(std::vector<std::uint8_t>& traced) const {
   // a changed region first, then the stalest, ties broken by a rotating
   // offset (round-robin).
   const std::size_t n = traced.size(), offset = frame_ * static_cast<std::size_t>(settings_.update_budget) % n;
-  std::vector<std::tuple<int, std::uint64_t, std::size_t, std::size_t>> order;  // (not urgent, last traced, turn, probe)
+  // With a focus (the camera), ties go nearest-first instead of by turn.
+  std::vector<std::tuple<int, std::uint64_t, float, std::size_t, std::size_t>> order;  // (not urgent, last traced, distance^2, turn, probe)
   for (std::size_t q = 0; q < n; ++q) {
     traced[q] = 0;
     const int not_urgent = q < urgent_.size() && urgent_[q] ? 0 : 1;
-    if (state_[q] == ProbeState::Active || needs_classify_[q])
-      order.emplace_back(not_urgent, last_traced_[q], (q + n - offset) % n, q);
+    if (state_[q] == ProbeState::Active || needs_classify_[q]) {
+      const glm::vec3 d = has_focus_ ? grid_.grid_point(static_cast<int>(q)) - focus_ : glm::vec3(0.0f);
+      order.emplace_back(not_urgent, last_traced_[q], glm::dot(d, d), (q + n - offset) % n, q);
+    }
   }
   const std::size_t k = std::min(order.size(), static_cast<std::size_t>(settings_.update_budget));
   std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(k), order.end());
-  for (std::size_t i = 0; i < k; ++i) traced[std::get<3>(order[i])] = 1;
+  for (std::size_t i = 0; i < k; ++i) traced[std::get<4>(order[i])] = 1;
 }
 
 void ProbeField::forget_light(int probe) {
@@ -141,7 +150,54 @@ void ProbeField::forget_light(int probe) {
   direct_frames_[q] = 0;
 }
 
-ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights) {
+int ProbeField::scroll(glm::ivec3 cells, const ProbeField* seed) {
+  if (cells == glm::ivec3(0)) return 0;
+  settings_.grid.scroll_by(cells);
+  grid_.scroll_by(cells);
+  const std::size_t n = states_.size();
+  last_traced_.resize(n, 0);
+  needs_classify_.resize(n, 0);
+  urgent_.resize(n, 0);
+  saw_light_.resize(n, 0);
+  int entered = 0;
+  for (std::size_t q = 0; q < n; ++q) {
+    if (!grid_.entered_by_scroll(static_cast<int>(q), cells)) continue;
+    ++entered;
+    forget_light(static_cast<int>(q));
+    if (!grid_.offsets.empty()) grid_.offsets[q] = glm::vec3(0.0f);
+    state_[q] = ProbeState::Active;
+    usable_[q] = 1;
+    saw_light_[q] = 0;
+    needs_classify_[q] = settings_.skip.classify ? 1 : 0;
+    urgent_[q] = 1;
+    last_traced_[q] = 0;
+    if (seed) seed->light_at_point(grid_.grid_point(static_cast<int>(q)), sh_.data() + q * 75, direct_sh_.data() + q * 75);
+  }
+  // Without a budget only a classification frame classifies: make the next one.
+  if (settings_.skip.classify && settings_.update_budget <= 0) classify_pending_ = true;
+  return entered;
+}
+
+void ProbeField::light_at_point(const glm::vec3& p, float* out, float* out_direct) const {
+  const ProbeGrid::Cage cage = grid_.cage(p);
+  std::fill_n(out, 75, 0.0f);
+  std::fill_n(out_direct, 75, 0.0f);
+  float sum = 0;
+  for (std::size_t i = 0; i < 8; ++i) sum += usable_[static_cast<std::size_t>(cage.probes[i])] ? cage.weights[i] : 0.0f;
+  if (!(sum > 0)) return;
+  for (std::size_t i = 0; i < 8; ++i) {
+    const auto q = static_cast<std::size_t>(cage.probes[i]);
+    if (!usable_[q] || cage.weights[i] == 0.0f) continue;
+    const float w = cage.weights[i] / sum;
+    for (int k = 0; k < 75; ++k) {
+      out[k] += w * sh_[q * 75 + static_cast<std::size_t>(k)];
+      out_direct[k] += w * direct_sh_[q * 75 + static_cast<std::size_t>(k)];
+    }
+  }
+}
+
+ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                                   const ProbeField* outer) {
   using namespace engine;
   ProbeFrameStats stats;
   const ProbeGrid& grid = grid_;
@@ -182,6 +238,8 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
         const glm::vec3 dir = glm::normalize(rotation * fibonacci_[static_cast<std::size_t>(i)]);
         const ProbeRayHit h = trace_probe_ray(scene, lights, origin, dir, rng, [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3&) {
           // Indirect light from last frame's probes (multi-bounce feedback).
+          if (outer && (glm::any(glm::lessThan(p, grid.min)) || glm::any(glm::greaterThan(p, grid.max))))
+            return outer->irradiance(p, n);
           return frame_ > 0 ? irradiance(p, n) : glm::vec3(0.0f);
         });
         if (h.emitted != glm::vec3(0.0f)) {

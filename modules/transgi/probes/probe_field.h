@@ -107,6 +107,11 @@ struct ProbeFieldSettings {
   // seed studies use off).
   bool fixed_pattern = false;
   std::uint64_t seed = 1;
+  // Where several fields hold a point (cascades, authored volumes;
+  // cascades.h), the band inside this grid's faces across which it hands
+  // the point over to the next field, in cells. Higher = smoother seams, at
+  // the cost of two interpolations over more of the screen. 0 = a hard edge.
+  float blend_cells = 0.0f;
 
   bool operator==(const ProbeFieldSettings&) const = default;
 };
@@ -151,7 +156,10 @@ class ProbeField {
  public:
   explicit ProbeField(ProbeFieldSettings settings);
 
-  ProbeFrameStats update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights);
+  // `outer` (the next coarser cascade, cascades.h) lights the probe rays'
+  // hits outside this grid's box, which this field would only clamp.
+  ProbeFrameStats update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                         const ProbeField* outer = nullptr);
 
   // The scene changed since the last update: converged probes wake up, and
   // if the geometry moved the probes are classified again and their depth
@@ -161,6 +169,19 @@ class ProbeField {
   // with a budget, the probes within one cell of it are updated before any
   // other, so a moving object re-lights its neighbourhood first.
   void notify_region_changed(const glm::vec3& min, const glm::vec3& max);
+
+  // The grid moved by whole cells (a camera-centred cascade following the
+  // camera, cascades.h): probes still inside keep their light and history;
+  // the slab that entered starts afresh, queued first for the budget and for
+  // classification, its SH seeded from `seed` (the next coarser field; null =
+  // black) until its own first trace. Returns how many probes entered.
+  int scroll(glm::ivec3 cells, const ProbeField* seed);
+  // With a budget, probes equally stale are refreshed nearest to `p` first
+  // (the camera) instead of round-robin.
+  void set_focus(const glm::vec3& p) { focus_ = p; has_focus_ = true; }
+  // Trilinear light at a point with no surface (no pruning, buried and far
+  // probes excluded): the indirect and the direct sky SH, 75 each.
+  void light_at_point(const glm::vec3& p, float* out75, float* out_direct75) const;
 
   // Error decomposition: every probe that holds light gets its radiance map
   // path-traced instead (`rays_per_texel` paths per texel, stratified, each
@@ -173,18 +194,21 @@ class ProbeField {
 
   // 75 SH coefficients of probe i, [c * 25 + k], world space.
   [[nodiscard]] const float* light_sh(int probe) const { return sh_.data() + static_cast<std::size_t>(probe) * 75; }
-  // Interpolated SH light at a surface point (pruned trilinear).
-  void interpolate(const glm::vec3& position, const glm::vec3& normal, float* out75) const;
+  // Interpolated SH light at a surface point (pruned trilinear). Each
+  // overload returns whether any probe that holds light weighed in: false
+  // (out all zero) where every probe around p is buried or far, which tells
+  // a caller with several fields to ask the next one (cascades.h).
+  bool interpolate(const glm::vec3& position, const glm::vec3& normal, float* out75) const;
   // One set of weights applied to two probe SH arrays (the indirect and the
   // direct light, possibly rotated): half the cost of two calls.
-  void interpolate(const glm::vec3& position, const glm::vec3& normal, const float* sh_a, float* out_a, const float* sh_b,
+  bool interpolate(const glm::vec3& position, const glm::vec3& normal, const float* sh_a, float* out_a, const float* sh_b,
                    float* out_b) const;
   // The direct sky and emitter light of every probe, probes x 75, world space.
   [[nodiscard]] const std::vector<float>& direct_sh_all() const { return direct_sh_; }
   // The same weights applied to another copy of the probes' SH (probes x 75,
   // e.g. rotated into an object's frame: interpolation is linear, so rotating
   // the probes once equals rotating every interpolated result).
-  void interpolate(const glm::vec3& position, const glm::vec3& normal, const float* probe_sh, float* out75) const;
+  bool interpolate(const glm::vec3& position, const glm::vec3& normal, const float* probe_sh, float* out75) const;
   // All probes' SH, probes x 75, world space.
   [[nodiscard]] const std::vector<float>& light_sh_all() const { return sh_; }
   // Irradiance from the interpolated SH (clamped-cosine convolution).
@@ -229,6 +253,8 @@ class ProbeField {
   std::vector<std::uint32_t> direct_frames_;    // frames in each probe's running mean
   std::vector<glm::vec3> fibonacci_;
   std::uint64_t frame_ = 0;
+  glm::vec3 focus_{0.0f};
+  bool has_focus_ = false;
 };
 
 }  // namespace transgi::probes

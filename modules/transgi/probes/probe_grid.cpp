@@ -14,6 +14,14 @@ float ProbeGrid::min_spacing() const {
   return std::isfinite(m) ? m : 1.0f;
 }
 
+void ProbeGrid::scroll_by(glm::ivec3 cells) {
+  const glm::vec3 shift = glm::vec3(cells) * spacing();
+  min += shift;
+  max += shift;
+  const glm::ivec3 d = glm::max(dims, glm::ivec3(1));
+  scroll = ((scroll + cells) % d + d) % d;
+}
+
 ProbeGrid::Cage ProbeGrid::cage(const glm::vec3& p) const {
   const glm::vec3 s = spacing();
   glm::vec3 g(0.0f);

@@ -1,7 +1,14 @@
 #pragma once
 // A regular grid of probes over an axis-aligned box (8 x 8 x 8 by default),
-// probe 0 at `min`, the last at `max`; each probe may be moved off its grid
-// point (relocation, open_space.h) by up to half a cell.
+// grid coordinates (0,0,0) at `min`, dims - 1 at `max`; each probe may be
+// moved off its grid point (relocation, open_space.h) by up to half a cell.
+//
+// Storage is toroidal: probe data lives at index((c + scroll) mod dims), so a
+// grid that moves by whole cells (camera-centred cascades, cascades.h) keeps
+// every probe that stays in it where it is in memory, and only the slab that
+// enters reuses the slots of the slab that left. Every per-probe array is
+// indexed by storage index; coords() and grid_point() map it back to the
+// world. scroll = 0 is the plain row-major layout.
 #include <array>
 #include <vector>
 
@@ -15,6 +22,7 @@ struct ProbeGrid {
   // Per probe, where relocation moved it from its grid point; empty = none
   // moved. Trilinear weights (cage) stay those of the grid points, as in RTXGI.
   std::vector<glm::vec3> offsets{};
+  glm::ivec3 scroll{0};  // each component in [0, dims)
 
   bool operator==(const ProbeGrid&) const = default;
 
@@ -27,8 +35,31 @@ struct ProbeGrid {
   }
 
   [[nodiscard]] int count() const { return dims.x * dims.y * dims.z; }
-  [[nodiscard]] int index(glm::ivec3 c) const { return (c.z * dims.y + c.y) * dims.x + c.x; }
-  [[nodiscard]] glm::ivec3 coords(int i) const { return {i % dims.x, (i / dims.x) % dims.y, i / (dims.x * dims.y)}; }
+  // Storage index of grid coordinates c (each in [0, dims)).
+  [[nodiscard]] int index(glm::ivec3 c) const {
+    c += scroll;
+    c -= glm::ivec3(glm::greaterThanEqual(c, dims)) * dims;
+    return (c.z * dims.y + c.y) * dims.x + c.x;
+  }
+  // Grid coordinates of storage index i.
+  [[nodiscard]] glm::ivec3 coords(int i) const {
+    glm::ivec3 c{i % dims.x, (i / dims.x) % dims.y, i / (dims.x * dims.y)};
+    c -= scroll;
+    c += glm::ivec3(glm::lessThan(c, glm::ivec3(0))) * dims;
+    return c;
+  }
+  // Moves the box by whole cells (min and max by cells x spacing()) and the
+  // storage origin with it, so storage index i holds the same world point
+  // before and after wherever that point is still inside. Offsets stay with
+  // their storage index: the caller resets those of the probes that entered
+  // (entered_by_scroll).
+  void scroll_by(glm::ivec3 cells);
+  // Whether the probe at storage index i entered the grid with the last
+  // scroll_by(cells): its world point was outside the grid before.
+  [[nodiscard]] bool entered_by_scroll(int i, glm::ivec3 cells) const {
+    const glm::ivec3 before = coords(i) + cells;
+    return glm::any(glm::lessThan(before, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(before, dims));
+  }
   // Distance between neighbouring probes per axis; an axis with a single
   // probe has no spacing (0) and is ignored by cage() and min_spacing().
   [[nodiscard]] glm::vec3 spacing() const { return (max - min) / glm::vec3(glm::max(dims - 1, glm::ivec3(1))); }

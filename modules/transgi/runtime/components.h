@@ -5,7 +5,10 @@
 
 #include <glm/glm.hpp>
 
+#include <vector>
+
 #include "model/transfer_model.h"
+#include "probes/cascades.h"
 #include "probes/probe_field.h"
 
 namespace transgi::runtime {
@@ -25,9 +28,26 @@ struct LatentMesh {
 struct ProbeVolume {
   glm::vec3 min{1.0f}, max{-1.0f};  // min > max: fit to the scene
   glm::ivec3 dims{8};
+  // Where it meets another volume or the cascades, the band inside its faces
+  // across which it hands over to them, in cells (cascades.h). Higher =
+  // smoother seams, at the cost of two interpolations there.
+  float blend_cells = 1.0f;
 
   std::shared_ptr<probes::ProbeField> field = nullptr;  // written by the plugin only
   [[nodiscard]] bool fits_scene() const { return glm::any(glm::greaterThan(min, max)); }
+};
+
+// Probes where the viewer is (probes/cascades.h): `cascades.count` grids of
+// the same dims around the camera (GiFrame::camera, else the first camera),
+// each twice the extent of the one before. They scroll by whole cells as the
+// camera moves; the plugin owns `fields` (finest first) and rebuilds them
+// when the settings change. A ProbeVolume with explicit bounds takes
+// precedence over them inside it.
+struct ProbeCascades {
+  probes::CascadeSettings cascades;
+
+  std::vector<std::shared_ptr<probes::ProbeField>> fields{};  // written by the plugin only
+  std::vector<glm::ivec3> origins{};                          // each field's cascade_origin, plugin only
 };
 
 }  // namespace transgi::runtime

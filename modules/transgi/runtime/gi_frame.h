@@ -2,6 +2,7 @@
 // The GI renderer's per-frame output and what it cost, read by the game,
 // tools and the CLI after the Render phase.
 #include <cstddef>
+#include <vector>
 
 #include "engine/ecs/entity.h"
 #include "engine/image/image.h"
@@ -35,6 +36,9 @@ struct GiFrame {
   std::size_t shaded_samples = 0, inferred_samples = 0;
   // This frame's probe update (summed over volumes).
   probes::ProbeFrameStats probe_stats;
+  // The same per cascade (ProbeCascades), finest first; empty without them.
+  std::vector<probes::ProbeFrameStats> cascade_stats;
+  int cascade_probes_entered = 0;  // probes that entered by scrolling this frame
   std::uint64_t probe_frames = 0;
   // Real-time path only: decoded pixels, rotations and their times.
   shading::RealtimeGiStats realtime;

@@ -14,6 +14,8 @@
 #include "shading/realtime_gi.h"
 #include "engine/render/temporal_accumulation.h"
 #include "shading/transfer_renderer.h"
+#include "runtime/probe_sync.h"
+#include "probes/cascades.h"
 
 namespace transgi::runtime {
 
@@ -22,36 +24,6 @@ namespace {
 using namespace engine;
 using namespace engine::schedule;
 using transform::WorldTransform;
-
-struct SeenVersions {
-  std::uint64_t lights = 0, geometry = 0;
-};
-
-void sync_probe_volumes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res<render::SceneLights> lights,
-                        Res<TransGISettings> settings, Local<SeenVersions> seen) {
-  const bool geometry_moved = lights->geometry_version != seen->geometry;
-  const bool lighting_changed = lights->version != seen->lights;
-  // Where it moved: probes there are updated first (RtScene keeps the list for its last commit).
-  static const std::vector<rt::WorldBounds> kNothing;
-  const auto& regions = geometry_moved ? rt->changed_at_last_commit() : kNothing;
-  volumes.each([&](ProbeVolume& v) {
-    if (v.fits_scene()) {
-      // Fitted once: a later move must not shift every probe (and reset them).
-      v.min = rt->bounds_min();
-      v.max = rt->bounds_max();
-    }
-    probes::ProbeFieldSettings wanted = settings->probes;
-    wanted.grid = probes::ProbeGrid::centred_in(v.min, v.max, v.dims);
-    if (!v.field || !(v.field->settings() == wanted)) {
-      v.field = std::make_shared<probes::ProbeField>(wanted);
-      return;
-    }
-    if (geometry_moved || lighting_changed) v.field->notify_scene_changed(geometry_moved);
-    for (const rt::WorldBounds& b : regions) v.field->notify_region_changed(b.min, b.max);
-  });
-  seen->geometry = lights->geometry_version;
-  seen->lights = lights->version;
-}
 
 bool deterministic_direct(const TransGISettings& s) {
   return s.gi_path == GiPath::Realtime && s.direct_light == DirectLight::Deterministic;
@@ -65,12 +37,24 @@ void request_light_settings(Res<TransGISettings> settings, ResMut<render::LightS
   if (lights->split_sun != split) lights->split_sun = split;
 }
 
-void update_probes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res<render::SceneLights> lights,
-                   Res<TransGISettings> settings, ResMut<GiFrame> frame) {
+void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> cascades, Res<rt::RtScene> rt,
+                   Res<render::SceneLights> lights, Res<TransGISettings> settings, ResMut<GiFrame> frame) {
   if (settings->freeze_probes) return;
   probes::ProbeFrameStats total;
   volumes.each([&](ProbeVolume& v) {
     if (v.field) total += v.field->update(*rt, lights->set);
+  });
+  frame->cascade_stats.clear();
+  cascades.each([&](ProbeCascades& set) {
+    for (std::size_t k = 0; k < set.fields.size(); ++k) {
+      // Hits beyond a cascade are lit by the next coarser one.
+      const probes::ProbeField* outer = k + 1 < set.fields.size() ? set.fields[k + 1].get() : nullptr;
+      if (!set.fields[k]) continue;
+      const probes::ProbeFrameStats st = set.fields[k]->update(*rt, lights->set, outer);
+      if (frame->cascade_stats.size() <= k) frame->cascade_stats.resize(k + 1);
+      frame->cascade_stats[k] += st;
+      total += st;
+    }
   });
   frame->probe_stats = total;
   ++frame->probe_frames;
@@ -148,7 +132,8 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   compose_full(frame);
 }
 
-void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Get<const LatentMesh>> latents,
+void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Get<const ProbeCascades>> cascades,
+               View<Get<const LatentMesh>> latents,
                Res<rt::RtScene> rt, Res<scene::SceneAssets> assets, Res<render::SceneLights> lights,
                Res<TransGISettings> settings, ResMut<GiFrame> frame, Local<PackedDecoder> packed) {
   if (frame->width <= 0 || frame->height <= 0) return;
@@ -161,9 +146,15 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
     if (!model) model = l.model;
   });
   static const model::TransferModel kNoModel;
+  // In the order shading consults them (probes::fields_at): volumes, which
+  // take precedence inside their boxes, then the cascades, finest first.
   std::vector<const probes::ProbeField*> fields;
   volumes.each([&](const ProbeVolume& v) {
     if (v.field) fields.push_back(v.field.get());
+  });
+  cascades.each([&](const ProbeCascades& set) {
+    for (const auto& f : set.fields)
+      if (f) fields.push_back(f.get());
   });
 
   shading::TransferRenderSettings rs;
@@ -189,7 +180,7 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
       std::fill_n(out, 75, 0.0f);
       return;
     }
-    shading::field_holding(fields, p)->interpolate(p, n, out);
+    probes::interpolate_fields(fields, p, n, out);
   };
   const shading::TransferRenderResult r = shading::render_transfer(
       *rt, *assets, model ? *model : kNoModel, *rays, frame->width, frame->height, light_at, nullptr, settings->transfer, rs);
@@ -237,6 +228,7 @@ void TransGIPlugin::build(app::App& app) {
   if (!w.has_resource<GiFrame>()) w.insert_resource<GiFrame>();
   app.add_system(Phase::PostUpdate, "transgi::request_light_settings", request_light_settings);
   app.add_system(Phase::PrepareRender, "transgi::sync_probe_volumes", sync_probe_volumes);
+  app.add_system(Phase::PrepareRender, "transgi::sync_probe_cascades", sync_probe_cascades);
   app.add_system(Phase::Render, "transgi::update_probes", update_probes);
   app.add_system(Phase::Render, "transgi::render_gi", render_gi);
 }

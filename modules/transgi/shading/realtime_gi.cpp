@@ -1,5 +1,7 @@
 #include "shading/realtime_gi.h"
 
+#include "probes/cascades.h"
+
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -90,15 +92,6 @@ class RotatedProbes {
 };
 
 }  // namespace
-
-const probes::ProbeField* field_holding(std::span<const probes::ProbeField* const> fields, const glm::vec3& p) {
-  if (fields.size() == 1) return fields.front();  // the usual case, asked once per decoded pixel
-  for (const probes::ProbeField* f : fields) {
-    const auto& grid = f->grid();
-    if (glm::all(glm::greaterThanEqual(p, grid.min)) && glm::all(glm::lessThanEqual(p, grid.max))) return f;
-  }
-  return fields.front();
-}
 
 GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                       const engine::render::CameraRays& camera, int width, int height) {
@@ -248,11 +241,9 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     float world[75], world_direct[75];
     for (std::size_t k = b; k < e; ++k) {
       const GSample& s = g.samples[decode[diffuse[k]]];
-      const probes::ProbeField* f = field_holding(fields, s.position);
-      if (with_direct)
-        f->interpolate(s.position, s.normal_world, f->light_sh_all().data(), world, f->direct_sh_all().data(), world_direct);
-      else
-        f->interpolate(s.position, s.normal_world, world);
+      probes::interpolate_fields_with(
+          fields, s.position, s.normal_world, [](const probes::ProbeField* f) { return f->light_sh_all().data(); },
+          [](const probes::ProbeField* f) { return f->direct_sh_all().data(); }, world, with_direct ? world_direct : nullptr);
       value[diffuse[k]] = s.diffuse * engine::math::kInvPi * sh_irradiance(world, s.normal_world);
       if (with_direct) value_direct[diffuse[k]] = s.diffuse * engine::math::kInvPi * sh_irradiance(world_direct, s.normal_world);
     }
@@ -270,13 +261,11 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
       for (std::size_t k = b; k < e; ++k) {
         const glm::vec3& position = sc.net_position[k];
         const glm::vec3& normal = sc.net_normal[k];
-        const probes::ProbeField* f = field_holding(fields, position);
-        float* l = light + (k - b) * 75;
-        if (light_direct)
-          f->interpolate(position, normal, rotated.sh(rotation_of[k], f), l, rotated.sh(rotation_of[k], f, true),
-                         light_direct + (k - b) * 75);
-        else
-          f->interpolate(position, normal, rotated.sh(rotation_of[k], f), l);
+        const int r = rotation_of[k];
+        probes::interpolate_fields_with(
+            fields, position, normal, [&](const probes::ProbeField* f) { return rotated.sh(r, f); },
+            [&](const probes::ProbeField* f) { return rotated.sh(r, f, true); }, light + (k - b) * 75,
+            light_direct ? light_direct + (k - b) * 75 : nullptr);
       }
     };
     fill_seconds = shade_transfer_fused(*decoder, *model, assets, queries, fill, shaded.data(),
@@ -337,7 +326,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   // Mirrors at full resolution (transfer_renderer.h's MirrorRay).
   if (mirror.max_roughness >= 0) {
     t0 = Clock::now();
-    const LightAt light_at = [&](const glm::vec3& p, const glm::vec3& n, float* out) { field_holding(fields, p)->interpolate(p, n, out); };
+    const LightAt light_at = [&](const glm::vec3& p, const glm::vec3& n, float* out) { probes::interpolate_fields(fields, p, n, out); };
     engine::jobs::parallel_for<std::size_t>(0, g.samples.size(), 1024, [&](std::size_t b, std::size_t e) {
       for (std::size_t p = b; p < e; ++p) {
         // metal_roughness <= max_roughness is is_mirror() on the pixel's material.

@@ -89,10 +89,6 @@ struct RealtimeGiScratch {
   RealtimeGiScratch& operator=(RealtimeGiScratch&&) noexcept;
 };
 
-// The volume whose grid holds p (the first one if none does); fields must
-// not be empty.
-const probes::ProbeField* field_holding(std::span<const probes::ProbeField* const> fields, const glm::vec3& p);
-
 struct RealtimeGiStats {
   double rotate_ms = 0;     // probe SH into moved objects' frames
   double light_ms = 0;      // probe interpolation per decoded pixel

@@ -1,0 +1,100 @@
+#include "probes/cascades.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "probes/probe_field.h"
+
+namespace transgi::probes {
+
+float cascade_cell(const CascadeSettings& s, int k) { return std::ldexp(s.finest_cell, k); }
+
+glm::ivec3 cascade_origin(const CascadeSettings& s, int k, const glm::vec3& eye) {
+  const glm::ivec3 camera_cell(glm::floor(eye / cascade_cell(s, k)));
+  return camera_cell - s.dims / 2;
+}
+
+glm::ivec3 cascade_origin(const CascadeSettings& s, int k, const glm::vec3& eye, const glm::vec3& forward) {
+  const glm::vec3 half_extent = 0.5f * glm::vec3(s.dims) * cascade_cell(s, k);
+  return cascade_origin(s, k, eye + s.look_ahead * half_extent * forward);
+}
+
+ProbeGrid cascade_grid(const CascadeSettings& s, int k, const glm::ivec3& origin) {
+  const float cell = cascade_cell(s, k);
+  ProbeGrid g;
+  g.dims = glm::max(s.dims, glm::ivec3(1));
+  g.min = (glm::vec3(origin) + 0.5f) * cell;
+  g.max = g.min + glm::vec3(g.dims - 1) * cell;
+  return g;
+}
+
+namespace {
+// How far p lies inside [lo, hi] (its nearest face), negative outside.
+float depth_inside(const BlendBox& b, const glm::vec3& p) {
+  const glm::vec3 d = glm::min(p - b.lo, b.hi - p);
+  return std::min({d.x, d.y, d.z});
+}
+}  // namespace
+
+BoxMix blend_boxes(std::span<const BlendBox> boxes, const glm::vec3& p) {
+  BoxMix m;
+  m.box = {static_cast<int>(boxes.size()) - 1, 0};
+  std::size_t i = 0;
+  for (; i < boxes.size(); ++i)
+    if (depth_inside(boxes[i], p) >= 0) break;
+  if (i == boxes.size()) return m;  // outside all: the last one, clamped
+  const float depth = depth_inside(boxes[i], p);
+  const float w = boxes[i].band > 0 ? std::clamp(depth / boxes[i].band, 0.0f, 1.0f) : 1.0f;
+  m.box[0] = static_cast<int>(i);
+  if (w >= 1.0f) return m;
+  std::size_t j = i + 1;
+  for (; j < boxes.size(); ++j)
+    if (depth_inside(boxes[j], p) >= 0) break;
+  if (j == boxes.size()) {
+    // Nothing beyond holds p: the fading box keeps it all, unless a later
+    // box exists to clamp into (the coarsest cascade).
+    if (i + 1 == boxes.size()) return m;
+    j = boxes.size() - 1;
+  }
+  m.box[1] = static_cast<int>(j);
+  m.weight = {w, 1.0f - w};
+  m.count = 2;
+  return m;
+}
+
+FieldMix fields_at(std::span<const ProbeField* const> fields, const glm::vec3& p) {
+  FieldMix m;
+  m.field[0] = fields.front();
+  if (fields.size() == 1) return m;  // the usual case, asked once per decoded pixel
+  std::array<BlendBox, 16> local{};
+  const std::size_t n = std::min(fields.size(), local.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const ProbeGrid& g = fields[i]->settings().grid;
+    local[i] = {g.min, g.max, fields[i]->settings().blend_cells * g.min_spacing()};
+  }
+  const BoxMix b = blend_boxes(std::span<const BlendBox>(local.data(), n), p);
+  m.count = b.count;
+  for (int k = 0; k < b.count; ++k) {
+    m.field[static_cast<std::size_t>(k)] = fields[static_cast<std::size_t>(b.box[static_cast<std::size_t>(k)])];
+    m.weight[static_cast<std::size_t>(k)] = b.weight[static_cast<std::size_t>(k)];
+  }
+  return m;
+}
+
+const ProbeField* next_field_holding(std::span<const ProbeField* const> fields, const ProbeField* after, const glm::vec3& p) {
+  std::size_t i = 0;
+  while (i < fields.size() && fields[i] != after) ++i;
+  for (++i; i < fields.size(); ++i) {
+    const ProbeGrid& g = fields[i]->settings().grid;
+    if (glm::all(glm::greaterThanEqual(p, g.min)) && glm::all(glm::lessThanEqual(p, g.max))) return fields[i];
+  }
+  return i > fields.size() || fields.back() == after ? nullptr : fields.back();
+}
+
+void interpolate_fields(std::span<const ProbeField* const> fields, const glm::vec3& p, const glm::vec3& n, float* out) {
+  interpolate_fields_with(
+      fields, p, n, [](const ProbeField* f) { return f->light_sh_all().data(); },
+      [](const ProbeField* f) { return f->direct_sh_all().data(); }, out, nullptr);
+}
+
+}  // namespace transgi::probes

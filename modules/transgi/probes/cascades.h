@@ -1,0 +1,127 @@
+#pragma once
+// Probes where the viewer is: camera-centred cascades of probe grids, and
+// the blend that hands a shading point from one probe field to the next.
+// Shared by both probe plugins (TransGI's ProbeField and DDGI's volume): a
+// cascade is a ProbeGrid, placed here, scrolled by whole cells
+// (ProbeGrid::scroll_by) by whoever owns its probes.
+//
+// Cascade k refreshes budget / 2^k probes a frame (at least one) when the
+// run-time settings give a budget (ProbeFieldSettings::update_budget), nearest
+// the camera and stalest first: coarse cascades, whose probes light what is
+// far away, update less often.
+//
+// Cascade k has the same dims as the others and cells 2^k times the finest
+// one, centred on the camera and snapped to whole cells of its own size: its
+// probes sit at cell centres, (origin + c + 0.5) x cell, so no probe ever
+// lies on a plane through the world origin (a ground plane at y = 0).
+#include <array>
+#include <span>
+
+#include "probes/probe_field.h"
+
+#include <glm/glm.hpp>
+
+#include "probes/probe_grid.h"
+
+namespace transgi::probes {
+
+
+struct CascadeSettings {
+  // Cascades, each covering twice the extent of the one before. Higher = GI
+  // reaches further from the camera, at the cost of dims^3 more probes each
+  // (memory, and rays when they update).
+  int count = 4;
+  // Probe spacing of the finest cascade, in metres. Lower = finer lighting
+  // near the camera, at the cost of reach: the coarsest cascade spans
+  // dims x finest_cell x 2^(count - 1).
+  float finest_cell = 0.5f;
+  glm::ivec3 dims{8};
+  // Width of the band inside each cascade's faces across which it hands over
+  // to the next coarser one, in its own cells. Higher = smoother
+  // transitions, at the cost of two interpolations over more of the screen.
+  float blend_cells = 1.0f;
+  // How far ahead of the camera each cascade's centre sits, as a fraction of
+  // its half extent along the view direction (0 = centred on the camera, 1 =
+  // the camera at its back face). Higher = more of each cascade's probes in
+  // view, where they are seen, at the cost of more probes entering (and
+  // starting from their coarser cascade's light) when the camera turns.
+  float look_ahead = 0.0f;
+
+  bool operator==(const CascadeSettings&) const = default;
+};
+
+// Cell size of cascade k.
+[[nodiscard]] float cascade_cell(const CascadeSettings& s, int k);
+// Grid coordinates (in cascade k's cells, world-anchored) of probe (0,0,0)
+// for a camera at `eye`: the camera lies within half a cell of probe dims/2 on
+// each axis.
+[[nodiscard]] glm::ivec3 cascade_origin(const CascadeSettings& s, int k, const glm::vec3& eye);
+// The same with the look-ahead: centred at eye + look_ahead x half extent x
+// forward (a unit view direction).
+[[nodiscard]] glm::ivec3 cascade_origin(const CascadeSettings& s, int k, const glm::vec3& eye, const glm::vec3& forward);
+// Cascade k's grid for an origin from cascade_origin (scroll 0).
+[[nodiscard]] ProbeGrid cascade_grid(const CascadeSettings& s, int k, const glm::ivec3& origin);
+
+// How much of a point's light each box gives: boxes in priority order (an
+// authored volume before the cascades, finest cascade first), each the
+// probes' extent [lo, hi] with a band width (world units, 0 = hard edge).
+// The first box holding p takes w = clamp(depth / band, 0, 1), where depth is
+// p's distance inside its nearest face; the rest, 1 - w, goes to the next box
+// holding p, whole. If no box holds p the last box takes it all (clamped
+// interpolation, as a single grid does). Weights sum to 1.
+struct BlendBox {
+  glm::vec3 lo{0.0f}, hi{0.0f};
+  float band = 0.0f;
+};
+struct BoxMix {
+  std::array<int, 2> box{0, 0};
+  std::array<float, 2> weight{1.0f, 0.0f};
+  int count = 1;
+};
+[[nodiscard]] BoxMix blend_boxes(std::span<const BlendBox> boxes, const glm::vec3& p);
+
+// The same over probe fields, each box its grid's extent and band
+// (ProbeFieldSettings::blend_cells x its smallest spacing). fields must not be
+// empty; a single field takes everything, whatever p.
+struct FieldMix {
+  std::array<const ProbeField*, 2> field{};
+  std::array<float, 2> weight{1.0f, 0.0f};
+  int count = 1;
+};
+[[nodiscard]] FieldMix fields_at(std::span<const ProbeField* const> fields, const glm::vec3& p);
+// The first field after `after` in `fields` whose grid holds p, else the last
+// field, else null (after is the last).
+[[nodiscard]] const ProbeField* next_field_holding(std::span<const ProbeField* const> fields, const ProbeField* after,
+                                                   const glm::vec3& p);
+
+// Interpolated SH light at a surface point from the fields, blended as
+// fields_at says. A field with no probe that holds light around p (all
+// buried or far: a fine cascade in open space) hands its whole weight to the
+// next field holding p. indirect(f) and direct(f) give field f's SH arrays
+// (world or rotated, probes x 75); out_direct null = indirect only. With one
+// field this is exactly that field's ProbeField::interpolate.
+template <class IndirectOf, class DirectOf>
+void interpolate_fields_with(std::span<const ProbeField* const> fields, const glm::vec3& p, const glm::vec3& n,
+                             IndirectOf indirect, DirectOf direct, float* out, float* out_direct) {
+  const auto one = [&](const ProbeField* f, float* o, float* od) {
+    return od ? f->interpolate(p, n, indirect(f), o, direct(f), od) : f->interpolate(p, n, indirect(f), o);
+  };
+  const FieldMix m = fields_at(fields, p);
+  const ProbeField* first = m.field[0];
+  // An unlit field passes the point on; a lit one ends the search.
+  while (!one(first, out, out_direct)) {
+    first = next_field_holding(fields, first, p);
+    if (!first) return;  // nothing lit anywhere: zero
+  }
+  if (m.count == 1 || first != m.field[0]) return;
+  float a[75], b[75];
+  if (!one(m.field[1], a, out_direct ? b : nullptr)) return;  // the second is unlit: the first keeps it all
+  for (int k = 0; k < 75; ++k) out[k] = m.weight[0] * out[k] + m.weight[1] * a[k];
+  if (out_direct)
+    for (int k = 0; k < 75; ++k) out_direct[k] = m.weight[0] * out_direct[k] + m.weight[1] * b[k];
+}
+
+// The indirect light alone, from the fields' world-space SH.
+void interpolate_fields(std::span<const ProbeField* const> fields, const glm::vec3& p, const glm::vec3& n, float* out75);
+
+}  // namespace transgi::probes

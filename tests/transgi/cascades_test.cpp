@@ -1,0 +1,262 @@
+// Camera-centred probe cascades (issue 16): toroidal addressing that keeps
+// each probe's data attached to its world position, blend weights that sum
+// to one, an authored volume that overrides the cascades inside it, and a
+// camera that crosses cell boundaries without a black or non-finite pixel.
+#include <gtest/gtest.h>
+
+#include "lambert.h"
+
+#include <cmath>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "engine/app/app.h"
+#include "engine/math/rng.h"
+#include "engine/render/light_plugin.h"
+#include "engine/scene/procedural.h"
+#include "probes/cascades.h"
+#include "runtime/transgi_plugin.h"
+
+using namespace transgi;
+using namespace transgi::probes;
+using namespace engine;
+
+namespace {
+
+glm::ivec3 random_cells(math::Pcg32& rng, int reach) {
+  const auto one = [&] { return static_cast<int>(rng.next_u32() % static_cast<std::uint32_t>(2 * reach + 1)) - reach; };
+  return {one(), one(), one()};
+}
+
+bool inside(const ProbeGrid& g, const glm::vec3& p) {
+  const glm::vec3 tol = 1e-3f * g.spacing();
+  return glm::all(glm::greaterThanEqual(p, g.min - tol)) && glm::all(glm::lessThanEqual(p, g.max + tol));
+}
+
+}  // namespace
+
+TEST(ToroidalGrid, EveryStorageIndexKeepsItsWorldPointForAnyWholeCellScroll) {
+  ProbeGrid g{{-2.0f, 0.5f, 1.0f}, {2.0f, 1.5f, 4.0f}, {5, 3, 4}};
+  const glm::vec3 spacing = g.spacing();
+  math::Pcg32 rng = math::make_rng(16, 1, 0);
+  for (int step = 0; step < 200; ++step) {
+    // Mostly small moves (a walking camera), sometimes a teleport past the grid.
+    const glm::ivec3 cells = random_cells(rng, step % 10 == 9 ? 9 : 2);
+    const ProbeGrid before = g;
+    g.scroll_by(cells);
+    EXPECT_EQ(g.spacing(), spacing);
+    for (int i = 0; i < g.count(); ++i) {
+      ASSERT_EQ(g.index(g.coords(i)), i) << "storage " << i << " after scroll (" << cells.x << "," << cells.y << "," << cells.z << ")";
+      const glm::vec3 was = before.grid_point(i), now = g.grid_point(i);
+      const bool entered = g.entered_by_scroll(i, cells);
+      // Entered exactly when its new world point was outside the old grid.
+      EXPECT_EQ(entered, !inside(before, now)) << "storage " << i << " at step " << step;
+      if (!entered) {
+        // Kept: the same world point, to float rounding of min + c x spacing.
+        EXPECT_NEAR(now.x, was.x, 1e-4f) << "storage " << i << " at step " << step;
+        EXPECT_NEAR(now.y, was.y, 1e-4f) << "storage " << i << " at step " << step;
+        EXPECT_NEAR(now.z, was.z, 1e-4f) << "storage " << i << " at step " << step;
+      }
+    }
+  }
+}
+
+TEST(ToroidalGrid, ZeroScrollIsTheRowMajorLayout) {
+  const ProbeGrid g{{0, 0, 0}, {1, 1, 1}, {3, 4, 5}};
+  for (int i = 0; i < g.count(); ++i) {
+    const glm::ivec3 c = g.coords(i);
+    EXPECT_EQ((c.z * 4 + c.y) * 3 + c.x, i);
+  }
+}
+
+TEST(CascadePlacement, CellsDoubleAndTheCameraSitsInTheMiddleCell) {
+  CascadeSettings s;
+  s.finest_cell = 0.5f;
+  const glm::vec3 eye{3.3f, 1.7f, -12.1f};
+  for (int k = 0; k < s.count; ++k) {
+    const ProbeGrid g = cascade_grid(s, k, cascade_origin(s, k, eye));
+    const float cell = 0.5f * static_cast<float>(1 << k);
+    EXPECT_NEAR(g.spacing().x, cell, 1e-5f) << "cascade " << k;
+    // The eye lies within half a cell of probe dims/2 on each axis.
+    for (int a = 0; a < 3; ++a) {
+      const float middle = g.min[a] + static_cast<float>(s.dims[a] / 2) * cell;
+      EXPECT_LE(std::abs(eye[a] - middle), 0.5f * cell + 1e-4f) << "cascade " << k << " axis " << a;
+    }
+    // Probes at cell centres: none on a plane through the origin (y = 0).
+    const float f = g.min.y / cell - std::floor(g.min.y / cell);
+    EXPECT_NEAR(f, 0.5f, 1e-4f) << "cascade " << k;
+  }
+}
+
+TEST(CascadeBlend, WeightsSumToOneAndTheFinestHoldsItsInterior) {
+  CascadeSettings s;
+  const glm::vec3 eye{0.3f, 1.6f, -0.2f};
+  std::vector<BlendBox> boxes;
+  for (int k = 0; k < s.count; ++k) {
+    const ProbeGrid g = cascade_grid(s, k, cascade_origin(s, k, eye));
+    boxes.push_back({g.min, g.max, s.blend_cells * g.min_spacing()});
+  }
+  math::Pcg32 rng = math::make_rng(16, 2, 0);
+  int blended = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const glm::vec3 p = eye + 40.0f * (glm::vec3(rng.next_float(), rng.next_float(), rng.next_float()) - 0.5f);
+    const BoxMix m = blend_boxes(boxes, p);
+    const float sum = m.weight[0] + (m.count > 1 ? m.weight[1] : 0.0f);
+    ASSERT_NEAR(sum, 1.0f, 1e-6f) << "at (" << p.x << "," << p.y << "," << p.z << ")";
+    for (int j = 0; j < m.count; ++j) {
+      ASSERT_GE(m.weight[static_cast<std::size_t>(j)], 0.0f);
+      ASSERT_LE(m.weight[static_cast<std::size_t>(j)], 1.0f);
+    }
+    if (m.count == 2) {
+      ++blended;
+      EXPECT_LT(m.box[0], m.box[1]) << "hands over to a coarser cascade";
+    }
+  }
+  EXPECT_GT(blended, 100) << "the bands were never crossed: the test sampled nothing";
+  // Deep inside the finest cascade: all of it, from the finest.
+  const BoxMix centre = blend_boxes(boxes, eye);
+  EXPECT_EQ(centre.count, 1);
+  EXPECT_EQ(centre.box[0], 0);
+  // Halfway through the finest cascade's band: half and half with the next.
+  const float band = boxes[0].band;
+  const glm::vec3 half_band{boxes[0].hi.x - 0.5f * band, eye.y, eye.z};
+  const BoxMix mid = blend_boxes(boxes, half_band);
+  ASSERT_EQ(mid.count, 2);
+  EXPECT_EQ(mid.box[1], 1);
+  EXPECT_NEAR(mid.weight[0], 0.5f, 1e-4f);
+  // Outside every box: the coarsest, clamped.
+  const BoxMix far = blend_boxes(boxes, eye + glm::vec3(1e4f));
+  EXPECT_EQ(far.count, 1);
+  EXPECT_EQ(far.box[0], s.count - 1);
+}
+
+TEST(CascadeBlend, AnAuthoredVolumeOverridesTheCascadesInsideIt) {
+  CascadeSettings s;
+  const glm::vec3 eye{0.0f, 1.5f, 0.0f};
+  std::vector<BlendBox> boxes;
+  // The authored volume first (a 6 m room, bands of one of its 0.75 m cells), then the cascades.
+  boxes.push_back({{-3.0f, 0.0f, -3.0f}, {3.0f, 3.0f, 3.0f}, 0.75f});
+  for (int k = 0; k < s.count; ++k) {
+    const ProbeGrid g = cascade_grid(s, k, cascade_origin(s, k, eye));
+    boxes.push_back({g.min, g.max, s.blend_cells * g.min_spacing()});
+  }
+  for (const glm::vec3 p : {glm::vec3(0.0f, 1.5f, 0.0f), glm::vec3(1.9f, 0.8f, -2.2f), glm::vec3(-2.2f, 2.2f, 2.2f)}) {
+    const BoxMix m = blend_boxes(boxes, p);
+    EXPECT_EQ(m.count, 1) << "at (" << p.x << "," << p.y << "," << p.z << ")";
+    EXPECT_EQ(m.box[0], 0) << "at (" << p.x << "," << p.y << "," << p.z << ")";
+  }
+  // Past its faces, the cascades take over.
+  const BoxMix out = blend_boxes(boxes, glm::vec3(3.4f, 1.5f, 0.0f));
+  EXPECT_GT(out.box[0], 0);
+}
+
+namespace {
+
+// A closed 12 x 4 x 12 m room lit by one point light, with a box in it: every
+// surface the camera sees gets indirect light. No model: every pixel is
+// shaded diffusely from the probes, so each pixel's GI is the cascades' alone.
+struct Room {
+  app::App app{app::AppOptions{.jobs = {.threads = 2}}};
+  ecs::Entity camera;
+
+  explicit Room(const CascadeSettings& cascades) {
+    auto& w = app.world();
+    scene::SceneAssets a;
+    a.generation = scene::next_scene_generation();
+    a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_box({6.0f, 2.0f, 6.0f}, true, 0)),
+                std::make_shared<scene::MeshAsset>(scene::make_box(glm::vec3(0.6f), false, 1))};
+    a.materials = {lambert(glm::vec3(0.6f)), lambert({0.8f, 0.4f, 0.2f})};
+    w.insert_resource<scene::SceneAssets>(std::move(a));
+    runtime::TransGISettings s = runtime::realtime_preset();
+    s.probes.map = MapLayout{16, 8};
+    s.probes.update_budget = 64;
+    s.direct_spp = 0;
+    app.add_plugin<runtime::TransGIPlugin>(s);
+    const ecs::Entity room = w.spawn();
+    w.emplace<transform::Transform>(room, transform::Transform::from_translation({0.0f, 2.0f, 0.0f}));
+    w.emplace<scene::MeshInstance>(room, scene::MeshInstance{0});
+    const ecs::Entity box = w.spawn();
+    w.emplace<transform::Transform>(box, transform::Transform::from_translation({1.5f, 0.6f, -2.0f}));
+    w.emplace<scene::MeshInstance>(box, scene::MeshInstance{1});
+    const ecs::Entity lamp = w.spawn();
+    w.emplace<transform::Transform>(lamp, transform::Transform::from_translation({-2.0f, 3.2f, 1.0f}));
+    w.emplace<scene::PunctualLight>(lamp, scene::PunctualLight{.type = scene::PunctualLight::Type::Point, .intensity = 40.0f});
+    camera = w.spawn();
+    w.emplace<transform::Transform>(camera, pose(0.0f));
+    w.emplace<scene::Camera>(camera, scene::Camera{.yfov_radians = 1.0f});
+    w.emplace<runtime::ProbeCascades>(w.spawn(), runtime::ProbeCascades{.cascades = cascades});
+  }
+  static transform::Transform pose(float x) {
+    transform::Transform t = transform::Transform::from_translation({x, 1.7f, 3.0f});
+    t.rotation = glm::quatLookAtRH(glm::normalize(glm::vec3(0.3f, -0.35f, -1.0f)), glm::vec3(0, 1, 0));
+    return t;
+  }
+  runtime::GiFrame& frame() { return app.world().resource<runtime::GiFrame>(); }
+};
+
+}  // namespace
+
+TEST(CascadeScroll, ACameraCrossingCellsNeverGivesABlackOrNonFinitePixel) {
+  CascadeSettings cs;
+  cs.count = 3;
+  cs.finest_cell = 0.5f;
+  cs.dims = glm::ivec3(6);
+  Room room(cs);
+  auto& frame = room.frame();
+  frame.width = 48;
+  frame.height = 27;
+  // Warm up at rest, then walk 4 m sideways in 0.13 m steps: the finest
+  // cascade crosses a cell every 4 frames or so, the others less often.
+  for (int f = 0; f < 48; ++f) room.app.jobs().run([&] { room.app.update(); });
+  int crossings = 0, entered = 0;
+  for (int f = 0; f < 31; ++f) {
+    room.app.world().get_mut<transform::Transform>(room.camera) = Room::pose(0.13f * static_cast<float>(f + 1));
+    room.app.jobs().run([&] { room.app.update(); });
+    crossings += frame.cascade_probes_entered > 0;
+    entered += frame.cascade_probes_entered;
+    int black = 0, nonfinite = 0;
+    for (const glm::vec3& p : frame.gi.pixels) {
+      if (!std::isfinite(p.r) || !std::isfinite(p.g) || !std::isfinite(p.b)) ++nonfinite;
+      else if (p.r <= 0.0f && p.g <= 0.0f && p.b <= 0.0f) ++black;
+    }
+    ASSERT_EQ(nonfinite, 0) << "frame " << f;
+    ASSERT_EQ(black, 0) << "frame " << f << ": black GI pixels right after " << frame.cascade_probes_entered << " probes entered";
+  }
+  EXPECT_GE(crossings, 6) << "the walk crossed too few cells to test scrolling";
+  EXPECT_GT(entered, 0);
+  ASSERT_EQ(frame.cascade_stats.size(), 3u);
+}
+
+TEST(CascadeScroll, ProbesThatStayKeepTheirLightAndEnteredOnesAreSeededFromTheCoarser) {
+  CascadeSettings cs;
+  cs.count = 2;
+  cs.dims = glm::ivec3(6);
+  Room room(cs);
+  for (int f = 0; f < 24; ++f) room.app.jobs().run([&] { room.app.update(); });
+  runtime::ProbeCascades* set = nullptr;
+  room.app.world().view<runtime::ProbeCascades>().each([&](runtime::ProbeCascades& c) { set = &c; });
+  ASSERT_NE(set, nullptr);
+  ProbeField& fine = *set->fields[0];
+  const ProbeField& coarse = *set->fields[1];
+  std::vector<float> before(fine.light_sh_all());
+  const ProbeGrid grid_before = fine.grid();
+  const glm::ivec3 cells{1, 0, -2};
+  const int entered = fine.scroll(cells, &coarse);
+  EXPECT_EQ(entered, 6 * 6 * 6 - 5 * 6 * 4) << "a (1, 0, -2) scroll of a 6^3 grid";
+  int kept = 0, seeded = 0;
+  for (int q = 0; q < fine.grid().count(); ++q) {
+    const float* now = fine.light_sh(q);
+    if (!fine.grid().entered_by_scroll(q, cells)) {
+      ++kept;
+      ASSERT_NEAR(glm::length(fine.grid().grid_point(q) - grid_before.grid_point(q)), 0.0f, 1e-4f);
+      for (int k = 0; k < 75; ++k) ASSERT_EQ(now[k], before[static_cast<std::size_t>(q) * 75 + k]) << "probe " << q << " coefficient " << k;
+    } else {
+      float expect[75], expect_direct[75];
+      coarse.light_at_point(fine.grid().grid_point(q), expect, expect_direct);
+      for (int k = 0; k < 75; ++k) ASSERT_EQ(now[k], expect[k]) << "entered probe " << q << " coefficient " << k;
+      seeded += expect[0] > 0.0f;
+    }
+  }
+  EXPECT_EQ(kept, 5 * 6 * 4);
+  EXPECT_GT(seeded, 0) << "no entered probe got light from the coarser cascade";
+}
