@@ -72,6 +72,9 @@ def main():
     ap.add_argument("--size", type=float, default=200.0, help="side of the square plane, metres (default 200)")
     ap.add_argument("--albedo", type=float, default=0.2, help="grey diffuse albedo (default 0.2)")
     ap.add_argument("--gap", type=float, default=0.001, help="how far below the scene's lowest point (default 1 mm)")
+    ap.add_argument("--volume", action="store_true",
+                    help="also add an authored TransGI probe volume tight around the original scene: an empty node "
+                         "'ProbeVolume' whose extras.transgi_probe_volume is true, its scale the bounds' half extents")
     args = ap.parse_args()
     if not (args.size > 0 and math.isfinite(args.size)):
         sys.exit(f"{args.scene}: --size must be a positive number of metres, got {args.size}")
@@ -142,6 +145,12 @@ def main():
     nodes = doc["nodes"]
     nodes.append({"name": "GroundPlane", "mesh": len(meshes) - 1})
     scene["nodes"].append(len(nodes) - 1)
+    if args.volume:
+        centre = [0.5 * (lo[a] + hi[a]) for a in range(3)]
+        half = [0.5 * (hi[a] - lo[a]) for a in range(3)]
+        nodes.append({"name": "ProbeVolume", "translation": centre, "scale": half,
+                      "extras": {"transgi_probe_volume": True}})
+        scene["nodes"].append(len(nodes) - 1)
 
     out = os.path.join(args.out_dir, "scene.gltf")
     tmp = out + ".tmp"

@@ -498,6 +498,16 @@ GltfLoadResult load_gltf(ecs::World& world, const fs::path& path, const GltfLoad
     if (parent >= 0) world.emplace<transform::Parent>(e, transform::Parent{entity_of[static_cast<std::size_t>(parent)]});
     world.emplace<Name>(e, Name{n.name.empty() ? nf : n.name});
     world.emplace<GltfNodeSource>(e, GltfNodeSource{static_cast<std::uint32_t>(ni), nt.local, nt.needs_bake});
+    if (n.extras.IsObject()) {
+      NodeMarkers markers;
+      for (const std::string& key : n.extras.Keys()) {
+        const tinygltf::Value& v = n.extras.Get(key);
+        const bool set = (v.IsBool() && v.Get<bool>()) || (v.IsNumber() && v.GetNumberAsDouble() != 0.0) || v.IsObject();
+        if (set) markers.keys.push_back(key);
+      }
+      markers.scale = nt.local.scale * nt.residual_scale;
+      if (!markers.keys.empty()) world.emplace<NodeMarkers>(e, std::move(markers));
+    }
 
     if (n.mesh >= 0) {
       if (static_cast<std::size_t>(n.mesh) >= model.meshes.size())

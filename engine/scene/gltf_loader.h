@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "engine/ecs/world.h"
@@ -44,6 +45,24 @@ struct GltfNodeSource {
   std::uint32_t node = 0;
   transform::Transform loaded;
   bool baked_scale = false;
+};
+
+// The markers a node's extras set: each top-level key of nodes[i].extras whose
+// value is true, a non-zero number, or a non-empty object (tinygltf drops
+// empty objects and nulls) -- e.g. "transgi_probe_volume": true -- for
+// modules to find their own (a probe volume, a spawn point). Only
+// nodes with at least one get it. `scale` is the node's whole scale,
+// non-uniform part included, which a Transform (a similarity) cannot hold:
+// a marker that stands for a box (a Blender empty cube) reads it as its half
+// extents.
+struct NodeMarkers {
+  std::vector<std::string> keys;
+  glm::vec3 scale{1.0f};
+  [[nodiscard]] bool has(std::string_view key) const {
+    for (const std::string& k : keys)
+      if (k == key) return true;
+    return false;
+  }
 };
 
 struct GltfLoadResult {

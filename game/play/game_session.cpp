@@ -19,6 +19,7 @@
 #include "level/level_save.h"
 #include "model/model_file.h"
 #include "play/fly_camera.h"
+#include "runtime/probe_placement.h"
 #include "runtime/transgi_plugin.h"
 
 namespace game {
@@ -70,7 +71,9 @@ GameSession::GameSession(const GameOptions& options) : options_(options), refere
   }
   app_->add_plugin<transgi::runtime::TransGIPlugin>(transgi::runtime::realtime_preset());
   if (model) transgi::runtime::attach_latent_meshes(world, model);
-  world.emplace<transgi::runtime::ProbeVolume>(world.spawn(), transgi::runtime::ProbeVolume{});
+  // Cascades around the camera; the sample level is small enough that they
+  // stand as one grid over it (CascadeSettings::fit_scene_cell).
+  transgi::runtime::spawn_probes(world, transgi::runtime::ProbePlacement{});
 
   engine::script::ScriptSettings script_settings;
   if (!manifest_path.empty()) {

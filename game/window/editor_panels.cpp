@@ -13,6 +13,7 @@
 #include "engine/transform/transform.h"
 #include "level/level_save.h"
 #include "runtime/components.h"
+#include "runtime/probe_placement.h"
 #include "runtime/settings.h"
 #include "window/editor_ui.h"
 
@@ -162,16 +163,13 @@ void EditorUi::gi_settings() {
   changed |= ImGui::Checkbox("edge-aware upsampling", &edit.realtime.edge_aware);
   changed |= ImGui::SliderInt("probe budget / frame", &edit.probes.update_budget, 0, 512);
   if (changed) *s = edit;
-  w.view<const transgi::runtime::ProbeVolume>().each([&](Entity e, const transgi::runtime::ProbeVolume& v) {
-    ImGui::PushID(static_cast<int>(e.index));
-    ImGui::Text("probe volume %u: %dx%dx%d probes", e.index, v.dims.x, v.dims.y, v.dims.z);
-    if (v.field) {
-      const auto& g = v.field->settings().grid;
-      ImGui::Text("bounds (%.2f %.2f %.2f) - (%.2f %.2f %.2f)", g.min.x, g.min.y, g.min.z, g.max.x, g.max.y, g.max.z);
-      ImGui::Text("state %.1f MB", static_cast<double>(v.field->memory_bytes()) / (1 << 20));
-    }
-    ImGui::PopID();
-  });
+  int index = 0;
+  for (const auto& field : transgi::runtime::probe_fields(w)) {
+    const auto& g = field->settings().grid;
+    ImGui::Text("probe field %d: %dx%dx%d probes, %.2f m apart", index++, g.dims.x, g.dims.y, g.dims.z, g.min_spacing());
+    ImGui::Text("  bounds (%.2f %.2f %.2f) - (%.2f %.2f %.2f)", g.min.x, g.min.y, g.min.z, g.max.x, g.max.y, g.max.z);
+    ImGui::Text("  state %.1f MB", static_cast<double>(field->memory_bytes()) / (1 << 20));
+  }
 }
 
 void EditorUi::save_level() {

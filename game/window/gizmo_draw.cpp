@@ -7,6 +7,7 @@
 #include "engine/scene/components.h"
 #include "engine/transform/transform.h"
 #include "runtime/components.h"
+#include "runtime/probe_placement.h"
 #include "shading/sh_light.h"
 #include "window/editor_ui.h"
 
@@ -107,9 +108,8 @@ void EditorUi::draw_probes(const ViewRect& rect) {
   ImDrawList* dl = ImGui::GetForegroundDrawList();
   const Projector project = projector(session_, rect);
   const glm::vec3 eye = project.view.camera.translation;
-  session_.world().view<const transgi::runtime::ProbeVolume>().each([&](engine::ecs::Entity, const transgi::runtime::ProbeVolume& v) {
-    if (!v.field) return;
-    const auto& grid = v.field->settings().grid;
+  for (const auto& field : transgi::runtime::probe_fields(session_.world())) {
+    const auto& grid = field->grid();
     // The volume's box.
     for (int e = 0; e < 12; ++e) {
       const int axis = e / 4, k = e % 4;
@@ -123,7 +123,7 @@ void EditorUi::draw_probes(const ViewRect& rect) {
     }
     // Each probe as a small sphere: discs shaded by the SH irradiance toward
     // the viewer and toward four sides, so a probe's light direction shows.
-    const std::vector<float>& sh = v.field->light_sh_all();
+    const std::vector<float>& sh = field->light_sh_all();
     const float radius_world = 0.06f;
     for (int i = 0; i < grid.count(); ++i) {
       const glm::vec3 p = grid.position(i);
@@ -144,7 +144,7 @@ void EditorUi::draw_probes(const ViewRect& rect) {
       for (int k = 0; k < 4; ++k)
         dl->AddCircleFilled(ImVec2(c->x + offs[k].x, c->y + offs[k].y), 0.4f * r, shade(glm::normalize(to_eye + dirs[k])), 12);
     }
-  });
+  }
 }
 
 }  // namespace game

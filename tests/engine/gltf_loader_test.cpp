@@ -367,3 +367,26 @@ TEST(GltfLoaderBadInput, MissingSceneFileAndDirectory) {
   ecs::World w;
   EXPECT_THROW(load_gltf(w, d.path), GltfError);
 }
+
+TEST(GltfLoader, NodeExtrasThatAreSetBecomeMarkersWithTheWholeScale) {
+  TempDir d;
+  json j = quad_gltf();
+  j["nodes"].push_back({{"name", "volume"}, {"translation", {1, 2, 3}}, {"scale", {2, 0.5, 4}},
+                        {"extras", {{"some_volume", true}, {"off", false}, {"zero", 0}, {"weight", 2.5}, {"object", {{"dims", 8}}}, {"text", "x"}}}});
+  j["scenes"][0]["nodes"].push_back(3);
+  ecs::World w;
+  const GltfLoadResult r = load_gltf(w, write_scene(d, j));
+  const ecs::Entity e = r.entities.back();
+  ASSERT_EQ(w.get<Name>(e).value, "volume");
+  const NodeMarkers* m = w.try_get<NodeMarkers>(e);
+  ASSERT_NE(m, nullptr);
+  EXPECT_TRUE(m->has("some_volume"));
+  EXPECT_TRUE(m->has("weight"));
+  EXPECT_TRUE(m->has("object"));
+  EXPECT_FALSE(m->has("off")) << "false is not set";
+  EXPECT_FALSE(m->has("zero")) << "0 is not set";
+  EXPECT_FALSE(m->has("text")) << "only true, non-zero numbers and objects mark";
+  EXPECT_EQ(m->scale, glm::vec3(2.0f, 0.5f, 4.0f)) << "the non-uniform scale a Transform cannot hold";
+  // Nodes without extras get none.
+  EXPECT_EQ(w.try_get<NodeMarkers>(r.entities.front()), nullptr);
+}

@@ -13,8 +13,11 @@
 #include "engine/app/app.h"
 #include "engine/math/rng.h"
 #include "engine/render/light_plugin.h"
+#include "engine/rt/rt_scene.h"
 #include "engine/scene/procedural.h"
 #include "probes/cascades.h"
+#include "engine/scene/gltf_loader.h"
+#include "runtime/probe_placement.h"
 #include "runtime/transgi_plugin.h"
 
 using namespace transgi;
@@ -201,6 +204,7 @@ TEST(CascadeScroll, ACameraCrossingCellsNeverGivesABlackOrNonFinitePixel) {
   cs.count = 3;
   cs.finest_cell = 0.5f;
   cs.dims = glm::ivec3(6);
+  cs.fit_scene_cell = 0.0f;  // always cascades, small as the room is
   Room room(cs);
   auto& frame = room.frame();
   frame.width = 48;
@@ -231,6 +235,7 @@ TEST(CascadeScroll, ProbesThatStayKeepTheirLightAndEnteredOnesAreSeededFromTheCo
   CascadeSettings cs;
   cs.count = 2;
   cs.dims = glm::ivec3(6);
+  cs.fit_scene_cell = 0.0f;
   Room room(cs);
   for (int f = 0; f < 24; ++f) room.app.jobs().run([&] { room.app.update(); });
   runtime::ProbeCascades* set = nullptr;
@@ -259,4 +264,63 @@ TEST(CascadeScroll, ProbesThatStayKeepTheirLightAndEnteredOnesAreSeededFromTheCo
   }
   EXPECT_EQ(kept, 5 * 6 * 4);
   EXPECT_GT(seeded, 0) << "no entered probe got light from the coarser cascade";
+}
+
+TEST(CascadeFit, ASmallSceneGetsOneGridOverItsBoundsAndABigOneGetsCascades) {
+  for (const float fit : {2.5f, 1.0f}) {
+    CascadeSettings cs;
+    cs.dims = glm::ivec3(6);
+    cs.fit_scene_cell = fit;  // the room is 12 m: 2 m cells over its bounds
+    Room room(cs);
+    room.app.jobs().run([&] { room.app.update(); });
+    const runtime::ProbeCascades* set = nullptr;
+    room.app.world().view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& c) { set = &c; });
+    ASSERT_NE(set, nullptr);
+    const auto& rt = room.app.world().resource<rt::RtScene>();
+    if (fit >= 2.0f) {
+      ASSERT_EQ(set->fields.size(), 1u) << "fit_scene_cell " << fit;
+      EXPECT_TRUE(set->fitted_to_scene);
+      const ProbeGrid expect = ProbeGrid::centred_in(rt.bounds_min(), rt.bounds_max(), cs.dims);
+      EXPECT_EQ(set->fields[0]->settings().grid, expect);
+    } else {
+      EXPECT_EQ(set->fields.size(), static_cast<std::size_t>(cs.count)) << "fit_scene_cell " << fit;
+      EXPECT_FALSE(set->fitted_to_scene);
+    }
+  }
+}
+
+TEST(AuthoredVolumes, AMarkedNodeGetsAVolumeOverItsRotatedBoxAndAFlatOneIsRefusedByName) {
+  ecs::World w;
+  const ecs::Entity e = w.spawn();
+  transform::Transform t = transform::Transform::from_translation({1.0f, 2.0f, 3.0f});
+  t.rotation = glm::angleAxis(glm::radians(90.0f), glm::vec3(0, 1, 0));  // swaps x and z extents
+  w.emplace<transform::Transform>(e, t);
+  w.emplace<scene::Name>(e, scene::Name{"Room"});
+  w.emplace<scene::NodeMarkers>(e, scene::NodeMarkers{{std::string(runtime::kProbeVolumeMarker)}, {6.0f, 1.5f, 3.0f}});
+  const ecs::Entity other = w.spawn();  // marked for something else
+  w.emplace<transform::Transform>(other);
+  w.emplace<scene::NodeMarkers>(other, scene::NodeMarkers{{"spawn_point"}, glm::vec3(1.0f)});
+  ASSERT_EQ(runtime::attach_authored_volumes(w, 8), 1u);
+  const auto& v = w.get<runtime::ProbeVolume>(e);
+  EXPECT_NEAR(v.min.x, 1.0f - 3.0f, 1e-5f);
+  EXPECT_NEAR(v.max.x, 1.0f + 3.0f, 1e-5f);
+  EXPECT_NEAR(v.min.y, 2.0f - 1.5f, 1e-5f);
+  EXPECT_NEAR(v.min.z, 3.0f - 6.0f, 1e-5f);
+  EXPECT_NEAR(v.max.z, 3.0f + 6.0f, 1e-5f);
+  // 8 cells on the longest axis (z, 12 m), proportionally fewer on the others.
+  EXPECT_EQ(v.dims, glm::ivec3(4, 2, 8));
+  EXPECT_EQ(w.try_get<runtime::ProbeVolume>(other), nullptr);
+
+  ecs::World flat;
+  const ecs::Entity f = flat.spawn();
+  flat.emplace<transform::Transform>(f);
+  flat.emplace<scene::Name>(f, scene::Name{"Floor volume"});
+  flat.emplace<scene::NodeMarkers>(f, scene::NodeMarkers{{std::string(runtime::kProbeVolumeMarker)}, {4.0f, 0.0f, 4.0f}});
+  try {
+    runtime::attach_authored_volumes(flat);
+    ADD_FAILURE() << "a flat volume was accepted";
+  } catch (const std::exception& ex) {
+    EXPECT_NE(std::string(ex.what()).find("Floor volume"), std::string::npos) << ex.what();
+    EXPECT_NE(std::string(ex.what()).find("flat"), std::string::npos) << ex.what();
+  }
 }

@@ -76,7 +76,7 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   const Args args("bench-frame", argv,
                   {"scene", "model", "width", "height", "frames", "warmup", "preset", "csv", "object", "threads", "camera",
                    "direct-spp", "gi-scale", "probe-budget", "direct", "gi-out", "reference-out", "reference-spp", "map-width",
-                   "probe-volume", "probe-grid", "cascades", "cascade-cell", "cascade-look-ahead"},
+                   "probe-volume", "probe-grid", "cascades", "cascade-cell", "cascade-look-ahead", "cascade-fit-scene"},
                   {"allow-unbaked"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const int width = static_cast<int>(args.integer("width", 16, 8192, 640));
@@ -95,7 +95,7 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   settings.direct_spp = static_cast<int>(args.integer("direct-spp", 0, 100000, settings.direct_spp));
   scene.app->add_plugin<runtime::TransGIPlugin>(settings);
   runtime::attach_latent_meshes(world, std::make_shared<const model::TransferModel>(std::move(model)));
-  const runtime::ProbePlacement placement = probe_placement_from(args, runtime::ProbeVolumeMode::Scene);
+  const runtime::ProbePlacement placement = probe_placement_from(args, runtime::ProbeVolumeMode::Cascades);
   runtime::spawn_probes(world, placement);
 
   const ecs::Entity mover = pick_moving_object(world, args.str("object", std::string()));
@@ -160,12 +160,16 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   std::printf("last frame: %zu pixels decoded (%zu grid, %zu edge), %zu rotations, %d probes traced\n",
               frame.realtime.grid_samples + frame.realtime.edge_samples, frame.realtime.grid_samples,
               frame.realtime.edge_samples, frame.realtime.rotations, frame.probe_stats.traced);
-  for (std::size_t k = 0; k < frame.cascade_stats.size(); ++k) {
-    const probes::ProbeFrameStats& c = frame.cascade_stats[k];
-    std::printf("cascade %zu (%.2f m cells): %d traced, %d active, %d converged, %d buried, %d far\n", k,
-                static_cast<double>(probes::cascade_cell(placement.cascades, static_cast<int>(k))), c.traced, c.active,
-                c.converged, c.buried, c.far);
-  }
+  world.view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& set) {
+    if (set.fitted_to_scene) std::printf("cascades: the scene is small enough for one grid over its bounds (--cascade-fit-scene)\n");
+    for (std::size_t k = 0; k < set.fields.size() && k < frame.cascade_stats.size(); ++k) {
+      const probes::ProbeFrameStats& c = frame.cascade_stats[k];
+      const glm::vec3 cell = set.fields[k]->grid().spacing();
+      std::printf("cascade %zu (%.2f x %.2f x %.2f m cells): %d traced, %d active, %d converged, %d buried, %d far\n", k,
+                  static_cast<double>(cell.x), static_cast<double>(cell.y), static_cast<double>(cell.z), c.traced, c.active,
+                  c.converged, c.buried, c.far);
+    }
+  });
   if (!csv.empty()) std::printf("per-frame CSV: %s\n", csv.c_str());
   std::printf("direct light, last frame: %zu shadow rays to %zu punctual lights\n", frame.direct_stats.shadow_rays,
               frame.direct_stats.lights);

@@ -40,7 +40,7 @@ int run_eval(const std::vector<std::string>& argv) {
   const Args args("eval", argv,
                   {"scene", "model", "out", "width", "height", "spp", "frames", "ddgi-frames", "ddgi-warmup", "probe-grid",
                    "gbuffer-spp", "camera", "threads", "cache", "seed", "reference-error", "temporal", "probe-volume", "cascades",
-                   "cascade-cell", "cascade-look-ahead"},
+                   "cascade-cell", "cascade-look-ahead", "cascade-fit-scene"},
                   {"decompose", "allow-unbaked"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const std::filesystem::path out = args.str("out");
@@ -55,7 +55,7 @@ int run_eval(const std::vector<std::string>& argv) {
 
   eval::TransgiRunOptions t;
   t.frames = static_cast<int>(args.integer("frames", 1, 100000, 160));
-  t.placement = probe_placement_from(args, runtime::ProbeVolumeMode::Scene);
+  t.placement = probe_placement_from(args, runtime::ProbeVolumeMode::Cascades);
   t.settings.gbuffer_spp = static_cast<int>(args.integer("gbuffer-spp", 1, 64, 1));
   t.settings.direct_spp = 0;  // both setups take direct light from the reference
   t.settings.seed = seed;

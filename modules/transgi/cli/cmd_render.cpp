@@ -128,7 +128,7 @@ int render_transgi(const Args& args, eval::LoadedScene& scene, int width, int he
                                        : transgi::probes::SharingMode::DepthGuard;
   t.frames = static_cast<int>(args.integer("frames", 1, 100000, 32));
   t.timing_frames = static_cast<int>(args.integer("timing-frames", 1, 1000, 3));
-  t.placement = probe_placement_from(args, runtime::ProbeVolumeMode::Scene);
+  t.placement = probe_placement_from(args, runtime::ProbeVolumeMode::Cascades);
   t.no_latent = split_names(args.str("no-latent", std::string()));
   const auto shared = std::make_shared<const transgi::model::TransferModel>(std::move(model));
   const eval::MethodRun r = eval::run_transgi(scene, shared, width, height, t);
@@ -197,7 +197,7 @@ int run_render(const std::vector<std::string>& argv) {
                   {"scene", "method", "pass", "spp", "width", "height", "out", "camera", "seed", "threads", "png", "exposure",
                    "model", "transfer", "gt-rays", "coefficient-maps", "lighting", "frames", "probe-grid", "probe-rays",
                    "direct-spp", "probe-skip", "sharing", "no-latent", "timing-frames", "map-width", "hysteresis", "irradiance-gamma", "warmup-frames", "brightness-threshold", "preset", "gi-scale", "probe-budget", "direct",
-                   "probe-volume", "cascades", "cascade-cell", "cascade-look-ahead"},
+                   "probe-volume", "cascades", "cascade-cell", "cascade-look-ahead", "cascade-fit-scene"},
                   {"allow-unbaked"});
   const std::string scene_path = args.str("scene");
   const std::string method = args.choice("method", {"reference", "transgi", "ddgi"}, "reference");

@@ -23,11 +23,14 @@ runtime::TransGISettings runtime_settings_from(const Args& args, const char* def
 
 runtime::ProbePlacement probe_placement_from(const Args& args, runtime::ProbeVolumeMode default_mode) {
   runtime::ProbePlacement p;
-  const std::string mode = args.choice("probe-volume", {"cascades", "scene"}, std::string(runtime::name_of(default_mode)));
-  p.mode = mode == "cascades" ? runtime::ProbeVolumeMode::Cascades : runtime::ProbeVolumeMode::Scene;
+  const std::string mode = args.choice("probe-volume", {"cascades", "scene", "authored"}, std::string(runtime::name_of(default_mode)));
+  p.mode = mode == "cascades" ? runtime::ProbeVolumeMode::Cascades
+           : mode == "scene"  ? runtime::ProbeVolumeMode::Scene
+                              : runtime::ProbeVolumeMode::Authored;
   p.scene_dims = glm::ivec3(static_cast<int>(args.integer("probe-grid", 1, 64, 8)));
   p.cascades.count = static_cast<int>(args.integer("cascades", 1, 8, p.cascades.count));
   p.cascades.finest_cell = static_cast<float>(args.number("cascade-cell", 0.01, 100.0, p.cascades.finest_cell));
+  p.cascades.fit_scene_cell = static_cast<float>(args.number("cascade-fit-scene", 0.0, 1e6, p.cascades.fit_scene_cell));
   p.cascades.look_ahead = static_cast<float>(args.number("cascade-look-ahead", 0.0, 1.0, p.cascades.look_ahead));
   return p;
 }

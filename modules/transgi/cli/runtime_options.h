@@ -9,7 +9,7 @@ namespace transgi::cli {
 
 runtime::TransGISettings runtime_settings_from(const Args& args, const char* default_preset);
 
-// --probe-volume cascades|scene, --probe-grid N (scene), --cascades N,
+// --probe-volume cascades|scene|authored, --probe-grid N (scene), --cascades N,
 // --cascade-cell METRES (cascades; --probe-budget, read by
 // runtime_settings_from, is the finest cascade's budget, halved per cascade).
 runtime::ProbePlacement probe_placement_from(const Args& args, runtime::ProbeVolumeMode default_mode);

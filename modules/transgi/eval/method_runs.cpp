@@ -141,6 +141,8 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
   char line[256];
   if (o.placement.mode == runtime::ProbeVolumeMode::Scene)
     std::snprintf(line, sizeof(line), "%d^3 probes over the scene's bounds", o.placement.scene_dims.x);
+  else if (o.placement.mode == runtime::ProbeVolumeMode::Authored)
+    std::snprintf(line, sizeof(line), "the scene's authored probe volumes");
   else
     std::snprintf(line, sizeof(line), "%d cascades of %dx%dx%d probes, %.2f m finest cells", o.placement.cascades.count,
                   o.placement.cascades.dims.x, o.placement.cascades.dims.y, o.placement.cascades.dims.z,

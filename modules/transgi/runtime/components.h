@@ -48,6 +48,9 @@ struct ProbeCascades {
 
   std::vector<std::shared_ptr<probes::ProbeField>> fields{};  // written by the plugin only
   std::vector<glm::ivec3> origins{};                          // each field's cascade_origin, plugin only
+  // The scene was small enough (cascades.fit_scene_cell) that `fields` is
+  // one grid fitted to its bounds, as a scene-fitted ProbeVolume; plugin only.
+  bool fitted_to_scene = false;
 };
 
 }  // namespace transgi::runtime

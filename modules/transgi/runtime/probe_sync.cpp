@@ -84,6 +84,27 @@ void sync_probe_cascades(View<Get<const scene::Camera, const transform::WorldTra
   int entered = 0;
   sets.each([&](ProbeCascades& set) {
     const probes::CascadeSettings& c = set.cascades;
+    // A small scene: one grid over its bounds, decided and fitted once (as
+    // sync_probe_volumes does), so a later move does not reset every probe.
+    const glm::vec3 extent = rt->bounds_max() - rt->bounds_min();
+    const float cell = std::max({extent.x, extent.y, extent.z}) / static_cast<float>(std::max({c.dims.x, c.dims.y, c.dims.z, 1}));
+    if (set.fields.empty() && c.fit_scene_cell > 0 && std::isfinite(cell) && cell <= c.fit_scene_cell) {
+      probes::ProbeFieldSettings wanted = settings->probes;
+      wanted.grid = probes::ProbeGrid::centred_in(rt->bounds_min(), rt->bounds_max(), c.dims);
+      wanted.blend_cells = c.blend_cells;
+      set.fields = {std::make_shared<probes::ProbeField>(wanted)};
+      set.origins = {glm::ivec3(0)};
+      set.fitted_to_scene = true;
+      return;
+    }
+    if (set.fitted_to_scene) {
+      probes::ProbeFieldSettings wanted = settings->probes;
+      wanted.grid = set.fields[0]->settings().grid;
+      wanted.blend_cells = c.blend_cells;
+      if (!(wanted == set.fields[0]->settings())) set.fields[0] = std::make_shared<probes::ProbeField>(wanted);
+      else tell(*set.fields[0], changes);
+      return;
+    }
     const int n = std::max(1, c.count);
     set.fields.resize(static_cast<std::size_t>(n));
     set.origins.resize(static_cast<std::size_t>(n));
