@@ -241,8 +241,8 @@ TEST(CascadeScroll, ProbesThatStayKeepTheirLightAndEnteredOnesAreSeededFromTheCo
   runtime::ProbeCascades* set = nullptr;
   room.app.world().view<runtime::ProbeCascades>().each([&](runtime::ProbeCascades& c) { set = &c; });
   ASSERT_NE(set, nullptr);
-  ProbeField& fine = *set->fields[0];
-  const ProbeField& coarse = *set->fields[1];
+  ProbeField& fine = *set->state.fields[0];
+  const ProbeField& coarse = *set->state.fields[1];
   std::vector<float> before(fine.light_sh_all());
   const ProbeGrid grid_before = fine.grid();
   const glm::ivec3 cells{1, 0, -2};
@@ -278,13 +278,13 @@ TEST(CascadeFit, ASmallSceneGetsOneGridOverItsBoundsAndABigOneGetsCascades) {
     ASSERT_NE(set, nullptr);
     const auto& rt = room.app.world().resource<rt::RtScene>();
     if (fit >= 2.0f) {
-      ASSERT_EQ(set->fields.size(), 1u) << "fit_scene_cell " << fit;
-      EXPECT_TRUE(set->fitted_to_scene);
+      ASSERT_EQ(set->state.fields.size(), 1u) << "fit_scene_cell " << fit;
+      EXPECT_TRUE(set->state.fitted_to_scene);
       const ProbeGrid expect = ProbeGrid::centred_in(rt.bounds_min(), rt.bounds_max(), cs.dims);
-      EXPECT_EQ(set->fields[0]->settings().grid, expect);
+      EXPECT_EQ(set->state.fields[0]->settings().grid, expect);
     } else {
-      EXPECT_EQ(set->fields.size(), static_cast<std::size_t>(cs.count)) << "fit_scene_cell " << fit;
-      EXPECT_FALSE(set->fitted_to_scene);
+      EXPECT_EQ(set->state.fields.size(), static_cast<std::size_t>(cs.count)) << "fit_scene_cell " << fit;
+      EXPECT_FALSE(set->state.fitted_to_scene);
     }
   }
 }

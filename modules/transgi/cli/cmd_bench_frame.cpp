@@ -161,10 +161,10 @@ int run_bench_frame(const std::vector<std::string>& argv) {
               frame.realtime.grid_samples + frame.realtime.edge_samples, frame.realtime.grid_samples,
               frame.realtime.edge_samples, frame.realtime.rotations, frame.probe_stats.traced);
   world.view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& set) {
-    if (set.fitted_to_scene) std::printf("cascades: the scene is small enough for one grid over its bounds (--cascade-fit-scene)\n");
-    for (std::size_t k = 0; k < set.fields.size() && k < frame.cascade_stats.size(); ++k) {
+    if (set.state.fitted_to_scene) std::printf("cascades: the scene is small enough for one grid over its bounds (--cascade-fit-scene)\n");
+    for (std::size_t k = 0; k < set.state.fields.size() && k < frame.cascade_stats.size(); ++k) {
       const probes::ProbeFrameStats& c = frame.cascade_stats[k];
-      const glm::vec3 cell = set.fields[k]->grid().spacing();
+      const glm::vec3 cell = set.state.fields[k]->grid().spacing();
       std::printf("cascade %zu (%.2f x %.2f x %.2f m cells): %d traced, %d active, %d converged, %d buried, %d far\n", k,
                   static_cast<double>(cell.x), static_cast<double>(cell.y), static_cast<double>(cell.z), c.traced, c.active,
                   c.converged, c.buried, c.far);

@@ -134,7 +134,7 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
     if (v.field) r.probe_bytes += v.field->memory_bytes();
   });
   world.view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& c) {
-    for (const auto& f : c.fields)
+    for (const auto& f : c.state.fields)
       if (f) r.probe_bytes += f->memory_bytes();
   });
   const auto& st = frame.probe_stats;

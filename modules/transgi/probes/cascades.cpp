@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "probes/cascade_follow.h"
 #include "probes/probe_field.h"
 
 namespace transgi::probes {
@@ -26,6 +27,21 @@ ProbeGrid cascade_grid(const CascadeSettings& s, int k, const glm::ivec3& origin
   g.min = (glm::vec3(origin) + 0.5f) * cell;
   g.max = g.min + glm::vec3(g.dims - 1) * cell;
   return g;
+}
+
+CascadeViewer CascadeViewer::sanitised() const {
+  CascadeViewer v = *this;
+  if (!std::isfinite(v.eye.x) || !std::isfinite(v.eye.y) || !std::isfinite(v.eye.z)) v.eye = glm::vec3(0.0f);
+  v.eye = glm::clamp(v.eye, glm::vec3(-1e6f), glm::vec3(1e6f));
+  const float len2 = glm::dot(v.forward, v.forward);
+  v.forward = len2 > 0.5f && len2 < 2.0f ? v.forward / std::sqrt(len2) : glm::vec3(0.0f);
+  return v;
+}
+
+bool fits_one_grid(const CascadeSettings& c, const glm::vec3& lo, const glm::vec3& hi) {
+  const glm::vec3 extent = hi - lo;
+  const float cell = std::max({extent.x, extent.y, extent.z}) / static_cast<float>(std::max({c.dims.x, c.dims.y, c.dims.z, 1}));
+  return c.fit_scene_cell > 0 && std::isfinite(cell) && cell <= c.fit_scene_cell;
 }
 
 namespace {

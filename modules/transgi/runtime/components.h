@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "model/transfer_model.h"
-#include "probes/cascades.h"
+#include "probes/cascade_follow.h"
 #include "probes/probe_field.h"
 
 namespace transgi::runtime {
@@ -40,17 +40,14 @@ struct ProbeVolume {
 // Probes where the viewer is (probes/cascades.h): `cascades.count` grids of
 // the same dims around the camera (GiFrame::camera, else the first camera),
 // each twice the extent of the one before. They scroll by whole cells as the
-// camera moves; the plugin owns `fields` (finest first) and rebuilds them
+// camera moves; the plugin owns `state.fields` (finest first) and rebuilds them
 // when the settings change. A ProbeVolume with explicit bounds takes
 // precedence over them inside it.
 struct ProbeCascades {
   probes::CascadeSettings cascades;
 
-  std::vector<std::shared_ptr<probes::ProbeField>> fields{};  // written by the plugin only
-  std::vector<glm::ivec3> origins{};                          // each field's cascade_origin, plugin only
-  // The scene was small enough (cascades.fit_scene_cell) that `fields` is
-  // one grid fitted to its bounds, as a scene-fitted ProbeVolume; plugin only.
-  bool fitted_to_scene = false;
+  // Written by the plugin only: the fields, finest first (probes/cascade_follow.h).
+  probes::CascadeState<probes::ProbeField> state{};
 };
 
 }  // namespace transgi::runtime

@@ -63,7 +63,7 @@ std::vector<std::shared_ptr<const probes::ProbeField>> probe_fields(engine::ecs:
     if (v.field) out.push_back(v.field);
   });
   world.view<const ProbeCascades>().each([&](const ProbeCascades& c) {
-    for (const auto& f : c.fields)
+    for (const auto& f : c.state.fields)
       if (f) out.push_back(f);
   });
   return out;

@@ -46,11 +46,11 @@ void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> casc
   });
   frame->cascade_stats.clear();
   cascades.each([&](ProbeCascades& set) {
-    for (std::size_t k = 0; k < set.fields.size(); ++k) {
+    for (std::size_t k = 0; k < set.state.fields.size(); ++k) {
       // Hits beyond a cascade are lit by the next coarser one.
-      const probes::ProbeField* outer = k + 1 < set.fields.size() ? set.fields[k + 1].get() : nullptr;
-      if (!set.fields[k]) continue;
-      const probes::ProbeFrameStats st = set.fields[k]->update(*rt, lights->set, outer);
+      const probes::ProbeField* outer = k + 1 < set.state.fields.size() ? set.state.fields[k + 1].get() : nullptr;
+      if (!set.state.fields[k]) continue;
+      const probes::ProbeFrameStats st = set.state.fields[k]->update(*rt, lights->set, outer);
       if (frame->cascade_stats.size() <= k) frame->cascade_stats.resize(k + 1);
       frame->cascade_stats[k] += st;
       total += st;
@@ -153,7 +153,7 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
     if (v.field) fields.push_back(v.field.get());
   });
   cascades.each([&](const ProbeCascades& set) {
-    for (const auto& f : set.fields)
+    for (const auto& f : set.state.fields)
       if (f) fields.push_back(f.get());
   });
 

@@ -1,0 +1,91 @@
+#pragma once
+// The one implementation of cascades following the camera, shared by both
+// probe plugins (TransGI's ProbeField, DDGI's DdgiVolume): a plugin keeps a
+// CascadeState per cascade set and calls follow_camera each frame with how to
+// make, compare and scroll its own field type.
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "probes/cascades.h"
+
+namespace transgi::probes {
+
+template <class Field>
+struct CascadeState {
+  std::vector<std::shared_ptr<Field>> fields{};  // finest first
+  std::vector<glm::ivec3> origins{};             // each field's cascade_origin
+  // The scene was small enough (CascadeSettings::fit_scene_cell) that
+  // `fields` is one grid fitted to its bounds, decided and fitted once.
+  bool fitted_to_scene = false;
+};
+
+// The viewer: eye position and unit forward (zero when unknown); a non-finite
+// eye becomes the origin and a far one is clamped, so cell indices fit an int.
+struct CascadeViewer {
+  glm::vec3 eye{0.0f}, forward{0.0f};
+  [[nodiscard]] CascadeViewer sanitised() const;
+};
+
+// Whether a scene with these bounds gets one fitted grid (fit_scene_cell).
+[[nodiscard]] bool fits_one_grid(const CascadeSettings& c, const glm::vec3& lo, const glm::vec3& hi);
+
+// After it, `state` holds one field per cascade placed on the viewer, or the
+// one fitted grid. Fields are made by make(grid, k) (k = -1 for the fitted
+// grid); a field for which same_but_place(field, grid, k) is false is made
+// anew; one whose origin moved is scrolled by scroll(field, cells, coarser),
+// coarsest first, so a finer cascade's entered probes are seeded from a
+// coarser one that has already moved; scroll returns how many probes
+// entered, and so does follow_camera, summed. kept(field) is called on each
+// field that was neither made nor rebuilt this frame (to tell it of scene
+// changes) and on every field with the viewer (to aim budgets).
+template <class Field, class Make, class SameButPlace, class Scroll, class Kept>
+int follow_camera(CascadeState<Field>& state, const CascadeSettings& c, const CascadeViewer& viewer, const glm::vec3& scene_lo,
+                  const glm::vec3& scene_hi, Make make, SameButPlace same_but_place, Scroll scroll, Kept kept) {
+  if (state.fields.empty() && fits_one_grid(c, scene_lo, scene_hi)) {
+    state.fields = {make(ProbeGrid::centred_in(scene_lo, scene_hi, c.dims), -1)};
+    state.origins = {glm::ivec3(0)};
+    state.fitted_to_scene = true;
+    return 0;
+  }
+  if (state.fitted_to_scene) {
+    auto& f = state.fields.front();
+    const ProbeGrid grid = f->settings().grid;
+    if (!same_but_place(*f, grid, -1))
+      f = make(grid, -1);
+    else
+      kept(*f, false);
+    return 0;
+  }
+  const CascadeViewer v = viewer.sanitised();
+  const int n = std::max(1, c.count);
+  state.fields.resize(static_cast<std::size_t>(n));
+  state.origins.resize(static_cast<std::size_t>(n));
+  int entered = 0;
+  for (int k = n - 1; k >= 0; --k) {
+    auto& field = state.fields[static_cast<std::size_t>(k)];
+    glm::ivec3& origin = state.origins[static_cast<std::size_t>(k)];
+    const glm::ivec3 wanted_origin = cascade_origin(c, k, v.eye, v.forward);
+    const ProbeGrid wanted = cascade_grid(c, k, wanted_origin);
+    if (field) {
+      // Equal but for where it stands: scroll it; anything else: rebuild.
+      const ProbeGrid& now = field->settings().grid;
+      if (!same_but_place(*field, now, k) || now.dims != wanted.dims || now.spacing() != wanted.spacing()) field.reset();
+    }
+    if (!field) {
+      field = make(wanted, k);
+      origin = wanted_origin;
+    } else {
+      const Field* coarser = k + 1 < n ? state.fields[static_cast<std::size_t>(k + 1)].get() : nullptr;
+      entered += scroll(*field, wanted_origin - origin, coarser);
+      origin = wanted_origin;
+      kept(*field, true);
+    }
+  }
+  return entered;
+}
+
+}  // namespace transgi::probes
