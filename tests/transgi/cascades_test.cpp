@@ -10,6 +10,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "ddgi/ddgi_plugin.h"
 #include "engine/app/app.h"
 #include "engine/math/rng.h"
 #include "engine/render/light_plugin.h"
@@ -162,7 +163,7 @@ struct Room {
   app::App app{app::AppOptions{.jobs = {.threads = 2}}};
   ecs::Entity camera;
 
-  explicit Room(const CascadeSettings& cascades) {
+  explicit Room(const CascadeSettings& cascades, bool ddgi = false) {
     auto& w = app.world();
     scene::SceneAssets a;
     a.generation = scene::next_scene_generation();
@@ -170,11 +171,18 @@ struct Room {
                 std::make_shared<scene::MeshAsset>(scene::make_box(glm::vec3(0.6f), false, 1))};
     a.materials = {lambert(glm::vec3(0.6f)), lambert({0.8f, 0.4f, 0.2f})};
     w.insert_resource<scene::SceneAssets>(std::move(a));
-    runtime::TransGISettings s = runtime::realtime_preset();
-    s.probes.map = MapLayout{16, 8};
-    s.probes.update_budget = 64;
-    s.direct_spp = 0;
-    app.add_plugin<runtime::TransGIPlugin>(s);
+    if (ddgi) {
+      ddgi::DdgiSettings d;
+      d.rays_per_probe = 64;
+      d.warmup_frames = 16;
+      app.add_plugin<ddgi::DdgiPlugin>(d, ddgi::DdgiRenderOptions{.direct_spp = 0});
+    } else {
+      runtime::TransGISettings s = runtime::realtime_preset();
+      s.probes.map = MapLayout{16, 8};
+      s.probes.update_budget = 64;
+      s.direct_spp = 0;
+      app.add_plugin<runtime::TransGIPlugin>(s);
+    }
     const ecs::Entity room = w.spawn();
     w.emplace<transform::Transform>(room, transform::Transform::from_translation({0.0f, 2.0f, 0.0f}));
     w.emplace<scene::MeshInstance>(room, scene::MeshInstance{0});
@@ -187,7 +195,10 @@ struct Room {
     camera = w.spawn();
     w.emplace<transform::Transform>(camera, pose(0.0f));
     w.emplace<scene::Camera>(camera, scene::Camera{.yfov_radians = 1.0f});
-    w.emplace<runtime::ProbeCascades>(w.spawn(), runtime::ProbeCascades{.cascades = cascades});
+    if (ddgi)
+      w.emplace<ddgi::DdgiCascades>(w.spawn(), ddgi::DdgiCascades{.cascades = cascades});
+    else
+      w.emplace<runtime::ProbeCascades>(w.spawn(), runtime::ProbeCascades{.cascades = cascades});
   }
   static transform::Transform pose(float x) {
     transform::Transform t = transform::Transform::from_translation({x, 1.7f, 3.0f});
@@ -322,5 +333,48 @@ TEST(AuthoredVolumes, AMarkedNodeGetsAVolumeOverItsRotatedBoxAndAFlatOneIsRefuse
   } catch (const std::exception& ex) {
     EXPECT_NE(std::string(ex.what()).find("Floor volume"), std::string::npos) << ex.what();
     EXPECT_NE(std::string(ex.what()).find("flat"), std::string::npos) << ex.what();
+  }
+}
+
+TEST(DdgiCascades, TheSameScrollKeepsMapsSeedsTheEnteredAndNeverGivesABlackPixel) {
+  CascadeSettings cs;
+  cs.count = 2;
+  cs.dims = glm::ivec3(6);
+  cs.fit_scene_cell = 0.0f;
+  Room room(cs, /*ddgi=*/true);
+  auto& frame = room.app.world().resource<ddgi::DdgiFrame>();
+  frame.width = 48;
+  frame.height = 27;
+  for (int f = 0; f < 32; ++f) room.app.jobs().run([&] { room.app.update(); });
+  ddgi::DdgiCascades* set = nullptr;
+  room.app.world().view<ddgi::DdgiCascades>().each([&](ddgi::DdgiCascades& c) { set = &c; });
+  ASSERT_NE(set, nullptr);
+  ASSERT_EQ(set->state.fields.size(), 2u);
+  // Kept probes keep their maps; entered ones hold the coarser cascade's light.
+  ddgi::DdgiVolume& fine = *set->state.fields[0];
+  std::vector<std::vector<glm::vec3>> before;
+  for (int q = 0; q < fine.grid().count(); ++q) before.push_back(fine.irradiance_map(q).texels);
+  const glm::ivec3 cells{-1, 0, 1};
+  EXPECT_EQ(fine.scroll(cells, set->state.fields[1].get()), 6 * 6 * 6 - 5 * 6 * 5);
+  set->state.origins[0] += cells;  // as follow_camera would record it
+  int seeded = 0;
+  for (int q = 0; q < fine.grid().count(); ++q) {
+    if (!fine.grid().entered_by_scroll(q, cells)) {
+      ASSERT_EQ(fine.irradiance_map(q).texels, before[static_cast<std::size_t>(q)]) << "kept probe " << q;
+    } else {
+      float sum = 0;
+      for (const glm::vec3& t : fine.irradiance_map(q).texels) sum += t.r + t.g + t.b;
+      seeded += sum > 0;
+    }
+  }
+  EXPECT_GT(seeded, 0) << "no entered probe got the coarser cascade's light";
+  // Walk across cells: every pixel finite and lit.
+  for (int f = 0; f < 24; ++f) {
+    room.app.world().get_mut<transform::Transform>(room.camera) = Room::pose(0.15f * static_cast<float>(f + 1));
+    room.app.jobs().run([&] { room.app.update(); });
+    for (const glm::vec3& p : frame.gi.pixels) {
+      ASSERT_TRUE(std::isfinite(p.r) && std::isfinite(p.g) && std::isfinite(p.b)) << "frame " << f;
+      ASSERT_GT(p.r + p.g + p.b, 0.0f) << "black DDGI pixel at frame " << f;
+    }
   }
 }

@@ -47,7 +47,7 @@ TEST(ThickRoom, BothProbeMethodsMeanGiIsWithinTenPercentOfTheReference) {
 
   eval::DdgiRunOptions d;
   d.frames = 200;
-  d.probe_grid = 6;
+  d.placement.scene_dims = glm::ivec3(6);
   d.progress = false;
   d.settings.warmup_frames = 64;
   d.render.direct_spp = 0;

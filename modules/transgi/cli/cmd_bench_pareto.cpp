@@ -164,7 +164,7 @@ int run_bench_pareto(const std::vector<std::string>& argv) {
     eval::DdgiRunOptions d;
     d.frames = ddgi_frames;
     d.timing_frames = timing;
-    d.probe_grid = g;
+    d.placement.scene_dims = glm::ivec3(g);
     d.progress = false;
     d.settings.warmup_frames = static_cast<int>(args.integer("ddgi-warmup", 0, 100000, 64));
     d.settings.seed = seed + 1;

@@ -68,7 +68,7 @@ int run_eval(const std::vector<std::string>& argv) {
   eval::DdgiRunOptions d;
   d.frames = static_cast<int>(args.integer("ddgi-frames", 1, 100000, 200));
   d.settings.warmup_frames = static_cast<int>(args.integer("ddgi-warmup", 0, 100000, 64));
-  d.probe_grid = t.placement.scene_dims.x;
+  d.placement = t.placement;
   d.render.gbuffer_spp = t.settings.gbuffer_spp;
   d.render.direct_spp = 0;
   d.render.seed = seed;

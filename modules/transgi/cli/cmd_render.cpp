@@ -153,7 +153,7 @@ int render_ddgi(const Args& args, eval::LoadedScene& scene, int width, int heigh
   d.settings.irradiance_gamma = static_cast<float>(args.number("irradiance-gamma", 0.1, 20.0, d.settings.irradiance_gamma));
   d.frames = static_cast<int>(args.integer("frames", 1, 100000, 400));
   d.timing_frames = static_cast<int>(args.integer("timing-frames", 1, 1000, 3));
-  d.probe_grid = static_cast<int>(args.integer("probe-grid", 1, 64, 8));
+  d.placement = probe_placement_from(args, runtime::ProbeVolumeMode::Cascades);
   const eval::MethodRun r = eval::run_ddgi(scene, width, height, d);
   write_passes(o, r.full, r.direct, r.gi);
   std::printf("rendered %s (ddgi, %s pass) %dx%d at %d spp\n", o.out.c_str(), o.pass.c_str(), width, height, d.render.gbuffer_spp);

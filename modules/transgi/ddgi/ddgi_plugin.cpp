@@ -18,7 +18,10 @@ using namespace engine::schedule;
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
-void sync_volumes(View<Get<DdgiProbeVolume>> volumes, Res<rt::RtScene> rt, Res<DdgiSettings> settings) {
+using CameraView = View<Get<const scene::Camera, const transform::WorldTransform>>;
+
+void sync_volumes(View<Get<DdgiProbeVolume>> volumes, View<Get<DdgiCascades>> cascades, CameraView cameras,
+                  Res<rt::RtScene> rt, Res<DdgiSettings> settings, Res<DdgiFrame> frame) {
   volumes.each([&](DdgiProbeVolume& v) {
     if (v.fits_scene()) {
       v.min = rt->bounds_min();
@@ -27,6 +30,17 @@ void sync_volumes(View<Get<DdgiProbeVolume>> volumes, Res<rt::RtScene> rt, Res<D
     const probes::ProbeGrid grid = probes::ProbeGrid::centred_in(v.min, v.max, v.dims);
     if (!v.volume || !(v.volume->grid() == grid) || !(v.volume->settings() == *settings))
       v.volume = std::make_shared<DdgiVolume>(grid, *settings);
+  });
+  const probes::CascadeViewer viewer = probes::viewer_of(cameras, frame->camera, rt->bounds_min(), rt->bounds_max());
+  cascades.each([&](DdgiCascades& set) {
+    DdgiSettings s = *settings;
+    s.blend_cells = set.cascades.blend_cells;
+    probes::follow_camera(
+        set.state, set.cascades, viewer, rt->bounds_min(), rt->bounds_max(),
+        [&](const probes::ProbeGrid& grid, int) { return std::make_shared<DdgiVolume>(grid, s); },
+        [&](const DdgiVolume& v, const probes::ProbeGrid&, int) { return v.settings() == s; },
+        [&](DdgiVolume& v, glm::ivec3 cells, const DdgiVolume* coarser) { return v.scroll(cells, coarser); },
+        [&](DdgiVolume&, bool) {});
   });
 }
 
@@ -37,7 +51,7 @@ struct SkylessLights {
   render::LightSet set;
 };
 
-void update_volumes(View<Get<DdgiProbeVolume>> volumes, Res<rt::RtScene> rt, Res<render::SceneLights> lights,
+void update_volumes(View<Get<DdgiProbeVolume>> volumes, View<Get<DdgiCascades>> cascades, Res<rt::RtScene> rt, Res<render::SceneLights> lights,
                     Res<DdgiSettings> settings, ResMut<DdgiFrame> frame, Local<SkylessLights> skyless) {
   const render::LightSet* set = &lights->set;
   const scene::Environment* sky = lights->set.environment();
@@ -49,13 +63,19 @@ void update_volumes(View<Get<DdgiProbeVolume>> volumes, Res<rt::RtScene> rt, Res
     set = &skyless->set;
   }
   DdgiFrameStats total;
-  volumes.each([&](DdgiProbeVolume& v) {
-    if (!v.volume) return;
-    const DdgiFrameStats s = v.volume->update(*rt, *set, sky);
+  const auto add = [&](const DdgiFrameStats& s) {
     total.rays += s.rays;
     total.inactive += s.inactive;
     total.trace_ms += s.trace_ms;
     total.blend_ms += s.blend_ms;
+  };
+  volumes.each([&](DdgiProbeVolume& v) {
+    if (v.volume) add(v.volume->update(*rt, *set, sky));
+  });
+  cascades.each([&](DdgiCascades& c) {
+    const auto& fields = c.state.fields;
+    for (std::size_t k = 0; k < fields.size(); ++k)
+      if (fields[k]) add(fields[k]->update(*rt, *set, sky, k + 1 < fields.size() ? fields[k + 1].get() : nullptr));
   });
   frame->probe_stats = total;
   frame->times.probe_trace = total.trace_ms;
@@ -63,20 +83,25 @@ void update_volumes(View<Get<DdgiProbeVolume>> volumes, Res<rt::RtScene> rt, Res
   ++frame->frames;
 }
 
-void render_frame(View<Get<const scene::Camera, const transform::WorldTransform>> cameras, View<Get<const DdgiProbeVolume>> volumes,
+void render_frame(CameraView cameras, View<Get<const DdgiProbeVolume>> volumes, View<Get<const DdgiCascades>> cascades,
                   Res<rt::RtScene> rt, Res<render::SceneLights> lights, Res<DdgiRenderOptions> options, ResMut<DdgiFrame> frame,
                   Local<render::TemporalAccumulation> history) {
   if (frame->width <= 0 || frame->height <= 0) return;
   const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
   if (!rays) throw std::runtime_error("ddgi::render: DdgiFrame asks for an image but the world has no camera");
-  const DdgiVolume* volume = nullptr;
+  // Authored (and scene) volumes first, then cascades finest first.
+  std::vector<const DdgiVolume*> all;
   volumes.each([&](const DdgiProbeVolume& v) {
-    if (!volume && v.volume) volume = v.volume.get();
+    if (v.volume) all.push_back(v.volume.get());
   });
-  if (!volume) throw std::runtime_error("ddgi::render: no DdgiProbeVolume in the world");
+  cascades.each([&](const DdgiCascades& c) {
+    for (const auto& f : c.state.fields)
+      if (f) all.push_back(f.get());
+  });
+  if (all.empty()) throw std::runtime_error("ddgi::render: no DdgiProbeVolume or DdgiCascades in the world");
   const std::uint64_t seed = options->seed + frame->frames;
   auto t0 = Clock::now();
-  frame->gi = render::accumulate(*history, render_ddgi_gi(*rt, *volume, *rays, frame->width, frame->height, {.spp = options->gbuffer_spp, .seed = seed}),
+  frame->gi = render::accumulate(*history, render_ddgi_gi(*rt, all, *rays, frame->width, frame->height, {.spp = options->gbuffer_spp, .seed = seed}),
                                  render::view_key(rays->to_world(), frame->width, frame->height, lights->geometry_version, lights->version),
                                  options->temporal_window);
   frame->times.shading = ms_since(t0);

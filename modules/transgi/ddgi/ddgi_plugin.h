@@ -4,13 +4,15 @@
 // DdgiSettings resource, and a DdgiFrame with the images and stage times.
 //
 //  PrepareRender  ddgi::sync_volumes: each DdgiProbeVolume has a volume for the
-//                 current settings and bounds (fitted to the scene once).
+//                 current settings and bounds (fitted to the scene once), and
+//                 each DdgiCascades one per cascade on the camera (scrolled).
 //  Render         ddgi::update_volumes: rays traced, irradiance and distance blended.
 //                 ddgi::render: if DdgiFrame has a size, its gi / direct / full
 //                 images and stage times are this frame's.
 #include <memory>
 
 #include "ddgi/ddgi_volume.h"
+#include "probes/cascade_follow.h"
 #include "engine/app/app.h"
 #include "engine/image/image.h"
 
@@ -21,6 +23,14 @@ struct DdgiProbeVolume {
   glm::ivec3 dims{8};
   std::shared_ptr<DdgiVolume> volume = nullptr;  // written by the plugin only
   [[nodiscard]] bool fits_scene() const { return glm::any(glm::greaterThan(min, max)); }
+};
+
+// DDGI's probes where the viewer is: the same cascades as TransGI's
+// ProbeCascades (probes/cascade_follow.h), of DDGI volumes. A DdgiProbeVolume
+// with explicit bounds takes precedence inside it.
+struct DdgiCascades {
+  probes::CascadeSettings cascades;
+  probes::CascadeState<DdgiVolume> state{};  // written by the plugin only
 };
 
 struct DdgiRenderOptions {

@@ -4,10 +4,27 @@
 #include "engine/math/rng.h"
 #include "engine/math/sampling.h"
 #include "engine/render/surface.h"
+#include "probes/cascades.h"
 
 namespace transgi::ddgi {
 
-engine::image::ImageRGB render_ddgi_gi(const engine::rt::RtScene& scene, const DdgiVolume& volume,
+glm::vec3 irradiance_from(std::span<const DdgiVolume* const> volumes, const glm::vec3& p, const glm::vec3& n, const glm::vec3& v) {
+  const probes::FieldMixOf<DdgiVolume> m = probes::mix_at(volumes, p);
+  const DdgiVolume* first = m.field[0];
+  bool lit = false;
+  glm::vec3 e = first->irradiance(p, n, v, &lit);
+  while (!lit) {
+    first = probes::next_holding(volumes, first, p);
+    if (!first) return glm::vec3(0.0f);
+    e = first->irradiance(p, n, v, &lit);
+  }
+  if (m.count == 1 || first != m.field[0]) return e;
+  bool second_lit = false;
+  const glm::vec3 e2 = m.field[1]->irradiance(p, n, v, &second_lit);
+  return second_lit ? m.weight[0] * e + m.weight[1] * e2 : e;
+}
+
+engine::image::ImageRGB render_ddgi_gi(const engine::rt::RtScene& scene, std::span<const DdgiVolume* const> volumes,
                                        const engine::render::CameraRays& camera, int width, int height,
                                        const DdgiRenderSettings& s) {
   using namespace engine;
@@ -24,7 +41,7 @@ engine::image::ImageRGB render_ddgi_gi(const engine::rt::RtScene& scene, const D
           rt::Hit hit;
           if (!scene.intersect(ray, hit)) continue;
           const render::Surface surf = render::make_surface(scene, hit, ray.direction);
-          sum += material::diffuse_albedo(surf.brdf) * math::kInvPi * volume.irradiance(surf.position, surf.shading_normal, ray.direction);
+          sum += material::diffuse_albedo(surf.brdf) * math::kInvPi * irradiance_from(volumes, surf.position, surf.shading_normal, ray.direction);
         }
         img.pixels[pixel] = sum / static_cast<float>(s.spp);
       }

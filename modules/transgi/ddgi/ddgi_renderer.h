@@ -2,6 +2,8 @@
 // DDGI's indirect diffuse at every pixel: a filtered primary ray per sample
 // (as TransGI's G-buffer), then diffuse albedo / pi x the volume's irradiance
 // at the hit. Glossy indirect light is not DDGI's to give.
+#include <span>
+
 #include "ddgi/ddgi_volume.h"
 #include "engine/image/image.h"
 #include "engine/render/camera_rays.h"
@@ -14,7 +16,14 @@ struct DdgiRenderSettings {
   float filter_width = 1.5f;
 };
 
-engine::image::ImageRGB render_ddgi_gi(const engine::rt::RtScene& scene, const DdgiVolume& volume,
+// Irradiance from several volumes (authored ones, then cascades finest
+// first), blended as probes::mix_at says; a volume with no active probe
+// around the point hands it to the next one holding it. With one volume,
+// exactly its DdgiVolume::irradiance.
+glm::vec3 irradiance_from(std::span<const DdgiVolume* const> volumes, const glm::vec3& position, const glm::vec3& normal,
+                          const glm::vec3& view_dir);
+
+engine::image::ImageRGB render_ddgi_gi(const engine::rt::RtScene& scene, std::span<const DdgiVolume* const> volumes,
                                        const engine::render::CameraRays& camera, int width, int height,
                                        const DdgiRenderSettings& settings);
 

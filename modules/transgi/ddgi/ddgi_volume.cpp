@@ -123,8 +123,40 @@ std::size_t DdgiVolume::memory_bytes() const {
   return b;
 }
 
+int DdgiVolume::scroll(glm::ivec3 cells, const DdgiVolume* seed) {
+  if (cells == glm::ivec3(0)) return 0;
+  grid_.scroll_by(cells);
+  placed_.scroll_by(cells);
+  int entered = 0;
+  for (int q = 0; q < grid_.count(); ++q) {
+    if (!grid_.entered_by_scroll(q, cells)) continue;
+    ++entered;
+    const auto i = static_cast<std::size_t>(q);
+    if (!placed_.offsets.empty()) placed_.offsets[i] = glm::vec3(0.0f);
+    active_[i] = 1;
+    OctahedralMap<glm::vec3>& irr = irradiance_[i];
+    std::fill(irr.texels.begin(), irr.texels.end(), glm::vec3(0.0f));
+    if (seed) {
+      // What the coarser cascade says a surface here facing each texel's
+      // direction receives, stored as the maps store it.
+      const glm::vec3 p = grid_.grid_point(q);
+      for (int y = 0; y < irr.interior; ++y)
+        for (int x = 0; x < irr.interior; ++x) {
+          const glm::vec3 d = texel_direction(x, y, irr.interior);
+          const glm::vec3 e = seed->irradiance(p, d, -d) / engine::math::kTwoPi;
+          irr.at(x + 1, y + 1) = glm::pow(glm::max(e, glm::vec3(0.0f)), glm::vec3(1.0f / settings_.irradiance_gamma));
+        }
+      update_border(irr);
+    }
+    std::fill(distance_[i].texels.begin(), distance_[i].texels.end(), glm::vec2(0.0f));
+  }
+  // Entered probes may stand inside walls: classify again (per cascade).
+  if (settings_.classification) classified_ = false;
+  return entered;
+}
+
 DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
-                                  const engine::scene::Environment* sky) {
+                                  const engine::scene::Environment* sky, const DdgiVolume* outer) {
   using namespace engine;
   DdgiFrameStats stats;
   const int probes = grid_.count(), M = settings_.rays_per_probe;
@@ -148,6 +180,8 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
         const glm::vec3 dir = glm::normalize(rotation * directions_[static_cast<std::size_t>(i)]);
         const probes::ProbeRayHit h = probes::trace_probe_ray(
             scene, lights, origin, dir, rng, [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3& towards_probe) {
+              if (outer && (glm::any(glm::lessThan(p, grid_.min)) || glm::any(glm::greaterThan(p, grid_.max))))
+                return outer->irradiance(p, n, -towards_probe);
               return frame_ > 0 ? irradiance(p, n, -towards_probe) : glm::vec3(0.0f);
             });
         if (h.saw_light) saw_light[static_cast<std::size_t>(q)] = 1;
@@ -206,7 +240,8 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
   return stats;
 }
 
-glm::vec3 DdgiVolume::irradiance(const glm::vec3& position, const glm::vec3& n, const glm::vec3& view_dir) const {
+glm::vec3 DdgiVolume::irradiance(const glm::vec3& position, const glm::vec3& n, const glm::vec3& view_dir, bool* lit) const {
+  if (lit) *lit = false;
   const glm::vec3 bias = n * settings_.normal_bias - view_dir * settings_.view_bias;
   const glm::vec3 biased = position + bias;
   const glm::vec3 spacing = grid_.spacing();
@@ -256,6 +291,7 @@ glm::vec3 DdgiVolume::irradiance(const glm::vec3& position, const glm::vec3& n, 
     weights += w;
   }
   if (weights <= 0) return glm::vec3(0.0f);
+  if (lit) *lit = true;
   glm::vec3 e = sum / weights;
   return e * e * engine::math::kTwoPi;
 }

@@ -69,6 +69,11 @@ struct DdgiSettings {
   // smoother start, at the cost of slower convergence.
   int warmup_frames = 0;
   std::uint64_t seed = 1;
+  // Where several volumes hold a point (cascades, authored volumes;
+  // probes/cascades.h), the band inside this grid's faces across which it
+  // hands the point over to the next, in cells. Higher = smoother seams, at
+  // the cost of two lookups there. 0 = a hard edge.
+  float blend_cells = 0.0f;
 
   bool operator==(const DdgiSettings&) const = default;
 };
@@ -85,12 +90,25 @@ class DdgiVolume {
 
   // One update: trace, blend irradiance and distance, update borders.
   // `sky` is what escaped rays see with EscapedRays::Environment (may be null).
+  // `outer` (the next coarser cascade) lights hits outside this grid's box.
   DdgiFrameStats update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
-                        const engine::scene::Environment* sky = nullptr);
+                        const engine::scene::Environment* sky = nullptr, const DdgiVolume* outer = nullptr);
 
   // Irradiance at a surface point with unit normal n, seen along view_dir
   // (from the eye towards the point), as RTXGI's DDGIGetVolumeIrradiance.
-  [[nodiscard]] glm::vec3 irradiance(const glm::vec3& position, const glm::vec3& normal, const glm::vec3& view_dir) const;
+  // `lit`, if given, says whether any active probe weighed in (false: every
+  // probe around is inactive, and the result is zero).
+  [[nodiscard]] glm::vec3 irradiance(const glm::vec3& position, const glm::vec3& normal, const glm::vec3& view_dir,
+                                     bool* lit = nullptr) const;
+
+  // The grid moved by whole cells (a cascade following the camera): probes
+  // still inside keep their maps; the entered slab starts from `seed`'s
+  // irradiance at each texel direction (the next coarser cascade; null =
+  // black) with distances unknown, and the volume is classified again.
+  // Returns how many probes entered.
+  int scroll(glm::ivec3 cells, const DdgiVolume* seed);
+  // The grid as placed, before relocation (probes/cascade_follow.h).
+  [[nodiscard]] const probes::ProbeGrid& placement() const { return grid_; }
 
   [[nodiscard]] const probes::ProbeGrid& grid() const { return grid_; }
   // grid() with each probe where relocation moved it.

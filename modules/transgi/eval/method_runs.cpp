@@ -175,8 +175,17 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
 MethodRun run_ddgi(LoadedScene& scene, int width, int height, const DdgiRunOptions& o) {
   ecs::World& world = scene.app->world();
   scene.app->add_plugin<ddgi::DdgiPlugin>(o.settings, o.render);
-  const ecs::Entity volume = world.spawn();
-  world.emplace<ddgi::DdgiProbeVolume>(volume, ddgi::DdgiProbeVolume{.dims = glm::ivec3(o.probe_grid)});
+  // The same placement as TransGI's, so both compare on the same probes.
+  if (o.placement.mode != runtime::ProbeVolumeMode::Scene) {
+    const auto boxes = runtime::authored_boxes(world);
+    if (boxes.empty() && o.placement.mode == runtime::ProbeVolumeMode::Authored)
+      throw std::runtime_error("--probe-volume authored: the scene has no node whose extras." + std::string(runtime::kProbeVolumeMarker) + " is set");
+    for (const auto& b : boxes) world.emplace<ddgi::DdgiProbeVolume>(b.node, ddgi::DdgiProbeVolume{.min = b.min, .max = b.max, .dims = b.dims});
+  }
+  if (o.placement.mode == runtime::ProbeVolumeMode::Scene)
+    world.emplace<ddgi::DdgiProbeVolume>(world.spawn(), ddgi::DdgiProbeVolume{.dims = o.placement.scene_dims});
+  else if (o.placement.mode == runtime::ProbeVolumeMode::Cascades)
+    world.emplace<ddgi::DdgiCascades>(world.spawn(), ddgi::DdgiCascades{.cascades = o.placement.cascades});
   auto& frame = world.resource<ddgi::DdgiFrame>();
   frame.camera = scene.camera;
   const auto samples = run_frames(
@@ -189,13 +198,29 @@ MethodRun run_ddgi(LoadedScene& scene, int width, int height, const DdgiRunOptio
   r.full = frame.full;
   r.stages = medians({"probe update: trace and shade rays", "probe update: blend", "probe interpolation (render)", "direct light"}, samples);
   r.frame_ms = median_total(samples, 3);
+  int probes = 0;
   world.view<const ddgi::DdgiProbeVolume>().each([&](const ddgi::DdgiProbeVolume& v) {
     if (v.volume) r.probe_bytes += v.volume->memory_bytes();
+    if (v.volume) probes += v.volume->grid().count();
   });
-  char line[160];
-  std::snprintf(line, sizeof(line), "%d^3 probes, %d rays, %d updates, %d inactive", o.probe_grid, o.settings.rays_per_probe,
-                o.frames, frame.probe_stats.inactive);
+  int cascades = 0;
+  bool fitted = false;
+  world.view<const ddgi::DdgiCascades>().each([&](const ddgi::DdgiCascades& c) {
+    fitted = fitted || c.state.fitted_to_scene;
+    for (const auto& f : c.state.fields) {
+      r.probe_bytes += f->memory_bytes();
+      probes += f->grid().count();
+      ++cascades;
+    }
+  });
+  char line[200];
+  std::snprintf(line, sizeof(line), "%s: %d probes, %d rays, %d updates, %d inactive", runtime::name_of(o.placement.mode).data(),
+                probes, o.settings.rays_per_probe, o.frames, frame.probe_stats.inactive);
   r.probe_summary = line;
+  if (cascades > 0) {
+    std::snprintf(line, sizeof(line), fitted ? " (the scene fits one grid)" : " (%d cascades)", cascades);
+    r.probe_summary += line;
+  }
   return r;
 }
 

@@ -59,7 +59,8 @@ struct DdgiRunOptions {
   // updates to converge from black (tests/transgi/ddgi_test.cpp).
   int frames = 400;
   int timing_frames = 3;
-  int probe_grid = 8;
+  // Where the probes go, as for TransGI (scene_dims is the scene grid's).
+  runtime::ProbePlacement placement{.mode = runtime::ProbeVolumeMode::Scene};
   bool progress = true;
 };
 

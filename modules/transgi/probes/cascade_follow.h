@@ -2,7 +2,8 @@
 // The one implementation of cascades following the camera, shared by both
 // probe plugins (TransGI's ProbeField, DDGI's DdgiVolume): a plugin keeps a
 // CascadeState per cascade set and calls follow_camera each frame with how to
-// make, compare and scroll its own field type.
+// make, compare and scroll its own field type. A Field has placement(): its
+// grid as placed, before any probe relocation.
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -30,6 +31,23 @@ struct CascadeViewer {
   [[nodiscard]] CascadeViewer sanitised() const;
 };
 
+// Where the cascades centre: the requested camera (else the first one; with
+// none, the middle of [lo, hi]) and its view direction. `cameras` is an ECS
+// view of (const Camera, const WorldTransform).
+template <class CameraView, class Entity>
+CascadeViewer viewer_of(const CameraView& cameras, Entity requested, const glm::vec3& lo, const glm::vec3& hi) {
+  CascadeViewer v{0.5f * (lo + hi), glm::vec3(0.0f)};
+  bool found = false;
+  cameras.each([&](Entity e, const auto&, const auto& to_world) {
+    if (!found || e == requested) {
+      v.eye = to_world.translation;
+      v.forward = to_world.rotation * glm::vec3(0.0f, 0.0f, -1.0f);  // glTF cameras look down -z
+    }
+    found = true;
+  });
+  return v;
+}
+
 // Whether a scene with these bounds gets one fitted grid (fit_scene_cell).
 [[nodiscard]] bool fits_one_grid(const CascadeSettings& c, const glm::vec3& lo, const glm::vec3& hi);
 
@@ -53,7 +71,7 @@ int follow_camera(CascadeState<Field>& state, const CascadeSettings& c, const Ca
   }
   if (state.fitted_to_scene) {
     auto& f = state.fields.front();
-    const ProbeGrid grid = f->settings().grid;
+    const ProbeGrid grid = f->placement();
     if (!same_but_place(*f, grid, -1))
       f = make(grid, -1);
     else
@@ -72,7 +90,7 @@ int follow_camera(CascadeState<Field>& state, const CascadeSettings& c, const Ca
     const ProbeGrid wanted = cascade_grid(c, k, wanted_origin);
     if (field) {
       // Equal but for where it stands: scroll it; anything else: rebuild.
-      const ProbeGrid& now = field->settings().grid;
+      const ProbeGrid& now = field->placement();
       if (!same_but_place(*field, now, k) || now.dims != wanted.dims || now.spacing() != wanted.spacing()) field.reset();
     }
     if (!field) {

@@ -78,35 +78,6 @@ BoxMix blend_boxes(std::span<const BlendBox> boxes, const glm::vec3& p) {
   return m;
 }
 
-FieldMix fields_at(std::span<const ProbeField* const> fields, const glm::vec3& p) {
-  FieldMix m;
-  m.field[0] = fields.front();
-  if (fields.size() == 1) return m;  // the usual case, asked once per decoded pixel
-  std::array<BlendBox, 16> local{};
-  const std::size_t n = std::min(fields.size(), local.size());
-  for (std::size_t i = 0; i < n; ++i) {
-    const ProbeGrid& g = fields[i]->settings().grid;
-    local[i] = {g.min, g.max, fields[i]->settings().blend_cells * g.min_spacing()};
-  }
-  const BoxMix b = blend_boxes(std::span<const BlendBox>(local.data(), n), p);
-  m.count = b.count;
-  for (int k = 0; k < b.count; ++k) {
-    m.field[static_cast<std::size_t>(k)] = fields[static_cast<std::size_t>(b.box[static_cast<std::size_t>(k)])];
-    m.weight[static_cast<std::size_t>(k)] = b.weight[static_cast<std::size_t>(k)];
-  }
-  return m;
-}
-
-const ProbeField* next_field_holding(std::span<const ProbeField* const> fields, const ProbeField* after, const glm::vec3& p) {
-  std::size_t i = 0;
-  while (i < fields.size() && fields[i] != after) ++i;
-  for (++i; i < fields.size(); ++i) {
-    const ProbeGrid& g = fields[i]->settings().grid;
-    if (glm::all(glm::greaterThanEqual(p, g.min)) && glm::all(glm::lessThanEqual(p, g.max))) return fields[i];
-  }
-  return i > fields.size() || fields.back() == after ? nullptr : fields.back();
-}
-
 void interpolate_fields(std::span<const ProbeField* const> fields, const glm::vec3& p, const glm::vec3& n, float* out) {
   interpolate_fields_with(
       fields, p, n, [](const ProbeField* f) { return f->light_sh_all().data(); },

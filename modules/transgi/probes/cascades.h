@@ -86,19 +86,51 @@ struct BoxMix {
 };
 [[nodiscard]] BoxMix blend_boxes(std::span<const BlendBox> boxes, const glm::vec3& p);
 
-// The same over probe fields, each box its grid's extent and band
-// (ProbeFieldSettings::blend_cells x its smallest spacing). fields must not be
+// The same over probe fields of either plugin (ProbeField, DdgiVolume: a
+// Field has placement() and settings().blend_cells), each box its grid's
+// extent and band (blend_cells x its smallest spacing). fields must not be
 // empty; a single field takes everything, whatever p.
-struct FieldMix {
-  std::array<const ProbeField*, 2> field{};
+template <class Field>
+struct FieldMixOf {
+  std::array<const Field*, 2> field{};
   std::array<float, 2> weight{1.0f, 0.0f};
   int count = 1;
 };
-[[nodiscard]] FieldMix fields_at(std::span<const ProbeField* const> fields, const glm::vec3& p);
-// The first field after `after` in `fields` whose grid holds p, else the last
-// field, else null (after is the last).
-[[nodiscard]] const ProbeField* next_field_holding(std::span<const ProbeField* const> fields, const ProbeField* after,
-                                                   const glm::vec3& p);
+template <class Field>
+[[nodiscard]] FieldMixOf<Field> mix_at(std::span<const Field* const> fields, const glm::vec3& p) {
+  FieldMixOf<Field> m;
+  m.field[0] = fields.front();
+  if (fields.size() == 1) return m;  // the usual case, asked once per decoded pixel
+  std::array<BlendBox, 16> local{};
+  const std::size_t n = std::min(fields.size(), local.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const ProbeGrid& g = fields[i]->placement();
+    local[i] = {g.min, g.max, fields[i]->settings().blend_cells * g.min_spacing()};
+  }
+  const BoxMix b = blend_boxes(std::span<const BlendBox>(local.data(), n), p);
+  m.count = b.count;
+  for (std::size_t k = 0; k < static_cast<std::size_t>(b.count); ++k) {
+    m.field[k] = fields[static_cast<std::size_t>(b.box[k])];
+    m.weight[k] = b.weight[k];
+  }
+  return m;
+}
+// The first field after `after` whose grid holds p, else the last field,
+// else null (after is the last, or not in fields).
+template <class Field>
+[[nodiscard]] const Field* next_holding(std::span<const Field* const> fields, const Field* after, const glm::vec3& p) {
+  std::size_t i = 0;
+  while (i < fields.size() && fields[i] != after) ++i;
+  if (i + 1 >= fields.size()) return nullptr;
+  for (std::size_t j = i + 1; j < fields.size(); ++j) {
+    const ProbeGrid& g = fields[j]->placement();
+    if (glm::all(glm::greaterThanEqual(p, g.min)) && glm::all(glm::lessThanEqual(p, g.max))) return fields[j];
+  }
+  return fields.back();
+}
+
+using FieldMix = FieldMixOf<ProbeField>;
+[[nodiscard]] inline FieldMix fields_at(std::span<const ProbeField* const> fields, const glm::vec3& p) { return mix_at(fields, p); }
 
 // Interpolated SH light at a surface point from the fields, blended as
 // fields_at says. A field with no probe that holds light around p (all
@@ -116,7 +148,7 @@ void interpolate_fields_with(std::span<const ProbeField* const> fields, const gl
   const ProbeField* first = m.field[0];
   // An unlit field passes the point on; a lit one ends the search.
   while (!one(first, out, out_direct)) {
-    first = next_field_holding(fields, first, p);
+    first = next_holding(fields, first, p);
     if (!first) return;  // nothing lit anywhere: zero
   }
   if (m.count == 1 || first != m.field[0]) return;

@@ -215,6 +215,8 @@ class ProbeField {
   [[nodiscard]] glm::vec3 irradiance(const glm::vec3& position, const glm::vec3& normal) const;
 
   [[nodiscard]] const ProbeFieldSettings& settings() const { return settings_; }
+  // The grid as placed (settings().grid), before relocation (cascade_follow.h).
+  [[nodiscard]] const ProbeGrid& placement() const { return settings_.grid; }
   // settings().grid with each probe where relocation moved it.
   [[nodiscard]] const ProbeGrid& grid() const { return grid_; }
   [[nodiscard]] std::uint64_t frame() const { return frame_; }

@@ -24,9 +24,9 @@ std::string_view name_of(ProbeVolumeMode mode) {
   return "?";
 }
 
-std::size_t attach_authored_volumes(engine::ecs::World& world, int cells_along_longest) {
+std::vector<AuthoredBox> authored_boxes(engine::ecs::World& world, int cells_along_longest) {
   using engine::scene::NodeMarkers;
-  std::vector<std::pair<engine::ecs::Entity, ProbeVolume>> found;
+  std::vector<AuthoredBox> found;
   world.view<const NodeMarkers, const engine::transform::Transform>().each(
       [&](engine::ecs::Entity e, const NodeMarkers& m, const engine::transform::Transform& t) {
         if (!m.has(kProbeVolumeMarker)) return;
@@ -47,14 +47,17 @@ std::size_t attach_authored_volumes(engine::ecs::World& world, int cells_along_l
           throw std::runtime_error(who + ": its box is flat (scale " + std::to_string(m.scale.x) + ", " + std::to_string(m.scale.y) +
                                    ", " + std::to_string(m.scale.z) + "): give every axis a size");
         const float cell = 2.0f * std::max({half.x, half.y, half.z}) / static_cast<float>(std::max(1, cells_along_longest));
-        ProbeVolume v;
-        v.min = t.translation - half;
-        v.max = t.translation + half;
-        for (int a = 0; a < 3; ++a) v.dims[a] = std::clamp(static_cast<int>(std::lround(2.0f * half[a] / cell)), 2, 16);
-        found.emplace_back(e, v);
+        AuthoredBox box{e, t.translation - half, t.translation + half, glm::ivec3(2)};
+        for (int a = 0; a < 3; ++a) box.dims[a] = std::clamp(static_cast<int>(std::lround(2.0f * half[a] / cell)), 2, 16);
+        found.push_back(box);
       });
-  for (auto& [e, v] : found) world.emplace<ProbeVolume>(e, std::move(v));
-  return found.size();
+  return found;
+}
+
+std::size_t attach_authored_volumes(engine::ecs::World& world, int cells_along_longest) {
+  const std::vector<AuthoredBox> boxes = authored_boxes(world, cells_along_longest);
+  for (const AuthoredBox& b : boxes) world.emplace<ProbeVolume>(b.node, ProbeVolume{.min = b.min, .max = b.max, .dims = b.dims});
+  return boxes.size();
 }
 
 std::vector<std::shared_ptr<const probes::ProbeField>> probe_fields(engine::ecs::World& world) {

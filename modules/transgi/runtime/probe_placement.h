@@ -40,6 +40,17 @@ struct ProbePlacement {
 // The glTF extras key that marks an authored probe volume.
 inline constexpr std::string_view kProbeVolumeMarker = "transgi_probe_volume";
 
+// A node marked kProbeVolumeMarker and its box: the axis-aligned bounds of
+// its scaled, rotated unit cube, with about `cells_along_longest` cells on
+// the longest axis and proportionally fewer on the others (2 to 16). Throws
+// naming the node if its box is degenerate or not finite, or it has a parent.
+struct AuthoredBox {
+  engine::ecs::Entity node;
+  glm::vec3 min{0.0f}, max{0.0f};
+  glm::ivec3 dims{8};
+};
+std::vector<AuthoredBox> authored_boxes(engine::ecs::World& world, int cells_along_longest = 8);
+
 // Gives every node marked kProbeVolumeMarker a ProbeVolume over its box (the
 // axis-aligned bounds of the node's scaled, rotated unit cube), with about
 // `cells_along_longest` cells on its longest axis and proportionally fewer on

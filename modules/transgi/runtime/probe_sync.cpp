@@ -32,21 +32,6 @@ void tell(probes::ProbeField& field, const SceneChanges& c) {
 
 }  // namespace
 
-probes::CascadeViewer viewer_of(View<Get<const scene::Camera, const transform::WorldTransform>> cameras, ecs::Entity requested,
-                                const rt::RtScene& rt) {
-  // The frame's camera, else the first; with none, the scene's centre.
-  probes::CascadeViewer v{0.5f * (rt.bounds_min() + rt.bounds_max()), glm::vec3(0.0f)};
-  bool found = false;
-  cameras.each([&](ecs::Entity e, const scene::Camera&, const transform::WorldTransform& w) {
-    if (!found || e == requested) {
-      v.eye = w.translation;
-      v.forward = w.rotation * glm::vec3(0.0f, 0.0f, -1.0f);  // glTF cameras look down -z
-    }
-    found = true;
-  });
-  return v;
-}
-
 void sync_probe_volumes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res<render::SceneLights> lights,
                         Res<TransGISettings> settings, Local<SeenVersions> seen) {
   const SceneChanges changes = changes_since(*seen, *rt, *lights);
@@ -81,7 +66,7 @@ probes::ProbeFieldSettings cascade_field_settings(const probes::ProbeFieldSettin
 void sync_probe_cascades(View<Get<const scene::Camera, const transform::WorldTransform>> cameras,
                          View<Get<ProbeCascades>> sets, Res<rt::RtScene> rt, Res<render::SceneLights> lights,
                          Res<TransGISettings> settings, ResMut<GiFrame> frame, Local<SeenVersions> seen) {
-  const probes::CascadeViewer viewer = viewer_of(cameras, frame->camera, *rt);
+  const probes::CascadeViewer viewer = probes::viewer_of(cameras, frame->camera, rt->bounds_min(), rt->bounds_max());
   const SceneChanges changes = changes_since(*seen, *rt, *lights);
   int entered = 0;
   sets.each([&](ProbeCascades& set) {

@@ -38,12 +38,6 @@ void sync_probe_cascades(
     engine::schedule::Res<engine::render::SceneLights> lights, engine::schedule::Res<TransGISettings> settings,
     engine::schedule::ResMut<GiFrame> frame, engine::schedule::Local<SeenVersions> seen);
 
-// Where the cascades centre: GiFrame::camera (else the first camera; with
-// none, the scene's centre) and its view direction. Used by both plugins.
-probes::CascadeViewer viewer_of(
-    engine::schedule::View<engine::schedule::Get<const engine::scene::Camera, const engine::transform::WorldTransform>> cameras,
-    engine::ecs::Entity requested, const engine::rt::RtScene& rt);
-
 // A cascade's field settings: the run-time probe settings on cascade k's grid
 // at `origin`, with its share of the budget and its blend band.
 probes::ProbeFieldSettings cascade_field_settings(const probes::ProbeFieldSettings& base, const probes::CascadeSettings& c,
