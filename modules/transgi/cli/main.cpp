@@ -25,7 +25,10 @@ void usage() {
                "  eval     --scene S.gltf --model M.tgm --out DIR [--width W --height H --spp N --frames F --ddgi-frames F2]\n"
                "           [--probe-grid N] [--cache DIR] [--reference-error E] [--temporal N] [--decompose]\n"
                "  bench-pareto --scene S.gltf --model M.tgm --out DIR [--width W --height H --spp N] [--quick]\n"
-               "  bench-frame --scene S.gltf --model M.tgm [--width W --height H --frames N --warmup W --preset realtime|quality --csv F]\n");
+               "  bench-frame --scene S.gltf --model M.tgm [--width W --height H --frames N --warmup W --preset realtime|quality --csv F]\n"
+               "  render, eval and bench-frame also take: --probe-volume cascades|scene|authored (default cascades; a scene small\n"
+               "           enough for 2 m cells gets one grid over it) [--cascades N] [--cascade-cell M] [--cascade-look-ahead F]\n"
+               "           [--cascade-fit-scene M], and --allow-unbaked (meshes added after the bake are shaded diffusely)\n");
 }
 }  // namespace
 

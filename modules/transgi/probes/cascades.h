@@ -48,7 +48,7 @@ struct CascadeSettings {
   float look_ahead = 0.0f;
   // A scene small enough that one dims grid over its bounds has cells no
   // larger than this (metres) gets that grid instead of cascades, fitted once
-  // (a closed room: on the sample level GI RMSE 0.0109 against 0.0221 for
+  // (a closed room: on the sample level GI RMSE 0.0109 against 0.0216 for
   // cascades, docs/results.md). Higher = more scenes lit by one fitted grid,
   // at the cost of coarser probes in big ones; 0 = always cascades.
   float fit_scene_cell = 2.0f;
@@ -133,9 +133,10 @@ using FieldMix = FieldMixOf<ProbeField>;
 [[nodiscard]] inline FieldMix fields_at(std::span<const ProbeField* const> fields, const glm::vec3& p) { return mix_at(fields, p); }
 
 // Interpolated SH light at a surface point from the fields, blended as
-// fields_at says. A field with no probe that holds light around p (all
-// buried or far: a fine cascade in open space) hands its whole weight to the
-// next field holding p. indirect(f) and direct(f) give field f's SH arrays
+// fields_at says. A field with no probe that holds light and sees p (all
+// buried, far or pruned: a fine cascade in open space, or whose only lit
+// probes stand behind the wall) hands its whole weight to the next field
+// holding p; if every field does, the last one asked gives its fallback. indirect(f) and direct(f) give field f's SH arrays
 // (world or rotated, probes x 75); out_direct null = indirect only. With one
 // field this is exactly that field's ProbeField::interpolate.
 template <class IndirectOf, class DirectOf>

@@ -50,7 +50,7 @@ bool ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float
     const float* L = probe_sh + static_cast<std::size_t>(r.probes[i]) * 75;
     for (int k = 0; k < 75; ++k) out[k] += r.weights[i] * L[k];
   }
-  return lit;
+  return lit && !r.fallback;
 }
 
 namespace {
@@ -74,6 +74,7 @@ bool ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float
                              float* out_b) const {
   const InterpolationResult r = interpolate_probes(grid_, settings_.map, states_, p, n, settings_.interpolation, usable_);
   blend_two(r, sh_a, out_a, sh_b, out_b);
+  if (r.fallback) return false;
   for (float w : r.weights)
     if (w != 0.0f) return true;
   return false;

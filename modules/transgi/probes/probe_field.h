@@ -195,9 +195,11 @@ class ProbeField {
   // 75 SH coefficients of probe i, [c * 25 + k], world space.
   [[nodiscard]] const float* light_sh(int probe) const { return sh_.data() + static_cast<std::size_t>(probe) * 75; }
   // Interpolated SH light at a surface point (pruned trilinear). Each
-  // overload returns whether any probe that holds light weighed in: false
-  // (out all zero) where every probe around p is buried or far, which tells
-  // a caller with several fields to ask the next one (cascades.h).
+  // overload returns whether probes that hold light and see the point
+  // weighed in: false where every probe around p is buried or far (out all
+  // zero) or pruned (out is the distance-weighted fallback), which tells a
+  // caller with several fields to ask the next one (cascades.h): a fine
+  // cascade's fallback is often a probe behind a wall, in other light.
   bool interpolate(const glm::vec3& position, const glm::vec3& normal, float* out75) const;
   // One set of weights applied to two probe SH arrays (the indirect and the
   // direct light, possibly rotated): half the cost of two calls.
