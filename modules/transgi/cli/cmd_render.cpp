@@ -5,6 +5,7 @@
 #include "cli/args.h"
 #include "cli/commands.h"
 #include "cli/runtime_options.h"
+#include "cli/sun_options.h"
 #include "engine/core/progress.h"
 #include "engine/image/exr.h"
 #include "engine/image/tonemap.h"
@@ -197,7 +198,7 @@ int run_render(const std::vector<std::string>& argv) {
                   {"scene", "method", "pass", "spp", "width", "height", "out", "camera", "seed", "threads", "png", "exposure",
                    "model", "transfer", "gt-rays", "coefficient-maps", "lighting", "frames", "probe-grid", "probe-rays",
                    "direct-spp", "probe-skip", "sharing", "no-latent", "timing-frames", "map-width", "hysteresis", "irradiance-gamma", "warmup-frames", "brightness-threshold", "preset", "gi-scale", "probe-budget", "direct",
-                   "probe-volume", "cascades", "cascade-cell", "cascade-look-ahead", "cascade-fit-scene"},
+                   "probe-volume", "cascades", "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "sun-elevation", "sun-azimuth"},
                   {"allow-unbaked"});
   const std::string scene_path = args.str("scene");
   const std::string method = args.choice("method", {"reference", "transgi", "ddgi"}, "reference");
@@ -210,6 +211,7 @@ int run_render(const std::vector<std::string>& argv) {
   const int height = static_cast<int>(args.integer("height", 1, 16384, 180));
   const int threads = static_cast<int>(args.integer("threads", 0, 1024, 0));
   eval::LoadedScene scene = eval::load_scene(scene_path, args.str("camera", std::string()), threads);
+  apply_sun_options(args, scene);
   if (method == "transgi") return render_transgi(args, scene, width, height, o);
   if (method == "ddgi") return render_ddgi(args, scene, width, height, o);
   return render_reference(args, scene, width, height, o);

@@ -14,5 +14,6 @@ int run_transfer_study(const std::vector<std::string>& args);
 int run_eval(const std::vector<std::string>& args);
 int run_bench_pareto(const std::vector<std::string>& args);
 int run_bench_frame(const std::vector<std::string>& args);
+int run_sun_sweep(const std::vector<std::string>& args);
 
 }  // namespace transgi::cli
