@@ -68,7 +68,7 @@ int run_sun_sweep(const std::vector<std::string>& argv) {
                   {"scene", "model", "out", "width", "height", "positions", "frames", "warmup", "elevation-from",
                    "elevation-to", "azimuth-from", "azimuth-to", "reference-spp", "camera", "threads", "preset",
                    "probe-budget", "gi-scale", "map-width", "direct", "probe-volume", "probe-grid", "cascades",
-                   "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "settle-tolerance"},
+                   "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "settle-tolerance", "changed-first", "probe-skip"},
                   {"allow-unbaked"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const std::filesystem::path out = args.str("out");
@@ -95,7 +95,9 @@ int run_sun_sweep(const std::vector<std::string>& argv) {
 
   auto model = model::load_model(model_path);
   model::validate_model(model, world.resource<scene::SceneAssets>(), model_path, args.has("allow-unbaked"));
-  scene.app->add_plugin<runtime::TransGIPlugin>(runtime_settings_from(args, "realtime"));
+  runtime::TransGISettings settings = runtime_settings_from(args, "realtime");
+  if (args.choice("probe-skip", {"on", "off"}, "on") == "off") settings.probes.skip.classify = settings.probes.skip.skip_converged = false;
+  scene.app->add_plugin<runtime::TransGIPlugin>(settings);
   runtime::attach_latent_meshes(world, std::make_shared<const model::TransferModel>(std::move(model)));
   runtime::spawn_probes(world, probe_placement_from(args, runtime::ProbeVolumeMode::Cascades));
   auto& frame = world.resource<runtime::GiFrame>();

@@ -14,6 +14,8 @@ runtime::TransGISettings runtime_settings_from(const Args& args, const char* def
   s.probes.update_budget = static_cast<int>(args.integer("probe-budget", 0, 1 << 20, s.probes.update_budget));
   s.probes.map.width = static_cast<int>(args.integer("map-width", 4, 4096, s.probes.map.width));
   s.probes.map.height = std::max(2, s.probes.map.width / 2);
+  if (args.has("changed-first"))
+    s.probes.changed_first = args.choice("changed-first", {"on", "off"}, "off") == "on";
   if (args.has("direct"))
     s.direct_light = args.choice("direct", {"deterministic", "stochastic"}, "stochastic") == "deterministic"
                          ? runtime::DirectLight::Deterministic

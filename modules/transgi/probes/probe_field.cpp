@@ -128,10 +128,12 @@ void ProbeField::select_within_budget(std::vector<std::uint8_t>& traced) const {
   // offset (round-robin).
   const std::size_t n = traced.size(), offset = frame_ * static_cast<std::size_t>(settings_.update_budget) % n;
   // With a focus (the camera), ties go nearest-first instead of by turn.
+  // With changed_first, probes whose light just changed count as urgent.
   std::vector<std::tuple<int, std::uint64_t, float, std::size_t, std::size_t>> order;  // (not urgent, last traced, distance^2, turn, probe)
   for (std::size_t q = 0; q < n; ++q) {
     traced[q] = 0;
-    const int not_urgent = q < urgent_.size() && urgent_[q] ? 0 : 1;
+    const bool changed = settings_.changed_first && q < changed_.size() && changed_[q];
+    const int not_urgent = (q < urgent_.size() && urgent_[q]) || changed ? 0 : 1;
     if (state_[q] == ProbeState::Active || needs_classify_[q]) {
       const glm::vec3 d = has_focus_ ? grid_.grid_point(static_cast<int>(q)) - focus_ : glm::vec3(0.0f);
       order.emplace_back(not_urgent, last_traced_[q], glm::dot(d, d), (q + n - offset) % n, q);
@@ -215,6 +217,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
     traced[q] = classify || !settings_.skip.classify || state_[q] == ProbeState::Active;
   last_traced_.resize(static_cast<std::size_t>(probes), 0);
   needs_classify_.resize(static_cast<std::size_t>(probes), 0);
+  changed_.resize(static_cast<std::size_t>(probes), 0);
   const bool budgeted = settings_.update_budget > 0 && !classify;
   if (budgeted) select_within_budget(traced);
 
@@ -339,7 +342,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
     for (int q = b; q < e; ++q) {
       if (!updates(q)) continue;
       ProbeMapState& st = states_[static_cast<std::size_t>(q)];
-      accumulate(st, frame[static_cast<std::size_t>(q)], settings_.accumulation);
+      changed_[static_cast<std::size_t>(q)] = accumulate(st, frame[static_cast<std::size_t>(q)], settings_.accumulation) ? 1 : 0;
       if (settings_.skip.skip_converged && st.stable_frames >= settings_.skip.settle_frames)
         state_[static_cast<std::size_t>(q)] = ProbeState::Converged;
       const std::size_t at = static_cast<std::size_t>(q) * 75;

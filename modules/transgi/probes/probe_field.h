@@ -92,6 +92,11 @@ struct ProbeFieldSettings {
   // frame, at the cost of each probe refreshing only every active/budget
   // frames, so lighting responds that many times slower.
   int update_budget = 0;
+  // With a budget: a probe whose last update detected a lighting change (a
+  // sun that moved, a lamp switched) goes before the merely stale, so the
+  // budget follows the change. On = GI settles sooner after a light moves,
+  // at the cost of unchanged probes refreshing less often meanwhile.
+  bool changed_first = false;
   // Frames the direct sky and emitter SH averages over (a running mean,
   // restarted short when the scene changes). Higher = less noise from M rays
   // a frame, at the cost of a slower response to a changed sky or lamp.
@@ -252,6 +257,7 @@ class ProbeField {
   std::vector<std::uint64_t> last_traced_;
   std::vector<std::uint8_t> needs_classify_;
   std::vector<std::uint8_t> urgent_;  // in a changed region, not yet traced since
+  std::vector<std::uint8_t> changed_;  // its last update detected a lighting change (changed_first)
   std::vector<float> sh_;  // probes x 75
   std::vector<float> direct_mean_, direct_sh_;  // probes x 75: running mean, and that windowed
   std::vector<std::uint32_t> direct_frames_;    // frames in each probe's running mean
