@@ -65,6 +65,75 @@ def node_points(doc, node_index, parent):
     return points
 
 
+def scene_bounds(doc):
+    """World-space bounds (lo, hi) of the default scene's meshes."""
+    scene = doc["scenes"][doc.get("scene", 0)]
+    points = []
+    for n in scene["nodes"]:
+        points += node_points(doc, n, lambda p: p)
+    if not points:
+        return None
+    return [min(p[a] for p in points) for a in range(3)], [max(p[a] for p in points) for a in range(3)]
+
+
+def copy_referenced_files(doc, src_dir, out_dir):
+    """Copies what the scene refers to by relative URI (buffers, images, the
+    environment map in the scene's extras) from src_dir into out_dir."""
+    def copy_uri(uri):
+        if uri.startswith("data:"):
+            return
+        dst = os.path.join(out_dir, uri)
+        os.makedirs(os.path.dirname(dst), exist_ok=True)
+        shutil.copyfile(os.path.join(src_dir, uri), dst)
+    for b in doc.get("buffers", []):
+        if "uri" in b:
+            copy_uri(b["uri"])
+    for im in doc.get("images", []):
+        if "uri" in im:
+            copy_uri(im["uri"])
+    env = doc["scenes"][doc.get("scene", 0)].get("extras", {}).get("environment", {})
+    if "uri" in env:
+        copy_uri(env["uri"])
+
+
+def add_mesh_node(doc, scene, name, blob_parts, counts, albedo):
+    """Appends one triangle mesh (positions, normals as float32 VEC3, uint32
+    indices) in a new data: buffer, a grey material and a root node."""
+    pos, nrm, idx = blob_parts
+    blob = pos + nrm + idx
+    buf = len(doc.setdefault("buffers", []))
+    doc["buffers"].append({"uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode(),
+                           "byteLength": len(blob)})
+    views = doc.setdefault("bufferViews", [])
+    v0 = len(views)
+    views += [{"buffer": buf, "byteOffset": 0, "byteLength": len(pos), "target": 34962},
+              {"buffer": buf, "byteOffset": len(pos), "byteLength": len(nrm), "target": 34962},
+              {"buffer": buf, "byteOffset": len(pos) + len(nrm), "byteLength": len(idx), "target": 34963}]
+    vertex_count, index_count, lo, hi = counts
+    accs = doc.setdefault("accessors", [])
+    a0 = len(accs)
+    accs += [{"bufferView": v0, "componentType": 5126, "count": vertex_count, "type": "VEC3", "min": lo, "max": hi},
+             {"bufferView": v0 + 1, "componentType": 5126, "count": vertex_count, "type": "VEC3"},
+             {"bufferView": v0 + 2, "componentType": 5125, "count": index_count, "type": "SCALAR"}]
+    mats = doc.setdefault("materials", [])
+    mats.append({"name": name, "pbrMetallicRoughness": {
+        "baseColorFactor": [albedo, albedo, albedo, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0}})
+    meshes = doc.setdefault("meshes", [])
+    meshes.append({"name": name, "primitives": [
+        {"attributes": {"POSITION": a0, "NORMAL": a0 + 1}, "indices": a0 + 2, "material": len(mats) - 1}]})
+    doc["nodes"].append({"name": name, "mesh": len(meshes) - 1})
+    scene["nodes"].append(len(doc["nodes"]) - 1)
+
+
+def write_scene(doc, out_dir):
+    out = os.path.join(out_dir, "scene.gltf")
+    tmp = out + ".tmp"
+    with open(tmp, "w") as f:
+        json.dump(doc, f, indent=1)
+    os.replace(tmp, out)
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("scene", help="input .gltf (with external or data: buffers)")
@@ -87,64 +156,21 @@ def main():
     os.makedirs(args.out_dir, exist_ok=True)
 
     scene = doc["scenes"][doc.get("scene", 0)]
-    points = []
-    for n in scene["nodes"]:
-        points += node_points(doc, n, lambda p: p)
-    if not points:
+    bounds = scene_bounds(doc)
+    if not bounds:
         sys.exit(f"{args.scene}: no mesh to stand on a ground plane")
-    lo = [min(p[a] for p in points) for a in range(3)]
-    hi = [max(p[a] for p in points) for a in range(3)]
+    lo, hi = bounds
     cx, cz, y = 0.5 * (lo[0] + hi[0]), 0.5 * (lo[2] + hi[2]), lo[1] - args.gap
     h = 0.5 * args.size
 
-    # Copy what the scene refers to by relative URI (buffers, images, the
-    # environment map in the scene's extras).
-    def copy_uri(uri):
-        if uri.startswith("data:"):
-            return
-        src = os.path.join(src_dir, uri)
-        dst = os.path.join(args.out_dir, uri)
-        os.makedirs(os.path.dirname(dst), exist_ok=True)
-        shutil.copyfile(src, dst)
-    for b in doc.get("buffers", []):
-        if "uri" in b:
-            copy_uri(b["uri"])
-    for im in doc.get("images", []):
-        if "uri" in im:
-            copy_uri(im["uri"])
-    env = scene.get("extras", {}).get("environment", {})
-    if "uri" in env:
-        copy_uri(env["uri"])
+    copy_referenced_files(doc, src_dir, args.out_dir)
 
-    # The plane: positions, normals, indices in one new data: buffer.
+    # The plane: one quad, counter-clockwise seen from above (+y).
     pos = [(cx - h, y, cz - h), (cx + h, y, cz - h), (cx + h, y, cz + h), (cx - h, y, cz + h)]
-    nrm = [(0.0, 1.0, 0.0)] * 4
-    idx = [0, 2, 1, 0, 3, 2]  # counter-clockwise seen from above (+y)
-    blob = b"".join(struct.pack("<3f", *p) for p in pos) + b"".join(struct.pack("<3f", *n) for n in nrm) + \
-        struct.pack("<6H", *idx) + b"\0\0"
-    buf = len(doc.setdefault("buffers", []))
-    doc["buffers"].append({"uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode(),
-                           "byteLength": len(blob)})
-    views = doc.setdefault("bufferViews", [])
-    v0 = len(views)
-    views += [{"buffer": buf, "byteOffset": 0, "byteLength": 48, "target": 34962},
-              {"buffer": buf, "byteOffset": 48, "byteLength": 48, "target": 34962},
-              {"buffer": buf, "byteOffset": 96, "byteLength": 12, "target": 34963}]
-    accs = doc.setdefault("accessors", [])
-    a0 = len(accs)
-    accs += [{"bufferView": v0, "componentType": 5126, "count": 4, "type": "VEC3",
-              "min": [cx - h, y, cz - h], "max": [cx + h, y, cz + h]},
-             {"bufferView": v0 + 1, "componentType": 5126, "count": 4, "type": "VEC3"},
-             {"bufferView": v0 + 2, "componentType": 5123, "count": 6, "type": "SCALAR"}]
-    mats = doc.setdefault("materials", [])
-    mats.append({"name": "GroundPlane", "pbrMetallicRoughness": {
-        "baseColorFactor": [args.albedo, args.albedo, args.albedo, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0}})
-    meshes = doc.setdefault("meshes", [])
-    meshes.append({"name": "GroundPlane", "primitives": [
-        {"attributes": {"POSITION": a0, "NORMAL": a0 + 1}, "indices": a0 + 2, "material": len(mats) - 1}]})
+    parts = (b"".join(struct.pack("<3f", *p) for p in pos), struct.pack("<3f", 0.0, 1.0, 0.0) * 4,
+             struct.pack("<6I", 0, 2, 1, 0, 3, 2))
+    add_mesh_node(doc, scene, "GroundPlane", parts, (4, 6, [cx - h, y, cz - h], [cx + h, y, cz + h]), args.albedo)
     nodes = doc["nodes"]
-    nodes.append({"name": "GroundPlane", "mesh": len(meshes) - 1})
-    scene["nodes"].append(len(nodes) - 1)
     if args.volume:
         centre = [0.5 * (lo[a] + hi[a]) for a in range(3)]
         half = [0.5 * (hi[a] - lo[a]) for a in range(3)]
@@ -152,11 +178,7 @@ def main():
                       "extras": {"transgi_probe_volume": True}})
         scene["nodes"].append(len(nodes) - 1)
 
-    out = os.path.join(args.out_dir, "scene.gltf")
-    tmp = out + ".tmp"
-    with open(tmp, "w") as f:
-        json.dump(doc, f, indent=1)
-    os.replace(tmp, out)
+    out = write_scene(doc, args.out_dir)
     print(f"{out}: {args.size:g} m ground plane at y = {y:.4f}, centred at ({cx:.3f}, {cz:.3f}); "
           f"scene bounds ({lo[0]:.3f}, {lo[1]:.3f}, {lo[2]:.3f}) - ({hi[0]:.3f}, {hi[1]:.3f}, {hi[2]:.3f})")
 

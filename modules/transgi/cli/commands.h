@@ -15,5 +15,6 @@ int run_eval(const std::vector<std::string>& args);
 int run_bench_pareto(const std::vector<std::string>& args);
 int run_bench_frame(const std::vector<std::string>& args);
 int run_sun_sweep(const std::vector<std::string>& args);
+int run_fly_through(const std::vector<std::string>& args);
 
 }  // namespace transgi::cli

@@ -28,6 +28,8 @@ void usage() {
                "  bench-frame --scene S.gltf --model M.tgm [--width W --height H --frames N --warmup W --preset realtime|quality --csv F]\n"
                "  sun-sweep --scene S.gltf --model M.tgm --out DIR [--positions 8 --frames 96 --warmup 96 --elevation-from E0\n"
                "           --elevation-to E1 --azimuth-from A0 --azimuth-to A1 --reference-spp N --settle-tolerance 0.05]\n"
+               "  fly-through --scene S.gltf --model M.tgm --out DIR --path x,y,z;x,y,z;... [--frames 300 --stops F1,F2,F3\n"
+               "           --reference-spp N --pitch DEG]\n"
                "  render also takes --sun-elevation DEG --sun-azimuth DEG (turns the scene's directional light)\n"
                "  render, eval and bench-frame also take: --probe-volume cascades|scene|authored (default cascades; a scene small\n"
                "           enough for 2 m cells gets one grid over it) [--cascades N] [--cascade-cell M] [--cascade-look-ahead F]\n"
@@ -52,6 +54,7 @@ int main(int argc, char** argv) {
     if (command == "bench-pareto") return transgi::cli::run_bench_pareto(args);
     if (command == "bench-frame") return transgi::cli::run_bench_frame(args);
     if (command == "sun-sweep") return transgi::cli::run_sun_sweep(args);
+    if (command == "fly-through") return transgi::cli::run_fly_through(args);
     if (command == "--help" || command == "help") {
       usage();
       return 0;

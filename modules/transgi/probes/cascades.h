@@ -14,6 +14,7 @@
 // one, centred on the camera and snapped to whole cells of its own size: its
 // probes sit at cell centres, (origin + c + 0.5) x cell, so no probe ever
 // lies on a plane through the world origin (a ground plane at y = 0).
+#include <algorithm>
 #include <array>
 #include <span>
 
@@ -150,7 +151,18 @@ void interpolate_fields_with(std::span<const ProbeField* const> fields, const gl
   // An unlit field passes the point on; a lit one ends the search.
   while (!one(first, out, out_direct)) {
     first = next_holding(fields, first, p);
-    if (!first) return;  // nothing lit anywhere: zero
+    if (first) continue;
+    // No field has a lit probe around p (past the coarsest cascade's reach):
+    // rather than black, the last field's mean light, where the arrays are
+    // its world-space ones (a rotated copy keeps what it got).
+    const ProbeField* last = fields.back();
+    bool black = true;
+    for (int k = 0; k < 75 && black; ++k) black = out[k] == 0.0f;
+    if (black && fields.size() > 1 && indirect(last) == last->light_sh_all().data()) {
+      std::copy_n(last->mean_light_sh(), 75, out);
+      if (out_direct) std::copy_n(last->mean_direct_sh(), 75, out_direct);
+    }
+    return;
   }
   if (m.count == 1 || first != m.field[0]) return;
   float a[75], b[75];

@@ -369,6 +369,22 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   });
   stats.nonfinite_probes = bad_probes.load();
   stats.project_ms = ms_since(t0);
+  // The ambient term: the mean of the probes that hold light.
+  std::fill(mean_sh_.begin(), mean_sh_.end(), 0.0f);
+  std::fill(mean_direct_sh_.begin(), mean_direct_sh_.end(), 0.0f);
+  std::size_t lit = 0;
+  for (std::size_t q = 0; q < state_.size(); ++q) {
+    if (!usable_[q]) continue;
+    ++lit;
+    for (std::size_t k = 0; k < 75; ++k) {
+      mean_sh_[k] += sh_[q * 75 + k];
+      mean_direct_sh_[k] += direct_sh_[q * 75 + k];
+    }
+  }
+  for (std::size_t k = 0; k < 75 && lit > 0; ++k) {
+    mean_sh_[k] /= static_cast<float>(lit);
+    mean_direct_sh_[k] /= static_cast<float>(lit);
+  }
   for (std::size_t q = 0; q < state_.size(); ++q) {
     stats.active += state_[q] == ProbeState::Active;
     stats.converged += state_[q] == ProbeState::Converged;

@@ -210,6 +210,11 @@ class ProbeField {
   // direct light, possibly rotated): half the cost of two calls.
   bool interpolate(const glm::vec3& position, const glm::vec3& normal, const float* sh_a, float* out_a, const float* sh_b,
                    float* out_b) const;
+  // The mean SH light (75, world space) of the probes that hold light, as of
+  // the last update: the ambient term for points no probe lights (beyond the
+  // coarsest cascade's reach, cascades.h). Zero before any update.
+  [[nodiscard]] const float* mean_light_sh() const { return mean_sh_.data(); }
+  [[nodiscard]] const float* mean_direct_sh() const { return mean_direct_sh_.data(); }
   // The direct sky and emitter light of every probe, probes x 75, world space.
   [[nodiscard]] const std::vector<float>& direct_sh_all() const { return direct_sh_; }
   // The same weights applied to another copy of the probes' SH (probes x 75,
@@ -261,6 +266,7 @@ class ProbeField {
   std::vector<float> sh_;  // probes x 75
   std::vector<float> direct_mean_, direct_sh_;  // probes x 75: running mean, and that windowed
   std::vector<std::uint32_t> direct_frames_;    // frames in each probe's running mean
+  std::vector<float> mean_sh_ = std::vector<float>(75, 0.0f), mean_direct_sh_ = std::vector<float>(75, 0.0f);
   std::vector<glm::vec3> fibonacci_;
   std::uint64_t frame_ = 0;
   glm::vec3 focus_{0.0f};
