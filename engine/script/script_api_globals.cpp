@@ -16,6 +16,7 @@
 #include "engine/input/input_state.h"
 #include "engine/rt/rt_scene.h"
 #include "engine/scene/components.h"
+#include "engine/scene/sun.h"
 #include "engine/scene/find_named.h"
 #include "engine/scene/scene_assets.h"
 #include "engine/script/script_api.h"
@@ -202,6 +203,25 @@ int sky_get_strength(lua_State* L) {
   return 1;
 }
 
+// --- sun: the first directional light, by elevation and azimuth (degrees) --
+
+int sun_set(lua_State* L) {
+  const float elevation = check_finite(L, 1, "elevation"), azimuth = check_finite(L, 2, "azimuth");
+  if (elevation < -90.0f || elevation > 90.0f) luaL_error(L, "sun.set: elevation must lie in [-90, 90] degrees");
+  if (!scene::find_sun(world_of(L))) luaL_error(L, "sun.set: this scene has no directional light");
+  scene::set_sun(world_of(L), elevation, azimuth);
+  return 0;
+}
+int sun_get(lua_State* L) {
+  ecs::World& world = world_of(L);
+  const auto sun = scene::find_sun(world);
+  if (!sun) luaL_error(L, "sun.get: this scene has no directional light");
+  const glm::vec2 a = scene::sun_angles(glm::normalize(world.get<transform::Transform>(*sun).rotation * glm::vec3(0, 0, 1)));
+  lua_pushnumber(L, a.x);
+  lua_pushnumber(L, a.y);
+  return 2;
+}
+
 // --- log, send, property -----------------------------------------------------
 
 std::string joined_arguments(lua_State* L) {
@@ -315,6 +335,8 @@ void register_api(lua_State* L) {
   const luaL_Reg sky_fns[] = {{"set_yaw", sky_set_yaw}, {"get_yaw", sky_get_yaw}, {"set_strength", sky_set_strength},
                               {"get_strength", sky_get_strength}, {nullptr, nullptr}};
   set_table(L, "sky", sky_fns);
+  const luaL_Reg sun_fns[] = {{"set", sun_set}, {"get", sun_get}, {nullptr, nullptr}};
+  set_table(L, "sun", sun_fns);
   lua_pushcfunction(L, log_at<0>);
   lua_setfield(L, -2, "print");
   lua_pushcfunction(L, send);

@@ -14,6 +14,7 @@
 #include "engine/input/input_state.h"
 #include "engine/rt/rt_plugin.h"
 #include "engine/scene/components.h"
+#include "engine/scene/sun.h"
 #include "engine/scene/procedural.h"
 #include "engine/scene/scene_assets.h"
 #include "engine/script/script_plugin.h"
@@ -419,6 +420,19 @@ TEST_F(ScriptTest, SkyTurnsTheEnvironmentAndBumpsItsVersion) {
 }  // namespace
 
 namespace {
+
+TEST_F(ScriptTest, SunSetTurnsTheDirectionalLightAndGetReadsItBack) {
+  const ecs::Entity sun = world().spawn();
+  world().emplace<transform::Transform>(sun);
+  world().emplace<scene::PunctualLight>(sun, scene::PunctualLight{.type = scene::PunctualLight::Type::Directional});
+  write("sun.lua", R"(
+    function init(self) sun.set(30, 120); local e, a = sun.get(); log.info(math.floor(e + 0.5), math.floor(a + 0.5)) end)");
+  spawn_scripted("sun.lua");
+  app_.update();
+  EXPECT_EQ(logged(core::LogLevel::Info), "30 120\n");
+  const glm::vec3 travel = world().get<transform::Transform>(sun).rotation * glm::vec3(0, 0, -1);
+  EXPECT_NEAR(glm::dot(travel, -scene::direction_to_sun(30, 120)), 1.0f, 1e-5f);
+}
 
 TEST_F(ScriptTest, WorldPositionForwardAndLogLevels) {
   write("world.lua", R"(
