@@ -378,3 +378,30 @@ TEST(DdgiCascades, TheSameScrollKeepsMapsSeedsTheEnteredAndNeverGivesABlackPixel
     }
   }
 }
+
+TEST(CascadeMemory, ProbesThatHoldNoLightHoldNoMapsAndActiveOnesDo) {
+  CascadeSettings cs;
+  cs.count = 3;
+  cs.dims = glm::ivec3(6);
+  cs.fit_scene_cell = 0.0f;  // the coarse cascades reach outside the room: buried and far probes
+  Room room(cs);
+  for (int f = 0; f < 8; ++f) room.app.jobs().run([&] { room.app.update(); });
+  const runtime::ProbeCascades* set = nullptr;
+  room.app.world().view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& c) { set = &c; });
+  ASSERT_NE(set, nullptr);
+  int released = 0, held = 0;
+  std::size_t bytes_if_all_held = 0, bytes = 0;
+  for (const auto& f : set->state.fields) {
+    for (int q = 0; q < f->grid().count(); ++q) {
+      const bool lit = f->state(q) == ProbeState::Active || f->state(q) == ProbeState::Converged;
+      EXPECT_EQ(f->states()[static_cast<std::size_t>(q)].held(), lit) << "probe " << q << " state " << static_cast<int>(f->state(q));
+      released += lit ? 0 : 1;
+      held += lit ? 1 : 0;
+    }
+    bytes += f->memory_bytes();
+    bytes_if_all_held += ProbeField(f->settings()).memory_bytes();
+  }
+  EXPECT_GT(released, 0) << "no buried or far probe: the test sees nothing";
+  EXPECT_GT(held, 0);
+  EXPECT_LT(bytes, bytes_if_all_held) << "released maps must not count";
+}

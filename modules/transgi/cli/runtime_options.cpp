@@ -33,6 +33,7 @@ runtime::ProbePlacement probe_placement_from(const Args& args, runtime::ProbeVol
   p.cascades.count = static_cast<int>(args.integer("cascades", 1, 8, p.cascades.count));
   p.cascades.finest_cell = static_cast<float>(args.number("cascade-cell", 0.01, 100.0, p.cascades.finest_cell));
   p.cascades.fit_scene_cell = static_cast<float>(args.number("cascade-fit-scene", 0.0, 1e6, p.cascades.fit_scene_cell));
+  p.cascades.map_width = static_cast<int>(args.integer("cascade-map-width", 0, 4096, p.cascades.map_width));
   p.cascades.look_ahead = static_cast<float>(args.number("cascade-look-ahead", 0.0, 1.0, p.cascades.look_ahead));
   return p;
 }

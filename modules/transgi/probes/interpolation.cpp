@@ -104,7 +104,8 @@ InterpolationResult weigh(const ProbeGrid::Cage& cage, const Corners& c, const s
   // the geometry, so they overlap.
   std::array<DepthMap::Texel, 8> depth{};
   for (std::size_t i = 0; i < 8; ++i)
-    if (c.texel[i] >= 0) depth[i] = states[static_cast<std::size_t>(cage.probes[i])].depth.texels[static_cast<std::size_t>(c.texel[i])];
+    if (c.texel[i] >= 0 && (usable.empty() || usable[static_cast<std::size_t>(cage.probes[i])]))  // unusable: maps released
+      depth[i] = states[static_cast<std::size_t>(cage.probes[i])].depth.texels[static_cast<std::size_t>(c.texel[i])];
   const auto& facing = c.facing;
   const auto& dist = c.dist;
   const auto& from_dist = c.from_dist;

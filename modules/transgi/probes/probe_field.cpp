@@ -309,7 +309,13 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
       if (moved || !usable_[q]) {
         forget_light(static_cast<int>(q));
         points[q].clear();
+      } else if (!states_[q].held()) {
+        // Active again: fresh maps (as forget_light left them when it was
+        // released); this frame's rays count.
+        states_[q].reset(settings_.map.texel_count(), depth_unit());
       }
+      // No light, no maps.
+      if (!usable_[q]) states_[q].release();
     }
     classify_pending_ = false;
   }

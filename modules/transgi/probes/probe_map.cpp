@@ -20,6 +20,12 @@ void ProbeMapState::reset(int texels, float depth_unit) {
   drift = 0.0f;
 }
 
+void ProbeMapState::release() {
+  const float unit = depth.unit;
+  *this = ProbeMapState{};
+  depth.unit = unit;
+}
+
 glm::vec3 ProbeMapState::radiance_at(std::size_t t) const {
   const HalfRgb& h = radiance[t];
   using engine::math::from_half;

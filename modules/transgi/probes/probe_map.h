@@ -62,6 +62,11 @@ struct ProbeMapState {
   // depth_unit: the length the depth is stored in units of (the grid's
   // smallest spacing).
   void reset(int texels, float depth_unit = 1.0f);
+  // Frees the maps (a probe buried or far from everything holds no light,
+  // so it needs none: half the probes of camera-centred cascades); reset
+  // allocates them again. held() says which.
+  void release();
+  [[nodiscard]] bool held() const { return !radiance.empty(); }
   [[nodiscard]] glm::vec3 radiance_at(std::size_t texel) const;
   // v in [0, 2^14 * radiance_scale] is stored to 11 significant bits; more is
   // clamped to the half range (choose the scale with fitted_scale first),

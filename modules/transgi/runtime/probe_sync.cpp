@@ -60,6 +60,7 @@ probes::ProbeFieldSettings cascade_field_settings(const probes::ProbeFieldSettin
   s.grid = probes::cascade_grid(c, k, origin);
   s.update_budget = base.update_budget > 0 ? std::max(1, base.update_budget >> k) : 0;
   s.blend_cells = c.blend_cells;
+  if (c.map_width > 0) s.map = probes::MapLayout{c.map_width, std::max(2, c.map_width / 2)};
   return s;
 }
 
