@@ -244,7 +244,14 @@ std::string check_image_buffer_views(const nlohmann::json& j, const FileAccess& 
     if (b < 0 || buffers == j.end() || !buffers->is_array() || static_cast<std::size_t>(b) >= buffers->size())
       return vfield + ".buffer: not the index of a buffer";
     if (offset < 0 || length < 0) return vfield + ": byteOffset and byteLength must be non-negative integers";
-    const long long have = real_buffer_bytes((*buffers)[static_cast<std::size_t>(b)], static_cast<std::size_t>(b), access, bin_length);
+    const auto& buffer = (*buffers)[static_cast<std::size_t>(b)];
+    long long have = real_buffer_bytes(buffer, static_cast<std::size_t>(b), access, bin_length);
+    // tinygltf keeps only the declared byteLength of a buffer (a BIN chunk
+    // may be longer), and hands images a pointer into what it kept: both
+    // bounds apply (found by the glTF fuzzer: a view inside the BIN chunk
+    // but past byteLength read 989 bytes beyond the buffer).
+    if (const long long declared = buffer.is_object() ? index_member(buffer, "byteLength", -1) : -1; declared >= 0)
+      have = have < 0 ? declared : std::min(have, declared);
     if (have >= 0 && offset + length > have)
       return vfield + ": bytes [" + std::to_string(offset) + ", " + std::to_string(offset + length) + ") lie outside buffers[" +
              std::to_string(b) + "], which holds " + std::to_string(have) + " bytes (used by images[" + std::to_string(i) + "])";

@@ -252,6 +252,32 @@ TEST(GltfLoaderBadInput, ImageBufferViewPastItsBuffer) {
   expect_rejected(write_scene(d, j), {"bufferViews[", "lie outside buffers[0], which holds 140 bytes", "images[0]"});
 }
 
+// Found by the glTF fuzzer (tests/fuzz/corpus/gltf/crash-image-view-past-byte-length.glb):
+// the view lay inside the GLB's BIN chunk but past the buffer's declared
+// byteLength, which is all tinygltf keeps, so the image decoder read past it.
+TEST(GltfLoaderBadInput, ImageBufferViewInsideTheBinChunkButPastByteLength) {
+  TempDir d;
+  json j = quad_gltf();
+  std::vector<unsigned char> bin = quad_bin();
+  bin.resize(bin.size() + 60, 0);  // the chunk holds 200 bytes; the buffer declares 140
+  j["buffers"] = json::array({{{"byteLength", 140}}});
+  j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 128}, {"byteLength", 64}});
+  j["images"] = json::array({{{"bufferView", j["bufferViews"].size() - 1}, {"mimeType", "image/png"}}});
+  std::string text = j.dump();
+  while (text.size() % 4) text += ' ';
+  const auto u32 = [](std::string& out, std::uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+  std::string glb = "glTF";
+  u32(glb, 2);
+  u32(glb, static_cast<std::uint32_t>(12 + 8 + text.size() + 8 + bin.size()));
+  u32(glb, static_cast<std::uint32_t>(text.size()));
+  glb += "JSON" + text;
+  u32(glb, static_cast<std::uint32_t>(bin.size()));
+  glb += std::string("BIN\0", 4);
+  glb.append(reinterpret_cast<const char*>(bin.data()), bin.size());
+  std::ofstream(d.path / "scene.glb", std::ios::binary) << glb;
+  expect_rejected(d.path / "scene.glb", {"bufferViews[", "lie outside buffers[0], which holds 140 bytes", "images[0]"});
+}
+
 // Found by the image fuzzer (tests/fuzz/corpus/image/oom-png-chunk-claims-2gb.png):
 // stb_image sized its IDAT buffer from the chunk's declared length, so a
 // 489-byte PNG claiming 1.75 GB made it allocate that much.
