@@ -405,3 +405,22 @@ TEST(CascadeMemory, ProbesThatHoldNoLightHoldNoMapsAndActiveOnesDo) {
   EXPECT_GT(held, 0);
   EXPECT_LT(bytes, bytes_if_all_held) << "released maps must not count";
 }
+
+TEST(CascadeBlend, MoreFieldsThanTheStackHoldsStillReachTheOnesPastSixteen) {
+  // 20 nested fields, each twice the size of the one before; a point only the
+  // last four hold must come from field 16, not be clamped into field 15.
+  std::vector<std::unique_ptr<ProbeField>> owned;
+  std::vector<const ProbeField*> fields;
+  for (int i = 0; i < 20; ++i) {
+    ProbeFieldSettings s;
+    s.map = MapLayout{4, 2};
+    s.rays_per_probe = 4;
+    const float half = std::ldexp(1.0f, i);
+    s.grid = ProbeGrid{glm::vec3(-half), glm::vec3(half), glm::ivec3(2)};
+    owned.push_back(std::make_unique<ProbeField>(s));
+    fields.push_back(owned.back().get());
+  }
+  const glm::vec3 p(std::ldexp(1.0f, 16) - 1.0f, 0.0f, 0.0f);  // inside field 16 (half 65,536), outside 15
+  const FieldMix m = fields_at(fields, p);
+  EXPECT_EQ(m.field[0], fields[16]) << "got field " << (std::find(fields.begin(), fields.end(), m.field[0]) - fields.begin());
+}

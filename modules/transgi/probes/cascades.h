@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <array>
 #include <span>
+#include <vector>
 
 #include "probes/probe_field.h"
 
@@ -109,13 +110,19 @@ template <class Field>
   FieldMixOf<Field> m;
   m.field[0] = fields.front();
   if (fields.size() == 1) return m;  // the usual case, asked once per decoded pixel
+  // On the stack for the usual few fields (authored volumes and four cascades).
   std::array<BlendBox, 16> local{};
-  const std::size_t n = std::min(fields.size(), local.size());
-  for (std::size_t i = 0; i < n; ++i) {
-    const ProbeGrid& g = fields[i]->placement();
-    local[i] = {g.min, g.max, fields[i]->settings().blend_cells * g.min_spacing()};
+  std::vector<BlendBox> many;
+  BlendBox* boxes = local.data();
+  if (fields.size() > local.size()) {
+    many.resize(fields.size());
+    boxes = many.data();
   }
-  const BoxMix b = blend_boxes(std::span<const BlendBox>(local.data(), n), p);
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const ProbeGrid& g = fields[i]->placement();
+    boxes[i] = {g.min, g.max, fields[i]->settings().blend_cells * g.min_spacing()};
+  }
+  const BoxMix b = blend_boxes(std::span<const BlendBox>(boxes, fields.size()), p);
   m.count = b.count;
   for (std::size_t k = 0; k < static_cast<std::size_t>(b.count); ++k) {
     m.field[k] = fields[static_cast<std::size_t>(b.box[k])];
