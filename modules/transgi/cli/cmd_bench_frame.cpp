@@ -11,6 +11,7 @@
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "cli/reference_view.h"
 #include "cli/runtime_options.h"
 #include "engine/core/progress.h"
 #include "engine/image/exr.h"
@@ -186,17 +187,11 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   }
   if (args.has("reference-out")) {
     const int spp = static_cast<int>(args.integer("reference-spp", 1, 1 << 20, 1024));
-    const auto& assets = world.resource<scene::SceneAssets>();
-    // The map as it is (no sun split): the reference's own estimator.
-    const render::LightSet lights(world.resource<rt::RtScene>(), render::gather_punctual_lights(world),
-                                  assets.environment ? &*assets.environment : nullptr);
-    const render::CameraRays rays(world.get<scene::Camera>(scene.camera), world.get<transform::WorldTransform>(scene.camera),
-                                  width, height);
-    render::PathTracer pt(world.resource<rt::RtScene>(), lights, rays, width, height, render::PathTracerSettings{.seed = 1});
     core::ProgressBar ref_bar("reference", static_cast<std::uint64_t>(spp), true);
-    scene.app->jobs().run([&] { pt.render(spp, [&](int done, int) { ref_bar.update(static_cast<std::uint64_t>(done)); }); });
+    const image::ImageRGB ref =
+        reference_gi_now(scene, width, height, spp, [&](int done, int) { ref_bar.update(static_cast<std::uint64_t>(done)); });
     ref_bar.finish();
-    image::write_exr(args.str("reference-out"), pt.image(render::Pass::Gi));
+    image::write_exr(args.str("reference-out"), ref);
     std::printf("reference GI pass of the moved scene (%d spp): %s\n", spp, args.str("reference-out").c_str());
   }
   return 0;

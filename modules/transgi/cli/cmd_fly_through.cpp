@@ -16,6 +16,7 @@
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "cli/reference_view.h"
 #include "cli/runtime_options.h"
 #include "engine/core/progress.h"
 #include "engine/image/exr.h"
@@ -172,11 +173,7 @@ int run_fly_through(const std::vector<std::string>& argv) {
       image::write_exr(out / name, frame.gi);
       double rmse = -1, ratio = -1;
       if (reference_spp > 0) {
-        const auto& assets = world.resource<scene::SceneAssets>();
-        const render::LightSet lights(rt, render::gather_punctual_lights(world), assets.environment ? &*assets.environment : nullptr);
-        render::PathTracer pt(rt, lights, rays, width, height, render::PathTracerSettings{.seed = 1});
-        scene.app->jobs().run([&] { pt.render(reference_spp); });
-        const image::ImageRGB ref = pt.image(render::Pass::Gi);
+        const image::ImageRGB ref = reference_gi_now(scene, width, height, reference_spp);
         std::snprintf(name, sizeof(name), "reference_gi_%03d.exr", f);
         image::write_exr(out / name, ref);
         const image::ErrorMetrics m = image::compare_images(frame.gi, ref);

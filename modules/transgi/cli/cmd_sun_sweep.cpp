@@ -13,6 +13,7 @@
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "cli/reference_view.h"
 #include "cli/runtime_options.h"
 #include "engine/core/progress.h"
 #include "engine/image/exr.h"
@@ -154,15 +155,7 @@ int run_sun_sweep(const std::vector<std::string>& argv) {
     Row row{s, settle, settled, -1, -1};
     double ssim = -1;
     if (reference_spp > 0) {
-      const auto& assets = world.resource<scene::SceneAssets>();
-      // The map as it is (no sun split): the reference's own estimator.
-      const render::LightSet lights(world.resource<rt::RtScene>(), render::gather_punctual_lights(world),
-                                    assets.environment ? &*assets.environment : nullptr);
-      const render::CameraRays rays(world.get<scene::Camera>(scene.camera), world.get<transform::WorldTransform>(scene.camera),
-                                    width, height);
-      render::PathTracer pt(world.resource<rt::RtScene>(), lights, rays, width, height, render::PathTracerSettings{.seed = 1});
-      scene.app->jobs().run([&] { pt.render(reference_spp); });
-      const image::ImageRGB ref = pt.image(render::Pass::Gi);
+      const image::ImageRGB ref = reference_gi_now(scene, width, height, reference_spp);
       std::snprintf(name, sizeof(name), "reference_gi_%02d.exr", p);
       image::write_exr(out / name, ref);
       const image::ErrorMetrics m = image::compare_images(frame.gi, ref);
