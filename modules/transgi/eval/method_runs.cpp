@@ -137,12 +137,17 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
     for (const auto& f : c.state.fields)
       if (f) r.probe_bytes += f->memory_bytes();
   });
+  bool fitted_to_scene = false;
+  world.view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& c) { fitted_to_scene = fitted_to_scene || c.state.fitted_to_scene; });
   const auto& st = frame.probe_stats;
   char line[256];
   if (o.placement.mode == runtime::ProbeVolumeMode::Scene)
     std::snprintf(line, sizeof(line), "%d^3 probes over the scene's bounds", o.placement.scene_dims.x);
   else if (o.placement.mode == runtime::ProbeVolumeMode::Authored)
     std::snprintf(line, sizeof(line), "the scene's authored probe volumes");
+  else if (fitted_to_scene)
+    std::snprintf(line, sizeof(line), "cascades: the scene fits one %dx%dx%d grid over its bounds (--cascade-fit-scene)",
+                  o.placement.cascades.dims.x, o.placement.cascades.dims.y, o.placement.cascades.dims.z);
   else
     std::snprintf(line, sizeof(line), "%d cascades of %dx%dx%d probes, %.2f m finest cells", o.placement.cascades.count,
                   o.placement.cascades.dims.x, o.placement.cascades.dims.y, o.placement.cascades.dims.z,
