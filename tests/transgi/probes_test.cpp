@@ -292,6 +292,45 @@ TEST(ProbeMap, HysteresisAdaptsOnlyToChangesBeyondTheNoise) {
   EXPECT_NEAR(st.radiance_at(0).r, 0.5f * before, kHalfRounding);
 }
 
+// A firefly (one texel catching a glint 1,000 times the map's light) is noise,
+// not a change of light: it blends in at the slow weight and the texels it
+// did not touch keep their history. A change over a quarter of the map (a
+// lamp on one side) is still a change.
+TEST(ProbeMap, AFireflyIsNotAChangeButALampOnOneSideIs) {
+  const MapLayout m{16, 8};
+  AccumulationSettings settings;
+  settings.warmup_frames = 0;
+  const auto steady = [&](ProbeMapState& st, FrameSamples& f) {
+    st.reset(m.texel_count());
+    f.reset(m.texel_count());
+    engine::math::Pcg32 rng = engine::math::make_rng(7, 0, 0);
+    for (int i = 0; i < 40; ++i) {  // independent +-10 % noise on every texel
+      for (int t = 0; t < m.texel_count(); ++t) {
+        f.sum[static_cast<std::size_t>(t)] = glm::vec3(0.9f + 0.2f * rng.next_float());
+        f.count[static_cast<std::size_t>(t)] = 1;
+      }
+      accumulate(st, f, settings);
+    }
+  };
+  ProbeMapState st;
+  FrameSamples f;
+  steady(st, f);
+  const float firefly_before = st.radiance_at(37).r, other_before = st.radiance_at(5).r;
+  f.sum[37] = glm::vec3(1000.0f);
+  EXPECT_FALSE(accumulate(st, f, settings)) << "one texel 1,000x brighter was judged a change of light";
+  EXPECT_NEAR(st.radiance_at(37).r, 0.95f * firefly_before + 0.05f * 1000.0f, 1e-3f * 50.0f)
+      << "the firefly texel should blend in at the slow weight (h = 0.95)";
+  EXPECT_NEAR(st.radiance_at(5).r, 0.95f * other_before + 0.05f * f.sum[5].r, kHalfRounding);
+
+  steady(st, f);
+  const float lit_before = st.radiance_at(3).r;
+  for (int y = 0; y < m.height; ++y)
+    for (int x = 0; x < m.width / 4; ++x) f.sum[static_cast<std::size_t>(y * m.width + x)] = glm::vec3(8.0f);
+  EXPECT_TRUE(accumulate(st, f, settings)) << "a quarter of the map 8x brighter was not judged a change of light";
+  EXPECT_NEAR(st.radiance_at(3).r, 0.5f * lit_before + 0.5f * 8.0f, 4 * kHalfRounding * 8.0f)
+      << "a change of light should blend fast (h = 0.5)";
+}
+
 TEST(ProbeMap, ColdStartRampsTheHysteresisUp) {
   const MapLayout m{4, 2};
   ProbeMapState st;
