@@ -72,8 +72,18 @@ std::vector<DecompositionRow> decompose_transgi(LoadedScene& scene, const image:
 
   const render::LightSet& lights = world.resource<render::SceneLights>().set;
   const auto& rt = world.resource<rt::RtScene>();
+  // Every field shading reads: authored or scene volumes and the cascades'
+  // fields (the default placement), which this row once left out, so that it
+  // measured nothing.
+  const auto oracle = [&](probes::ProbeField& f) {
+    scene.app->jobs().run([&] { f.replace_with_oracle(rt, lights, o.oracle_rays_per_texel, 0x0AC1E); });
+  };
   world.view<runtime::ProbeVolume>().each([&](runtime::ProbeVolume& v) {
-    if (v.field) scene.app->jobs().run([&] { v.field->replace_with_oracle(rt, lights, o.oracle_rays_per_texel, 0x0AC1E); });
+    if (v.field) oracle(*v.field);
+  });
+  world.view<runtime::ProbeCascades>().each([&](runtime::ProbeCascades& c) {
+    for (const auto& f : c.state.fields)
+      if (f) oracle(*f);
   });
   add("probes -> path-traced oracle probes", "oracle_probes", render_frozen(scene, width, height, keep));
   add("both oracles (left: SH-4 truncation, interpolation, G-buffer)", "both_oracles", render_frozen(scene, width, height, gt));
