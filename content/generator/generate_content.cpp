@@ -8,13 +8,15 @@
 //                              wallpaper and a window onto a sky with a sun
 //                              (issue 14's real-content problems, of our making)
 //   levels/living_room/        the sample level: a room with a window lit by
-//                              a sky map, a ceiling area light, large diffuse
+//                              a sun (a directional light) and a sky map, a
+//                              ceiling area light, large diffuse
 //                              pieces, a glossy metal sphere, a mirror panel
 //                              and a rough plastic object
 //
 //   content_generator --out DIR
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 
 #include <glm/gtc/quaternion.hpp>
@@ -25,6 +27,8 @@
 #include "engine/scene/environment.h"
 #include "engine/scene/gltf_writer.h"
 #include "engine/scene/procedural.h"
+#include "engine/scene/sun.h"
+#include "engine/scene/sun_extraction.h"
 
 namespace {
 
@@ -147,8 +151,8 @@ GltfSceneDesc furnace() {
 // ---- sky for the sample level ------------------------------------------------------
 
 // A clear sky in the Mitsuba lat-long convention: blue zenith, pale horizon,
-// dark ground and a small bright sun.
-image::ImageRGB sky_map(glm::vec3 sun_dir) {
+// dark ground and (with_disk) a small bright sun.
+image::ImageRGB sky_map(glm::vec3 sun_dir, bool with_disk = true) {
   const int w = 256, h = 128;
   image::ImageRGB img(w, h);
   for (int y = 0; y < h; ++y)
@@ -162,11 +166,34 @@ image::ImageRGB sky_map(glm::vec3 sun_dir) {
         c = glm::vec3(0.25f, 0.22f, 0.2f);
       }
       const float cos_sun = glm::dot(d, sun_dir);
-      if (cos_sun > std::cos(glm::radians(2.5f))) c += glm::vec3(2000.0f, 1800.0f, 1500.0f);
+      if (with_disk && cos_sun > std::cos(glm::radians(2.5f))) c += glm::vec3(2000.0f, 1800.0f, 1500.0f);
       img.at(x, y) = c;
     }
   return img;
 }
+
+// The sample level's sun as a directional light (KHR_lights_punctual), so a
+// time-of-day control can turn it (engine/scene/sun.h): the light the sky
+// map's disk would give, split out of that map exactly (its irradiance and
+// power-weighted direction), while the level's sky.exr is written without
+// the disk. Until 2026-11-24 the disk was in the map and the sun could only
+// turn with the whole sky about the vertical.
+void add_sun(GltfSceneDesc& s, glm::vec3 sun_dir) {
+  const scene::SunSplit split = scene::split_sun(scene::Environment(sky_map(sun_dir, true), 1.0f, glm::mat4(1.0f)));
+  if (!split.sun) throw std::runtime_error("the level's sky map has no sun to split out");
+  const glm::vec3 e = split.sun->irradiance;
+  const float peak = std::max(e.r, std::max(e.g, e.b));
+  GltfNodeDesc n;
+  n.name = "Sun";
+  // A directional light shines along its local -z.
+  const glm::vec2 angles = scene::sun_angles(glm::normalize(split.sun->direction));
+  n.transform.rotation = scene::sun_rotation(angles.x, angles.y);
+  n.light = scene::PunctualLight{.type = scene::PunctualLight::Type::Directional, .color = e / peak, .intensity = peak};
+  s.nodes.push_back(n);
+  s.roots.push_back(static_cast<int>(s.nodes.size() - 1));
+}
+
+const glm::vec3 kLevelSun = glm::normalize(glm::vec3(1.0f, 0.55f, -0.25f));
 
 GltfSceneDesc living_room() {
   GltfSceneDesc s;
@@ -207,6 +234,7 @@ GltfSceneDesc living_room() {
   for (auto& t : lamp.triangles) std::swap(t.y, t.z);
   add(s, lamp, "CeilingLamp", {0.0f, 2.99f, 0.0f});
   add_camera(s, {-2.4f, 1.6f, 2.2f}, {0.6f, 0.9f, -0.9f}, 60.0f, 16.0f / 9.0f);
+  add_sun(s, kLevelSun);
   s.environment = scene::GltfEnvironmentDesc{"sky.exr", 1.0f, glm::mat4(1.0f)};
   return s;
 }
@@ -360,8 +388,7 @@ int main(int argc, char** argv) {
     scene::write_gltf(out / "test_scenes/cornell_box/scene.gltf", cornell_box());
     image::write_exr(out / "test_scenes/furnace/white_sky.exr", image::ImageRGB(8, 4, glm::vec3(1.0f)), image::ExrPixelType::Half);
     scene::write_gltf(out / "test_scenes/furnace/scene.gltf", furnace());
-    const glm::vec3 sun = glm::normalize(glm::vec3(1.0f, 0.55f, -0.25f));
-    image::write_exr(out / "levels/living_room/sky.exr", sky_map(sun), image::ExrPixelType::Half);
+    image::write_exr(out / "levels/living_room/sky.exr", sky_map(kLevelSun, false), image::ExrPixelType::Half);
     scene::write_gltf(out / "levels/living_room/scene.gltf", living_room());
     for (const char* dir : {"test_scenes/object_metal", "test_scenes/object_textured"})
       image::write_exr(out / dir / "studio.exr", studio_map(), image::ExrPixelType::Half);
