@@ -111,6 +111,28 @@ TEST(Exr, RejectsMalformedFilesWithTheFileNamed) {
   }
 }
 
+// The EXR fuzzer's 24-byte file: its one attribute declares 1,768,685,568
+// bytes, which OpenEXR allocated before finding the file too short (250 MB,
+// half a second). And a valid file whose first attribute's size is patched
+// to run past the end. Both are refused before OpenEXR reads them.
+TEST(Exr, AnAttributeLongerThanTheFileIsRefusedNamingIt) {
+  TempDir d;
+  const std::string fuzzed("v/1\x01\x02\0\0\0\x01t\0c\0\0\0lineOrder", 24);
+  write_raw(d.path / "fuzzed.exr", fuzzed);
+  expect_error_mentions([&] { read_exr(d.path / "fuzzed.exr"); }, "fuzzed.exr", "attribute '\\x01t' (c) declares 1768685568 bytes, but the file has 7 left");
+
+  write_exr(d.path / "full.exr", ramp(8, 8));
+  std::ifstream in(d.path / "full.exr", std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // The first attribute starts at byte 8: its name, its type, then 4 size bytes.
+  const std::size_t name_end = bytes.find('\0', 8), type_end = bytes.find('\0', name_end + 1);
+  const std::string first = bytes.substr(8, name_end - 8);
+  bytes.replace(type_end + 1, 4, std::string("\xff\xff\xff\x7f", 4));
+  write_raw(d.path / "patched.exr", bytes);
+  expect_error_mentions([&] { read_exr(d.path / "patched.exr"); }, "patched.exr", "attribute '" + first + "'");
+  expect_error_mentions([&] { read_exr(d.path / "patched.exr"); }, "patched.exr", "declares 2147483647 bytes");
+}
+
 TEST(Exr, RejectsARealTiledFile) {
   TempDir d;
   const fs::path p = d.path / "real_tiled.exr";
