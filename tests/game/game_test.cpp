@@ -24,6 +24,7 @@
 #include "level/level_save.h"
 #include "engine/script/script_runtime.h"
 #include "engine/scene/scene_assets.h"
+#include "engine/scene/sun.h"
 #include "play/game_session.h"
 #include "replay/replay.h"
 
@@ -329,3 +330,33 @@ TEST(WindowSmoke, TheWindowRendersTenFramesAndItsScreenshotIsNotBlank) {
 }
 
 }  // namespace
+
+// day_night.lua's hour turns the level's sun (a directional light) along its
+// arc: at 10:00 it stands at 56.23 sin(60 deg) = 48.70 degrees, azimuth
+// 44.06 - 2 x 15 = 14.06, at full strength; at 22:00 it is below the horizon,
+// off, and the sky holds its night strength (0.35 of the day's).
+TEST(GameSession, TheTimeOfDayTurnsTheLevelsSunAndPutsItOutAtNight) {
+  game::GameSession s(level_options(32, 18));
+  auto& world = s.world();
+  auto& scripts = world.resource<engine::script::ScriptRuntime>();
+  const auto clock = s.find("DayNight");
+  const auto sun = engine::scene::find_sun(world);
+  ASSERT_TRUE(sun) << "the level has a directional sun";
+  const float day_intensity = world.get<engine::scene::PunctualLight>(*sun).intensity;
+  const float day_sky = world.resource<engine::scene::SceneAssets>().environment->strength();
+  idle(s, 2);  // the scripts start
+  ASSERT_TRUE(scripts.set_property(world, clock, "running", false));
+  ASSERT_TRUE(scripts.set_property(world, clock, "hour", 10.0));
+  idle(s, 8);  // the script turns the sun every 0.1 s of game time (6 frames)
+  const glm::vec2 at10 = engine::scene::sun_angles(
+      glm::normalize(world.get<engine::transform::Transform>(*sun).rotation * glm::vec3(0, 0, 1)));
+  EXPECT_NEAR(at10.x, 48.697f, 0.01f) << "elevation at 10:00";
+  EXPECT_NEAR(at10.y, 14.06f, 0.01f) << "azimuth at 10:00";
+  EXPECT_NEAR(world.get<engine::scene::PunctualLight>(*sun).intensity, day_intensity, 1e-4f * day_intensity);
+
+  ASSERT_TRUE(scripts.set_property(world, clock, "hour", 22.0));
+  idle(s, 8);
+  EXPECT_EQ(world.get<engine::scene::PunctualLight>(*sun).intensity, 0.0f) << "the sun is out below the horizon";
+  EXPECT_NEAR(world.resource<engine::scene::SceneAssets>().environment->strength(), 0.35f * day_sky, 1e-5f * day_sky)
+      << "the sky at night strength";
+}
