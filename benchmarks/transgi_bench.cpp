@@ -13,6 +13,7 @@
 #include "shading/transfer_inference.h"
 #include "eval/machine_peak.h"
 #include "engine/math/rng.h"
+#include "probes/probe_grid.h"
 #include "engine/scene/procedural.h"
 #include "model/mlp.h"
 
@@ -182,10 +183,32 @@ void BM_OneDnnBf16Chain(benchmark::State& state) {
 
 }  // namespace
 
+// ProbeGrid::cage against its reference on 4,096 points of an 8^3 grid
+// (scrolled, relocated probes): Arg 0 = reference, 1 = the fast path.
+void BM_ProbeCage(benchmark::State& state) {
+  transgi::probes::ProbeGrid g{glm::vec3(-3.0f, 0.0f, -2.5f), glm::vec3(3.0f, 3.0f, 2.5f), glm::ivec3(8)};
+  g.scroll_by(glm::ivec3(2, 1, 3));
+  g.offsets.assign(static_cast<std::size_t>(g.count()), glm::vec3(0.01f));
+  std::vector<glm::vec3> points(4096);
+  engine::math::Pcg32 rng = engine::math::make_rng(3, 0, 0);
+  for (auto& p : points) p = glm::mix(g.min, g.max, glm::vec3(rng.next_float(), rng.next_float(), rng.next_float()));
+  const bool fast = state.range(0) == 1;
+  for (auto _ : state) {
+    float sum = 0;
+    for (const glm::vec3& p : points) {
+      const auto c = fast ? g.cage(p) : g.cage_reference(p);
+      sum += c.weights[3] + c.positions[5].y + static_cast<float>(c.probes[7]);
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(points.size()));
+}
+
 BENCHMARK(BM_Bf16Peak)->Threads(1)->Threads(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_AmxPeak)->Threads(1)->Threads(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FusedShade)->Arg(3)->Arg(2)->Arg(1)->Arg(0)->Threads(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FusedShade)->Arg(3)->Arg(2)->Threads(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ProbeCage)->Arg(0)->Arg(1)->Arg(0)->Arg(1);
 BENCHMARK(BM_OneDnnBf16Chain)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_InferTransfer)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 // Argument: 32 = f32 sgemm, 16 = bf16 matmul.

@@ -75,7 +75,12 @@ struct ProbeGrid {
     std::array<float, 8> weights{};
     std::array<glm::vec3, 8> positions{};  // position(probes[i]), without its divisions
   };
+  // Per axis once, then the 8 corners combine them: it runs for every
+  // interpolation (every decoded pixel, every probe ray's feedback).
   [[nodiscard]] Cage cage(const glm::vec3& p) const;
+  // The plain statement, corner by corner through index(): the reference
+  // cage() is tested against (identical results).
+  [[nodiscard]] Cage cage_reference(const glm::vec3& p) const;
 
   // Probe q's 3x3x3 neighbourhood (itself included), clamped to the grid;
   // calls fn(neighbour index).
