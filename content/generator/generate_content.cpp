@@ -188,7 +188,8 @@ void add_sun(GltfSceneDesc& s, glm::vec3 sun_dir) {
   // A directional light shines along its local -z.
   const glm::vec2 angles = scene::sun_angles(glm::normalize(split.sun->direction));
   n.transform.rotation = scene::sun_rotation(angles.x, angles.y);
-  n.light = scene::PunctualLight{.type = scene::PunctualLight::Type::Directional, .color = e / peak, .intensity = peak};
+  n.light = scene::PunctualLight{.type = scene::PunctualLight::Type::Directional, .color = e / peak, .intensity = peak,
+                                 .angular_radius = split.sun->angular_radius};  // the disk's soft shadow edge
   s.nodes.push_back(n);
   s.roots.push_back(static_cast<int>(s.nodes.size() - 1));
 }

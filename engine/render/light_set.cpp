@@ -172,7 +172,8 @@ float LightSet::pdf_environment(const glm::vec3& dir) const {
 
 std::optional<PunctualInstance> punctual_instance(const scene::PunctualLight& l, const transform::Similarity& w) {
   if (!l.enabled || l.intensity <= 0) return std::nullopt;
-  return PunctualInstance{l, w.translation, glm::normalize(w.apply_direction({0, 0, -1}))};
+  return PunctualInstance{l, w.translation, glm::normalize(w.apply_direction({0, 0, -1})),
+                          l.type == scene::PunctualLight::Type::Directional ? l.angular_radius : 0.0f};
 }
 
 std::vector<PunctualInstance> gather_punctual_lights(ecs::World& world) {

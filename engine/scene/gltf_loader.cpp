@@ -563,6 +563,13 @@ GltfLoadResult load_gltf(ecs::World& world, const fs::path& path, const GltfLoad
         if (pl.outer_cone_angle < pl.inner_cone_angle)
           c.fail(lif + ".spot.outerConeAngle", "is smaller than innerConeAngle");
       }
+      if (l.extras.IsObject() && l.extras.Has("angular_radius")) {
+        const std::string af = lif + ".extras.angular_radius";
+        if (pl.type != PunctualLight::Type::Directional) c.fail(af, "is for directional lights only");
+        const double r = value_number(c, l.extras.Get("angular_radius"), af);
+        if (!(r >= 0 && r <= 0.5)) c.fail(af, "must lie in [0, 0.5] radians, got " + std::to_string(r));
+        pl.angular_radius = static_cast<float>(r);
+      }
       world.emplace<PunctualLight>(e, pl);
     }
     for (auto ch = n.children.rbegin(); ch != n.children.rend(); ++ch) stack.emplace_back(*ch, node);

@@ -120,6 +120,7 @@ void write_gltf(const std::filesystem::path& path, const GltfSceneDesc& scene) {
                  {"intensity", l.intensity}};
       if (l.type == PunctualLight::Type::Spot)
         lj["spot"] = {{"innerConeAngle", l.inner_cone_angle}, {"outerConeAngle", l.outer_cone_angle}};
+      if (l.type == PunctualLight::Type::Directional && l.angular_radius > 0) lj["extras"] = {{"angular_radius", l.angular_radius}};
       lights.push_back(lj);
       j["extensions"]["KHR_lights_punctual"] = {{"light", lights.size() - 1}};
       used.insert("KHR_lights_punctual");

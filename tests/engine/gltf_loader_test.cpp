@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "engine/image/exr.h"
+#include "engine/render/light_set.h"
 #include "engine/scene/components.h"
 #include "engine/scene/gltf_loader.h"
 #include "engine/scene/scene_assets.h"
@@ -192,6 +193,38 @@ TEST(GltfLoader, LightsPunctual) {
   EXPECT_FLOAT_EQ(l.intensity, 100.0f);
   EXPECT_FLOAT_EQ(l.outer_cone_angle, 0.5f);
   EXPECT_EQ(l.color, glm::vec3(1, 0.5f, 0.25f));
+}
+
+// A directional light's disk: extras.angular_radius, read into the light and
+// turned into the sampled disk's half-angle by the light set.
+TEST(GltfLoader, ADirectionalLightsAngularRadiusComesFromItsExtras) {
+  TempDir d;
+  json j = quad_gltf();
+  j["extensionsUsed"] = {"KHR_lights_punctual"};
+  j["extensions"]["KHR_lights_punctual"]["lights"] =
+      json::parse(R"([{"type": "directional", "intensity": 10, "extras": {"angular_radius": 0.045}}])");
+  j["nodes"][2]["extensions"]["KHR_lights_punctual"]["light"] = 0;
+  ecs::World w;
+  const auto r = load_gltf(w, write_scene(d, j));
+  EXPECT_FLOAT_EQ(w.get<PunctualLight>(r.entities[2]).angular_radius, 0.045f);
+  const auto inst = render::punctual_instance(w.get<PunctualLight>(r.entities[2]), transform::Similarity{});
+  ASSERT_TRUE(inst);
+  EXPECT_FLOAT_EQ(inst->angular_radius, 0.045f) << "the light set samples a disk of that half-angle";
+}
+
+TEST(GltfLoaderBadInput, AnAngularRadiusOutOfRangeOrOnAPointLight) {
+  TempDir d;
+  const auto with_light = [&](const char* light) {
+    json j = quad_gltf();
+    j["extensionsUsed"] = {"KHR_lights_punctual"};
+    j["extensions"]["KHR_lights_punctual"]["lights"] = json::array({json::parse(light)});
+    j["nodes"][2]["extensions"]["KHR_lights_punctual"]["light"] = 0;
+    return write_scene(d, j);
+  };
+  expect_rejected(with_light(R"({"type": "directional", "intensity": 1, "extras": {"angular_radius": 2}})"),
+                  {"lights[0].extras.angular_radius", "[0, 0.5]"});
+  expect_rejected(with_light(R"({"type": "point", "intensity": 1, "extras": {"angular_radius": 0.01}})"),
+                  {"lights[0].extras.angular_radius", "directional lights only"});
 }
 
 TEST(GltfLoader, EnvironmentFromSceneExtras) {

@@ -16,7 +16,9 @@ TEST(Sun, AnglesRoundTripAndTheLightShinesAwayFromTheSun) {
       EXPECT_NEAR(d.y, std::sin(glm::radians(e)), 1e-6f) << "elevation " << e;
       const glm::vec2 back = scene::sun_angles(d);
       EXPECT_NEAR(back.x, e, 1e-3f);
-      if (e < 89.0f) EXPECT_NEAR(back.y, a, 1e-3f) << "elevation " << e << " azimuth " << a;
+      if (e < 89.0f) {
+        EXPECT_NEAR(back.y, a, 1e-3f) << "elevation " << e << " azimuth " << a;
+      }
       // A glTF directional light shines along its -z.
       const glm::vec3 travel = scene::sun_rotation(e, a) * glm::vec3(0, 0, -1);
       EXPECT_NEAR(glm::dot(travel, -d), 1.0f, 1e-5f) << "elevation " << e << " azimuth " << a;
