@@ -51,6 +51,28 @@ bake::DatasetSettings tiny_data() {
   return s;
 }
 
+// Points by area, capped per vertex: a 200 m ground plane of 4 vertices
+// (40,000 m^2) beside a 10 m^2 mesh of 1,000 vertices. By area alone the plane
+// takes all but the floor of 32; capped at 64 a vertex it takes 256 and the
+// detailed mesh the remaining 9,744. A cap that binds no mesh changes nothing.
+TEST(BakeDataset, ACoarseGroundPlaneDoesNotTakeThePointsFromTheDetailedMeshes) {
+  bake::DatasetSettings s;
+  s.points = 10000;
+  s.min_points_per_mesh = 32;
+  const std::vector<double> area = {40000.0, 10.0, 0.0};
+  const std::vector<std::size_t> vertices = {4, 1000, 3};
+  s.max_points_per_vertex = 0;
+  const auto by_area = bake::points_per_mesh(area, vertices, s);
+  EXPECT_EQ(by_area, (std::vector<int>{9998, 32, 0})) << "by area alone: " << by_area[0] << ", " << by_area[1];
+  s.max_points_per_vertex = 64;
+  const auto capped = bake::points_per_mesh(area, vertices, s);
+  EXPECT_EQ(capped, (std::vector<int>{256, 9744, 0})) << "capped: " << capped[0] << ", " << capped[1];
+  s.max_points_per_vertex = 8192;  // the default: 32,768 for the plane, which 10,000 points do not reach
+  EXPECT_EQ(bake::points_per_mesh(area, vertices, s), by_area);
+  s.points = 131072;  // the CLI's default points: now the cap binds
+  EXPECT_EQ(bake::points_per_mesh(area, vertices, s), (std::vector<int>{32768, 98304, 0}));
+}
+
 struct TempDir {
   fs::path path = fs::temp_directory_path() / ("bake_test_" + std::to_string(::getpid()));
   TempDir() { fs::create_directories(path); }

@@ -32,7 +32,8 @@ std::uint64_t dataset_key(const engine::scene::SceneAssets& assets, const Datase
     h = fnv(&mh, sizeof(mh), h);
   }
   const double fields[] = {double(s.points), double(s.min_points_per_mesh), double(s.outgoing_per_point), double(s.rays),
-                           double(s.visibility_fraction), double(s.validation_fraction), double(s.seed)};
+                           double(s.visibility_fraction), double(s.validation_fraction), double(s.seed),
+                           double(s.max_points_per_vertex)};
   return fnv(fields, sizeof(fields), h);
 }
 

@@ -4,10 +4,43 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "engine/jobs/parallel_for.h"
 
 namespace transgi::bake {
+
+std::vector<int> points_per_mesh(const std::vector<double>& area, const std::vector<std::size_t>& vertices,
+                                 const DatasetSettings& s) {
+  const std::size_t n = area.size();
+  std::vector<int> points(n, 0);
+  std::vector<double> cap(n, std::numeric_limits<double>::infinity());
+  if (s.max_points_per_vertex > 0)
+    for (std::size_t m = 0; m < n; ++m)
+      cap[m] = std::max<double>(s.min_points_per_mesh, static_cast<double>(s.max_points_per_vertex) * static_cast<double>(vertices[m]));
+  // Water-filling: meshes whose share by area exceeds their cap take the cap;
+  // the rest share what is left by area. Each round caps at least one more
+  // mesh or ends, so at most n rounds.
+  std::vector<char> capped(n, 0);
+  for (std::size_t round = 0; round <= n; ++round) {
+    double left = s.points, free_area = 0;
+    for (std::size_t m = 0; m < n; ++m) {
+      if (capped[m]) left -= cap[m];
+      else if (area[m] > 0) free_area += area[m];
+    }
+    bool more = false;
+    for (std::size_t m = 0; m < n; ++m)
+      if (!capped[m] && area[m] > 0 && left * area[m] / free_area > cap[m]) capped[m] = 1, more = true;
+    if (more) continue;
+    for (std::size_t m = 0; m < n; ++m) {
+      if (area[m] <= 0) continue;
+      const double share = capped[m] ? cap[m] : std::max(0.0, left) * area[m] / free_area;
+      points[m] = std::max(s.min_points_per_mesh, static_cast<int>(std::lround(share)));
+    }
+    break;
+  }
+  return points;
+}
 
 TransferDataset generate_dataset(const engine::scene::SceneAssets& assets, const DatasetSettings& s,
                                  const std::function<void(std::size_t, std::size_t)>& progress) {
@@ -15,20 +48,16 @@ TransferDataset generate_dataset(const engine::scene::SceneAssets& assets, const
   const std::size_t mesh_count = assets.meshes.size();
   // Points per mesh: by area, with a floor.
   std::vector<double> area(mesh_count, 0.0);
-  double total_area = 0;
   for (std::size_t m = 0; m < mesh_count; ++m) {
     const auto& mesh = *assets.meshes[m];
     for (const glm::uvec3& t : mesh.triangles)
       area[m] += 0.5 * glm::length(glm::cross(mesh.positions[t.y] - mesh.positions[t.x], mesh.positions[t.z] - mesh.positions[t.x]));
-    total_area += area[m];
   }
-  std::vector<int> points(mesh_count, 0);
+  std::vector<std::size_t> vertices(mesh_count);
+  for (std::size_t m = 0; m < mesh_count; ++m) vertices[m] = assets.meshes[m]->positions.size();
+  const std::vector<int> points = points_per_mesh(area, vertices, s);
   std::size_t total_points = 0;
-  for (std::size_t m = 0; m < mesh_count; ++m) {
-    if (area[m] <= 0) continue;
-    points[m] = std::max(s.min_points_per_mesh, static_cast<int>(std::lround(s.points * area[m] / total_area)));
-    total_points += static_cast<std::size_t>(points[m]);
-  }
+  for (int p : points) total_points += static_cast<std::size_t>(p);
 
   const int K = s.outgoing_per_point;
   struct PointResult {

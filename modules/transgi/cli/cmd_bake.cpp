@@ -17,13 +17,15 @@ namespace transgi::cli {
 int run_bake(const std::vector<std::string>& argv) {
   const Args args("bake", argv,
                   {"scene", "out", "points", "dirs", "outgoing", "iters", "batch", "lr", "latent-dim", "width", "depth",
-                   "threads", "seed", "curve"},
+                   "threads", "seed", "curve", "max-points-per-vertex"},
                   {"resume", "keep-dataset"});
   bake::BakeSettings s;
   const std::string scene_path = args.str("scene");
   const std::string out = args.str("out");
   s.data.points = static_cast<int>(args.integer("points", 1, 100'000'000, s.data.points));
   s.data.rays = static_cast<int>(args.integer("dirs", 1, 1'000'000, s.data.rays));
+  s.data.max_points_per_vertex =
+      static_cast<int>(args.integer("max-points-per-vertex", 0, 100'000'000, s.data.max_points_per_vertex));
   s.data.outgoing_per_point = static_cast<int>(args.integer("outgoing", 1, 256, s.data.outgoing_per_point));
   s.train.iterations = static_cast<int>(args.integer("iters", 0, 100'000'000, s.train.iterations));
   s.train.batch = static_cast<int>(args.integer("batch", 1, 1 << 20, s.train.batch));

@@ -19,6 +19,7 @@ void usage() {
                "  compare  A.exr B.exr [--heatmap out.png] [--heatmap-max E]\n"
                "  tonemap  IN.exr OUT.png [--exposure EV] [--signed SCALE] [--minus B.exr]\n"
                "  bake     --scene S.gltf --out M.tgm [--points N] [--dirs D] [--outgoing K] [--iters I] [--batch B]\n"
+               "           [--max-points-per-vertex P (default 8192; 0 = by area alone)]\n"
                "           [--lr R] [--latent-dim K] [--width W] [--depth L] [--threads T] [--seed S] [--resume] [--keep-dataset]\n"
                "  render   --scene S.gltf --method ddgi [--frames F] [--probe-grid N] [--probe-rays M] [--warmup-frames W] ...\n"
                "  transfer-study --scene S.gltf [--points N] [--outgoing K] [--reference-rays R]\n"
