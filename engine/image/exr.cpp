@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <mutex>
 #include <span>
 #include <string>
 
@@ -145,6 +146,13 @@ ImageRGB read_exr(const fs::path& path, const ExrLimits& limits) {
   if (Imf::isNonImage(version)) throw ImageError(quote(path) + ": deep OpenEXR files are not supported");
   if (Imf::isTiled(version)) throw ImageError(quote(path) + ": tiled OpenEXR files are not supported (scanline only)");
   check_header_attributes(path, size);
+  // OpenEXR sizes its line buffers from the data window while opening the
+  // file, before check_dimensions can look: the EXR fuzzer's 104-byte file
+  // with a 67,108,353-pixel-wide window made it ask for 2.17 GB. Its own
+  // sanity check refuses wider windows first; set once, process-wide, to the
+  // largest size any caller accepts (ExrLimits' default).
+  static std::once_flag exr_size_cap;
+  std::call_once(exr_size_cap, [] { Imf::Header::setMaxImageSize(ExrLimits{}.max_dimension, ExrLimits{}.max_dimension); });
 
   try {
     Imf::InputFile file(path.c_str());
