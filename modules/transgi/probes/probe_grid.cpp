@@ -22,13 +22,29 @@ void ProbeGrid::scroll_by(glm::ivec3 cells) {
   scroll = ((scroll + cells) % d + d) % d;
 }
 
-ProbeGrid::Cage ProbeGrid::cage_reference(const glm::vec3& p) const {
-  const glm::vec3 s = spacing();
+namespace {
+
+// The cell holding p (clamped to the grid) and p's place in it: what both
+// cage() and its reference start from.
+struct Cell {
+  glm::vec3 spacing;
+  glm::ivec3 base;  // the cell's lower corner, grid coordinates
+  glm::vec3 f;      // p's fraction across the cell, per axis
+};
+Cell cell_of(const ProbeGrid& grid, const glm::vec3& p) {
+  const glm::vec3 s = grid.spacing();
   glm::vec3 g(0.0f);
   for (int a = 0; a < 3; ++a)
-    if (dims[a] > 1 && s[a] > 0) g[a] = std::clamp((p[a] - min[a]) / s[a], 0.0f, static_cast<float>(dims[a] - 1));
-  const glm::ivec3 base = glm::min(glm::ivec3(glm::floor(g)), glm::max(dims - 2, glm::ivec3(0)));
-  const glm::vec3 f = glm::clamp(g - glm::vec3(base), glm::vec3(0.0f), glm::vec3(1.0f));
+    if (grid.dims[a] > 1 && s[a] > 0)
+      g[a] = std::clamp((p[a] - grid.min[a]) / s[a], 0.0f, static_cast<float>(grid.dims[a] - 1));
+  const glm::ivec3 base = glm::min(glm::ivec3(glm::floor(g)), glm::max(grid.dims - 2, glm::ivec3(0)));
+  return {s, base, glm::clamp(g - glm::vec3(base), glm::vec3(0.0f), glm::vec3(1.0f))};
+}
+
+}  // namespace
+
+ProbeGrid::Cage ProbeGrid::cage_reference(const glm::vec3& p) const {
+  const auto [s, base, f] = cell_of(*this, p);
   Cage c;
   for (int i = 0; i < 8; ++i) {
     const glm::ivec3 o((i >> 0) & 1, (i >> 1) & 1, (i >> 2) & 1);
@@ -43,12 +59,7 @@ ProbeGrid::Cage ProbeGrid::cage_reference(const glm::vec3& p) const {
 }
 
 ProbeGrid::Cage ProbeGrid::cage(const glm::vec3& p) const {
-  const glm::vec3 s = spacing();
-  glm::vec3 g(0.0f);
-  for (int a = 0; a < 3; ++a)
-    if (dims[a] > 1 && s[a] > 0) g[a] = std::clamp((p[a] - min[a]) / s[a], 0.0f, static_cast<float>(dims[a] - 1));
-  const glm::ivec3 base = glm::min(glm::ivec3(glm::floor(g)), glm::max(dims - 2, glm::ivec3(0)));
-  const glm::vec3 f = glm::clamp(g - glm::vec3(base), glm::vec3(0.0f), glm::vec3(1.0f));
+  const auto [s, base, f] = cell_of(*this, p);
   // Per axis and side (0 = base, 1 = base + 1, clamped): the storage
   // coordinate, the world coordinate and the weight factor, in the
   // reference's arithmetic.
