@@ -9,6 +9,7 @@ packages=(
   libtbb-dev libglm-dev libstb-dev libopenexr-dev libtinygltf-dev nlohmann-json3-dev libembree-dev libdnnl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   liblua5.4-dev libglfw3-dev libimgui-dev libgl-dev libgl1-mesa-dri
+  libvulkan-dev glslang-dev spirv-tools mesa-vulkan-drivers vulkan-validationlayers
   xvfb xauth ffmpeg
 )
 # --fuzz: also the compiler of the `fuzz` preset (clang 14 with libFuzzer and

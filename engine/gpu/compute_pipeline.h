@@ -1,0 +1,45 @@
+#pragma once
+// One compute kernel: its SPIR-V, a descriptor set of storage buffers at
+// set 0, bindings 0..N-1 (the kernel's declared inputs and outputs, in
+// order), and a push-constant block. A pass binds buffers, then records a
+// dispatch into a command buffer.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <vulkan/vulkan_core.h>
+
+namespace engine::gpu {
+
+class GpuBuffer;
+class VulkanContext;
+
+class ComputePipeline {
+ public:
+  ComputePipeline(VulkanContext& ctx, std::span<const std::uint32_t> spirv, std::uint32_t storage_buffers,
+                  std::uint32_t push_constant_bytes);
+  ~ComputePipeline();
+  ComputePipeline(const ComputePipeline&) = delete;
+  ComputePipeline& operator=(const ComputePipeline&) = delete;
+
+  // Throws GpuError for a binding out of range.
+  void bind(std::uint32_t binding, const GpuBuffer& buffer);
+  // push: exactly push_constant_bytes.
+  void record_dispatch(VkCommandBuffer cmd, std::uint32_t groups_x, std::uint32_t groups_y, std::uint32_t groups_z,
+                       const void* push) const;
+
+ private:
+  VkDevice device_ = VK_NULL_HANDLE;
+  std::uint32_t bindings_ = 0, push_bytes_ = 0;
+  VkShaderModule module_ = VK_NULL_HANDLE;
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;
+};
+
+// Makes the writes of one dispatch visible to the reads of the next.
+void record_compute_barrier(VkCommandBuffer cmd);
+
+}  // namespace engine::gpu

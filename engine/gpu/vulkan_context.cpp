@@ -1,0 +1,220 @@
+#include "engine/gpu/vulkan_context.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include "engine/gpu/gpu_error.h"
+
+namespace engine::gpu {
+namespace {
+
+DeviceKind kind_of(VkPhysicalDeviceType t) {
+  switch (t) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return DeviceKind::Discrete;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return DeviceKind::Integrated;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return DeviceKind::Virtual;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return DeviceKind::Cpu;
+    default: return DeviceKind::Other;
+  }
+}
+
+std::optional<std::uint32_t> compute_family(VkPhysicalDevice d) {
+  std::uint32_t n = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(d, &n, nullptr);
+  std::vector<VkQueueFamilyProperties> families(n);
+  vkGetPhysicalDeviceQueueFamilyProperties(d, &n, families.data());
+  for (std::uint32_t i = 0; i < n; ++i)
+    if (families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) return i;
+  return std::nullopt;
+}
+
+bool layer_installed(const char* name) {
+  std::uint32_t n = 0;
+  if (vkEnumerateInstanceLayerProperties(&n, nullptr) != VK_SUCCESS) return false;
+  std::vector<VkLayerProperties> layers(n);
+  vkEnumerateInstanceLayerProperties(&n, layers.data());
+  for (const auto& l : layers)
+    if (std::strcmp(l.layerName, name) == 0) return true;
+  return false;
+}
+
+}  // namespace
+
+VKAPI_ATTR VkBool32 VKAPI_CALL VulkanContext::on_validation(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                            VkDebugUtilsMessageTypeFlagsEXT,
+                                                            const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                                            void* self) {
+  if (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) {
+    ++static_cast<VulkanContext*>(self)->validation_errors_;
+    std::fprintf(stderr, "vulkan validation error: %s\n", data->pMessage);
+  } else if (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) {
+    std::fprintf(stderr, "vulkan validation warning: %s\n", data->pMessage);
+  }
+  return VK_FALSE;
+}
+
+std::unique_ptr<VulkanContext> VulkanContext::create(const GpuOptions& options, std::string* why_not) {
+  auto fail = [&](std::string why) {
+    if (why_not) *why_not = std::move(why);
+    return std::unique_ptr<VulkanContext>();
+  };
+  std::unique_ptr<VulkanContext> ctx(new VulkanContext());
+
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.pApplicationName = "engine";
+  app.apiVersion = VK_API_VERSION_1_2;
+  std::vector<const char*> layers, extensions;
+  const char* kValidation = "VK_LAYER_KHRONOS_validation";
+  const bool validate = options.validation && layer_installed(kValidation);
+  if (validate) {
+    layers.push_back(kValidation);
+    extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  }
+  VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  ici.pApplicationInfo = &app;
+  ici.enabledLayerCount = static_cast<std::uint32_t>(layers.size());
+  ici.ppEnabledLayerNames = layers.data();
+  ici.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
+  ici.ppEnabledExtensionNames = extensions.data();
+  if (const VkResult r = vkCreateInstance(&ici, nullptr, &ctx->instance_); r != VK_SUCCESS)
+    return fail("vkCreateInstance failed: " + vk_result_name(r) + " (is a Vulkan driver installed? Debian: mesa-vulkan-drivers)");
+
+  if (validate) {
+    auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(ctx->instance_, "vkCreateDebugUtilsMessengerEXT"));
+    VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT;
+    mci.pfnUserCallback = &VulkanContext::on_validation;
+    mci.pUserData = ctx.get();
+    if (create_messenger) ENGINE_VK_CHECK(create_messenger(ctx->instance_, &mci, nullptr, &ctx->messenger_));
+  }
+
+  std::uint32_t count = 0;
+  ENGINE_VK_CHECK(vkEnumeratePhysicalDevices(ctx->instance_, &count, nullptr));
+  std::vector<VkPhysicalDevice> physicals(count);
+  ENGINE_VK_CHECK(vkEnumeratePhysicalDevices(ctx->instance_, &count, physicals.data()));
+  std::vector<DeviceCandidate> candidates;
+  for (auto p : physicals) {
+    VkPhysicalDeviceProperties props;
+    vkGetPhysicalDeviceProperties(p, &props);
+    candidates.push_back({props.deviceName, kind_of(props.deviceType), compute_family(p).has_value()});
+  }
+  std::string requested = options.device;
+  if (requested.empty())
+    if (const char* env = std::getenv("ENGINE_GPU_DEVICE")) requested = env;
+  const DeviceChoice choice = choose_device(candidates, requested);
+  if (!choice.index) return fail(choice.why);
+  ctx->physical_ = physicals[*choice.index];
+  ctx->queue_family_ = *compute_family(ctx->physical_);
+
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(ctx->physical_, &props);
+  VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  f2.pNext = &f12;
+  vkGetPhysicalDeviceFeatures2(ctx->physical_, &f2);
+  VkPhysicalDeviceVulkan12Properties p12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_PROPERTIES};
+  VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  p2.pNext = &p12;
+  vkGetPhysicalDeviceProperties2(ctx->physical_, &p2);
+  ctx->info_.name = props.deviceName;
+  ctx->info_.kind = kind_of(props.deviceType);
+  ctx->info_.driver = std::string(p12.driverName) + " " + p12.driverInfo;
+  ctx->info_.shader_float16 = f12.shaderFloat16 == VK_TRUE;
+  ctx->info_.max_shared_memory = props.limits.maxComputeSharedMemorySize;
+
+  // Enable only what the kernels use, so a device without float16 still runs
+  // the fp32 variants.
+  VkPhysicalDeviceVulkan12Features enable12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  enable12.shaderFloat16 = f12.shaderFloat16;
+  const float priority = 1.0f;
+  VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  qci.queueFamilyIndex = ctx->queue_family_;
+  qci.queueCount = 1;
+  qci.pQueuePriorities = &priority;
+  VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  dci.pNext = &enable12;
+  dci.queueCreateInfoCount = 1;
+  dci.pQueueCreateInfos = &qci;
+  ENGINE_VK_CHECK(vkCreateDevice(ctx->physical_, &dci, nullptr, &ctx->device_));
+  vkGetDeviceQueue(ctx->device_, ctx->queue_family_, 0, &ctx->queue_);
+
+  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pci.queueFamilyIndex = ctx->queue_family_;
+  ENGINE_VK_CHECK(vkCreateCommandPool(ctx->device_, &pci, nullptr, &ctx->pool_));
+  VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  cai.commandPool = ctx->pool_;
+  cai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  cai.commandBufferCount = 1;
+  ENGINE_VK_CHECK(vkAllocateCommandBuffers(ctx->device_, &cai, &ctx->cmd_));
+  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  ENGINE_VK_CHECK(vkCreateFence(ctx->device_, &fci, nullptr, &ctx->fence_));
+
+  std::uint32_t families = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(ctx->physical_, &families, nullptr);
+  std::vector<VkQueueFamilyProperties> fam(families);
+  vkGetPhysicalDeviceQueueFamilyProperties(ctx->physical_, &families, fam.data());
+  if (fam[ctx->queue_family_].timestampValidBits > 0 && props.limits.timestampPeriod > 0) {
+    VkQueryPoolCreateInfo qpi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    qpi.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    qpi.queryCount = 2;
+    ENGINE_VK_CHECK(vkCreateQueryPool(ctx->device_, &qpi, nullptr, &ctx->timestamps_));
+    ctx->info_.timestamp_period_ns = props.limits.timestampPeriod;
+  }
+  return ctx;
+}
+
+VulkanContext::~VulkanContext() {
+  if (device_) {
+    vkDeviceWaitIdle(device_);
+    if (timestamps_) vkDestroyQueryPool(device_, timestamps_, nullptr);
+    if (fence_) vkDestroyFence(device_, fence_, nullptr);
+    if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
+    vkDestroyDevice(device_, nullptr);
+  }
+  if (messenger_) {
+    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+    if (destroy) destroy(instance_, messenger_, nullptr);
+  }
+  if (instance_) vkDestroyInstance(instance_, nullptr);
+}
+
+std::uint32_t VulkanContext::memory_type(std::uint32_t type_bits, VkMemoryPropertyFlags flags) const {
+  VkPhysicalDeviceMemoryProperties mem;
+  vkGetPhysicalDeviceMemoryProperties(physical_, &mem);
+  for (std::uint32_t i = 0; i < mem.memoryTypeCount; ++i)
+    if ((type_bits & (1u << i)) && (mem.memoryTypes[i].propertyFlags & flags) == flags) return i;
+  throw GpuError("no Vulkan memory type with flags " + std::to_string(flags) + " on " + info_.name);
+}
+
+double VulkanContext::submit_and_wait(const std::function<void(VkCommandBuffer)>& record) {
+  ENGINE_VK_CHECK(vkResetCommandBuffer(cmd_, 0));
+  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  ENGINE_VK_CHECK(vkBeginCommandBuffer(cmd_, &bi));
+  if (timestamps_) {
+    vkCmdResetQueryPool(cmd_, timestamps_, 0, 2);
+    vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, timestamps_, 0);
+  }
+  record(cmd_);
+  if (timestamps_) vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, timestamps_, 1);
+  ENGINE_VK_CHECK(vkEndCommandBuffer(cmd_));
+  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &cmd_;
+  ENGINE_VK_CHECK(vkResetFences(device_, 1, &fence_));
+  ENGINE_VK_CHECK(vkQueueSubmit(queue_, 1, &si, fence_));
+  ENGINE_VK_CHECK(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX));
+  if (!timestamps_) return -1.0;
+  std::uint64_t ticks[2] = {0, 0};
+  ENGINE_VK_CHECK(vkGetQueryPoolResults(device_, timestamps_, 0, 2, sizeof(ticks), ticks, sizeof(std::uint64_t),
+                                        VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+  return static_cast<double>(ticks[1] - ticks[0]) * info_.timestamp_period_ns * 1e-6;
+}
+
+}  // namespace engine::gpu

@@ -1,0 +1,37 @@
+#pragma once
+// The fused transfer inference as a Vulkan compute kernel
+// (shaders/fused_inference.comp): the same contract as
+// shading::FusedDecoder::shade_tile, for any number of points at once.
+// The CPU's scalar backend is its oracle (tests/transgi/gpu_fused_test.cpp).
+#include <memory>
+#include <span>
+
+#include "engine/gpu/compute_pipeline.h"
+#include "engine/gpu/gpu_buffer.h"
+#include "engine/gpu/vulkan_context.h"
+#include "model/mlp.h"
+
+namespace transgi::gpu {
+
+class VulkanFusedDecoder {
+ public:
+  // Throws std::invalid_argument for a layout the kernel cannot hold (wider
+  // than kFusedMaxWidth, or not 75 outputs), GpuError for Vulkan failures.
+  VulkanFusedDecoder(engine::gpu::VulkanContext& ctx, const model::Mlp& mlp);
+
+  // rgb (n x 3) = sum_o decoder(inputs[i])[o] * light[i][o]; inputs n x 16,
+  // light n x 75. Returns the kernel's GPU time in ms (-1 without timestamps).
+  double shade(std::span<const float> inputs, std::span<const float> light, std::span<float> rgb);
+
+ private:
+  void reserve(std::size_t n);
+
+  engine::gpu::VulkanContext& ctx_;
+  model::MlpLayout layout_;
+  engine::gpu::GpuBuffer params_;
+  engine::gpu::GpuBuffer inputs_, light_, rgb_;
+  std::size_t capacity_ = 0;
+  std::unique_ptr<engine::gpu::ComputePipeline> pipeline_;
+};
+
+}  // namespace transgi::gpu

@@ -1,0 +1,113 @@
+// The generic Vulkan pieces: device choice (no driver needed), shader
+// compile errors, buffers.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <vector>
+
+#include "engine/gpu/device_choice.h"
+#include "engine/gpu/gpu_buffer.h"
+#include "engine/gpu/gpu_error.h"
+#include "engine/gpu/shader_compiler.h"
+#include "gpu_fixture.h"
+
+using namespace engine::gpu;
+
+TEST(GpuDeviceChoice, ADiscreteGpuBeatsIntegratedAndLavapipeWhateverTheOrder) {
+  const std::vector<DeviceCandidate> devices = {
+      {"llvmpipe (LLVM 15.0.6, 256 bits)", DeviceKind::Cpu}, {"Intel UHD 770", DeviceKind::Integrated},
+      {"NVIDIA H100", DeviceKind::Discrete}};
+  const DeviceChoice c = choose_device(devices, "");
+  ASSERT_TRUE(c.index) << c.why;
+  EXPECT_EQ(*c.index, 2u) << "expected the discrete GPU, got " << devices[*c.index].name;
+}
+
+TEST(GpuDeviceChoice, ANamedDeviceWinsOverTheRankCaseInsensitively) {
+  const std::vector<DeviceCandidate> devices = {{"NVIDIA H100", DeviceKind::Discrete},
+                                                {"llvmpipe (LLVM 15.0.6, 256 bits)", DeviceKind::Cpu}};
+  const DeviceChoice c = choose_device(devices, "LLVMpipe");
+  ASSERT_TRUE(c.index) << c.why;
+  EXPECT_EQ(*c.index, 1u);
+}
+
+TEST(GpuDeviceChoice, AnUnmatchedNameIsAnErrorListingTheDevices) {
+  const std::vector<DeviceCandidate> devices = {{"llvmpipe", DeviceKind::Cpu}};
+  const DeviceChoice c = choose_device(devices, "radeon");
+  EXPECT_FALSE(c.index);
+  EXPECT_NE(c.why.find("radeon"), std::string::npos) << c.why;
+  EXPECT_NE(c.why.find("'llvmpipe'"), std::string::npos) << c.why;
+}
+
+TEST(GpuDeviceChoice, ADeviceWithoutAComputeQueueIsPassedOver) {
+  const std::vector<DeviceCandidate> devices = {{"display only", DeviceKind::Discrete, false},
+                                                {"llvmpipe", DeviceKind::Cpu, true}};
+  const DeviceChoice c = choose_device(devices, "");
+  ASSERT_TRUE(c.index) << c.why;
+  EXPECT_EQ(*c.index, 1u);
+  EXPECT_FALSE(choose_device({}, "").index);
+}
+
+TEST(ShaderCompiler, AGlslErrorNamesTheFileAndLine) {
+  const char* source =
+      "#version 460\n"
+      "layout(local_size_x = 1) in;\n"
+      "void main() {\n"
+      "  float x = undeclared_thing;\n"
+      "}\n";
+  try {
+    compile_compute_source(source, "bad.comp");
+    FAIL() << "expected a compile error";
+  } catch (const GpuError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("bad.comp:4: error:"), std::string::npos) << "expected 'bad.comp:4: error:', got: " << msg;
+    EXPECT_NE(msg.find("undeclared_thing"), std::string::npos) << msg;
+  }
+}
+
+TEST(ShaderCompiler, AnErrorInAnIncludedHeaderNamesTheHeaderAndItsLine) {
+  const auto dir = std::filesystem::temp_directory_path() / "engine_gpu_include_test";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "broken.h") << "// a header\nfloat f() { return not_declared; }\n";
+  std::ofstream(dir / "main.comp") << "#version 460\n#extension GL_GOOGLE_include_directive : require\n"
+                                      "#include \"broken.h\"\nlayout(local_size_x = 1) in;\nvoid main() {}\n";
+  try {
+    compile_compute_shader(dir / "main.comp");
+    FAIL() << "expected a compile error";
+  } catch (const GpuError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("broken.h:2: error:"), std::string::npos) << "expected 'broken.h:2: error:', got: " << msg;
+  }
+  EXPECT_THROW(compile_compute_shader(dir / "missing.comp"), GpuError);
+}
+
+TEST(ShaderCompiler, AValidShaderBecomesSpirvWithItsMagicNumber) {
+  const auto spirv = compile_compute_source("#version 460\nlayout(local_size_x = 1) in;\nvoid main() {}\n", "ok.comp");
+  ASSERT_GT(spirv.size(), 5u);
+  EXPECT_EQ(spirv[0], 0x07230203u);
+}
+
+TEST(GpuBuffer, RoundTripsBytesAndRefusesAnOversizedUpload) {
+  GPU_TEST_CONTEXT_OR_SKIP(ctx);
+  GpuBuffer b(*ctx, 16 * sizeof(float));
+  std::vector<float> in(16), out(16, -1.0f);
+  for (int i = 0; i < 16; ++i) in[static_cast<std::size_t>(i)] = static_cast<float>(i) * 0.5f;
+  b.upload(std::span<const float>(in));
+  b.download(std::span<float>(out));
+  EXPECT_EQ(in, out);
+  std::vector<float> big(17);
+  EXPECT_THROW(b.upload(std::span<const float>(big)), GpuError);
+}
+
+TEST(VulkanContext, SaysWhichDeviceItRunsOnAndWhetherValidationIsOn) {
+  GPU_TEST_CONTEXT_OR_SKIP(ctx);
+  const auto& info = ctx->info();
+  std::printf("device: %s (%s), driver %s, float16 %s, shared memory %u bytes, timestamps %s, validation %s\n",
+              info.name.c_str(), device_kind_name(info.kind), info.driver.c_str(), info.shader_float16 ? "yes" : "no",
+              info.max_shared_memory, info.timestamp_period_ns > 0 ? "yes" : "no",
+              ctx->validation_enabled() ? "on" : "off (layer not installed)");
+  EXPECT_FALSE(info.name.empty());
+  // The kernels stage 16 KB of weights in shared memory; Vulkan guarantees 16 KB.
+  EXPECT_GE(info.max_shared_memory, 16384u);
+}
