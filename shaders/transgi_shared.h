@@ -35,7 +35,18 @@ struct FusedPush {
   uint pad2;
 };
 
+// SH projection of probe radiance maps (sh_projection.comp).
+TRANSGI_CONST uint kProjectGroupSize = 32u;  // invocations per probe; 32 x 75 partial sums = 9.6 KB shared
+
+struct ProjectPush {
+  uint probes;
+  uint texels;  // per map
+  uint pad0;
+  uint pad1;
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(ProjectPush) == 16 && offsetof(ProjectPush, texels) == 4, "ProjectPush layout");
 static_assert(sizeof(FusedPush) == 32, "FusedPush must match its std430/push-constant layout");
 static_assert(offsetof(FusedPush, count) == 0 && offsetof(FusedPush, inputs) == 4 && offsetof(FusedPush, width) == 8 &&
               offsetof(FusedPush, hidden_layers) == 12 && offsetof(FusedPush, outputs) == 16,

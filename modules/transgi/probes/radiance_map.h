@@ -69,6 +69,8 @@ class MapProjector {
   // radiance: texel_count() RGB values. out: 75 values [c * 25 + k].
   void project(const glm::vec3* radiance, float* out) const;
   [[nodiscard]] const MapLayout& layout() const { return layout_; }
+  // Per texel, the integral of each Y_k over it (what the GPU kernel uploads).
+  [[nodiscard]] const std::vector<std::array<float, engine::math::kShCount>>& basis_integrals() const { return basis_integrals_; }
 
  private:
   MapLayout layout_;
