@@ -45,7 +45,42 @@ struct ProjectPush {
   uint pad1;
 };
 
+// Probe interpolation with pruning (probe_interpolation.comp).
+TRANSGI_CONST uint kInterpolateGroupSize = 64u;
+TRANSGI_CONST uint kInterpolatePruneBackFacing = 1u;  // InterpolatePush::flags bits
+TRANSGI_CONST uint kInterpolatePruneOccluded = 2u;
+TRANSGI_CONST uint kInterpolateHasOffsets = 4u;
+
+struct InterpolatePush {
+  float min_x, min_y, min_z, bias_length;        // grid box corner; normal_bias x min_spacing
+  float spacing_x, spacing_y, spacing_z, visibility_threshold;
+  int dims_x, dims_y, dims_z, points;
+  int scroll_x, scroll_y, scroll_z;
+  uint flags;
+  uint map_width, map_height, texels, pad0;
+};
+
+// Per probe: its relocation offset, its depth unit, whether it holds light.
+struct ProbeGpu {
+  float offset_x, offset_y, offset_z, depth_unit;
+  uint usable, pad0, pad1, pad2;
+};
+
+// Per shading point: probes::InterpolationResult.
+struct InterpolationGpu {
+  int probes[8];
+  float weights[8];
+  uint pruned, fallback, pad0, pad1;
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(InterpolatePush) == 80 && offsetof(InterpolatePush, spacing_x) == 16 &&
+              offsetof(InterpolatePush, dims_x) == 32 && offsetof(InterpolatePush, scroll_x) == 48 &&
+              offsetof(InterpolatePush, flags) == 60 && offsetof(InterpolatePush, map_width) == 64,
+              "InterpolatePush layout");
+static_assert(sizeof(ProbeGpu) == 32 && offsetof(ProbeGpu, usable) == 16, "ProbeGpu layout");
+static_assert(sizeof(InterpolationGpu) == 80 && offsetof(InterpolationGpu, weights) == 32 &&
+              offsetof(InterpolationGpu, pruned) == 64, "InterpolationGpu layout");
 static_assert(sizeof(ProjectPush) == 16 && offsetof(ProjectPush, texels) == 4, "ProjectPush layout");
 static_assert(sizeof(FusedPush) == 32, "FusedPush must match its std430/push-constant layout");
 static_assert(offsetof(FusedPush, count) == 0 && offsetof(FusedPush, inputs) == 4 && offsetof(FusedPush, width) == 8 &&

@@ -1,0 +1,102 @@
+#include "gpu/vulkan_probe_interpolator.h"
+
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "gpu/shader_path.h"
+#include "transgi_shared.h"
+
+namespace transgi::gpu {
+
+VulkanProbeInterpolator::VulkanProbeInterpolator(engine::gpu::VulkanContext& ctx, probes::MapLayout layout)
+    : ctx_(ctx), layout_(layout) {
+  pipeline_ = std::make_unique<engine::gpu::ComputePipeline>(ctx, compile_module_shader("probe_interpolation.comp"), 6,
+                                                              static_cast<std::uint32_t>(sizeof(InterpolatePush)));
+}
+
+engine::gpu::GpuBuffer& VulkanProbeInterpolator::sized(engine::gpu::GpuBuffer& b, std::uint32_t binding,
+                                                       std::size_t bytes) {
+  if (b.handle() == VK_NULL_HANDLE || b.size() < bytes) {
+    b = engine::gpu::GpuBuffer(ctx_, bytes);
+    pipeline_->bind(binding, b);
+  }
+  return b;
+}
+
+GpuInterpolation VulkanProbeInterpolator::interpolate(const probes::ProbeGrid& grid,
+                                                      const std::vector<probes::ProbeMapState>& states,
+                                                      std::span<const float> probe_sh, std::span<const std::uint8_t> usable,
+                                                      const probes::InterpolationSettings& settings,
+                                                      std::span<const glm::vec3> positions,
+                                                      std::span<const glm::vec3> normals) {
+  const auto count = static_cast<std::size_t>(grid.count());
+  const auto texels = static_cast<std::size_t>(layout_.texel_count());
+  if (states.size() != count || probe_sh.size() != count * kTransferOutputs || (!usable.empty() && usable.size() != count) ||
+      normals.size() != positions.size() || (!grid.offsets.empty() && grid.offsets.size() != count))
+    throw std::invalid_argument("VulkanProbeInterpolator: " + std::to_string(count) + " probes but " +
+                                std::to_string(states.size()) + " states, " + std::to_string(probe_sh.size()) +
+                                " SH values, " + std::to_string(usable.size()) + " usable flags; " +
+                                std::to_string(positions.size()) + " positions, " + std::to_string(normals.size()) + " normals");
+  GpuInterpolation out;
+  const std::size_t n = positions.size();
+  if (n == 0) return out;
+
+  std::vector<float> points(n * 6);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::memcpy(&points[i * 6], &positions[i].x, 3 * sizeof(float));
+    std::memcpy(&points[i * 6 + 3], &normals[i].x, 3 * sizeof(float));
+  }
+  // Depth texels are two binary16 (mean, variance): exactly a GLSL half2.
+  static_assert(sizeof(probes::DepthMap::Texel) == 4);
+  std::vector<probes::DepthMap::Texel> depth(count * texels);
+  std::vector<ProbeGpu> probe_info(count);
+  for (std::size_t q = 0; q < count; ++q) {
+    const auto& d = states[q].depth;
+    const bool usable_q = usable.empty() || usable[q] != 0;
+    if (usable_q && d.texels.size() == texels) std::memcpy(&depth[q * texels], d.texels.data(), texels * sizeof(depth[0]));
+    const glm::vec3 off = grid.offsets.empty() ? glm::vec3(0.0f) : grid.offsets[q];
+    probe_info[q] = {off.x, off.y, off.z, d.unit, usable_q ? 1u : 0u, 0, 0, 0};
+  }
+  sized(points_, 0, points.size() * sizeof(float)).upload(std::span<const float>(points));
+  sized(depth_, 1, depth.size() * sizeof(depth[0])).upload(std::span<const probes::DepthMap::Texel>(depth));
+  sized(probes_, 2, probe_info.size() * sizeof(ProbeGpu)).upload(std::span<const ProbeGpu>(probe_info));
+  sized(probe_sh_, 3, probe_sh.size() * sizeof(float)).upload(probe_sh);
+  sized(results_, 4, n * sizeof(InterpolationGpu));
+  sized(point_sh_, 5, n * kTransferOutputs * sizeof(float));
+
+  const glm::vec3 s = grid.spacing();
+  InterpolatePush push{};
+  push.min_x = grid.min.x, push.min_y = grid.min.y, push.min_z = grid.min.z;
+  push.bias_length = settings.normal_bias * grid.min_spacing();
+  push.spacing_x = s.x, push.spacing_y = s.y, push.spacing_z = s.z;
+  push.visibility_threshold = settings.visibility_threshold;
+  push.dims_x = grid.dims.x, push.dims_y = grid.dims.y, push.dims_z = grid.dims.z;
+  push.points = static_cast<int>(n);
+  push.scroll_x = grid.scroll.x, push.scroll_y = grid.scroll.y, push.scroll_z = grid.scroll.z;
+  push.flags = (settings.prune_back_facing ? kInterpolatePruneBackFacing : 0u) |
+               (settings.prune_occluded ? kInterpolatePruneOccluded : 0u) |
+               (grid.offsets.empty() ? 0u : kInterpolateHasOffsets);
+  push.map_width = static_cast<uint>(layout_.width);
+  push.map_height = static_cast<uint>(layout_.height);
+  push.texels = static_cast<uint>(texels);
+  const auto groups = static_cast<std::uint32_t>((n + kInterpolateGroupSize - 1) / kInterpolateGroupSize);
+  out.gpu_ms = ctx_.submit_and_wait([&](VkCommandBuffer cmd) { pipeline_->record_dispatch(cmd, groups, 1, 1, &push); });
+
+  std::vector<InterpolationGpu> raw(n);
+  results_.download(std::span<InterpolationGpu>(raw));
+  out.results.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t c = 0; c < 8; ++c) {
+      out.results[i].probes[c] = raw[i].probes[c];
+      out.results[i].weights[c] = raw[i].weights[c];
+    }
+    out.results[i].pruned = static_cast<int>(raw[i].pruned);
+    out.results[i].fallback = raw[i].fallback != 0;
+  }
+  out.light_sh.resize(n * kTransferOutputs);
+  point_sh_.download(std::span<float>(out.light_sh));
+  return out;
+}
+
+}  // namespace transgi::gpu
