@@ -73,7 +73,36 @@ struct InterpolationGpu {
   uint pruned, fallback, pad0, pad1;
 };
 
+// Across-probe radiance sharing (radiance_raster.comp).
+TRANSGI_CONST uint kRasterGroupSize = 64u;     // one workgroup per target probe; lane t owns texels t mod 64
+TRANSGI_CONST uint kRasterChunk = 1024u;       // candidate points classified per pass (8 KB of shared memory)
+TRANSGI_CONST uint kRasterDepthGuard = 1u;     // RasterPush::flags bits
+TRANSGI_CONST uint kRasterSameSide = 2u;
+TRANSGI_CONST uint kRasterHasDepth = 4u;
+TRANSGI_CONST uint kRasterHasOffsets = 8u;
+
+struct RasterPush {
+  float min_x, min_y, min_z, relative_tolerance;
+  float spacing_x, spacing_y, spacing_z, absolute_tolerance;
+  int dims_x, dims_y, dims_z, probes;
+  int scroll_x, scroll_y, scroll_z;
+  uint flags;
+  uint map_width, map_height, texels, pad0;
+};
+
+// probes::ShadedPoint, each vec3 padded to 16 bytes.
+struct ShadedPointGpu {
+  float px, py, pz, distance;  // distance: +inf for an escaped ray
+  float rx, ry, rz, pad0;      // radiance towards the shooting probe
+  float dx, dy, dz, pad1;      // unit direction from the shooting probe
+  float nx, ny, nz, pad2;      // geometric normal on the shooting probe's side
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(RasterPush) == 80 && offsetof(RasterPush, flags) == 60 && offsetof(RasterPush, texels) == 72,
+              "RasterPush layout");
+static_assert(sizeof(ShadedPointGpu) == 64 && offsetof(ShadedPointGpu, rx) == 16 && offsetof(ShadedPointGpu, nx) == 48,
+              "ShadedPointGpu layout");
 static_assert(sizeof(InterpolatePush) == 80 && offsetof(InterpolatePush, spacing_x) == 16 &&
               offsetof(InterpolatePush, dims_x) == 32 && offsetof(InterpolatePush, scroll_x) == 48 &&
               offsetof(InterpolatePush, flags) == 60 && offsetof(InterpolatePush, map_width) == 64,

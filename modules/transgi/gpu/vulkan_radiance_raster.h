@@ -1,0 +1,35 @@
+#pragma once
+// Across-probe radiance sharing in one dispatch
+// (shaders/radiance_raster.comp): the contract of probes::rasterize_shared,
+// which is its oracle (tests/gpu/radiance_raster_test.cpp).
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "engine/gpu/compute_pipeline.h"
+#include "engine/gpu/gpu_buffer.h"
+#include "engine/gpu/vulkan_context.h"
+#include "probes/radiance_sharing.h"
+
+namespace transgi::gpu {
+
+class VulkanRadianceRaster {
+ public:
+  VulkanRadianceRaster(engine::gpu::VulkanContext& ctx, probes::MapLayout layout);
+
+  // As probes::rasterize_shared; *gpu_ms (if given) gets the kernel's time.
+  probes::SharingStats rasterize(const probes::ProbeGrid& grid, const std::vector<std::vector<probes::ShadedPoint>>& points,
+                                 const std::vector<const probes::DepthMap*>& own_depth,
+                                 const probes::SharingSettings& settings, std::vector<probes::FrameSamples>& out,
+                                 std::span<const std::uint8_t> targets = {}, double* gpu_ms = nullptr);
+
+ private:
+  engine::gpu::GpuBuffer& sized(engine::gpu::GpuBuffer& b, std::uint32_t binding, std::size_t bytes);
+
+  engine::gpu::VulkanContext& ctx_;
+  probes::MapLayout layout_;
+  engine::gpu::GpuBuffer points_, ranges_, depth_, probes_, targets_, samples_, stats_;
+  std::unique_ptr<engine::gpu::ComputePipeline> pipeline_;
+};
+
+}  // namespace transgi::gpu
