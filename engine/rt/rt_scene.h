@@ -72,6 +72,8 @@ class RtScene {
   void occluded16(const Ray* rays, int n, bool* blocked) const;
 
   [[nodiscard]] const InstanceRecord* instance(std::uint32_t id) const;
+  // Ids run from 0 below this; instance(id) is null for the removed ones.
+  [[nodiscard]] std::uint32_t instance_id_end() const { return static_cast<std::uint32_t>(instances_.size()); }
   // Calls fn(const InstanceRecord&) for every live instance, in id order.
   template <class Fn>
   void for_each_instance(Fn&& fn) const {

@@ -1,0 +1,147 @@
+#include "engine/gpu/gpu_rt_scene.h"
+
+#include <cstdlib>
+
+#include "engine/gpu/gpu_error.h"
+#include "engine/gpu/shader_compiler.h"
+#include "engine/rt/bvh_builder.h"
+#include "rt_shared.h"
+
+namespace engine::gpu {
+namespace {
+
+BvhNodeGpu to_gpu(const rt::BvhNode& n) {
+  return {n.bounds.min.x, n.bounds.min.y, n.bounds.min.z, n.first, n.bounds.max.x, n.bounds.max.y, n.bounds.max.z, n.count};
+}
+
+std::filesystem::path engine_shader_dir() {
+  if (const char* env = std::getenv("ENGINE_SHADER_DIR"); env && *env) return env;
+  return ENGINE_SOURCE_SHADER_DIR;
+}
+
+template <class T>
+void upload_to(VulkanContext& ctx, GpuBuffer& b, const std::vector<T>& v) {
+  const std::size_t bytes = v.size() * sizeof(T);
+  if (b.handle() == VK_NULL_HANDLE || b.size() < bytes) b = GpuBuffer(ctx, bytes);
+  b.upload(std::span<const T>(v));
+}
+
+}  // namespace
+
+GpuRtScene::GpuRtScene(VulkanContext& ctx) : ctx_(ctx) {
+  const auto dir = engine_shader_dir();
+  ShaderCompileOptions options;
+  options.include_dirs.push_back(dir);
+  query_ = std::make_unique<ComputePipeline>(ctx, compile_compute_shader(dir / "rt_query.comp", options), 6,
+                                             static_cast<std::uint32_t>(sizeof(std::uint32_t)));
+}
+
+GpuRtScene::~GpuRtScene() = default;
+
+void GpuRtScene::sync(const rt::RtScene& rt) {
+  const scene::SceneAssets* assets = rt.assets();
+  if (assets && assets->generation != generation_) {
+    generation_ = assets->generation;
+    std::vector<BvhNodeGpu> nodes;
+    std::vector<TriangleGpu> tris;
+    blas_root_.assign(assets->meshes.size(), 0);
+    triangle_offset_.assign(assets->meshes.size(), 0);
+    for (std::size_t m = 0; m < assets->meshes.size(); ++m) {
+      const scene::MeshAsset& mesh = *assets->meshes[m];
+      std::vector<rt::BvhBox> boxes(mesh.triangles.size());
+      for (std::size_t t = 0; t < boxes.size(); ++t) {
+        const glm::uvec3 tri = mesh.triangles[t];
+        const glm::vec3 a = mesh.positions[tri.x], b = mesh.positions[tri.y], c = mesh.positions[tri.z];
+        boxes[t] = {glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
+      }
+      const rt::Bvh bvh = rt::build_bvh(boxes);
+      blas_root_[m] = static_cast<std::uint32_t>(nodes.size());
+      triangle_offset_[m] = static_cast<std::uint32_t>(tris.size());
+      for (const auto& n : bvh.nodes) nodes.push_back(to_gpu(n));
+      for (std::uint32_t item : bvh.order) {
+        const glm::uvec3 tri = mesh.triangles[item];
+        const glm::vec3 a = mesh.positions[tri.x], b = mesh.positions[tri.y], c = mesh.positions[tri.z];
+        tris.push_back({a.x, a.y, a.z, item, b.x, b.y, b.z, 0, c.x, c.y, c.z, 0});
+      }
+      ++stats_.blas_builds;
+    }
+    if (nodes.empty()) nodes.push_back(to_gpu(rt::BvhNode{}));
+    if (tris.empty()) tris.push_back({});
+    upload_to(ctx_, blas_, nodes);
+    upload_to(ctx_, triangles_, tris);
+    stats_.blas_nodes = nodes.size();
+    stats_.triangles = tris.size();
+  }
+
+  std::vector<const rt::InstanceRecord*> live;
+  std::vector<std::uint32_t> ids;
+  std::vector<rt::BvhBox> boxes;
+  for (std::uint32_t id = 0; id < rt.instance_id_end(); ++id) {
+    const rt::InstanceRecord* r = rt.instance(id);
+    if (!r || r->mesh >= blas_root_.size()) continue;
+    live.push_back(r);
+    ids.push_back(id);
+    boxes.push_back({r->bounds.min, r->bounds.max});
+  }
+  const rt::Bvh tlas = rt::build_bvh(boxes, 1);
+  std::vector<BvhNodeGpu> nodes;
+  for (const auto& n : tlas.nodes) nodes.push_back(to_gpu(n));
+  std::vector<InstanceGpu> instances;
+  for (std::uint32_t item : tlas.order) {
+    const rt::InstanceRecord& r = *live[item];
+    // World to object: x_o = R^T (x_w - T) / s, as rows of a 3 x 4 matrix.
+    const glm::mat3 rt_ = glm::transpose(glm::mat3_cast(r.to_world.rotation)) / r.to_world.scale;
+    const glm::vec3 off = -(rt_ * r.to_world.translation);
+    instances.push_back({rt_[0][0], rt_[1][0], rt_[2][0], off.x, rt_[0][1], rt_[1][1], rt_[2][1], off.y, rt_[0][2],
+                         rt_[1][2], rt_[2][2], off.z, blas_root_[r.mesh], triangle_offset_[r.mesh], ids[item], r.mesh});
+  }
+  if (instances.empty()) instances.push_back({});
+  upload_to(ctx_, tlas_, nodes);
+  upload_to(ctx_, instances_, instances);
+  stats_.tlas_nodes = nodes.size();
+  stats_.instances = live.size();
+}
+
+void GpuRtScene::bind(ComputePipeline& pipeline, std::uint32_t first) const {
+  if (tlas_.handle() == VK_NULL_HANDLE) throw GpuError("GpuRtScene::bind before sync");
+  pipeline.bind(first, tlas_);
+  pipeline.bind(first + 1, instances_);
+  pipeline.bind(first + 2, blas_);
+  pipeline.bind(first + 3, triangles_);
+}
+
+void GpuRtScene::intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hits, std::span<bool> found, double* gpu_ms) {
+  if (hits.size() != rays.size() || found.size() != rays.size())
+    throw GpuError("GpuRtScene::intersect: " + std::to_string(rays.size()) + " rays, " + std::to_string(hits.size()) +
+                   " hits, " + std::to_string(found.size()) + " flags");
+  if (rays.empty()) return;
+  std::vector<RayGpu> in(rays.size());
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const rt::Ray& r = rays[i];
+    in[i] = {r.origin.x, r.origin.y, r.origin.z, r.tmin, r.direction.x, r.direction.y, r.direction.z, r.tmax};
+  }
+  const std::size_t hit_bytes = rays.size() * sizeof(HitGpu);
+  const bool grew = rays_.handle() == VK_NULL_HANDLE || rays_.size() < in.size() * sizeof(RayGpu);
+  upload_to(ctx_, rays_, in);
+  if (grew || hits_.size() < hit_bytes) hits_ = GpuBuffer(ctx_, hit_bytes);
+  query_->bind(0, rays_);
+  query_->bind(1, hits_);
+  bind(*query_, 2);
+  const auto count = static_cast<std::uint32_t>(rays.size());
+  const double ms = ctx_.submit_and_wait(
+      [&](VkCommandBuffer cmd) { query_->record_dispatch(cmd, (count + kRtGroupSize - 1) / kRtGroupSize, 1, 1, &count); });
+  if (gpu_ms) *gpu_ms = ms;
+  std::vector<HitGpu> out(rays.size());
+  hits_.download(std::span<HitGpu>(out));
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    found[i] = out[i].instance != kRtNoHit;
+    if (!found[i]) continue;
+    hits[i].instance = out[i].instance;
+    hits[i].mesh = out[i].mesh;
+    hits[i].primitive = out[i].primitive;
+    hits[i].barycentric = {out[i].u, out[i].v};
+    hits[i].t = out[i].t;
+  }
+}
+
+}  // namespace engine::gpu

@@ -1,0 +1,52 @@
+#pragma once
+// The ray-tracing scene on the GPU, mirrored from an RtScene: one BLAS per
+// mesh asset, built once on the CPU (engine/rt/bvh_builder) and uploaded; a
+// TLAS over the live instances, rebuilt on the CPU at every sync (a few
+// thousand instances take well under a millisecond) and uploaded with the
+// instances' world-to-object transforms. Kernels include
+// shaders/rt_traversal.glsl and bind bindings() at four consecutive slots.
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "engine/gpu/compute_pipeline.h"
+#include "engine/gpu/gpu_buffer.h"
+#include "engine/gpu/vulkan_context.h"
+#include "engine/rt/rt_scene.h"
+
+namespace engine::gpu {
+
+struct GpuRtStats {
+  std::size_t blas_builds = 0;
+  std::size_t blas_nodes = 0, triangles = 0, tlas_nodes = 0, instances = 0;
+};
+
+class GpuRtScene {
+ public:
+  explicit GpuRtScene(VulkanContext& ctx);
+  ~GpuRtScene();
+
+  // Mirrors rt's instances (and, for a new asset generation, its meshes).
+  void sync(const rt::RtScene& rt);
+
+  // Binds the TLAS, instances, BLAS and triangles at first .. first + 3.
+  void bind(ComputePipeline& pipeline, std::uint32_t first) const;
+
+  // Closest hits of a batch of rays (shaders/rt_query.comp); found[i] says
+  // whether ray i hit. Hit::entity is left empty: the instance id names it.
+  void intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hits, std::span<bool> found, double* gpu_ms = nullptr);
+
+  [[nodiscard]] const GpuRtStats& stats() const { return stats_; }
+
+ private:
+  VulkanContext& ctx_;
+  std::uint64_t generation_ = 0;
+  std::vector<std::uint32_t> blas_root_, triangle_offset_;  // per mesh
+  GpuBuffer tlas_, instances_, blas_, triangles_;
+  GpuBuffer rays_, hits_;
+  std::unique_ptr<ComputePipeline> query_;
+  GpuRtStats stats_;
+};
+
+}  // namespace engine::gpu

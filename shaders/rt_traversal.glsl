@@ -1,0 +1,141 @@
+// Closest-hit queries against a two-level BVH (rt_shared.h), for devices
+// without VK_KHR_ray_query (lavapipe 22.3 has none). The includer defines
+// RT_SET and RT_BINDING (the first of four consecutive bindings: TLAS nodes,
+// instances, BLAS nodes, triangles) before including this file.
+//
+// Arithmetic follows Embree's conventions, not its exact floating point:
+// t in (tmin, tmax], hits from both sides, barycentrics (u, v) such that the
+// point is (1 - u - v) p0 + u p1 + v p2. Alpha-masked materials are not
+// tested here yet (every triangle is opaque).
+#include "rt_shared.h"
+
+layout(std430, set = RT_SET, binding = RT_BINDING) readonly buffer RtTlas { BvhNodeGpu rt_tlas[]; };
+layout(std430, set = RT_SET, binding = RT_BINDING + 1) readonly buffer RtInstances { InstanceGpu rt_instances[]; };
+layout(std430, set = RT_SET, binding = RT_BINDING + 2) readonly buffer RtBlas { BvhNodeGpu rt_blas[]; };
+layout(std430, set = RT_SET, binding = RT_BINDING + 3) readonly buffer RtTriangles { TriangleGpu rt_triangles[]; };
+
+// 1 / d without infinities that would make 0 * inf = NaN in the slab test.
+vec3 rt_safe_inverse(vec3 d) {
+  const float tiny = 1e-30;
+  return vec3(1.0) / vec3(abs(d.x) > tiny ? d.x : (d.x < 0.0 ? -tiny : tiny),
+                          abs(d.y) > tiny ? d.y : (d.y < 0.0 ? -tiny : tiny),
+                          abs(d.z) > tiny ? d.z : (d.z < 0.0 ? -tiny : tiny));
+}
+
+// Entry distance into the node's box, or +inf when the ray misses it
+// within [tmin, tmax].
+float rt_enter(BvhNodeGpu n, vec3 o, vec3 inv_d, float tmin, float tmax) {
+  const vec3 t0 = (vec3(n.min_x, n.min_y, n.min_z) - o) * inv_d;
+  const vec3 t1 = (vec3(n.max_x, n.max_y, n.max_z) - o) * inv_d;
+  const vec3 lo = min(t0, t1), hi = max(t0, t1);
+  const float enter = max(max(lo.x, lo.y), max(lo.z, tmin));
+  const float leave = min(min(hi.x, hi.y), min(hi.z, tmax));
+  // The 1 + 2^-22 widening keeps rays grazing a box face from slipping past
+  // it through rounding (Ize 2013, "Robust BVH ray traversal").
+  return enter <= leave * 1.00000024 ? enter : uintBitsToFloat(0x7f800000u);
+}
+
+// Moeller-Trumbore; updates t, u, v and returns true for a closer hit.
+bool rt_triangle(TriangleGpu tri, vec3 o, vec3 d, float tmin, inout float t, inout float u, inout float v) {
+  const vec3 p0 = vec3(tri.p0_x, tri.p0_y, tri.p0_z);
+  const vec3 e1 = vec3(tri.p1_x, tri.p1_y, tri.p1_z) - p0;
+  const vec3 e2 = vec3(tri.p2_x, tri.p2_y, tri.p2_z) - p0;
+  const vec3 pv = cross(d, e2);
+  const float det = dot(e1, pv);
+  if (det == 0.0) return false;
+  const float inv_det = 1.0 / det;
+  const vec3 tv = o - p0;
+  const float bu = dot(tv, pv) * inv_det;
+  if (bu < 0.0 || bu > 1.0) return false;
+  const vec3 qv = cross(tv, e1);
+  const float bv = dot(d, qv) * inv_det;
+  if (bv < 0.0 || bu + bv > 1.0) return false;
+  const float th = dot(e2, qv) * inv_det;
+  if (!(th > tmin && th <= t)) return false;
+  t = th;
+  u = bu;
+  v = bv;
+  return true;
+}
+
+// The BLAS of one instance, in its object space (the similarity keeps t).
+void rt_traverse_blas(uint inst, vec3 wo, vec3 wd, float tmin, inout HitGpu hit) {
+  const InstanceGpu I = rt_instances[inst];
+  const vec4 r0 = vec4(I.r0_x, I.r0_y, I.r0_z, I.r0_w), r1 = vec4(I.r1_x, I.r1_y, I.r1_z, I.r1_w),
+             r2 = vec4(I.r2_x, I.r2_y, I.r2_z, I.r2_w);
+  const vec3 o = vec3(dot(r0, vec4(wo, 1.0)), dot(r1, vec4(wo, 1.0)), dot(r2, vec4(wo, 1.0)));
+  const vec3 d = vec3(dot(r0.xyz, wd), dot(r1.xyz, wd), dot(r2.xyz, wd));
+  const vec3 inv_d = rt_safe_inverse(d);
+  uint stack[kRtStackSize];
+  uint top = 0u;
+  uint node = I.blas_root;
+  while (true) {
+    const BvhNodeGpu n = rt_blas[node];
+    if (n.count > 0u) {
+      for (uint k = 0u; k < n.count; ++k) {
+        const TriangleGpu tri = rt_triangles[I.triangle_offset + n.first + k];
+        if (rt_triangle(tri, o, d, tmin, hit.t, hit.u, hit.v)) {
+          hit.instance = I.id;
+          hit.primitive = tri.primitive;
+          hit.mesh = I.mesh;
+        }
+      }
+    } else {
+      const uint a = I.blas_root + n.first, b = a + 1u;
+      const float ta = rt_enter(rt_blas[a], o, inv_d, tmin, hit.t), tb = rt_enter(rt_blas[b], o, inv_d, tmin, hit.t);
+      const bool hit_a = !isinf(ta), hit_b = !isinf(tb);
+      if (hit_a && hit_b && top < kRtStackSize) {
+        // Nearer child first; the other waits on the stack.
+        node = ta <= tb ? a : b;
+        stack[top++] = ta <= tb ? b : a;
+        continue;
+      }
+      if (hit_a || hit_b) {
+        node = hit_a ? a : b;
+        continue;
+      }
+    }
+    if (top == 0u) break;
+    node = stack[--top];
+  }
+}
+
+// Closest hit of the ray in world space; hit.instance == kRtNoHit if none.
+HitGpu rt_intersect(vec3 o, vec3 d, float tmin, float tmax) {
+  HitGpu hit;
+  hit.t = tmax;
+  hit.u = 0.0;
+  hit.v = 0.0;
+  hit.instance = kRtNoHit;
+  hit.primitive = 0u;
+  hit.mesh = 0u;
+  hit.pad0 = 0u;
+  hit.pad1 = 0u;
+  const vec3 inv_d = rt_safe_inverse(d);
+  if (isinf(rt_enter(rt_tlas[0], o, inv_d, tmin, hit.t))) return hit;
+  uint stack[kRtStackSize];
+  uint top = 0u;
+  uint node = 0u;
+  while (true) {
+    const BvhNodeGpu n = rt_tlas[node];
+    if (n.count > 0u) {
+      for (uint k = 0u; k < n.count; ++k) rt_traverse_blas(n.first + k, o, d, tmin, hit);
+    } else {
+      const uint a = n.first, b = a + 1u;
+      const float ta = rt_enter(rt_tlas[a], o, inv_d, tmin, hit.t), tb = rt_enter(rt_tlas[b], o, inv_d, tmin, hit.t);
+      const bool hit_a = !isinf(ta), hit_b = !isinf(tb);
+      if (hit_a && hit_b && top < kRtStackSize) {
+        node = ta <= tb ? a : b;
+        stack[top++] = ta <= tb ? b : a;
+        continue;
+      }
+      if (hit_a || hit_b) {
+        node = hit_a ? a : b;
+        continue;
+      }
+    }
+    if (top == 0u) break;
+    node = stack[--top];
+  }
+  return hit;
+}
