@@ -76,7 +76,7 @@ ecs::Entity pick_moving_object(ecs::World& world, const std::string& name) {
 int run_bench_frame(const std::vector<std::string>& argv) {
   const Args args("bench-frame", argv,
                   {"scene", "model", "width", "height", "frames", "warmup", "preset", "csv", "object", "threads", "camera",
-                   "direct-spp", "gi-scale", "probe-budget", "direct", "gi-out", "reference-out", "reference-spp", "map-width",
+                   "direct-spp", "gi-scale", "probe-budget", "backend", "gpu-device", "direct", "gi-out", "reference-out", "reference-spp", "map-width",
                    "probe-volume", "probe-grid", "cascades", "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "cascade-map-width"},
                   {"allow-unbaked"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
@@ -87,12 +87,13 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   const std::string preset = args.choice("preset", {"realtime", "quality"}, "realtime");
   const int threads = static_cast<int>(args.integer("threads", 0, 1024, 0));
   const std::string csv = args.str("csv", std::string());
+  // Options first, so a typo is reported before seconds of loading.
+  runtime::TransGISettings settings = runtime_settings_from(args, "realtime");
 
   eval::LoadedScene scene = eval::load_scene(scene_path, args.str("camera", std::string()), threads);
   ecs::World& world = scene.app->world();
   auto model = model::load_model(model_path);
   model::validate_model(model, world.resource<scene::SceneAssets>(), model_path, args.has("allow-unbaked"));
-  runtime::TransGISettings settings = runtime_settings_from(args, "realtime");
   settings.direct_spp = static_cast<int>(args.integer("direct-spp", 0, 100000, settings.direct_spp));
   scene.app->add_plugin<runtime::TransGIPlugin>(settings);
   runtime::attach_latent_meshes(world, std::make_shared<const model::TransferModel>(std::move(model)));
@@ -172,6 +173,10 @@ int run_bench_frame(const std::vector<std::string>& argv) {
     }
   });
   if (!csv.empty()) std::printf("per-frame CSV: %s\n", csv.c_str());
+  std::printf("probe kernels: %s%s%s", frame.backend.c_str(), frame.backend_fallback.empty() ? "" : "; ",
+              frame.backend_fallback.c_str());
+  if (frame.gpu_ms > 0) std::printf("; last frame's GPU time %.2f ms", frame.gpu_ms);
+  std::printf("\n");
   std::printf("direct light, last frame: %zu shadow rays to %zu punctual lights\n", frame.direct_stats.shadow_rays,
               frame.direct_stats.lights);
   // The NaN guards (docs/reliability.md): what each stage's boundary replaced in the last frame.

@@ -136,6 +136,7 @@ int render_transgi(const Args& args, eval::LoadedScene& scene, int width, int he
   write_passes(o, r.full, r.direct, r.gi);
   std::printf("rendered %s (transgi, probe light, %s pass) %dx%d at %d spp: %zu shaded samples, %zu inferred\n", o.out.c_str(),
               o.pass.c_str(), width, height, t.settings.gbuffer_spp, r.shaded_samples, r.inferred_samples);
+  std::printf("probe kernels: %s\n", r.backend.c_str());
   print_stages(r, std::min(t.timing_frames, t.frames));
   return 0;
 }
@@ -197,7 +198,7 @@ int run_render(const std::vector<std::string>& argv) {
   const Args args("render", argv,
                   {"scene", "method", "pass", "spp", "width", "height", "out", "camera", "seed", "threads", "png", "exposure",
                    "model", "transfer", "gt-rays", "coefficient-maps", "lighting", "frames", "probe-grid", "probe-rays",
-                   "direct-spp", "probe-skip", "sharing", "no-latent", "timing-frames", "map-width", "hysteresis", "irradiance-gamma", "warmup-frames", "brightness-threshold", "preset", "gi-scale", "probe-budget", "direct",
+                   "direct-spp", "probe-skip", "sharing", "no-latent", "timing-frames", "map-width", "hysteresis", "irradiance-gamma", "warmup-frames", "brightness-threshold", "preset", "gi-scale", "probe-budget", "backend", "gpu-device", "direct",
                    "probe-volume", "cascades", "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "cascade-map-width", "sun-elevation", "sun-azimuth"},
                   {"allow-unbaked"});
   const std::string scene_path = args.str("scene");

@@ -20,6 +20,8 @@ runtime::TransGISettings runtime_settings_from(const Args& args, const char* def
     s.direct_light = args.choice("direct", {"deterministic", "stochastic"}, "stochastic") == "deterministic"
                          ? runtime::DirectLight::Deterministic
                          : runtime::DirectLight::Stochastic;
+  s.backend = args.choice("backend", {"cpu", "vulkan"}, "cpu") == "vulkan" ? runtime::Backend::Vulkan : runtime::Backend::Cpu;
+  s.gpu_device = args.str("gpu-device", std::string());
   return s;
 }
 

@@ -38,6 +38,7 @@ struct MethodRun {
   std::size_t probe_bytes = 0; // probe storage
   std::string probe_summary;   // a line about the probes' states
   std::size_t shaded_samples = 0, inferred_samples = 0;
+  std::string backend;  // where the probe kernels ran (TransGI), with any fallback reason
 };
 
 struct TransgiRunOptions {

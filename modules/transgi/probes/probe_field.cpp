@@ -336,7 +336,8 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   std::vector<FrameSamples> frame;  // only the updated probes' maps are filled (and allocated)
   std::vector<std::uint8_t> targets(static_cast<std::size_t>(probes));
   for (int q = 0; q < probes; ++q) targets[static_cast<std::size_t>(q)] = updates(q) ? 1 : 0;
-  const SharingStats ss = rasterize_shared(grid, settings_.map, points, depth, settings_.sharing, frame, targets);
+  const SharingStats ss = kernels_ ? kernels_->rasterize(grid, settings_.map, points, depth, settings_.sharing, frame, targets)
+                                   : rasterize_shared(grid, settings_.map, points, depth, settings_.sharing, frame, targets);
   stats.shared_accepted = ss.accepted;
   stats.shared_rejected = ss.rejected_by_guard;
   stats.raster_ms = ms_since(t0);
@@ -344,35 +345,67 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   // 3. Accumulate, fill, project.
   t0 = Clock::now();
   std::atomic<int> bad_probes{0};
-  jobs::parallel_for(0, probes, 1, [&](int b, int e) {
-    for (int q = b; q < e; ++q) {
-      if (!updates(q)) continue;
-      ProbeMapState& st = states_[static_cast<std::size_t>(q)];
-      changed_[static_cast<std::size_t>(q)] = accumulate(st, frame[static_cast<std::size_t>(q)], settings_.accumulation) ? 1 : 0;
-      if (settings_.skip.skip_converged && st.stable_frames >= settings_.skip.settle_frames)
-        state_[static_cast<std::size_t>(q)] = ProbeState::Converged;
-      const std::size_t at = static_cast<std::size_t>(q) * 75;
-      const std::uint32_t frames = direct_frames_[static_cast<std::size_t>(q)] =
-          std::min<std::uint32_t>(direct_frames_[static_cast<std::size_t>(q)] + 1, static_cast<std::uint32_t>(std::max(1, settings_.direct_history)));
-      for (int k = 0; k < 75; ++k)
-        direct_mean_[at + k] += (direct_frame[at + k] - direct_mean_[at + k]) / static_cast<float>(frames);
-      std::copy_n(direct_mean_.data() + at, 75, direct_sh_.data() + at);
-      if (settings_.direct_window) apply_hanning_window(direct_sh_.data() + at);
-      const auto filled = filled_radiance(st, settings_.map, settings_.accumulation.fill_passes);
-      float* out = sh_.data() + static_cast<std::size_t>(q) * 75;
-      projector_.project(filled.data(), out);
-      if (settings_.window) apply_hanning_window(out);
-      bool finite = true;
-      for (int k = 0; k < 75; ++k)
-        finite = finite && std::isfinite(out[k]) && std::isfinite(direct_sh_[at + k]) && std::isfinite(direct_mean_[at + k]);
-      if (!finite) {
-        // A value that got past the ray guards (an overflowing sum): this
-        // probe's light is unusable, so it starts afresh rather than spread it.
-        forget_light(q);
-        bad_probes.fetch_add(1, std::memory_order_relaxed);
-      }
+  // Accumulates probe q's frame and updates its direct-light mean; returns
+  // the filled map to project.
+  auto accumulate_probe = [&](int q) {
+    ProbeMapState& st = states_[static_cast<std::size_t>(q)];
+    changed_[static_cast<std::size_t>(q)] = accumulate(st, frame[static_cast<std::size_t>(q)], settings_.accumulation) ? 1 : 0;
+    if (settings_.skip.skip_converged && st.stable_frames >= settings_.skip.settle_frames)
+      state_[static_cast<std::size_t>(q)] = ProbeState::Converged;
+    const std::size_t at = static_cast<std::size_t>(q) * 75;
+    const std::uint32_t frames = direct_frames_[static_cast<std::size_t>(q)] =
+        std::min<std::uint32_t>(direct_frames_[static_cast<std::size_t>(q)] + 1, static_cast<std::uint32_t>(std::max(1, settings_.direct_history)));
+    for (int k = 0; k < 75; ++k)
+      direct_mean_[at + k] += (direct_frame[at + k] - direct_mean_[at + k]) / static_cast<float>(frames);
+    std::copy_n(direct_mean_.data() + at, 75, direct_sh_.data() + at);
+    if (settings_.direct_window) apply_hanning_window(direct_sh_.data() + at);
+    return filled_radiance(st, settings_.map, settings_.accumulation.fill_passes);
+  };
+  // After probe q's SH is projected into sh_.
+  auto finish_probe = [&](int q) {
+    const std::size_t at = static_cast<std::size_t>(q) * 75;
+    float* out = sh_.data() + at;
+    if (settings_.window) apply_hanning_window(out);
+    bool finite = true;
+    for (int k = 0; k < 75; ++k)
+      finite = finite && std::isfinite(out[k]) && std::isfinite(direct_sh_[at + k]) && std::isfinite(direct_mean_[at + k]);
+    if (!finite) {
+      // A value that got past the ray guards (an overflowing sum): this
+      // probe's light is unusable, so it starts afresh rather than spread it.
+      forget_light(q);
+      bad_probes.fetch_add(1, std::memory_order_relaxed);
     }
-  });
+  };
+  if (!kernels_) {
+    // One probe at a time: its filled map stays in cache for the projection.
+    jobs::parallel_for(0, probes, 1, [&](int b, int e) {
+      for (int q = b; q < e; ++q) {
+        if (!updates(q)) continue;
+        const auto filled = accumulate_probe(q);
+        projector_.project(filled.data(), sh_.data() + static_cast<std::size_t>(q) * 75);
+        finish_probe(q);
+      }
+    });
+  } else {
+    // Every updated probe's map in one batch for the backend.
+    std::vector<int> batch;
+    for (int q = 0; q < probes; ++q)
+      if (updates(q)) batch.push_back(q);
+    const auto texels = static_cast<std::size_t>(settings_.map.texel_count());
+    std::vector<glm::vec3> maps(batch.size() * texels);
+    jobs::parallel_for(0, static_cast<int>(batch.size()), 1, [&](int b, int e) {
+      for (int i = b; i < e; ++i) {
+        const auto filled = accumulate_probe(batch[static_cast<std::size_t>(i)]);
+        std::copy(filled.begin(), filled.end(), maps.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(i) * texels));
+      }
+    });
+    std::vector<float> projected(batch.size() * 75);
+    kernels_->project(projector_, maps, projected);
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+      std::copy_n(projected.data() + i * 75, 75, sh_.data() + static_cast<std::size_t>(batch[i]) * 75);
+      finish_probe(batch[i]);
+    }
+  }
   stats.nonfinite_probes = bad_probes.load();
   stats.project_ms = ms_since(t0);
   // The ambient term: the mean of the probes that hold light.

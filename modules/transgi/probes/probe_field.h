@@ -22,6 +22,7 @@
 // `settle_frames` without a detected change stops updating until the
 // scene changes again (notify_scene_changed).
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "engine/render/light_set.h"
@@ -29,6 +30,7 @@
 #include "probes/interpolation.h"
 #include "probes/open_space.h"
 #include "probes/probe_map.h"
+#include "probes/probe_kernels.h"
 
 namespace transgi::probes {
 
@@ -226,6 +228,11 @@ class ProbeField {
   // Irradiance from the interpolated SH (clamped-cosine convolution).
   [[nodiscard]] glm::vec3 irradiance(const glm::vec3& position, const glm::vec3& normal) const;
 
+  // Runs the raster and the SH projection through `kernels` (a GPU backend)
+  // from the next update on; null = the CPU functions. Shared: one backend
+  // serves every field of a scene.
+  void set_kernels(std::shared_ptr<ProbeKernels> kernels) { kernels_ = std::move(kernels); }
+
   [[nodiscard]] const ProbeFieldSettings& settings() const { return settings_; }
   // The grid as placed (settings().grid), before relocation (cascade_follow.h).
   [[nodiscard]] const ProbeGrid& placement() const { return settings_.grid; }
@@ -248,6 +255,7 @@ class ProbeField {
   void select_within_budget(std::vector<std::uint8_t>& traced) const;
 
   ProbeFieldSettings settings_;
+  std::shared_ptr<ProbeKernels> kernels_;
   ProbeGrid grid_;  // settings_.grid, relocated
   MapProjector projector_;
   // The length probe depths are stored in units of (ProbeMapState::reset).

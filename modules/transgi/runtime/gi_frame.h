@@ -1,4 +1,5 @@
 #pragma once
+#include <string>
 // The GI renderer's per-frame output and what it cost, read by the game,
 // tools and the CLI after the Render phase.
 #include <cstddef>
@@ -44,6 +45,11 @@ struct GiFrame {
   shading::RealtimeGiStats realtime;
   // Deterministic direct light only: its shadow rays.
   shading::RealtimeDirectStats direct_stats;
+  // Which backend ran the probe kernels ("cpu", or "vulkan" with the
+  // device), and why not the one asked for, if it could not.
+  std::string backend = "cpu";
+  std::string backend_fallback;
+  double gpu_ms = 0.0;  // the probe kernels' GPU time this frame (timestamps)
 };
 
 }  // namespace transgi::runtime

@@ -2,6 +2,7 @@
 // Every TransGI run-time knob, in one resource. Each says what raising it
 // buys and what it costs.
 #include <cstdint>
+#include <string>
 
 #include "probes/probe_field.h"
 #include "shading/realtime_gi.h"
@@ -32,8 +33,21 @@ enum class DirectLight {
   Deterministic,
 };
 
+// Where the probes' data-parallel stages run (issue 12).
+enum class Backend {
+  Cpu,     // the oracle, and this machine's real-time path
+  // The radiance raster and the SH projection as Vulkan compute kernels
+  // (shaders/); ray tracing, shading and accumulation stay on the CPU for
+  // now. Without a usable device the CPU runs them and GiFrame says why.
+  Vulkan,
+};
+
 struct TransGISettings {
   GiPath gi_path = GiPath::Quality;
+  Backend backend = Backend::Cpu;
+  // Vulkan device name (substring) for Backend::Vulkan; empty = the
+  // ENGINE_GPU_DEVICE variable, then a discrete GPU first, lavapipe last.
+  std::string gpu_device;
   shading::RealtimeGiSettings realtime;  // read when gi_path is Realtime
   // Probe rays, map size, sharing, accumulation, interpolation and skips
   // (see ProbeFieldSettings and the structs it holds; its `grid` is ignored:

@@ -10,6 +10,7 @@
 #include "engine/rt/rt_scene.h"
 #include "engine/scene/components.h"
 #include "engine/transform/transform.h"
+#include "gpu/vulkan_probe_kernels.h"
 #include "shading/realtime_direct.h"
 #include "shading/realtime_gi.h"
 #include "engine/render/temporal_accumulation.h"
@@ -37,12 +38,42 @@ void request_light_settings(Res<TransGISettings> settings, ResMut<render::LightS
   if (lights->split_sun != split) lights->split_sun = split;
 }
 
+// The probe kernels' backend, made when the settings first ask for it.
+struct ProbeBackend {
+  Backend made_for = Backend::Cpu;
+  std::string device;
+  std::shared_ptr<probes::ProbeKernels> kernels;  // null: the CPU functions
+  std::string fallback;
+};
+
 void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> cascades, Res<rt::RtScene> rt,
-                   Res<render::SceneLights> lights, Res<TransGISettings> settings, ResMut<GiFrame> frame) {
+                   Res<render::SceneLights> lights, Res<TransGISettings> settings, ResMut<GiFrame> frame,
+                   Local<ProbeBackend> backend) {
   if (settings->freeze_probes) return;
+  if (backend->made_for != settings->backend || backend->device != settings->gpu_device) {
+    *backend = ProbeBackend{settings->backend, settings->gpu_device, nullptr, ""};
+    if (settings->backend == Backend::Vulkan) {
+      engine::gpu::GpuOptions options;
+      options.device = settings->gpu_device;
+      std::string why;
+      try {
+        if (auto ctx = engine::gpu::VulkanContext::create(options, &why))
+          backend->kernels = std::make_shared<gpu::VulkanProbeKernels>(std::shared_ptr<engine::gpu::VulkanContext>(std::move(ctx)));
+      } catch (const std::exception& e) {
+        why = e.what();
+      }
+      if (!backend->kernels) backend->fallback = "Vulkan backend unavailable, the CPU runs the probes: " + why;
+    }
+  }
+  frame->backend = backend->kernels ? std::string("vulkan (") +
+                                          static_cast<gpu::VulkanProbeKernels&>(*backend->kernels).context().info().name + ")"
+                                    : "cpu";
+  frame->backend_fallback = backend->fallback;
   probes::ProbeFrameStats total;
   volumes.each([&](ProbeVolume& v) {
-    if (v.field) total += v.field->update(*rt, lights->set);
+    if (!v.field) return;
+    v.field->set_kernels(backend->kernels);
+    total += v.field->update(*rt, lights->set);
   });
   frame->cascade_stats.clear();
   cascades.each([&](ProbeCascades& set) {
@@ -50,6 +81,7 @@ void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> casc
       // Hits beyond a cascade are lit by the next coarser one.
       const probes::ProbeField* outer = k + 1 < set.state.fields.size() ? set.state.fields[k + 1].get() : nullptr;
       if (!set.state.fields[k]) continue;
+      set.state.fields[k]->set_kernels(backend->kernels);
       const probes::ProbeFrameStats st = set.state.fields[k]->update(*rt, lights->set, outer);
       if (frame->cascade_stats.size() <= k) frame->cascade_stats.resize(k + 1);
       frame->cascade_stats[k] += st;
@@ -57,6 +89,7 @@ void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> casc
     }
   });
   frame->probe_stats = total;
+  frame->gpu_ms = backend->kernels ? static_cast<gpu::VulkanProbeKernels&>(*backend->kernels).take_gpu_ms() : 0.0;
   ++frame->probe_frames;
 }
 

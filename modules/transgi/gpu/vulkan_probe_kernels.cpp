@@ -1,0 +1,27 @@
+#include "gpu/vulkan_probe_kernels.h"
+
+namespace transgi::gpu {
+
+probes::SharingStats VulkanProbeKernels::rasterize(const probes::ProbeGrid& grid, const probes::MapLayout& layout,
+                                                   const std::vector<std::vector<probes::ShadedPoint>>& points,
+                                                   const std::vector<const probes::DepthMap*>& own_depth,
+                                                   const probes::SharingSettings& settings,
+                                                   std::vector<probes::FrameSamples>& out,
+                                                   std::span<const std::uint8_t> targets) {
+  auto& r = rasters_[{layout.width, layout.height}];
+  if (!r) r = std::make_unique<VulkanRadianceRaster>(*ctx_, layout);
+  double ms = 0;
+  const auto stats = r->rasterize(grid, points, own_depth, settings, out, targets, &ms);
+  gpu_ms_ += std::max(0.0, ms);
+  return stats;
+}
+
+void VulkanProbeKernels::project(const probes::MapProjector& projector, std::span<const glm::vec3> radiance,
+                                 std::span<float> out) {
+  const auto& l = projector.layout();
+  auto& p = projectors_[{l.width, l.height}];
+  if (!p) p = std::make_unique<VulkanShProjector>(*ctx_, projector);
+  gpu_ms_ += std::max(0.0, p->project(radiance, out));
+}
+
+}  // namespace transgi::gpu

@@ -1,0 +1,38 @@
+#pragma once
+// The probe field's raster and SH projection on a Vulkan device
+// (probes::ProbeKernels). One instance serves every field of a scene; the
+// kernels for each map size are made on first use.
+#include <map>
+#include <memory>
+#include <utility>
+
+#include "engine/gpu/vulkan_context.h"
+#include "gpu/vulkan_radiance_raster.h"
+#include "gpu/vulkan_sh_projector.h"
+#include "probes/probe_kernels.h"
+
+namespace transgi::gpu {
+
+class VulkanProbeKernels : public probes::ProbeKernels {
+ public:
+  explicit VulkanProbeKernels(std::shared_ptr<engine::gpu::VulkanContext> ctx) : ctx_(std::move(ctx)) {}
+
+  probes::SharingStats rasterize(const probes::ProbeGrid& grid, const probes::MapLayout& layout,
+                                 const std::vector<std::vector<probes::ShadedPoint>>& points,
+                                 const std::vector<const probes::DepthMap*>& own_depth,
+                                 const probes::SharingSettings& settings, std::vector<probes::FrameSamples>& out,
+                                 std::span<const std::uint8_t> targets) override;
+  void project(const probes::MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out) override;
+  [[nodiscard]] const char* name() const override { return "vulkan"; }
+  [[nodiscard]] const engine::gpu::VulkanContext& context() const { return *ctx_; }
+  // GPU milliseconds of the kernels since the last call (timestamps).
+  double take_gpu_ms() { return std::exchange(gpu_ms_, 0.0); }
+
+ private:
+  std::shared_ptr<engine::gpu::VulkanContext> ctx_;
+  std::map<std::pair<int, int>, std::unique_ptr<VulkanRadianceRaster>> rasters_;
+  std::map<std::pair<int, int>, std::unique_ptr<VulkanShProjector>> projectors_;
+  double gpu_ms_ = 0.0;
+};
+
+}  // namespace transgi::gpu
