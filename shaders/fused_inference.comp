@@ -20,6 +20,19 @@ layout(std430, set = 0, binding = 3) writeonly buffer Rgb { float rgb[]; };     
 
 layout(push_constant) uniform PushBlock { FusedPush p; };
 
+// The host compiles the kernel for its network's layout (FUSED_INPUTS,
+// FUSED_WIDTH, FUSED_HIDDEN as defines), so every loop bound is a constant
+// the driver can unroll; without them the push constants give the layout.
+#ifdef FUSED_WIDTH
+#define N_INPUTS FUSED_INPUTS
+#define N_WIDTH FUSED_WIDTH
+#define N_HIDDEN FUSED_HIDDEN
+#else
+#define N_INPUTS p.inputs
+#define N_WIDTH p.width
+#define N_HIDDEN p.hidden_layers
+#endif
+
 shared float chunk[kFusedRowsPerChunk * kFusedMaxWidth];
 
 void main() {
@@ -27,15 +40,15 @@ void main() {
   const bool in_range = i < p.count;  // idle lanes still join every barrier
   float a[kFusedMaxWidth];
   float b[kFusedMaxWidth];
-  for (uint k = 0; k < p.inputs; ++k) a[k] = in_range ? inputs[i * p.inputs + k] : 0.0;
+  for (uint k = 0; k < N_INPUTS; ++k) a[k] = in_range ? inputs[i * N_INPUTS + k] : 0.0;
   vec3 gi = vec3(0.0);
 
   uint offset = 0;
-  const uint layers = p.hidden_layers + 1;
+  const uint layers = N_HIDDEN + 1;
   for (uint layer = 0; layer < layers; ++layer) {
-    const uint n_in = layer == 0 ? p.inputs : p.width;
-    const bool last = layer == p.hidden_layers;
-    const uint n_out = last ? p.outputs : p.width;
+    const uint n_in = layer == 0 ? N_INPUTS : N_WIDTH;
+    const bool last = layer == N_HIDDEN;
+    const uint n_out = last ? kTransferOutputs : N_WIDTH;
     const uint bias_offset = offset + n_out * n_in;
     for (uint row0 = 0; row0 < n_out; row0 += kFusedRowsPerChunk) {
       const uint rows = min(kFusedRowsPerChunk, n_out - row0);

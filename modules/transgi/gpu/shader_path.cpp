@@ -9,10 +9,11 @@ std::filesystem::path shader_dir() {
   return TRANSGI_SOURCE_SHADER_DIR;
 }
 
-std::vector<std::uint32_t> compile_module_shader(const char* name) {
+std::vector<std::uint32_t> compile_module_shader(const char* name, std::vector<engine::gpu::ShaderDefine> defines) {
   const auto dir = shader_dir();
   engine::gpu::ShaderCompileOptions options;
   options.include_dirs.push_back(dir);
+  options.defines = std::move(defines);
   return engine::gpu::compile_compute_shader(dir / name, options);
 }
 

@@ -10,6 +10,6 @@ namespace transgi::gpu {
 
 std::filesystem::path shader_dir();
 // Compiles shaders/<name> with shaders/ on the include path.
-std::vector<std::uint32_t> compile_module_shader(const char* name);
+std::vector<std::uint32_t> compile_module_shader(const char* name, std::vector<engine::gpu::ShaderDefine> defines = {});
 
 }  // namespace transgi::gpu

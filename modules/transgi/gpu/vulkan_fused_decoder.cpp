@@ -18,7 +18,9 @@ VulkanFusedDecoder::VulkanFusedDecoder(engine::gpu::VulkanContext& ctx, const mo
                                 std::to_string(l.width) + " -> " + std::to_string(l.outputs));
   params_ = engine::gpu::GpuBuffer(ctx, mlp.params().size() * sizeof(float));
   params_.upload(std::span<const float>(mlp.params()));
-  const auto spirv = compile_module_shader("fused_inference.comp");
+  const auto spirv = compile_module_shader("fused_inference.comp", {{"FUSED_INPUTS", std::to_string(l.inputs) + "u"},
+                                                                     {"FUSED_WIDTH", std::to_string(l.width) + "u"},
+                                                                     {"FUSED_HIDDEN", std::to_string(l.hidden_layers) + "u"}});
   pipeline_ = std::make_unique<engine::gpu::ComputePipeline>(ctx, spirv, 4, static_cast<std::uint32_t>(sizeof(FusedPush)));
   pipeline_->bind(0, params_);
 }
