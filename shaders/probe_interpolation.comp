@@ -19,30 +19,9 @@ layout(std430, set = 0, binding = 5) writeonly buffer PointSh { float point_sh[]
 
 layout(push_constant) uniform PushBlock { InterpolatePush p; };
 
-// probes::fast_atan2 and fast_acos, the same polynomials.
-float fast_atan2(float y, float x) {
-  const float ax = abs(x), ay = abs(y);
-  const float hi = max(ax, ay), lo = min(ax, ay);
-  const float z = hi > 0.0 ? lo / hi : 0.0, z2 = z * z;
-  float a = z * (0.99997726 + z2 * (-0.33262347 + z2 * (0.19354346 + z2 * (-0.11643287 + z2 * (0.05265332 + z2 * -0.01172120)))));
-  a = ay > ax ? 1.57079633 - a : a;
-  a = (floatBitsToUint(x) >> 31) != 0u ? 3.14159265 - a : a;
-  return (floatBitsToUint(y) >> 31) != 0u ? -a : a;
-}
-float fast_acos(float x) {
-  const float ax = min(abs(x), 1.0);
-  const float q = 1.5707963050 + ax * (-0.2145988016 + ax * (0.0889789874 + ax * (-0.0501743046 + ax * (0.0308918810 +
-                  ax * (-0.0170881256 + ax * (0.0066700901 + ax * -0.0012624911))))));
-  const float r = sqrt(1.0 - ax) * q;
-  return x < 0.0 ? 3.14159265 - r : r;
-}
-int texel_of(vec3 d) {
-  const float u = fast_atan2(d.x, -d.z) * 0.15915494, v = fast_acos(d.y) * 0.31830989;
-  const float uw = u < 0.0 ? u + 1.0 : u;
-  const int x = min(int(p.map_width) - 1, max(0, int(uw * float(p.map_width))));
-  const int y = min(int(p.map_height) - 1, max(0, int(v * float(p.map_height))));
-  return y * int(p.map_width) + x;
-}
+#include "map_texel.glsl"
+
+int texel_of(vec3 d) { return map_texel_of(d, p.map_width, p.map_height); }
 float chebyshev_visibility(float mean, float variance_in, float distance) {
   if (isnan(mean) || isinf(mean) || distance <= mean) return 1.0;
   const float variance = max(variance_in, 1e-6 * mean * mean + 1e-8);
