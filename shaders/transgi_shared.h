@@ -98,7 +98,30 @@ struct ShadedPointGpu {
   float nx, ny, nz, pad2;      // geometric normal on the shooting probe's side
 };
 
+// DDGI irradiance at shading points (ddgi_irradiance.comp).
+TRANSGI_CONST uint kDdgiGroupSize = 64u;
+
+struct DdgiPush {
+  float min_x, min_y, min_z, normal_bias;
+  float spacing_x, spacing_y, spacing_z, view_bias;
+  int dims_x, dims_y, dims_z, points;
+  int scroll_x, scroll_y, scroll_z;
+  float irradiance_gamma;
+  uint irradiance_size, distance_size, irradiance_interior, distance_interior;  // sizes include the border
+};
+
+// A shading point for DDGI: position, normal, view direction (eye to point).
+struct DdgiPointGpu {
+  float px, py, pz, pad0;
+  float nx, ny, nz, pad1;
+  float vx, vy, vz, pad2;
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(DdgiPush) == 80 && offsetof(DdgiPush, irradiance_gamma) == 60 &&
+              offsetof(DdgiPush, irradiance_size) == 64, "DdgiPush layout");
+static_assert(sizeof(DdgiPointGpu) == 48 && offsetof(DdgiPointGpu, nx) == 16 && offsetof(DdgiPointGpu, vx) == 32,
+              "DdgiPointGpu layout");
 static_assert(sizeof(RasterPush) == 80 && offsetof(RasterPush, flags) == 60 && offsetof(RasterPush, texels) == 72,
               "RasterPush layout");
 static_assert(sizeof(ShadedPointGpu) == 64 && offsetof(ShadedPointGpu, rx) == 16 && offsetof(ShadedPointGpu, nx) == 48,
