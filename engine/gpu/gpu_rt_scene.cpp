@@ -38,7 +38,14 @@ GpuRtScene::GpuRtScene(VulkanContext& ctx) : ctx_(ctx) {
 
 GpuRtScene::~GpuRtScene() = default;
 
+bool GpuRtScene::traces_exactly(const scene::SceneAssets& assets) {
+  for (const auto& m : assets.materials)
+    if (m.alpha_mode == material::AlphaMode::Mask) return false;
+  return true;
+}
+
 void GpuRtScene::sync(const rt::RtScene& rt) {
+  synced_ = &rt;
   const scene::SceneAssets* assets = rt.assets();
   if (assets && assets->generation != generation_) {
     generation_ = assets->generation;
@@ -110,7 +117,8 @@ void GpuRtScene::bind(ComputePipeline& pipeline, std::uint32_t first) const {
   pipeline.bind(first + 3, triangles_);
 }
 
-void GpuRtScene::intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hits, std::span<bool> found, double* gpu_ms) {
+void GpuRtScene::intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hits, std::span<std::uint8_t> found,
+                           double* gpu_ms) {
   if (hits.size() != rays.size() || found.size() != rays.size())
     throw GpuError("GpuRtScene::intersect: " + std::to_string(rays.size()) + " rays, " + std::to_string(hits.size()) +
                    " hits, " + std::to_string(found.size()) + " flags");
@@ -134,8 +142,10 @@ void GpuRtScene::intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hit
   std::vector<HitGpu> out(rays.size());
   hits_.download(std::span<HitGpu>(out));
   for (std::size_t i = 0; i < rays.size(); ++i) {
-    found[i] = out[i].instance != kRtNoHit;
+    found[i] = out[i].instance != kRtNoHit ? 1 : 0;
     if (!found[i]) continue;
+    const rt::InstanceRecord* record = synced_ ? synced_->instance(out[i].instance) : nullptr;
+    hits[i].entity = record ? record->entity : ecs::Entity{};
     hits[i].instance = out[i].instance;
     hits[i].mesh = out[i].mesh;
     hits[i].primitive = out[i].primitive;

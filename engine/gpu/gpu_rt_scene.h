@@ -33,14 +33,22 @@ class GpuRtScene {
   // Binds the TLAS, instances, BLAS and triangles at first .. first + 3.
   void bind(ComputePipeline& pipeline, std::uint32_t first) const;
 
-  // Closest hits of a batch of rays (shaders/rt_query.comp); found[i] says
-  // whether ray i hit. Hit::entity is left empty: the instance id names it.
-  void intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hits, std::span<bool> found, double* gpu_ms = nullptr);
+  // Closest hits of a batch of rays (shaders/rt_query.comp) in the scene as
+  // of the last sync; found[i] says whether ray i hit. Hits carry the entity
+  // and instance id as Embree's do, so RtScene::instance_of and make_surface
+  // take them.
+  void intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hits, std::span<std::uint8_t> found,
+                 double* gpu_ms = nullptr);
+
+  // Whether every triangle is opaque to the traversal: alpha-masked
+  // materials are not tested on the GPU yet, so such scenes trace on the CPU.
+  [[nodiscard]] static bool traces_exactly(const scene::SceneAssets& assets);
 
   [[nodiscard]] const GpuRtStats& stats() const { return stats_; }
 
  private:
   VulkanContext& ctx_;
+  const rt::RtScene* synced_ = nullptr;
   std::uint64_t generation_ = 0;
   std::vector<std::uint32_t> blas_root_, triangle_offset_;  // per mesh
   GpuBuffer tlas_, instances_, blas_, triangles_;

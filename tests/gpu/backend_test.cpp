@@ -29,10 +29,11 @@ eval::MethodRun cornell(runtime::Backend backend) {
 
 }  // namespace
 
-// The raster is the CPU's arithmetic in the CPU's order and the projection
-// differs only in summation order (fp32 partial sums against double), so 16
-// frames of feedback through the probes leave the images equal to well
-// within 1e-4 of the mean GI (measured: see output).
+// The probe rays are traced through the GPU BVH (hit distances round
+// differently from Embree's), the raster is the CPU's arithmetic in the CPU's
+// order and the projection differs only in summation order (fp32 partial
+// sums against double): after 16 frames of feedback through the probes the
+// images stay within 1e-4 of the mean GI (measured 3.7e-7, 1.2 % of that).
 TEST(VulkanBackend, ACornellBoxGiFrameEqualsTheCpuBackends) {
   GPU_TEST_CONTEXT_OR_SKIP(ctx);
   const eval::MethodRun cpu = cornell(runtime::Backend::Cpu);

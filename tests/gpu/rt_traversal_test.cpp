@@ -138,7 +138,7 @@ TEST(GpuRtTraversal, FindsTheSameClosestHitsAsEmbree) {
   }
   std::vector<rt::Hit> want(rays.size()), got(rays.size());
   std::vector<bool> want_found(rays.size());
-  std::unique_ptr<bool[]> got_found(new bool[rays.size()]);
+  std::vector<std::uint8_t> got_found(rays.size());
   for (std::size_t i = 0; i < rays.size(); ++i) {
     rt::Hit h;
     want_found[i] = w.rt.intersect(rays[i], h);
@@ -147,12 +147,12 @@ TEST(GpuRtTraversal, FindsTheSameClosestHitsAsEmbree) {
   gpu::GpuRtScene gpu_rt(*ctx);
   gpu_rt.sync(w.rt);
   double ms = 0;
-  gpu_rt.intersect(rays, got, std::span<bool>(got_found.get(), rays.size()), &ms);
+  gpu_rt.intersect(rays, got, got_found, &ms);
 
   std::size_t hits = 0, disagree = 0, bad = 0;
   for (std::size_t i = 0; i < rays.size(); ++i) {
     hits += want_found[i];
-    if (want_found[i] != got_found[i] || (want_found[i] && (want[i].instance != got[i].instance || want[i].primitive != got[i].primitive))) {
+    if (want_found[i] != (got_found[i] != 0) || (want_found[i] && (want[i].instance != got[i].instance || want[i].primitive != got[i].primitive))) {
       ++disagree;
       continue;
     }
@@ -193,11 +193,12 @@ TEST(GpuRtTraversal, AMovedInstanceIsFoundWhereItMovedAfterASync) {
   EXPECT_EQ(gpu_rt.stats().blas_builds, w.assets.meshes.size()) << "a move must not rebuild a BLAS";
   const std::vector<rt::Ray> rays = {rt::Ray{glm::vec3(0.0f, 0.0f, 0.0f), glm::vec3(0.0f, 0.0f, -1.0f)}};
   std::vector<rt::Hit> h(1);
-  bool found[1] = {false};
+  std::vector<std::uint8_t> found(1, 0);
   gpu_rt.intersect(rays, h, found);
   rt::Hit want;
   ASSERT_TRUE(w.rt.intersect(rays[0], want));
   ASSERT_TRUE(found[0]);
   EXPECT_EQ(h[0].instance, want.instance);
+  EXPECT_EQ(h[0].entity, want.entity) << "a GPU hit names its entity as Embree's does";
   EXPECT_NEAR(h[0].t, want.t, 1e-4f * want.t) << "the sphere's front at z = -3.5 + 0.7";
 }

@@ -6,6 +6,7 @@
 #include <memory>
 #include <utility>
 
+#include "engine/gpu/gpu_rt_scene.h"
 #include "engine/gpu/vulkan_context.h"
 #include "gpu/vulkan_radiance_raster.h"
 #include "gpu/vulkan_sh_projector.h"
@@ -23,6 +24,11 @@ class VulkanProbeKernels : public probes::ProbeKernels {
                                  const probes::SharingSettings& settings, std::vector<probes::FrameSamples>& out,
                                  std::span<const std::uint8_t> targets) override;
   void project(const probes::MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out) override;
+  // Through the GPU BVH (engine/gpu/gpu_rt_scene), synced when the scene's
+  // top level was committed again; false for scenes with alpha-masked
+  // materials, which the GPU traversal does not test yet.
+  bool intersect(const engine::rt::RtScene& scene, std::span<const engine::rt::Ray> rays, std::span<engine::rt::Hit> hits,
+                 std::span<std::uint8_t> found) override;
   [[nodiscard]] const char* name() const override { return "vulkan"; }
   [[nodiscard]] const engine::gpu::VulkanContext& context() const { return *ctx_; }
   // GPU milliseconds of the kernels since the last call (timestamps).
@@ -32,6 +38,9 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   std::shared_ptr<engine::gpu::VulkanContext> ctx_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanRadianceRaster>> rasters_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanShProjector>> projectors_;
+  std::unique_ptr<engine::gpu::GpuRtScene> rt_;
+  const engine::rt::RtScene* rt_scene_ = nullptr;
+  std::size_t rt_commits_ = 0;
   double gpu_ms_ = 0.0;
 };
 

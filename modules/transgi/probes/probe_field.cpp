@@ -229,6 +229,25 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   std::vector<float> nearest(static_cast<std::size_t>(probes), std::numeric_limits<float>::infinity());
   std::atomic<std::size_t> hits{0}, nonfinite_rays{0};
   std::vector<float> direct_frame(static_cast<std::size_t>(probes) * 75, 0.0f);
+  auto ray_direction = [&](int i) { return glm::normalize(rotation * fibonacci_[static_cast<std::size_t>(i)]); };
+  // With a backend, every traced probe's rays go to it in one batch first
+  // (first_ray[q]: probe q's first ray in the batch); the shading below
+  // then reads those hits instead of tracing.
+  std::vector<rt::Hit> batch_hits;
+  std::vector<std::uint8_t> batch_found;
+  std::vector<std::size_t> first_ray;
+  if (kernels_) {
+    std::vector<rt::Ray> rays;
+    first_ray.assign(static_cast<std::size_t>(probes), 0);
+    for (int q = 0; q < probes; ++q) {
+      if (!traced[static_cast<std::size_t>(q)]) continue;
+      first_ray[static_cast<std::size_t>(q)] = rays.size();
+      for (int i = 0; i < M; ++i) rays.push_back(rt::Ray{grid.position(q), ray_direction(i)});
+    }
+    batch_hits.resize(rays.size());
+    batch_found.resize(rays.size());
+    if (!kernels_->intersect(scene, rays, batch_hits, batch_found)) first_ray.clear();  // the CPU traces
+  }
   jobs::parallel_for(0, probes, 1, [&](int b, int e) {
     for (int q = b; q < e; ++q) {
       if (!traced[static_cast<std::size_t>(q)]) continue;
@@ -239,13 +258,20 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
       bool saw_light = false;
       for (int i = 0; i < M; ++i) {
         math::Pcg32 rng = math::make_rng(seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
-        const glm::vec3 dir = glm::normalize(rotation * fibonacci_[static_cast<std::size_t>(i)]);
-        const ProbeRayHit h = trace_probe_ray(scene, lights, origin, dir, rng, [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3&) {
+        const glm::vec3 dir = ray_direction(i);
+        const auto feedback = [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3&) {
           // Indirect light from last frame's probes (multi-bounce feedback).
           if (outer && (glm::any(glm::lessThan(p, grid.min)) || glm::any(glm::greaterThan(p, grid.max))))
             return outer->irradiance(p, n);
           return frame_ > 0 ? irradiance(p, n) : glm::vec3(0.0f);
-        });
+        };
+        ProbeRayHit h;
+        if (first_ray.empty()) {
+          h = trace_probe_ray(scene, lights, origin, dir, rng, feedback);
+        } else {
+          const std::size_t k = first_ray[static_cast<std::size_t>(q)] + static_cast<std::size_t>(i);
+          h = shade_probe_ray(scene, lights, dir, batch_found[k] ? &batch_hits[k] : nullptr, rng, feedback);
+        }
         if (h.emitted != glm::vec3(0.0f)) {
           // Monte Carlo projection over a near-uniform set: 4 pi / M per ray.
           const math::ShBasis y = math::sh_eval(dir);

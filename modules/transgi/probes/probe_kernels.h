@@ -1,5 +1,6 @@
 #pragma once
-// The probe field's data-parallel stages behind one interface, so a backend
+// The probe field's data-parallel stages (ray tracing, raster, SH projection)
+// behind one interface, so a backend
 // can run them elsewhere (pbrt's split of interface and backend). The CPU
 // functions (rasterize_shared, MapProjector) are the oracle; a ProbeField
 // without kernels calls them directly. The Vulkan backend is
@@ -8,6 +9,7 @@
 #include <span>
 #include <vector>
 
+#include "engine/rt/rt_scene.h"
 #include "probes/radiance_sharing.h"
 
 namespace transgi::probes {
@@ -23,6 +25,11 @@ class ProbeKernels {
   // As MapProjector::project for `maps` maps stored one after another:
   // radiance maps x texel_count(), out maps x 75.
   virtual void project(const MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out) = 0;
+  // Closest hits of a batch of rays in `scene`; found[i] says whether ray i
+  // hit. Returns false, touching nothing, where the backend cannot trace this
+  // scene (the caller traces on the CPU).
+  virtual bool intersect(const engine::rt::RtScene& scene, std::span<const engine::rt::Ray> rays,
+                         std::span<engine::rt::Hit> hits, std::span<std::uint8_t> found) = 0;
   [[nodiscard]] virtual const char* name() const = 0;
 };
 

@@ -3,6 +3,7 @@
 // baseline): the ray set, and the shading of a probe ray's hit, so that the
 // two differ only in how they store, filter and interpolate light.
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -48,13 +49,15 @@ struct ProbeRayHit {
 // albedo / pi times `feedback(position, normal)`, the previous frame's
 // irradiance. Emitter hits and escaped rays carry zero: the probes hold
 // indirect light, direct light is added at the pixel.
+//
+// shade_probe_ray does the same for a ray already traced (`hit` null: it
+// escaped), so a backend can trace a frame's probe rays in one batch.
 template <class Feedback>
-ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, const glm::vec3& origin,
-                            const glm::vec3& dir, engine::math::Pcg32& rng, Feedback&& feedback) {
+ProbeRayHit shade_probe_ray(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, const glm::vec3& dir,
+                            const engine::rt::Hit* traced, engine::math::Pcg32& rng, Feedback&& feedback) {
   using namespace engine;
   ProbeRayHit r;
-  rt::Hit hit;
-  if (!scene.intersect(rt::Ray{origin, dir}, hit)) {
+  if (!traced) {
     if (const scene::Environment* env = lights.environment()) r.emitted = env->radiance(dir);
     if (!std::isfinite(r.emitted.r + r.emitted.g + r.emitted.b)) {
       r.emitted = glm::vec3(0.0f);
@@ -63,6 +66,7 @@ ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::rend
     r.saw_light = true;
     return r;
   }
+  const rt::Hit& hit = *traced;
   const render::Surface s = render::make_surface(scene, hit, dir);
   r.emitted = s.emission;
   if (!std::isfinite(r.emitted.r + r.emitted.g + r.emitted.b)) {
@@ -99,6 +103,14 @@ ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::rend
     r.replaced_non_finite = true;
   }
   return r;
+}
+
+template <class Feedback>
+ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, const glm::vec3& origin,
+                            const glm::vec3& dir, engine::math::Pcg32& rng, Feedback&& feedback) {
+  engine::rt::Hit hit;
+  const bool found = scene.intersect(engine::rt::Ray{origin, dir}, hit);
+  return shade_probe_ray(scene, lights, dir, found ? &hit : nullptr, rng, std::forward<Feedback>(feedback));
 }
 
 }  // namespace transgi::probes
