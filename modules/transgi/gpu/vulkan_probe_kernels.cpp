@@ -24,20 +24,4 @@ void VulkanProbeKernels::project(const probes::MapProjector& projector, std::spa
   gpu_ms_ += std::max(0.0, p->project(radiance, out));
 }
 
-bool VulkanProbeKernels::intersect(const engine::rt::RtScene& scene, std::span<const engine::rt::Ray> rays,
-                                   std::span<engine::rt::Hit> hits, std::span<std::uint8_t> found) {
-  if (!scene.assets() || !engine::gpu::GpuRtScene::traces_exactly(*scene.assets())) return false;
-  if (!rt_) rt_ = std::make_unique<engine::gpu::GpuRtScene>(*ctx_);
-  // A new commit (something moved) or another scene: the TLAS follows.
-  if (rt_scene_ != &scene || rt_commits_ != scene.stats().top_level_commits) {
-    rt_->sync(scene);
-    rt_scene_ = &scene;
-    rt_commits_ = scene.stats().top_level_commits;
-  }
-  double ms = 0;
-  rt_->intersect(rays, hits, found, &ms);
-  gpu_ms_ += std::max(0.0, ms);
-  return true;
-}
-
 }  // namespace transgi::gpu

@@ -6,7 +6,7 @@
 #include <memory>
 #include <utility>
 
-#include "engine/gpu/gpu_rt_scene.h"
+#include "engine/gpu/gpu_ray_tracer.h"
 #include "engine/gpu/vulkan_context.h"
 #include "gpu/vulkan_radiance_raster.h"
 #include "gpu/vulkan_sh_projector.h"
@@ -16,7 +16,7 @@ namespace transgi::gpu {
 
 class VulkanProbeKernels : public probes::ProbeKernels {
  public:
-  explicit VulkanProbeKernels(std::shared_ptr<engine::gpu::VulkanContext> ctx) : ctx_(std::move(ctx)) {}
+  explicit VulkanProbeKernels(std::shared_ptr<engine::gpu::VulkanContext> ctx) : ctx_(std::move(ctx)), tracer_(*ctx_) {}
 
   probes::SharingStats rasterize(const probes::ProbeGrid& grid, const probes::MapLayout& layout,
                                  const std::vector<std::vector<probes::ShadedPoint>>& points,
@@ -24,23 +24,17 @@ class VulkanProbeKernels : public probes::ProbeKernels {
                                  const probes::SharingSettings& settings, std::vector<probes::FrameSamples>& out,
                                  std::span<const std::uint8_t> targets) override;
   void project(const probes::MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out) override;
-  // Through the GPU BVH (engine/gpu/gpu_rt_scene), synced when the scene's
-  // top level was committed again; false for scenes with alpha-masked
-  // materials, which the GPU traversal does not test yet.
-  bool intersect(const engine::rt::RtScene& scene, std::span<const engine::rt::Ray> rays, std::span<engine::rt::Hit> hits,
-                 std::span<std::uint8_t> found) override;
+  engine::rt::RayBatchTracer* tracer() override { return &tracer_; }
   [[nodiscard]] const char* name() const override { return "vulkan"; }
   [[nodiscard]] const engine::gpu::VulkanContext& context() const { return *ctx_; }
   // GPU milliseconds of the kernels since the last call (timestamps).
-  double take_gpu_ms() { return std::exchange(gpu_ms_, 0.0); }
+  double take_gpu_ms() { return std::exchange(gpu_ms_, 0.0) + tracer_.take_gpu_ms(); }
 
  private:
   std::shared_ptr<engine::gpu::VulkanContext> ctx_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanRadianceRaster>> rasters_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanShProjector>> projectors_;
-  std::unique_ptr<engine::gpu::GpuRtScene> rt_;
-  const engine::rt::RtScene* rt_scene_ = nullptr;
-  std::size_t rt_commits_ = 0;
+  engine::gpu::GpuRayTracer tracer_;
   double gpu_ms_ = 0.0;
 };
 

@@ -236,7 +236,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   std::vector<rt::Hit> batch_hits;
   std::vector<std::uint8_t> batch_found;
   std::vector<std::size_t> first_ray;
-  if (kernels_) {
+  if (rt::RayBatchTracer* tracer = kernels_ ? kernels_->tracer() : nullptr) {
     std::vector<rt::Ray> rays;
     first_ray.assign(static_cast<std::size_t>(probes), 0);
     for (int q = 0; q < probes; ++q) {
@@ -246,7 +246,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
     }
     batch_hits.resize(rays.size());
     batch_found.resize(rays.size());
-    if (!kernels_->intersect(scene, rays, batch_hits, batch_found)) first_ray.clear();  // the CPU traces
+    if (!tracer->intersect(scene, rays, batch_hits, batch_found)) first_ray.clear();  // Embree traces
   }
   jobs::parallel_for(0, probes, 1, [&](int b, int e) {
     for (int q = b; q < e; ++q) {

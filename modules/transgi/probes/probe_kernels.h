@@ -9,7 +9,7 @@
 #include <span>
 #include <vector>
 
-#include "engine/rt/rt_scene.h"
+#include "engine/rt/ray_batch_tracer.h"
 #include "probes/radiance_sharing.h"
 
 namespace transgi::probes {
@@ -25,11 +25,9 @@ class ProbeKernels {
   // As MapProjector::project for `maps` maps stored one after another:
   // radiance maps x texel_count(), out maps x 75.
   virtual void project(const MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out) = 0;
-  // Closest hits of a batch of rays in `scene`; found[i] says whether ray i
-  // hit. Returns false, touching nothing, where the backend cannot trace this
-  // scene (the caller traces on the CPU).
-  virtual bool intersect(const engine::rt::RtScene& scene, std::span<const engine::rt::Ray> rays,
-                         std::span<engine::rt::Hit> hits, std::span<std::uint8_t> found) = 0;
+  // The backend's ray tracer for the probe rays (and the G-buffer's camera
+  // rays); null = Embree.
+  virtual engine::rt::RayBatchTracer* tracer() = 0;
   [[nodiscard]] virtual const char* name() const = 0;
 };
 

@@ -49,7 +49,7 @@ struct GiFrame {
   // device), and why not the one asked for, if it could not.
   std::string backend = "cpu";
   std::string backend_fallback;
-  double gpu_ms = 0.0;  // the probe kernels' GPU time this frame (timestamps)
+  double gpu_ms = 0.0;  // the backend's GPU time (timestamps) between the last two probe updates
 };
 
 }  // namespace transgi::runtime

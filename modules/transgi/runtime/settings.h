@@ -36,9 +36,10 @@ enum class DirectLight {
 // Where the probes' data-parallel stages run (issue 12).
 enum class Backend {
   Cpu,     // the oracle, and this machine's real-time path
-  // Probe rays traced through a GPU BVH, the radiance raster and the SH
-  // projection as Vulkan compute kernels (shaders/); shading the hits, the
-  // accumulation and the G-buffer stay on the CPU for now. Without a usable
+  // Probe rays and the real-time G-buffer's camera rays traced through a
+  // GPU BVH, the radiance raster and the SH projection as Vulkan compute
+  // kernels (shaders/); shading the hits and the accumulation stay on the
+  // CPU for now. Without a usable
   // device the CPU runs them and GiFrame says why.
   Vulkan,
 };

@@ -38,7 +38,8 @@ void request_light_settings(Res<TransGISettings> settings, ResMut<render::LightS
   if (lights->split_sun != split) lights->split_sun = split;
 }
 
-// The probe kernels' backend, made when the settings first ask for it.
+// The GI backend (probe kernels and ray tracer), made when the settings
+// first ask for it; a resource, as render_gi traces the G-buffer with it too.
 struct ProbeBackend {
   Backend made_for = Backend::Cpu;
   std::string device;
@@ -48,7 +49,7 @@ struct ProbeBackend {
 
 void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> cascades, Res<rt::RtScene> rt,
                    Res<render::SceneLights> lights, Res<TransGISettings> settings, ResMut<GiFrame> frame,
-                   Local<ProbeBackend> backend) {
+                   ResMut<ProbeBackend> backend) {
   if (settings->freeze_probes) return;
   if (backend->made_for != settings->backend || backend->device != settings->gpu_device) {
     *backend = ProbeBackend{settings->backend, settings->gpu_device, nullptr, ""};
@@ -127,7 +128,8 @@ struct PackedDecoder {
 void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const model::TransferModel>& model,
                      const std::function<bool(Entity)>& has_transfer, std::span<const probes::ProbeField* const> fields,
                      const rt::RtScene& rt, const scene::SceneAssets& assets, const render::LightSet& lights,
-                     const TransGISettings& settings, std::uint64_t seed, PackedDecoder& packed, GiFrame& frame) {
+                     const TransGISettings& settings, std::uint64_t seed, PackedDecoder& packed, GiFrame& frame,
+                     rt::RayBatchTracer* tracer) {
   if (model && packed.model != model) {
     packed.decoder = std::make_unique<shading::FusedDecoder>(model->decoder);
     packed.model = model;
@@ -138,7 +140,7 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   // G-buffer's loop, while each tile is in cache; its time counts there.
   std::optional<shading::DirectTileShader> direct;
   if (deterministic) direct.emplace(rt, lights, rays, frame.width, frame.height);
-  shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, packed.gbuffer, direct ? &*direct : nullptr);
+  shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, packed.gbuffer, direct ? &*direct : nullptr, tracer);
   const shading::GBuffer& g = packed.gbuffer;
   frame.times.gbuffer = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   shading::RealtimeGiStats st;
@@ -168,7 +170,7 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
 void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Get<const ProbeCascades>> cascades,
                View<Get<const LatentMesh>> latents,
                Res<rt::RtScene> rt, Res<scene::SceneAssets> assets, Res<render::SceneLights> lights,
-               Res<TransGISettings> settings, ResMut<GiFrame> frame, Local<PackedDecoder> packed) {
+               Res<TransGISettings> settings, ResMut<GiFrame> frame, Res<ProbeBackend> backend, Local<PackedDecoder> packed) {
   if (frame->width <= 0 || frame->height <= 0) return;
   const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
   if (!rays) throw std::runtime_error("transgi::render_gi: GiFrame asks for an image but the world has no camera");
@@ -201,7 +203,8 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
     return l && model && l->model == model;
   };
   if (settings->gi_path == GiPath::Realtime) {
-    render_realtime(*rays, model, rs.has_transfer, fields, *rt, *assets, lights->set, *settings, rs.seed, *packed, *frame);
+    render_realtime(*rays, model, rs.has_transfer, fields, *rt, *assets, lights->set, *settings, rs.seed, *packed, *frame,
+                    backend->kernels ? backend->kernels->tracer() : nullptr);
     frame->times.collect_points = frame->probe_stats.scatter_ms;
     frame->times.probe_raster = frame->probe_stats.raster_ms;
     frame->times.probe_projection = frame->probe_stats.project_ms;
@@ -259,6 +262,7 @@ void TransGIPlugin::build(app::App& app) {
   ecs::World& w = app.world();
   if (!w.has_resource<TransGISettings>()) w.insert_resource<TransGISettings>(settings_);
   if (!w.has_resource<GiFrame>()) w.insert_resource<GiFrame>();
+  if (!w.has_resource<ProbeBackend>()) w.insert_resource<ProbeBackend>();
   app.add_system(Phase::PostUpdate, "transgi::request_light_settings", request_light_settings);
   app.add_system(Phase::PrepareRender, "transgi::sync_probe_volumes", sync_probe_volumes);
   app.add_system(Phase::PrepareRender, "transgi::sync_probe_cascades", sync_probe_cascades);

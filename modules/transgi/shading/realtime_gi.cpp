@@ -101,7 +101,8 @@ GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::Sce
 }
 
 void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
-                   const engine::render::CameraRays& camera, int width, int height, GBuffer& g, DirectTileShader* direct) {
+                   const engine::render::CameraRays& camera, int width, int height, GBuffer& g, DirectTileShader* direct,
+                   engine::rt::RayBatchTracer* tracer) {
   g.width = width;
   g.height = height;
   g.samples.resize(static_cast<std::size_t>(width) * height);
@@ -112,6 +113,25 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
   // their traversal.
   const int tiles_x = (width + 3) / 4, tiles_y = (height + 3) / 4;
   const float spread = camera.pixel_spread();
+  // A backend traces every camera ray in one batch, in the tiles' order.
+  std::vector<engine::rt::Ray> batch_rays;
+  std::vector<engine::rt::Hit> batch_hits;
+  std::vector<std::uint8_t> batch_found;
+  std::vector<std::size_t> tile_first;
+  if (tracer) {
+    batch_rays.reserve(g.samples.size());
+    tile_first.resize(static_cast<std::size_t>(tiles_x) * tiles_y);
+    for (int t = 0; t < tiles_x * tiles_y; ++t) {
+      tile_first[static_cast<std::size_t>(t)] = batch_rays.size();
+      const int tx = t % tiles_x * 4, ty = t / tiles_x * 4;
+      for (int y = ty; y < std::min(ty + 4, height); ++y)
+        for (int x = tx; x < std::min(tx + 4, width); ++x)
+          batch_rays.push_back(camera.generate({static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f}));
+    }
+    batch_hits.resize(batch_rays.size());
+    batch_found.resize(batch_rays.size());
+    if (!tracer->intersect(scene, batch_rays, batch_hits, batch_found)) tile_first.clear();
+  }
   engine::jobs::parallel_for(0, tiles_x * tiles_y, 16, [&](int t0, int t1) {
     engine::rt::Ray rays[16];
     engine::rt::Hit hits[16];
@@ -125,7 +145,15 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
           rays[n] = camera.generate({static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f});
           pixel[n] = static_cast<std::size_t>(y) * width + x;
         }
-      scene.intersect16(rays, n, hits, found);
+      if (tile_first.empty()) {
+        scene.intersect16(rays, n, hits, found);
+      } else {
+        const std::size_t first = tile_first[static_cast<std::size_t>(t)];
+        for (int i = 0; i < n; ++i) {
+          found[i] = batch_found[first + static_cast<std::size_t>(i)] != 0;
+          hits[i] = batch_hits[first + static_cast<std::size_t>(i)];
+        }
+      }
       for (int i = 0; i < n; ++i) {
         GSample& s = g.samples[pixel[i]];
         make_gsample(scene, assets, rays[i], found[i] ? &hits[i] : nullptr, nullptr, spread, s);

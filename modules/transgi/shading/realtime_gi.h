@@ -73,10 +73,12 @@ GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::Sce
 // The same into `g`, reusing its storage (a frame loop keeps one G-buffer:
 // 230,400 samples are tens of MB to fault in afresh every frame). With
 // `direct`, each 4x4 tile is also shaded by it as soon as it is traced, while
-// its samples are in cache (realtime_direct.h).
+// its samples are in cache (realtime_direct.h). With `tracer` (a GPU
+// backend), every camera ray is traced by it in one batch first; Embree's
+// packets trace them where it declines.
 void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                    const engine::render::CameraRays& camera, int width, int height, GBuffer& g,
-                   DirectTileShader* direct = nullptr);
+                   DirectTileShader* direct = nullptr, engine::rt::RayBatchTracer* tracer = nullptr);
 
 // Buffers the real-time path keeps from frame to frame: at 640x360 they are
 // tens of MB that would otherwise be faulted in and zeroed every frame.

@@ -1,0 +1,30 @@
+#pragma once
+// rt::RayBatchTracer on a Vulkan device: a GpuRtScene that follows the
+// RtScene (synced whenever its top level was committed again) and traces
+// each batch in one dispatch. Declines scenes with alpha-masked materials,
+// which the GPU traversal does not test yet.
+#include <memory>
+
+#include "engine/gpu/gpu_rt_scene.h"
+#include "engine/rt/ray_batch_tracer.h"
+
+namespace engine::gpu {
+
+class GpuRayTracer : public rt::RayBatchTracer {
+ public:
+  explicit GpuRayTracer(VulkanContext& ctx) : ctx_(ctx) {}
+
+  bool intersect(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<rt::Hit> hits,
+                 std::span<std::uint8_t> found) override;
+  // GPU milliseconds of the traces since the last call (timestamps).
+  double take_gpu_ms();
+
+ private:
+  VulkanContext& ctx_;
+  std::unique_ptr<GpuRtScene> rt_;
+  const rt::RtScene* synced_ = nullptr;
+  std::size_t commits_ = 0;
+  double gpu_ms_ = 0.0;
+};
+
+}  // namespace engine::gpu

@@ -1,0 +1,24 @@
+#pragma once
+// A backend that traces a batch of rays against an RtScene somewhere other
+// than Embree (engine/gpu/gpu_ray_tracer: a BVH in a compute shader). Callers
+// that hold one trace a frame's rays in one call and fall back to the
+// RtScene's own queries when it declines.
+#include <cstdint>
+#include <span>
+
+#include "engine/rt/rt_scene.h"
+
+namespace engine::rt {
+
+class RayBatchTracer {
+ public:
+  virtual ~RayBatchTracer() = default;
+  // Closest hits of `rays` in `scene` as it is now; found[i] says whether ray
+  // i hit, and a hit carries what RtScene::intersect's does (entity,
+  // instance, mesh, primitive, barycentrics, t). Returns false, touching
+  // nothing, where this backend cannot trace the scene exactly.
+  virtual bool intersect(const RtScene& scene, std::span<const Ray> rays, std::span<Hit> hits,
+                         std::span<std::uint8_t> found) = 0;
+};
+
+}  // namespace engine::rt
