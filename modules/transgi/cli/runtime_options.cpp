@@ -21,7 +21,7 @@ runtime::TransGISettings runtime_settings_from(const Args& args, const char* def
                          ? runtime::DirectLight::Deterministic
                          : runtime::DirectLight::Stochastic;
   s.backend = args.choice("backend", {"cpu", "vulkan"}, "cpu") == "vulkan" ? runtime::Backend::Vulkan : runtime::Backend::Cpu;
-  s.gpu_device = args.str("gpu-device", std::string());
+  s.gpu_device = args.str("device", std::string());
   return s;
 }
 

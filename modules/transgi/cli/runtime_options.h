@@ -1,7 +1,7 @@
 #pragma once
 // The run-time options render and bench-frame share: --preset, --gi-scale,
 // --probe-budget, --map-width, --direct and --backend cpu|vulkan (with
-// --gpu-device NAME), applied on top of the preset.
+// --device NAME), applied on top of the preset.
 #include "cli/args.h"
 #include "runtime/probe_placement.h"
 #include "runtime/settings.h"
