@@ -4,9 +4,16 @@
 // transfer coefficients with that point's light SH as they come out, so they
 // never reach memory. Weights pass through shared memory a chunk of rows at a
 // time (a whole 128-wide layer is 64 KB; devices guarantee 16-32 KB), read by
-// all 64 points of the workgroup. fp32 throughout: the fp16 variant for
-// devices that have shaderFloat16 is still to come.
+// all 64 points of the workgroup. With FUSED_F16_WEIGHTS (devices with
+// shaderFloat16) the staged weights are fp16, half the shared memory and
+// bandwidth; activations and sums stay fp32 either way.
 #extension GL_GOOGLE_include_directive : require
+#ifdef FUSED_F16_WEIGHTS
+#extension GL_EXT_shader_explicit_arithmetic_types_float16 : require
+#define WEIGHT float16_t
+#else
+#define WEIGHT float
+#endif
 #include "transgi_shared.h"
 
 layout(local_size_x = kFusedGroupSize) in;
@@ -33,7 +40,7 @@ layout(push_constant) uniform PushBlock { FusedPush p; };
 #define N_HIDDEN p.hidden_layers
 #endif
 
-shared float chunk[kFusedRowsPerChunk * kFusedMaxWidth];
+shared WEIGHT chunk[kFusedRowsPerChunk * kFusedMaxWidth];
 
 void main() {
   const uint i = gl_GlobalInvocationID.x;
@@ -54,11 +61,11 @@ void main() {
       const uint rows = min(kFusedRowsPerChunk, n_out - row0);
       barrier();  // the previous chunk is no longer read
       for (uint t = gl_LocalInvocationID.x; t < rows * n_in; t += kFusedGroupSize)
-        chunk[t] = params[offset + row0 * n_in + t];
+        chunk[t] = WEIGHT(params[offset + row0 * n_in + t]);
       barrier();
       for (uint r = 0; r < rows; ++r) {
         float s = params[bias_offset + row0 + r];
-        for (uint k = 0; k < n_in; ++k) s += chunk[r * n_in + k] * a[k];
+        for (uint k = 0; k < n_in; ++k) s += float(chunk[r * n_in + k]) * a[k];
         const uint o = row0 + r;
         if (!last) {
           b[o] = max(s, 0.0);

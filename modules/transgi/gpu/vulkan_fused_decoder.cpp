@@ -3,12 +3,13 @@
 #include <stdexcept>
 #include <string>
 
+#include "engine/gpu/gpu_error.h"
 #include "gpu/shader_path.h"
 #include "transgi_shared.h"
 
 namespace transgi::gpu {
 
-VulkanFusedDecoder::VulkanFusedDecoder(engine::gpu::VulkanContext& ctx, const model::Mlp& mlp)
+VulkanFusedDecoder::VulkanFusedDecoder(engine::gpu::VulkanContext& ctx, const model::Mlp& mlp, FusedWeights weights)
     : ctx_(ctx), layout_(mlp.layout()) {
   const auto& l = layout_;
   if (l.outputs != static_cast<int>(kTransferOutputs) || l.width > static_cast<int>(kFusedMaxWidth) ||
@@ -18,9 +19,14 @@ VulkanFusedDecoder::VulkanFusedDecoder(engine::gpu::VulkanContext& ctx, const mo
                                 std::to_string(l.width) + " -> " + std::to_string(l.outputs));
   params_ = engine::gpu::GpuBuffer(ctx, mlp.params().size() * sizeof(float));
   params_.upload(std::span<const float>(mlp.params()));
-  const auto spirv = compile_module_shader("fused_inference.comp", {{"FUSED_INPUTS", std::to_string(l.inputs) + "u"},
-                                                                     {"FUSED_WIDTH", std::to_string(l.width) + "u"},
-                                                                     {"FUSED_HIDDEN", std::to_string(l.hidden_layers) + "u"}});
+  if (weights == FusedWeights::Fp16 && !ctx.info().shader_float16)
+    throw engine::gpu::GpuError("VulkanFusedDecoder: fp16 weights asked for, but " + ctx.info().name + " has no shaderFloat16");
+  fp16_ = weights == FusedWeights::Fp16 || (weights == FusedWeights::Auto && ctx.info().shader_float16);
+  std::vector<engine::gpu::ShaderDefine> defines = {{"FUSED_INPUTS", std::to_string(l.inputs) + "u"},
+                                                    {"FUSED_WIDTH", std::to_string(l.width) + "u"},
+                                                    {"FUSED_HIDDEN", std::to_string(l.hidden_layers) + "u"}};
+  if (fp16_) defines.push_back({"FUSED_F16_WEIGHTS", "1"});
+  const auto spirv = compile_module_shader("fused_inference.comp", std::move(defines));
   pipeline_ = std::make_unique<engine::gpu::ComputePipeline>(ctx, spirv, 4, static_cast<std::uint32_t>(sizeof(FusedPush)));
   pipeline_->bind(0, params_);
 }

@@ -13,11 +13,19 @@
 
 namespace transgi::gpu {
 
+// How the kernel holds the weights it stages in shared memory.
+enum class FusedWeights {
+  Auto,  // fp16 where the device has shaderFloat16, else fp32
+  Fp32,
+  Fp16,  // GpuError on a device without shaderFloat16
+};
+
 class VulkanFusedDecoder {
  public:
   // Throws std::invalid_argument for a layout the kernel cannot hold (wider
   // than kFusedMaxWidth, or not 75 outputs), GpuError for Vulkan failures.
-  VulkanFusedDecoder(engine::gpu::VulkanContext& ctx, const model::Mlp& mlp);
+  VulkanFusedDecoder(engine::gpu::VulkanContext& ctx, const model::Mlp& mlp, FusedWeights weights = FusedWeights::Auto);
+  [[nodiscard]] bool fp16_weights() const { return fp16_; }
 
   // rgb (n x 3) = sum_o decoder(inputs[i])[o] * light[i][o]; inputs n x 16,
   // light n x 75. Returns the kernel's GPU time in ms (-1 without timestamps).
@@ -28,6 +36,7 @@ class VulkanFusedDecoder {
 
   engine::gpu::VulkanContext& ctx_;
   model::MlpLayout layout_;
+  bool fp16_ = false;
   engine::gpu::GpuBuffer params_;
   engine::gpu::GpuBuffer inputs_, light_, rgb_;
   std::size_t capacity_ = 0;
