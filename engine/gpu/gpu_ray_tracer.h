@@ -4,6 +4,7 @@
 // each batch in one dispatch. Declines scenes with alpha-masked materials,
 // which the GPU traversal does not test yet.
 #include <memory>
+#include <vector>
 
 #include "engine/gpu/gpu_rt_scene.h"
 #include "engine/rt/ray_batch_tracer.h"
@@ -16,6 +17,9 @@ class GpuRayTracer : public rt::RayBatchTracer {
 
   bool intersect(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<rt::Hit> hits,
                  std::span<std::uint8_t> found) override;
+  // A closest-hit query within tmax (the traversal has no any-hit early out
+  // yet): the same answer, at a closest hit's cost.
+  bool occluded(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<std::uint8_t> blocked) override;
   // GPU milliseconds of the traces since the last call (timestamps).
   double take_gpu_ms();
 
@@ -24,7 +28,9 @@ class GpuRayTracer : public rt::RayBatchTracer {
   std::unique_ptr<GpuRtScene> rt_;
   const rt::RtScene* synced_ = nullptr;
   std::size_t commits_ = 0;
+  bool follow(const rt::RtScene& scene);  // syncs when needed; false: declines the scene
   double gpu_ms_ = 0.0;
+  std::vector<rt::Hit> scratch_;
 };
 
 }  // namespace engine::gpu

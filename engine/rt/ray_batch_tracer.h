@@ -19,6 +19,9 @@ class RayBatchTracer {
   // nothing, where this backend cannot trace the scene exactly.
   virtual bool intersect(const RtScene& scene, std::span<const Ray> rays, std::span<Hit> hits,
                          std::span<std::uint8_t> found) = 0;
+  // Shadow rays: blocked[i] = whether anything lies on ray i within
+  // (tmin, tmax]. Returns false, touching nothing, where it declines.
+  virtual bool occluded(const RtScene& scene, std::span<const Ray> rays, std::span<std::uint8_t> blocked) = 0;
 };
 
 }  // namespace engine::rt

@@ -230,23 +230,65 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   std::atomic<std::size_t> hits{0}, nonfinite_rays{0};
   std::vector<float> direct_frame(static_cast<std::size_t>(probes) * 75, 0.0f);
   auto ray_direction = [&](int i) { return glm::normalize(rotation * fibonacci_[static_cast<std::size_t>(i)]); };
-  // With a backend, every traced probe's rays go to it in one batch first
-  // (first_ray[q]: probe q's first ray in the batch); the shading below
-  // then reads those hits instead of tracing.
-  std::vector<rt::Hit> batch_hits;
-  std::vector<std::uint8_t> batch_found;
+  auto ray_rng = [&](int q, int i) {
+    return math::make_rng(seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
+  };
+  // Indirect light from last frame's probes at a probe ray's hit (multi-bounce feedback).
+  const auto feedback = [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3&) {
+    if (outer && (glm::any(glm::lessThan(p, grid.min)) || glm::any(glm::greaterThan(p, grid.max))))
+      return outer->irradiance(p, n);
+    return frame_ > 0 ? irradiance(p, n) : glm::vec3(0.0f);
+  };
+  // With a backend's ray tracer, every traced probe's rays go to it in one
+  // batch, then their shadow rays in another; shaded[first_ray[q] + i] is
+  // probe q's ray i. Where it declines the scene, Embree traces ray by ray
+  // in the loop below (first_ray empty).
+  std::vector<ProbeRayHit> shaded;
   std::vector<std::size_t> first_ray;
   if (rt::RayBatchTracer* tracer = kernels_ ? kernels_->tracer() : nullptr) {
     std::vector<rt::Ray> rays;
+    std::vector<int> ray_probe;
     first_ray.assign(static_cast<std::size_t>(probes), 0);
     for (int q = 0; q < probes; ++q) {
       if (!traced[static_cast<std::size_t>(q)]) continue;
       first_ray[static_cast<std::size_t>(q)] = rays.size();
       for (int i = 0; i < M; ++i) rays.push_back(rt::Ray{grid.position(q), ray_direction(i)});
     }
-    batch_hits.resize(rays.size());
-    batch_found.resize(rays.size());
-    if (!tracer->intersect(scene, rays, batch_hits, batch_found)) first_ray.clear();  // Embree traces
+    std::vector<rt::Hit> found_hits(rays.size());
+    std::vector<std::uint8_t> found(rays.size());
+    if (tracer->intersect(scene, rays, found_hits, found)) {
+      std::vector<PendingProbeRay> pending(rays.size());
+      jobs::parallel_for(0, probes, 1, [&](int b, int e) {
+        for (int q = b; q < e; ++q) {
+          if (!traced[static_cast<std::size_t>(q)]) continue;
+          for (int i = 0; i < M; ++i) {
+            const std::size_t k = first_ray[static_cast<std::size_t>(q)] + static_cast<std::size_t>(i);
+            math::Pcg32 rng = ray_rng(q, i);
+            pending[k] = begin_probe_ray(scene, lights, ray_direction(i), found[k] ? &found_hits[k] : nullptr, rng);
+          }
+        }
+      });
+      std::vector<rt::Ray> shadows;
+      std::vector<std::size_t> shadow_of;
+      for (std::size_t k = 0; k < pending.size(); ++k)
+        if (pending[k].needs_shadow) {
+          shadows.push_back(pending[k].shadow);
+          shadow_of.push_back(k);
+        }
+      std::vector<std::uint8_t> blocked(shadows.size());
+      if (!tracer->occluded(scene, shadows, blocked))
+        for (std::size_t j = 0; j < shadows.size(); ++j) blocked[j] = scene.occluded(shadows[j]) ? 1 : 0;
+      std::vector<std::uint8_t> blocked_at(pending.size(), 0);
+      for (std::size_t j = 0; j < shadows.size(); ++j) blocked_at[shadow_of[j]] = blocked[j];
+      shaded.resize(pending.size());
+      jobs::parallel_for(0, static_cast<int>(pending.size()), 256, [&](int b, int e) {
+        for (int k = b; k < e; ++k)
+          shaded[static_cast<std::size_t>(k)] =
+              finish_probe_ray(pending[static_cast<std::size_t>(k)], blocked_at[static_cast<std::size_t>(k)] != 0, feedback);
+      });
+    } else {
+      first_ray.clear();
+    }
   }
   jobs::parallel_for(0, probes, 1, [&](int b, int e) {
     for (int q = b; q < e; ++q) {
@@ -257,20 +299,13 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
       out.reserve(static_cast<std::size_t>(M));
       bool saw_light = false;
       for (int i = 0; i < M; ++i) {
-        math::Pcg32 rng = math::make_rng(seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
         const glm::vec3 dir = ray_direction(i);
-        const auto feedback = [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3&) {
-          // Indirect light from last frame's probes (multi-bounce feedback).
-          if (outer && (glm::any(glm::lessThan(p, grid.min)) || glm::any(glm::greaterThan(p, grid.max))))
-            return outer->irradiance(p, n);
-          return frame_ > 0 ? irradiance(p, n) : glm::vec3(0.0f);
-        };
         ProbeRayHit h;
         if (first_ray.empty()) {
+          math::Pcg32 rng = ray_rng(q, i);
           h = trace_probe_ray(scene, lights, origin, dir, rng, feedback);
         } else {
-          const std::size_t k = first_ray[static_cast<std::size_t>(q)] + static_cast<std::size_t>(i);
-          h = shade_probe_ray(scene, lights, dir, batch_found[k] ? &batch_hits[k] : nullptr, rng, feedback);
+          h = shaded[first_ray[static_cast<std::size_t>(q)] + static_cast<std::size_t>(i)];
         }
         if (h.emitted != glm::vec3(0.0f)) {
           // Monte Carlo projection over a near-uniform set: 4 pi / M per ray.

@@ -1,6 +1,7 @@
 #include "probes/probe_rays.h"
 
 #include <cmath>
+#include <limits>
 
 #include "engine/math/sampling.h"
 
@@ -40,6 +41,61 @@ glm::quat random_rotation(engine::math::Pcg32& rng) {
 
 glm::quat low_discrepancy_rotation(std::uint64_t index) {
   return rotation_from_cube(radical_inverse(index + 1, 2), radical_inverse(index + 1, 3), radical_inverse(index + 1, 5));
+}
+
+}  // namespace transgi::probes
+
+namespace transgi::probes {
+
+PendingProbeRay begin_probe_ray(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                                const glm::vec3& dir, const engine::rt::Hit* traced, engine::math::Pcg32& rng) {
+  using namespace engine;
+  PendingProbeRay p;
+  ProbeRayHit& r = p.r;
+  if (!traced) {
+    if (const scene::Environment* env = lights.environment()) r.emitted = env->radiance(dir);
+    if (!std::isfinite(r.emitted.r + r.emitted.g + r.emitted.b)) {
+      r.emitted = glm::vec3(0.0f);
+      r.replaced_non_finite = true;
+    }
+    r.saw_light = true;
+    return p;
+  }
+  const rt::Hit& hit = *traced;
+  const render::Surface s = render::make_surface(scene, hit, dir);
+  r.emitted = s.emission;
+  if (!std::isfinite(r.emitted.r + r.emitted.g + r.emitted.b)) {
+    r.emitted = glm::vec3(0.0f);
+    r.replaced_non_finite = true;
+  }
+  r.hit = true;
+  r.back_face = s.back_face;
+  r.distance = hit.t;
+  r.position = s.position;
+  r.normal = s.geometric_normal;
+  const bool emitter = s.emission.r > 0 || s.emission.g > 0 || s.emission.b > 0;
+  r.saw_light = emitter;
+  const glm::vec3 wo = s.frame.to_local(-dir);
+  if (emitter || wo.z <= 0) return p;
+  p.takes_feedback = true;
+  p.diffuse_over_pi = material::diffuse_albedo(s.brdf) * math::kInvPi;
+  p.shading_normal = s.shading_normal;
+  p.to_probe = -dir;
+  render::LightSample ls;
+  const float u_sel = rng.next_float();
+  const glm::vec2 u(rng.next_float(), rng.next_float());
+  if (lights.sample(s.position, u_sel, u, ls) && glm::dot(ls.direction, s.geometric_normal) > 0) {
+    const glm::vec3 wi = s.frame.to_local(ls.direction);
+    const glm::vec3 f = wi.z > 0 ? material::brdf_eval(s.brdf, wo, wi) : glm::vec3(0.0f);
+    if (f != glm::vec3(0.0f)) {
+      const glm::vec3 o = rt::offset_ray_origin(s.position, s.geometric_normal, scene.offset_scale());
+      const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
+      p.needs_shadow = true;
+      p.shadow = rt::Ray{o, ls.direction, 0.0f, tmax};
+      p.unoccluded = f * wi.z * ls.radiance / (ls.delta ? 1.0f : ls.pdf);
+    }
+  }
+  return p;
 }
 
 }  // namespace transgi::probes

@@ -43,61 +43,39 @@ struct ProbeRayHit {
   bool replaced_non_finite = false;
 };
 
-// Traces one probe ray. At a hit that is not an emitter and faces the ray,
-// the radiance is direct light by one next-event-estimation sample (MIS-free:
-// delta and area lights alike are sampled, never hit) plus the diffuse
-// albedo / pi times `feedback(position, normal)`, the previous frame's
-// irradiance. Emitter hits and escaped rays carry zero: the probes hold
-// indirect light, direct light is added at the pixel.
-//
-// shade_probe_ray does the same for a ray already traced (`hit` null: it
-// escaped), so a backend can trace a frame's probe rays in one batch.
-template <class Feedback>
-ProbeRayHit shade_probe_ray(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, const glm::vec3& dir,
-                            const engine::rt::Hit* traced, engine::math::Pcg32& rng, Feedback&& feedback) {
-  using namespace engine;
+// The shading of one probe ray's hit, in two halves around its shadow ray,
+// so that a backend can trace a frame's shadow rays in one batch
+// (probe_field.cpp). shade_probe_ray below is the two halves with Embree's
+// query between them.
+struct PendingProbeRay {
   ProbeRayHit r;
-  if (!traced) {
-    if (const scene::Environment* env = lights.environment()) r.emitted = env->radiance(dir);
-    if (!std::isfinite(r.emitted.r + r.emitted.g + r.emitted.b)) {
-      r.emitted = glm::vec3(0.0f);
-      r.replaced_non_finite = true;
-    }
+  bool needs_shadow = false;
+  engine::rt::Ray shadow;           // the next-event sample's shadow ray
+  glm::vec3 unoccluded{0.0f};       // what that sample adds if the shadow ray is clear
+  bool takes_feedback = false;      // a lit-side hit of a non-emitter: gets the bounce
+  glm::vec3 diffuse_over_pi{0.0f};  // diffuse albedo / pi
+  glm::vec3 shading_normal{0.0f};
+  glm::vec3 to_probe{0.0f};         // -dir
+};
+
+// Everything up to the shadow ray: the surface, its emission, and one
+// next-event-estimation sample (MIS-free: delta and area lights alike are
+// sampled, never hit). `traced` null: the ray escaped.
+PendingProbeRay begin_probe_ray(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                                const glm::vec3& dir, const engine::rt::Hit* traced, engine::math::Pcg32& rng);
+
+// The rest, given whether the shadow ray was blocked: the sample's light if
+// not, plus the diffuse albedo / pi times `feedback(position, normal,
+// to_probe)`, the previous frame's irradiance.
+template <class Feedback>
+ProbeRayHit finish_probe_ray(const PendingProbeRay& p, bool blocked, Feedback&& feedback) {
+  ProbeRayHit r = p.r;
+  if (!p.takes_feedback) return r;
+  if (p.needs_shadow && !blocked) {
+    r.radiance += p.unoccluded;
     r.saw_light = true;
-    return r;
   }
-  const rt::Hit& hit = *traced;
-  const render::Surface s = render::make_surface(scene, hit, dir);
-  r.emitted = s.emission;
-  if (!std::isfinite(r.emitted.r + r.emitted.g + r.emitted.b)) {
-    r.emitted = glm::vec3(0.0f);
-    r.replaced_non_finite = true;
-  }
-  r.hit = true;
-  r.back_face = s.back_face;
-  r.distance = hit.t;
-  r.position = s.position;
-  r.normal = s.geometric_normal;
-  const bool emitter = s.emission.r > 0 || s.emission.g > 0 || s.emission.b > 0;
-  r.saw_light = emitter;
-  const glm::vec3 wo = s.frame.to_local(-dir);
-  if (emitter || wo.z <= 0) return r;
-  render::LightSample ls;
-  const float u_sel = rng.next_float();
-  const glm::vec2 u(rng.next_float(), rng.next_float());
-  if (lights.sample(s.position, u_sel, u, ls) && glm::dot(ls.direction, s.geometric_normal) > 0) {
-    const glm::vec3 wi = s.frame.to_local(ls.direction);
-    const glm::vec3 f = wi.z > 0 ? material::brdf_eval(s.brdf, wo, wi) : glm::vec3(0.0f);
-    if (f != glm::vec3(0.0f)) {
-      const glm::vec3 o = rt::offset_ray_origin(s.position, s.geometric_normal, scene.offset_scale());
-      const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
-      if (!scene.occluded(rt::Ray{o, ls.direction, 0.0f, tmax})) {
-        r.radiance += f * wi.z * ls.radiance / (ls.delta ? 1.0f : ls.pdf);
-        r.saw_light = true;
-      }
-    }
-  }
-  r.radiance += material::diffuse_albedo(s.brdf) * math::kInvPi * feedback(s.position, s.shading_normal, -dir);
+  r.radiance += p.diffuse_over_pi * feedback(r.position, p.shading_normal, p.to_probe);
   if (!std::isfinite(r.radiance.r + r.radiance.g + r.radiance.b)) {
     r.radiance = glm::vec3(0.0f);
     r.replaced_non_finite = true;
@@ -105,6 +83,18 @@ ProbeRayHit shade_probe_ray(const engine::rt::RtScene& scene, const engine::rend
   return r;
 }
 
+// Shades one traced probe ray (`traced` null: it escaped). Emitter hits and
+// escaped rays carry zero radiance: the probes hold indirect light, direct
+// light is added at the pixel; what they saw is in `emitted`.
+template <class Feedback>
+ProbeRayHit shade_probe_ray(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, const glm::vec3& dir,
+                            const engine::rt::Hit* traced, engine::math::Pcg32& rng, Feedback&& feedback) {
+  const PendingProbeRay p = begin_probe_ray(scene, lights, dir, traced, rng);
+  const bool blocked = p.needs_shadow && scene.occluded(p.shadow);
+  return finish_probe_ray(p, blocked, std::forward<Feedback>(feedback));
+}
+
+// Traces and shades one probe ray.
 template <class Feedback>
 ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, const glm::vec3& origin,
                             const glm::vec3& dir, engine::math::Pcg32& rng, Feedback&& feedback) {
