@@ -36,8 +36,8 @@ enum class DirectLight {
 // Where the probes' data-parallel stages run (issue 12).
 enum class Backend {
   Cpu,     // the oracle, and this machine's real-time path
-  // Probe rays and the real-time G-buffer's camera rays traced through a
-  // GPU BVH, the radiance raster and the SH projection as Vulkan compute
+  // Probe rays, the real-time G-buffer's camera rays and their shadow rays
+  // traced through a GPU BVH, the radiance raster and the SH projection as Vulkan compute
   // kernels (shaders/); shading the hits and the accumulation stay on the
   // CPU for now. Without a usable
   // device the CPU runs them and GiFrame says why.

@@ -139,8 +139,13 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   // The deterministic direct light is shaded tile by tile inside the
   // G-buffer's loop, while each tile is in cache; its time counts there.
   std::optional<shading::DirectTileShader> direct;
-  if (deterministic) direct.emplace(rt, lights, rays, frame.width, frame.height);
+  // With a backend's tracer the shadow rays go to it in one batch after the
+  // G-buffer, not tile by tile inside it.
+  if (deterministic && !tracer) direct.emplace(rt, lights, rays, frame.width, frame.height);
   shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, packed.gbuffer, direct ? &*direct : nullptr, tracer);
+  std::optional<engine::image::ImageRGB> batched_direct;
+  if (deterministic && tracer)
+    batched_direct = shading::shade_direct_realtime(packed.gbuffer, rt, lights, rays, &frame.direct_stats, tracer);
   const shading::GBuffer& g = packed.gbuffer;
   frame.times.gbuffer = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   shading::RealtimeGiStats st;
@@ -158,7 +163,7 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
 
   if (deterministic) {
     t0 = std::chrono::steady_clock::now();
-    frame.direct = direct->take(&frame.direct_stats);
+    frame.direct = direct ? direct->take(&frame.direct_stats) : std::move(*batched_direct);
     shading::add_image(frame.direct, probe_direct);
     t.direct = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   } else {

@@ -46,11 +46,15 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
   glm::vec3 light[16];
   std::size_t traced = 0;
   const scene::Environment* background = lights_.background();
+  const std::size_t tile = static_cast<std::size_t>(ty / 4) * static_cast<std::size_t>((g.width + 3) / 4) + static_cast<std::size_t>(tx / 4);
+  const bool collecting = batch_.collect != nullptr;
+  std::size_t answer = batch_.answers ? (*batch_.first)[tile] : 0;
   // Emission and background first.
   for (int y = ty; y < std::min(ty + 4, g.height); ++y)
     for (int x = tx; x < std::min(tx + 4, g.width); ++x) {
       const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
       const GSample& s = g.samples[p];
+      if (collecting) break;
       if (s.hit)
         out_.pixels[p] = s.emission;
       else if (background)
@@ -81,7 +85,15 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
         ++n;
       }
     if (n == 0) continue;
-    scene_.occluded16(rays, n, blocked);
+    if (collecting) {
+      (*batch_.collect)[tile].insert((*batch_.collect)[tile].end(), rays, rays + n);
+      continue;
+    }
+    if (batch_.answers) {
+      for (int i = 0; i < n; ++i) blocked[i] = (*batch_.answers)[answer++] != 0;
+    } else {
+      scene_.occluded16(rays, n, blocked);
+    }
     traced += static_cast<std::size_t>(n);
     // The BRDF only where the light arrives: most of a room's pixels that face
     // the sun are in shadow.
@@ -91,6 +103,7 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
       if (c.r > 0 || c.g > 0 || c.b > 0) out_.pixels[pixel[i]] += c;
     }
   }
+  if (collecting) return;
   // The pass's boundary: an infinite emitter or light leaves no non-finite pixel.
   std::size_t bad = 0;
   for (int y = ty; y < std::min(ty + 4, g.height); ++y)
@@ -115,12 +128,37 @@ engine::image::ImageRGB DirectTileShader::take(RealtimeDirectStats* stats) {
 
 engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
                                               const engine::render::LightSet& lights,
-                                              const engine::render::CameraRays& camera, RealtimeDirectStats* stats) {
+                                              const engine::render::CameraRays& camera, RealtimeDirectStats* stats,
+                                              engine::rt::RayBatchTracer* tracer) {
   DirectTileShader shader(scene, lights, camera, g.width, g.height);
   const int tiles_x = (g.width + 3) / 4, tiles_y = (g.height + 3) / 4;
-  engine::jobs::parallel_for(0, tiles_x * tiles_y, 16, [&](int t0, int t1) {
-    for (int t = t0; t < t1; ++t) shader.shade_tile(g, t % tiles_x * 4, t / tiles_x * 4);
-  });
+  auto each_tile = [&] {
+    engine::jobs::parallel_for(0, tiles_x * tiles_y, 16, [&](int t0, int t1) {
+      for (int t = t0; t < t1; ++t) shader.shade_tile(g, t % tiles_x * 4, t / tiles_x * 4);
+    });
+  };
+  // The shader reads `blocked` and `first` in the second pass: they live
+  // as long as the function.
+  std::vector<engine::rt::Ray> rays;
+  std::vector<std::size_t> first;
+  std::vector<std::uint8_t> blocked;
+  if (tracer) {
+    std::vector<std::vector<engine::rt::Ray>> per_tile(static_cast<std::size_t>(tiles_x) * tiles_y);
+    shader.set_batch({&per_tile, nullptr, nullptr});
+    each_tile();
+    first.resize(per_tile.size());
+    for (std::size_t t = 0; t < per_tile.size(); ++t) {
+      first[t] = rays.size();
+      rays.insert(rays.end(), per_tile[t].begin(), per_tile[t].end());
+    }
+    blocked.resize(rays.size());
+    if (!tracer->occluded(scene, rays, blocked))
+      engine::jobs::parallel_for<std::size_t>(0, rays.size(), 256, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) blocked[i] = scene.occluded(rays[i]) ? 1 : 0;
+      });
+    shader.set_batch({nullptr, &blocked, &first});
+  }
+  each_tile();
   return shader.take(stats);
 }
 

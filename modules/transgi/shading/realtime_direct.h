@@ -44,6 +44,17 @@ class DirectTileShader {
   // The image, once every tile is shaded.
   engine::image::ImageRGB take(RealtimeDirectStats* stats = nullptr);
 
+  // Batched shadow rays (a GPU tracer): a first pass over the tiles with
+  // `collect` set only gathers each tile's shadow rays into (*collect)[tile];
+  // a second pass with `answers` set shades, reading tile t's answers from
+  // answers[first[t]] on, in the order the first pass gathered them.
+  struct Batch {
+    std::vector<std::vector<engine::rt::Ray>>* collect = nullptr;
+    const std::vector<std::uint8_t>* answers = nullptr;
+    const std::vector<std::size_t>* first = nullptr;
+  };
+  void set_batch(const Batch& batch) { batch_ = batch; }
+
  private:
   const engine::rt::RtScene& scene_;
   const engine::render::LightSet& lights_;
@@ -53,15 +64,19 @@ class DirectTileShader {
   std::vector<std::array<engine::render::LightSample, 64>> directional_;
   std::vector<std::uint8_t> is_directional_;
   std::atomic<std::size_t> rays_traced_{0}, nonfinite_{0};
+  Batch batch_;
 };
 
 // to += from, pixel by pixel (same size), in parallel.
 void add_image(engine::image::ImageRGB& to, const engine::image::ImageRGB& from);
 
+// With `tracer` (a GPU backend) the shadow rays of the whole image go to it
+// in one batch; Embree's packets trace them tile by tile where it declines.
 engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
                                               const engine::render::LightSet& lights,
                                               const engine::render::CameraRays& camera,
-                                              RealtimeDirectStats* stats = nullptr);
+                                              RealtimeDirectStats* stats = nullptr,
+                                              engine::rt::RayBatchTracer* tracer = nullptr);
 
 // The fixed point on [0, 1)^2 that pixel (x, y) uses for disk lights: an
 // R2 low-discrepancy sequence over each 8x8 block.
