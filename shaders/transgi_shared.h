@@ -117,7 +117,28 @@ struct DdgiPointGpu {
   float vx, vy, vz, pad2;
 };
 
+// DDGI blending (ddgi_blend.comp).
+TRANSGI_CONST uint kDdgiBlendGroupSize = 64u;  // one workgroup per probe
+
+struct DdgiBlendPush {
+  uint probes, rays_per_probe, irradiance_interior, distance_interior;
+  float hysteresis, irradiance_threshold, brightness_threshold, irradiance_gamma;
+  float distance_exponent, max_distance;
+  uint clamp_brightness;
+  int max_backfaces;
+};
+
+// ddgi::RayRecord, padded.
+struct DdgiRayGpu {
+  float dx, dy, dz, distance;
+  float rx, ry, rz, pad0;
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(DdgiBlendPush) == 48 && offsetof(DdgiBlendPush, hysteresis) == 16 &&
+              offsetof(DdgiBlendPush, distance_exponent) == 32 && offsetof(DdgiBlendPush, max_backfaces) == 44,
+              "DdgiBlendPush layout");
+static_assert(sizeof(DdgiRayGpu) == 32 && offsetof(DdgiRayGpu, rx) == 16, "DdgiRayGpu layout");
 static_assert(sizeof(DdgiPush) == 80 && offsetof(DdgiPush, irradiance_gamma) == 60 &&
               offsetof(DdgiPush, irradiance_size) == 64, "DdgiPush layout");
 static_assert(sizeof(DdgiPointGpu) == 48 && offsetof(DdgiPointGpu, nx) == 16 && offsetof(DdgiPointGpu, vx) == 32,
