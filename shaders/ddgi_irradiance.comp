@@ -6,6 +6,7 @@
 // in gamma-2 space.
 #extension GL_GOOGLE_include_directive : require
 #include "transgi_shared.h"
+#include "probe_grid.glsl"
 
 layout(local_size_x = kDdgiGroupSize) in;
 
@@ -51,8 +52,8 @@ void main() {
   if (i >= uint(p.points)) return;
   const DdgiPointGpu pt = points[i];
   const vec3 position = vec3(pt.px, pt.py, pt.pz), n = vec3(pt.nx, pt.ny, pt.nz), view_dir = vec3(pt.vx, pt.vy, pt.vz);
-  const ivec3 dims = ivec3(p.dims_x, p.dims_y, p.dims_z), scroll = ivec3(p.scroll_x, p.scroll_y, p.scroll_z);
-  const vec3 lo = vec3(p.min_x, p.min_y, p.min_z), spacing = vec3(p.spacing_x, p.spacing_y, p.spacing_z);
+  const ivec3 dims = grid_dims(p.grid);
+  const vec3 lo = grid_min(p.grid), spacing = grid_spacing(p.grid);
   const vec3 biased = position + (n * p.normal_bias - view_dir * p.view_bias);
   ivec3 base = ivec3(0);
   vec3 alpha = vec3(0.0);
@@ -66,9 +67,7 @@ void main() {
   float weights = 0.0;
   for (int c = 0; c < 8; ++c) {
     const ivec3 offset = ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
-    ivec3 st = clamp(base + offset, ivec3(0), dims - 1) + scroll;
-    st -= ivec3(greaterThanEqual(st, dims)) * dims;
-    const int q = (st.z * dims.y + st.y) * dims.x + st.x;
+    const int q = grid_index(p.grid, clamp(base + offset, ivec3(0), dims - 1));
     const vec4 probe = placed[q];
     if (probe.w == 0.0) continue;
     const vec3 to_probe = normalize(probe.xyz - position);

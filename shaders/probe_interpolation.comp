@@ -20,6 +20,7 @@ layout(std430, set = 0, binding = 5) writeonly buffer PointSh { float point_sh[]
 layout(push_constant) uniform PushBlock { InterpolatePush p; };
 
 #include "map_texel.glsl"
+#include "probe_grid.glsl"
 
 int texel_of(vec3 d) { return map_texel_of(d, p.map_width, p.map_height); }
 float chebyshev_visibility(float mean, float variance_in, float distance) {
@@ -34,9 +35,8 @@ void main() {
   if (i >= uint(p.points)) return;
   const vec3 x = vec3(points[i * 6], points[i * 6 + 1], points[i * 6 + 2]);
   const vec3 n = vec3(points[i * 6 + 3], points[i * 6 + 4], points[i * 6 + 5]);
-  const ivec3 dims = ivec3(p.dims_x, p.dims_y, p.dims_z);
-  const ivec3 scroll = ivec3(p.scroll_x, p.scroll_y, p.scroll_z);
-  const vec3 lo = vec3(p.min_x, p.min_y, p.min_z), s = vec3(p.spacing_x, p.spacing_y, p.spacing_z);
+  const ivec3 dims = grid_dims(p.grid);
+  const vec3 lo = grid_min(p.grid), s = grid_spacing(p.grid);
 
   // ProbeGrid::cage: the cell, clamped to the grid.
   vec3 g = vec3(0.0);
@@ -53,9 +53,7 @@ void main() {
   for (int c = 0; c < 8; ++c) {
     const ivec3 o = ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
     const ivec3 q = min(base + o, dims - 1);
-    ivec3 st = q + scroll;
-    st -= ivec3(greaterThanEqual(st, dims)) * dims;
-    const int at = (st.z * dims.y + st.y) * dims.x + st.x;
+    const int at = grid_index(p.grid, q);
     const float w = (o.x != 0 ? f.x : 1.0 - f.x) * (o.y != 0 ? f.y : 1.0 - f.y) * (o.z != 0 ? f.z : 1.0 - f.z);
     const ProbeGpu probe = probes[at];
     vec3 pos = lo + vec3(q) * s;

@@ -27,21 +27,9 @@ layout(std430, set = 0, binding = 6) buffer Stats { uint accepted; uint rejected
 layout(push_constant) uniform PushBlock { RasterPush p; };
 
 #include "map_texel.glsl"
+#include "probe_grid.glsl"
 
 int texel_of(vec3 d) { return map_texel_of(d, p.map_width, p.map_height); }
-
-// ProbeGrid::coords and index (toroidal storage).
-ivec3 coords_of(int i, ivec3 dims, ivec3 scroll) {
-  ivec3 c = ivec3(i % dims.x, (i / dims.x) % dims.y, i / (dims.x * dims.y));
-  c -= scroll;
-  c += ivec3(lessThan(c, ivec3(0))) * dims;
-  return c;
-}
-int index_of(ivec3 c, ivec3 dims, ivec3 scroll) {
-  c += scroll;
-  c -= ivec3(greaterThanEqual(c, dims)) * dims;
-  return (c.z * dims.y + c.y) * dims.x + c.x;
-}
 
 const int kRejected = -1;
 const int kSkipped = -2;
@@ -54,11 +42,10 @@ shared uint chunk_accepted, chunk_rejected;
 void main() {
   const int target = int(gl_WorkGroupID.x);
   const uint lane = gl_LocalInvocationID.x;
-  if (target >= p.probes || targets[target] == 0u) return;  // uniform per workgroup
-  const ivec3 dims = ivec3(p.dims_x, p.dims_y, p.dims_z), scroll = ivec3(p.scroll_x, p.scroll_y, p.scroll_z);
-  const vec3 spacing = vec3(p.spacing_x, p.spacing_y, p.spacing_z);
-  const ivec3 tc = coords_of(target, dims, scroll);
-  vec3 origin = vec3(p.min_x, p.min_y, p.min_z) + vec3(tc) * spacing;
+  if (target >= p.grid.probes || targets[target] == 0u) return;  // uniform per workgroup
+  const ivec3 dims = grid_dims(p.grid);
+  const ivec3 tc = grid_coords(p.grid, target);
+  vec3 origin = grid_min(p.grid) + vec3(tc) * grid_spacing(p.grid);
   if ((p.flags & kRasterHasOffsets) != 0u) origin += vec3(probes[target].offset_x, probes[target].offset_y, probes[target].offset_z);
   const uint base = uint(target) * p.texels;
   for (uint t = lane; t < p.texels; t += kRasterGroupSize) samples[base + t] = vec4(0.0);
@@ -74,7 +61,7 @@ void main() {
       for (int dx = -1; dx <= 1; ++dx) {
         const ivec3 nc = tc + ivec3(dx, dy, dz);
         if (any(lessThan(nc, ivec3(0))) || any(greaterThanEqual(nc, dims))) continue;  // uniform
-        const int q = index_of(nc, dims, scroll);
+        const int q = grid_index(p.grid, nc);
         const uint first = point_begin[q], last = point_begin[q + 1];
         for (uint c0 = first; c0 < last; c0 += kRasterChunk) {
           const uint n = min(kRasterChunk, last - c0);

@@ -35,6 +35,17 @@ float rt_enter(BvhNodeGpu n, vec3 o, vec3 inv_d, float tmin, float tmax) {
   return enter <= leave * 1.00000024 ? enter : uintBitsToFloat(0x7f800000u);
 }
 
+// Which children of an interior node the ray enters (their entry distances
+// ta, tb; +inf = missed): 0, 1 (`next`) or 2 (the nearer as `next`, the
+// other as `later`, to wait on the stack).
+uint rt_children(float ta, float tb, uint a, uint b, inout uint next, out uint later) {
+  const bool hit_a = !isinf(ta), hit_b = !isinf(tb);
+  const uint visit = uint(hit_a) + uint(hit_b);
+  if (visit > 0u) next = hit_a && (!hit_b || ta <= tb) ? a : b;
+  later = next == a ? b : a;
+  return visit;
+}
+
 // Moeller-Trumbore; updates t, u, v and returns true for a closer hit.
 bool rt_triangle(TriangleGpu tri, vec3 o, vec3 d, float tmin, inout float t, inout float u, inout float v) {
   const vec3 p0 = vec3(tri.p0_x, tri.p0_y, tri.p0_z);
@@ -82,18 +93,11 @@ void rt_traverse_blas(uint inst, vec3 wo, vec3 wd, float tmin, inout HitGpu hit)
       }
     } else {
       const uint a = I.blas_root + n.first, b = a + 1u;
-      const float ta = rt_enter(rt_blas[a], o, inv_d, tmin, hit.t), tb = rt_enter(rt_blas[b], o, inv_d, tmin, hit.t);
-      const bool hit_a = !isinf(ta), hit_b = !isinf(tb);
-      if (hit_a && hit_b && top < kRtStackSize) {
-        // Nearer child first; the other waits on the stack.
-        node = ta <= tb ? a : b;
-        stack[top++] = ta <= tb ? b : a;
-        continue;
-      }
-      if (hit_a || hit_b) {
-        node = hit_a ? a : b;
-        continue;
-      }
+      uint later;
+      const uint visit = rt_children(rt_enter(rt_blas[a], o, inv_d, tmin, hit.t), rt_enter(rt_blas[b], o, inv_d, tmin, hit.t),
+                                     a, b, node, later);
+      if (visit == 2u && top < kRtStackSize) stack[top++] = later;
+      if (visit > 0u) continue;
     }
     if (top == 0u) break;
     node = stack[--top];
@@ -122,17 +126,11 @@ HitGpu rt_intersect(vec3 o, vec3 d, float tmin, float tmax) {
       for (uint k = 0u; k < n.count; ++k) rt_traverse_blas(n.first + k, o, d, tmin, hit);
     } else {
       const uint a = n.first, b = a + 1u;
-      const float ta = rt_enter(rt_tlas[a], o, inv_d, tmin, hit.t), tb = rt_enter(rt_tlas[b], o, inv_d, tmin, hit.t);
-      const bool hit_a = !isinf(ta), hit_b = !isinf(tb);
-      if (hit_a && hit_b && top < kRtStackSize) {
-        node = ta <= tb ? a : b;
-        stack[top++] = ta <= tb ? b : a;
-        continue;
-      }
-      if (hit_a || hit_b) {
-        node = hit_a ? a : b;
-        continue;
-      }
+      uint later;
+      const uint visit = rt_children(rt_enter(rt_tlas[a], o, inv_d, tmin, hit.t), rt_enter(rt_tlas[b], o, inv_d, tmin, hit.t),
+                                     a, b, node, later);
+      if (visit == 2u && top < kRtStackSize) stack[top++] = later;
+      if (visit > 0u) continue;
     }
     if (top == 0u) break;
     node = stack[--top];

@@ -45,6 +45,19 @@ struct ProjectPush {
   uint pad1;
 };
 
+// A probe grid (probes::ProbeGrid) as the kernels read it; probe_grid.glsl
+// turns it into storage indices and grid points.
+struct ProbeGridGpu {
+  float min_x, min_y, min_z;
+  int probes;
+  float spacing_x, spacing_y, spacing_z;
+  float min_spacing;
+  int dims_x, dims_y, dims_z;
+  int pad0;
+  int scroll_x, scroll_y, scroll_z;
+  int pad1;
+};
+
 // Probe interpolation with pruning (probe_interpolation.comp).
 TRANSGI_CONST uint kInterpolateGroupSize = 64u;
 TRANSGI_CONST uint kInterpolatePruneBackFacing = 1u;  // InterpolatePush::flags bits
@@ -52,10 +65,10 @@ TRANSGI_CONST uint kInterpolatePruneOccluded = 2u;
 TRANSGI_CONST uint kInterpolateHasOffsets = 4u;
 
 struct InterpolatePush {
-  float min_x, min_y, min_z, bias_length;        // grid box corner; normal_bias x min_spacing
-  float spacing_x, spacing_y, spacing_z, visibility_threshold;
-  int dims_x, dims_y, dims_z, points;
-  int scroll_x, scroll_y, scroll_z;
+  ProbeGridGpu grid;
+  float bias_length;  // normal_bias x the grid's smallest spacing
+  float visibility_threshold;
+  int points;
   uint flags;
   uint map_width, map_height, texels, pad0;
 };
@@ -82,12 +95,11 @@ TRANSGI_CONST uint kRasterHasDepth = 4u;
 TRANSGI_CONST uint kRasterHasOffsets = 8u;
 
 struct RasterPush {
-  float min_x, min_y, min_z, relative_tolerance;
-  float spacing_x, spacing_y, spacing_z, absolute_tolerance;
-  int dims_x, dims_y, dims_z, probes;
-  int scroll_x, scroll_y, scroll_z;
+  ProbeGridGpu grid;
+  float relative_tolerance, absolute_tolerance;
+  int pad0;
   uint flags;
-  uint map_width, map_height, texels, pad0;
+  uint map_width, map_height, texels, pad1;
 };
 
 // probes::ShadedPoint, each vec3 padded to 16 bytes.
@@ -102,11 +114,9 @@ struct ShadedPointGpu {
 TRANSGI_CONST uint kDdgiGroupSize = 64u;
 
 struct DdgiPush {
-  float min_x, min_y, min_z, normal_bias;
-  float spacing_x, spacing_y, spacing_z, view_bias;
-  int dims_x, dims_y, dims_z, points;
-  int scroll_x, scroll_y, scroll_z;
-  float irradiance_gamma;
+  ProbeGridGpu grid;
+  float normal_bias, view_bias, irradiance_gamma;
+  int points;
   uint irradiance_size, distance_size, irradiance_interior, distance_interior;  // sizes include the border
 };
 
@@ -139,17 +149,18 @@ static_assert(sizeof(DdgiBlendPush) == 48 && offsetof(DdgiBlendPush, hysteresis)
               offsetof(DdgiBlendPush, distance_exponent) == 32 && offsetof(DdgiBlendPush, max_backfaces) == 44,
               "DdgiBlendPush layout");
 static_assert(sizeof(DdgiRayGpu) == 32 && offsetof(DdgiRayGpu, rx) == 16, "DdgiRayGpu layout");
-static_assert(sizeof(DdgiPush) == 80 && offsetof(DdgiPush, irradiance_gamma) == 60 &&
-              offsetof(DdgiPush, irradiance_size) == 64, "DdgiPush layout");
+static_assert(sizeof(DdgiPush) == 96 && offsetof(DdgiPush, normal_bias) == 64 &&
+              offsetof(DdgiPush, irradiance_size) == 80, "DdgiPush layout");
 static_assert(sizeof(DdgiPointGpu) == 48 && offsetof(DdgiPointGpu, nx) == 16 && offsetof(DdgiPointGpu, vx) == 32,
               "DdgiPointGpu layout");
-static_assert(sizeof(RasterPush) == 80 && offsetof(RasterPush, flags) == 60 && offsetof(RasterPush, texels) == 72,
+static_assert(sizeof(RasterPush) == 96 && offsetof(RasterPush, flags) == 76 && offsetof(RasterPush, texels) == 88,
               "RasterPush layout");
 static_assert(sizeof(ShadedPointGpu) == 64 && offsetof(ShadedPointGpu, rx) == 16 && offsetof(ShadedPointGpu, nx) == 48,
               "ShadedPointGpu layout");
-static_assert(sizeof(InterpolatePush) == 80 && offsetof(InterpolatePush, spacing_x) == 16 &&
-              offsetof(InterpolatePush, dims_x) == 32 && offsetof(InterpolatePush, scroll_x) == 48 &&
-              offsetof(InterpolatePush, flags) == 60 && offsetof(InterpolatePush, map_width) == 64,
+static_assert(sizeof(ProbeGridGpu) == 64 && offsetof(ProbeGridGpu, spacing_x) == 16 &&
+              offsetof(ProbeGridGpu, dims_x) == 32 && offsetof(ProbeGridGpu, scroll_x) == 48, "ProbeGridGpu layout");
+static_assert(sizeof(InterpolatePush) == 96 && offsetof(InterpolatePush, bias_length) == 64 &&
+              offsetof(InterpolatePush, flags) == 76 && offsetof(InterpolatePush, map_width) == 80,
               "InterpolatePush layout");
 static_assert(sizeof(ProbeGpu) == 32 && offsetof(ProbeGpu, usable) == 16, "ProbeGpu layout");
 static_assert(sizeof(InterpolationGpu) == 80 && offsetof(InterpolationGpu, weights) == 32 &&

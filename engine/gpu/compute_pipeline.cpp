@@ -82,6 +82,15 @@ void ComputePipeline::record_dispatch(VkCommandBuffer cmd, std::uint32_t gx, std
   vkCmdDispatch(cmd, gx, gy, gz);
 }
 
+GpuBuffer& bind_at_least(VulkanContext& ctx, ComputePipeline& pipeline, std::uint32_t binding, GpuBuffer& buffer,
+                         std::size_t bytes) {
+  if (buffer.handle() == VK_NULL_HANDLE || buffer.size() < bytes) {
+    buffer = GpuBuffer(ctx, bytes);
+    pipeline.bind(binding, buffer);
+  }
+  return buffer;
+}
+
 void record_compute_barrier(VkCommandBuffer cmd) {
   VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;

@@ -3,6 +3,7 @@
 // set 0, bindings 0..N-1 (the kernel's declared inputs and outputs, in
 // order), and a push-constant block. A pass binds buffers, then records a
 // dispatch into a command buffer.
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -38,6 +39,11 @@ class ComputePipeline {
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   VkDescriptorSet set_ = VK_NULL_HANDLE;
 };
+
+// `buffer` with at least `bytes`: kept if it is big enough, else replaced by
+// a new one bound at `binding` (buffers grow with the batch, never shrink).
+GpuBuffer& bind_at_least(VulkanContext& ctx, ComputePipeline& pipeline, std::uint32_t binding, GpuBuffer& buffer,
+                         std::size_t bytes);
 
 // Makes the writes of one dispatch visible to the reads of the next.
 void record_compute_barrier(VkCommandBuffer cmd);

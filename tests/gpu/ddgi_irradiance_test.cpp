@@ -1,55 +1,26 @@
 // shaders/ddgi_irradiance.comp against ddgi::DdgiVolume::irradiance (its CPU
-// stage): a floor with a box on it under a uniform sky, probes on a scrolled
+// stage): a floor with a box on it under a uniform sky (floor_under_sky.h), probes on a scrolled
 // grid after 40 updates, 4,000 random shading points.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 
-#include "engine/app/app.h"
 #include "engine/math/rng.h"
-#include "engine/rt/rt_plugin.h"
-#include "engine/scene/procedural.h"
 #include "gpu/vulkan_ddgi_irradiance.h"
+#include "../transgi/floor_under_sky.h"
 #include "gpu_fixture.h"
 
 using namespace engine;
 
-namespace {
-
-struct BoxOnFloor {
-  app::App app{app::AppOptions{.jobs = {.threads = 2}}};
-  BoxOnFloor() {
-    scene::SceneAssets a;
-    a.generation = scene::next_scene_generation();
-    a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({20, 20})),
-                std::make_shared<scene::MeshAsset>(scene::make_box(glm::vec3(0.4f, 0.6f, 0.3f)))};
-    material::Material m;
-    m.base_color_factor = glm::vec4(0.6f, 0.5f, 0.4f, 1);
-    m.metallic_factor = 0;
-    m.specular_factor = 0;
-    a.materials = {m};
-    a.environment = scene::uniform_environment(glm::vec3(1.0f));
-    app.world().insert_resource<scene::SceneAssets>(std::move(a));
-    app.add_plugin<rt::RtPlugin>();
-    const ecs::Entity floor = app.world().spawn();
-    app.world().emplace<transform::Transform>(floor);
-    app.world().emplace<scene::MeshInstance>(floor, scene::MeshInstance{0});
-    const ecs::Entity box = app.world().spawn();
-    app.world().emplace<transform::Transform>(box, transform::Transform::from_translation({0.3f, 0.6f, -0.2f}));
-    app.world().emplace<scene::MeshInstance>(box, scene::MeshInstance{1});
-    app.update();
-  }
-};
-
-}  // namespace
 
 // The kernel is the CPU's arithmetic in its order, but pow, normalize and
 // fused multiply-adds round differently on the device: 1e-4 of the point's
 // irradiance plus 1e-5 absolute (measured: see output).
 TEST(VulkanDdgiIrradiance, EqualsTheCpuStageOnAScrolledGrid) {
   GPU_TEST_CONTEXT_OR_SKIP(ctx);
-  BoxOnFloor s;
+  const scene::MeshAsset box = scene::make_box(glm::vec3(0.4f, 0.6f, 0.3f));
+  FloorUnderSky s(0.5f, &box, glm::vec3(0.3f, 0.6f, -0.2f));
   transgi::ddgi::DdgiSettings settings;
   settings.escaped = transgi::ddgi::EscapedRays::Environment;
   settings.rays_per_probe = 64;

@@ -9,28 +9,13 @@
 
 #include "engine/math/rng.h"
 #include "gpu/vulkan_fused_decoder.h"
+#include "../transgi/random_mlp.h"
 #include "gpu_fixture.h"
 #include "shading/fused_decoder.h"
 
 using namespace transgi;
 
 namespace {
-
-// Every layer at He scale (initialise() keeps the output layer tiny, which
-// would let a wrong kernel pass).
-model::Mlp random_mlp(std::uint64_t seed) {
-  model::Mlp mlp(model::MlpLayout{});
-  const auto& lay = mlp.layout();
-  engine::math::Pcg32 rng(seed, 7);
-  for (int l = 0; l < lay.layer_count(); ++l) {
-    const float bound = std::sqrt(6.0f / static_cast<float>(lay.in_of(l)));
-    float* w = mlp.params().data() + lay.weight_offset(l);
-    for (int i = 0; i < lay.out_of(l) * lay.in_of(l); ++i) w[i] = bound * (2 * rng.next_float() - 1);
-    float* b = mlp.params().data() + lay.bias_offset(l);
-    for (int i = 0; i < lay.out_of(l); ++i) b[i] = 0.1f * (2 * rng.next_float() - 1);
-  }
-  return mlp;
-}
 
 std::vector<float> cpu_shade(const model::Mlp& mlp, const std::vector<float>& inputs, const std::vector<float>& light,
                              int n) {
@@ -50,7 +35,7 @@ std::vector<float> cpu_shade(const model::Mlp& mlp, const std::vector<float>& in
 // tail are exercised. Returns the worst error over the batch's largest value.
 static float worst_relative_error(engine::gpu::VulkanContext& ctx, gpu::FusedWeights weights, float tolerance) {
   const int n = 333;
-  const model::Mlp mlp = random_mlp(42);
+  const model::Mlp mlp = random_mlp(model::MlpLayout{}, 42);
   engine::math::Pcg32 rng(9, 3);
   std::vector<float> inputs(static_cast<std::size_t>(n) * 16), light(static_cast<std::size_t>(n) * 75);
   for (float& x : inputs) x = 2 * rng.next_float() - 1;

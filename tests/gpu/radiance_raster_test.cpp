@@ -63,12 +63,10 @@ Frame random_frame(std::uint64_t seed) {
 
 }  // namespace
 
-// The kernel's arithmetic is the CPU's in the CPU's order, but the GPU may
-// fuse multiply-adds that the CPU (built with -ffp-contract=off) does not:
-// a point within an ulp of a texel border or of the depth guard's bound can
-// land on the other side. At most 0.1 % of the texels may hold a different
-// count (measured 0); every other texel's sum matches to 1e-5 relative, and
-// the accepted and rejected totals to 0.1 %.
+// Rounding may put a point the other side of a texel border or of the
+// depth guard's bound (see probe_interpolation_test.cpp): at most 0.1 % of
+// the texels may hold a different count (measured 0); the rest match to
+// 1e-5 relative, the accepted and rejected totals to 0.1 %.
 TEST(VulkanRadianceRaster, EqualsTheCpuStageWithGuardsAndABudget) {
   GPU_TEST_CONTEXT_OR_SKIP(ctx);
   const Frame f = random_frame(23);

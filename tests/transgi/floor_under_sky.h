@@ -8,11 +8,13 @@
 
 struct FloorUnderSky {
   engine::app::App app{engine::app::AppOptions{.jobs = {.threads = 2}}};
-  explicit FloorUnderSky(float albedo) {
+  // `extra`, if given, stands on the floor at `extra_at` (same material).
+  explicit FloorUnderSky(float albedo, const engine::scene::MeshAsset* extra = nullptr, glm::vec3 extra_at = glm::vec3(0.0f)) {
     using namespace engine;
     scene::SceneAssets a;
     a.generation = scene::next_scene_generation();
     a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({100, 100}))};
+    if (extra) a.meshes.push_back(std::make_shared<scene::MeshAsset>(*extra));
     material::Material m;
     m.base_color_factor = glm::vec4(albedo, albedo, albedo, 1);
     m.metallic_factor = 0;
@@ -24,6 +26,11 @@ struct FloorUnderSky {
     const ecs::Entity e = app.world().spawn();
     app.world().emplace<transform::Transform>(e);
     app.world().emplace<scene::MeshInstance>(e, scene::MeshInstance{0});
+    if (extra) {
+      const ecs::Entity x = app.world().spawn();
+      app.world().emplace<transform::Transform>(x, transform::Transform::from_translation(extra_at));
+      app.world().emplace<scene::MeshInstance>(x, scene::MeshInstance{1});
+    }
     app.update();
   }
 };

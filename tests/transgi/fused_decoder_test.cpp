@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "engine/math/rng.h"
+#include "random_mlp.h"
 #include "model/model_file.h"
 #include "shading/fused_decoder.h"
 #include "shading/sh_light.h"
@@ -15,21 +16,6 @@ using namespace transgi;
 using shading::FusedIsa;
 
 namespace {
-
-// Every layer random at He scale (initialise() keeps the output layer tiny,
-// which would make any kernel look right).
-model::Mlp random_mlp(model::MlpLayout layout, std::uint64_t seed) {
-  model::Mlp mlp(layout);
-  engine::math::Pcg32 rng(seed, 7);
-  for (int l = 0; l < layout.layer_count(); ++l) {
-    const float bound = std::sqrt(6.0f / static_cast<float>(layout.in_of(l)));
-    float* w = mlp.params().data() + layout.weight_offset(l);
-    for (int i = 0; i < layout.out_of(l) * layout.in_of(l); ++i) w[i] = bound * (2 * rng.next_float() - 1);
-    float* b = mlp.params().data() + layout.bias_offset(l);
-    for (int i = 0; i < layout.out_of(l); ++i) b[i] = 0.1f * (2 * rng.next_float() - 1);
-  }
-  return mlp;
-}
 
 struct Batch {
   std::vector<float> inputs, light;

@@ -13,14 +13,6 @@ VulkanDdgiBlend::VulkanDdgiBlend(engine::gpu::VulkanContext& ctx) : ctx_(ctx) {
                                                               static_cast<std::uint32_t>(sizeof(DdgiBlendPush)));
 }
 
-engine::gpu::GpuBuffer& VulkanDdgiBlend::sized(engine::gpu::GpuBuffer& b, std::uint32_t binding, std::size_t bytes) {
-  if (b.handle() == VK_NULL_HANDLE || b.size() < bytes) {
-    b = engine::gpu::GpuBuffer(ctx_, bytes);
-    pipeline_->bind(binding, b);
-  }
-  return b;
-}
-
 double VulkanDdgiBlend::blend(std::vector<ddgi::OctahedralMap<glm::vec3>>& irradiance,
                               std::vector<ddgi::OctahedralMap<glm::vec2>>& distance,
                               const std::vector<std::vector<ddgi::RayRecord>>& records, const ddgi::DdgiSettings& s,
@@ -54,10 +46,10 @@ double VulkanDdgiBlend::blend(std::vector<ddgi::OctahedralMap<glm::vec3>>& irrad
     for (std::size_t t = 0; t < dsz; ++t)
       for (int c = 0; c < 2; ++c) dist[(q * dsz + t) * 2 + static_cast<std::size_t>(c)] = distance[q].texels[t][c];
   }
-  sized(rays_, 0, rays.size() * sizeof(DdgiRayGpu)).upload(std::span<const DdgiRayGpu>(rays));
-  sized(irradiance_, 1, irr.size() * sizeof(float)).upload(std::span<const float>(irr));
-  sized(distance_, 2, dist.size() * sizeof(float)).upload(std::span<const float>(dist));
-  sized(flags_, 3, flags.size() * sizeof(std::uint32_t)).upload(std::span<const std::uint32_t>(flags));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 0, rays_, rays.size() * sizeof(DdgiRayGpu)).upload(std::span<const DdgiRayGpu>(rays));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 1, irradiance_, irr.size() * sizeof(float)).upload(std::span<const float>(irr));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 2, distance_, dist.size() * sizeof(float)).upload(std::span<const float>(dist));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 3, flags_, flags.size() * sizeof(std::uint32_t)).upload(std::span<const std::uint32_t>(flags));
   DdgiBlendPush push{};
   push.probes = static_cast<uint>(probes);
   push.rays_per_probe = static_cast<uint>(m);

@@ -24,8 +24,6 @@ class VulkanDdgiBlend {
                float hysteresis, bool clamp_brightness, float max_distance);
 
  private:
-  engine::gpu::GpuBuffer& sized(engine::gpu::GpuBuffer& b, std::uint32_t binding, std::size_t bytes);
-
   engine::gpu::VulkanContext& ctx_;
   engine::gpu::GpuBuffer rays_, irradiance_, distance_, flags_;
   std::unique_ptr<engine::gpu::ComputePipeline> pipeline_;

@@ -3,6 +3,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "gpu/probe_grid_gpu.h"
 #include "gpu/shader_path.h"
 #include "transgi_shared.h"
 
@@ -11,14 +12,6 @@ namespace transgi::gpu {
 VulkanDdgiIrradiance::VulkanDdgiIrradiance(engine::gpu::VulkanContext& ctx) : ctx_(ctx) {
   pipeline_ = std::make_unique<engine::gpu::ComputePipeline>(ctx, compile_module_shader("ddgi_irradiance.comp"), 5,
                                                               static_cast<std::uint32_t>(sizeof(DdgiPush)));
-}
-
-engine::gpu::GpuBuffer& VulkanDdgiIrradiance::sized(engine::gpu::GpuBuffer& b, std::uint32_t binding, std::size_t bytes) {
-  if (b.handle() == VK_NULL_HANDLE || b.size() < bytes) {
-    b = engine::gpu::GpuBuffer(ctx_, bytes);
-    pipeline_->bind(binding, b);
-  }
-  return b;
 }
 
 GpuDdgiIrradiance VulkanDdgiIrradiance::irradiance(const ddgi::DdgiVolume& volume, std::span<const glm::vec3> positions,
@@ -48,20 +41,19 @@ GpuDdgiIrradiance VulkanDdgiIrradiance::irradiance(const ddgi::DdgiVolume& volum
   for (std::size_t i = 0; i < n; ++i)
     pts[i] = {positions[i].x, positions[i].y, positions[i].z, 0, normals[i].x, normals[i].y, normals[i].z, 0,
               view_dirs[i].x, view_dirs[i].y, view_dirs[i].z, 0};
-  sized(points_, 0, n * sizeof(DdgiPointGpu)).upload(std::span<const DdgiPointGpu>(pts));
-  sized(irradiance_, 1, irr.size() * sizeof(float)).upload(std::span<const float>(irr));
-  sized(distance_, 2, dist.size() * sizeof(float)).upload(std::span<const float>(dist));
-  sized(placed_, 3, placed.size() * sizeof(glm::vec4)).upload(std::span<const glm::vec4>(placed));
-  sized(result_, 4, n * sizeof(glm::vec4));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 0, points_, n * sizeof(DdgiPointGpu)).upload(std::span<const DdgiPointGpu>(pts));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 1, irradiance_, irr.size() * sizeof(float)).upload(std::span<const float>(irr));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 2, distance_, dist.size() * sizeof(float)).upload(std::span<const float>(dist));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 3, placed_, placed.size() * sizeof(glm::vec4)).upload(std::span<const glm::vec4>(placed));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 4, result_, n * sizeof(glm::vec4));
 
   const ddgi::DdgiSettings& s = volume.settings();
-  const glm::vec3 sp = grid.spacing();
   DdgiPush push{};
-  push.min_x = grid.min.x, push.min_y = grid.min.y, push.min_z = grid.min.z, push.normal_bias = s.normal_bias;
-  push.spacing_x = sp.x, push.spacing_y = sp.y, push.spacing_z = sp.z, push.view_bias = s.view_bias;
-  push.dims_x = grid.dims.x, push.dims_y = grid.dims.y, push.dims_z = grid.dims.z, push.points = static_cast<int>(n);
-  push.scroll_x = grid.scroll.x, push.scroll_y = grid.scroll.y, push.scroll_z = grid.scroll.z;
+  push.grid = probe_grid_gpu(grid);
+  push.normal_bias = s.normal_bias;
+  push.view_bias = s.view_bias;
   push.irradiance_gamma = s.irradiance_gamma;
+  push.points = static_cast<int>(n);
   push.irradiance_size = static_cast<uint>(isize), push.distance_size = static_cast<uint>(dsize);
   push.irradiance_interior = static_cast<uint>(volume.irradiance_map(0).interior);
   push.distance_interior = static_cast<uint>(volume.distance_map(0).interior);

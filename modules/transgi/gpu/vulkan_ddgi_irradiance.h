@@ -32,8 +32,6 @@ class VulkanDdgiIrradiance {
                                std::span<const glm::vec3> normals, std::span<const glm::vec3> view_dirs);
 
  private:
-  engine::gpu::GpuBuffer& sized(engine::gpu::GpuBuffer& b, std::uint32_t binding, std::size_t bytes);
-
   engine::gpu::VulkanContext& ctx_;
   engine::gpu::GpuBuffer points_, irradiance_, distance_, placed_, result_;
   std::unique_ptr<engine::gpu::ComputePipeline> pipeline_;

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "gpu/probe_grid_gpu.h"
 #include "gpu/shader_path.h"
 #include "transgi_shared.h"
 
@@ -13,15 +14,6 @@ VulkanProbeInterpolator::VulkanProbeInterpolator(engine::gpu::VulkanContext& ctx
     : ctx_(ctx), layout_(layout) {
   pipeline_ = std::make_unique<engine::gpu::ComputePipeline>(ctx, compile_module_shader("probe_interpolation.comp"), 6,
                                                               static_cast<std::uint32_t>(sizeof(InterpolatePush)));
-}
-
-engine::gpu::GpuBuffer& VulkanProbeInterpolator::sized(engine::gpu::GpuBuffer& b, std::uint32_t binding,
-                                                       std::size_t bytes) {
-  if (b.handle() == VK_NULL_HANDLE || b.size() < bytes) {
-    b = engine::gpu::GpuBuffer(ctx_, bytes);
-    pipeline_->bind(binding, b);
-  }
-  return b;
 }
 
 GpuInterpolation VulkanProbeInterpolator::interpolate(const probes::ProbeGrid& grid,
@@ -58,22 +50,18 @@ GpuInterpolation VulkanProbeInterpolator::interpolate(const probes::ProbeGrid& g
     const glm::vec3 off = grid.offsets.empty() ? glm::vec3(0.0f) : grid.offsets[q];
     probe_info[q] = {off.x, off.y, off.z, d.unit, usable_q ? 1u : 0u, 0, 0, 0};
   }
-  sized(points_, 0, points.size() * sizeof(float)).upload(std::span<const float>(points));
-  sized(depth_, 1, depth.size() * sizeof(depth[0])).upload(std::span<const probes::DepthMap::Texel>(depth));
-  sized(probes_, 2, probe_info.size() * sizeof(ProbeGpu)).upload(std::span<const ProbeGpu>(probe_info));
-  sized(probe_sh_, 3, probe_sh.size() * sizeof(float)).upload(probe_sh);
-  sized(results_, 4, n * sizeof(InterpolationGpu));
-  sized(point_sh_, 5, n * kTransferOutputs * sizeof(float));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 0, points_, points.size() * sizeof(float)).upload(std::span<const float>(points));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 1, depth_, depth.size() * sizeof(depth[0])).upload(std::span<const probes::DepthMap::Texel>(depth));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 2, probes_, probe_info.size() * sizeof(ProbeGpu)).upload(std::span<const ProbeGpu>(probe_info));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 3, probe_sh_, probe_sh.size() * sizeof(float)).upload(probe_sh);
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 4, results_, n * sizeof(InterpolationGpu));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 5, point_sh_, n * kTransferOutputs * sizeof(float));
 
-  const glm::vec3 s = grid.spacing();
   InterpolatePush push{};
-  push.min_x = grid.min.x, push.min_y = grid.min.y, push.min_z = grid.min.z;
+  push.grid = probe_grid_gpu(grid);
   push.bias_length = settings.normal_bias * grid.min_spacing();
-  push.spacing_x = s.x, push.spacing_y = s.y, push.spacing_z = s.z;
   push.visibility_threshold = settings.visibility_threshold;
-  push.dims_x = grid.dims.x, push.dims_y = grid.dims.y, push.dims_z = grid.dims.z;
   push.points = static_cast<int>(n);
-  push.scroll_x = grid.scroll.x, push.scroll_y = grid.scroll.y, push.scroll_z = grid.scroll.z;
   push.flags = (settings.prune_back_facing ? kInterpolatePruneBackFacing : 0u) |
                (settings.prune_occluded ? kInterpolatePruneOccluded : 0u) |
                (grid.offsets.empty() ? 0u : kInterpolateHasOffsets);

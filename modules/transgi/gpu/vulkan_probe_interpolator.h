@@ -38,8 +38,6 @@ class VulkanProbeInterpolator {
                                std::span<const glm::vec3> normals);
 
  private:
-  engine::gpu::GpuBuffer& sized(engine::gpu::GpuBuffer& b, std::uint32_t binding, std::size_t bytes);
-
   engine::gpu::VulkanContext& ctx_;
   probes::MapLayout layout_;
   engine::gpu::GpuBuffer points_, depth_, probes_, probe_sh_, results_, point_sh_;

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "gpu/probe_grid_gpu.h"
 #include "gpu/shader_path.h"
 #include "transgi_shared.h"
 
@@ -13,14 +14,6 @@ VulkanRadianceRaster::VulkanRadianceRaster(engine::gpu::VulkanContext& ctx, prob
     : ctx_(ctx), layout_(layout) {
   pipeline_ = std::make_unique<engine::gpu::ComputePipeline>(ctx, compile_module_shader("radiance_raster.comp"), 7,
                                                               static_cast<std::uint32_t>(sizeof(RasterPush)));
-}
-
-engine::gpu::GpuBuffer& VulkanRadianceRaster::sized(engine::gpu::GpuBuffer& b, std::uint32_t binding, std::size_t bytes) {
-  if (b.handle() == VK_NULL_HANDLE || b.size() < bytes) {
-    b = engine::gpu::GpuBuffer(ctx_, bytes);
-    pipeline_->bind(binding, b);
-  }
-  return b;
 }
 
 probes::SharingStats VulkanRadianceRaster::rasterize(const probes::ProbeGrid& grid,
@@ -61,24 +54,19 @@ probes::SharingStats VulkanRadianceRaster::rasterize(const probes::ProbeGrid& gr
     info[q] = {off.x, off.y, off.z, d ? d->unit : 1.0f, 0, 0, 0, 0};
     if (!targets.empty()) target_flags[q] = targets[q] ? 1u : 0u;
   }
-  sized(points_, 0, flat.size() * sizeof(ShadedPointGpu)).upload(std::span<const ShadedPointGpu>(flat));
-  sized(ranges_, 1, begin.size() * sizeof(std::uint32_t)).upload(std::span<const std::uint32_t>(begin));
-  sized(depth_, 2, depth.size() * sizeof(depth[0])).upload(std::span<const probes::DepthMap::Texel>(depth));
-  sized(probes_, 3, info.size() * sizeof(ProbeGpu)).upload(std::span<const ProbeGpu>(info));
-  sized(targets_, 4, target_flags.size() * sizeof(std::uint32_t)).upload(std::span<const std::uint32_t>(target_flags));
-  sized(samples_, 5, count * texels * 4 * sizeof(float));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 0, points_, flat.size() * sizeof(ShadedPointGpu)).upload(std::span<const ShadedPointGpu>(flat));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 1, ranges_, begin.size() * sizeof(std::uint32_t)).upload(std::span<const std::uint32_t>(begin));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 2, depth_, depth.size() * sizeof(depth[0])).upload(std::span<const probes::DepthMap::Texel>(depth));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 3, probes_, info.size() * sizeof(ProbeGpu)).upload(std::span<const ProbeGpu>(info));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 4, targets_, target_flags.size() * sizeof(std::uint32_t)).upload(std::span<const std::uint32_t>(target_flags));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 5, samples_, count * texels * 4 * sizeof(float));
   const std::uint32_t zero[2] = {0, 0};
-  sized(stats_, 6, sizeof(zero)).upload(std::span<const std::uint32_t>(zero));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 6, stats_, sizeof(zero)).upload(std::span<const std::uint32_t>(zero));
 
-  const glm::vec3 sp = grid.spacing();
   RasterPush push{};
-  push.min_x = grid.min.x, push.min_y = grid.min.y, push.min_z = grid.min.z;
+  push.grid = probe_grid_gpu(grid);
   push.relative_tolerance = s.relative_tolerance;
-  push.spacing_x = sp.x, push.spacing_y = sp.y, push.spacing_z = sp.z;
   push.absolute_tolerance = s.absolute_tolerance;
-  push.dims_x = grid.dims.x, push.dims_y = grid.dims.y, push.dims_z = grid.dims.z;
-  push.probes = static_cast<int>(count);
-  push.scroll_x = grid.scroll.x, push.scroll_y = grid.scroll.y, push.scroll_z = grid.scroll.z;
   const bool guard = s.mode == probes::SharingMode::DepthGuard;
   push.flags = (guard ? kRasterDepthGuard : 0u) | (s.same_side ? kRasterSameSide : 0u) | (has_depth ? kRasterHasDepth : 0u) |
                (grid.offsets.empty() ? 0u : kRasterHasOffsets);

@@ -24,8 +24,6 @@ class VulkanRadianceRaster {
                                  std::span<const std::uint8_t> targets = {}, double* gpu_ms = nullptr);
 
  private:
-  engine::gpu::GpuBuffer& sized(engine::gpu::GpuBuffer& b, std::uint32_t binding, std::size_t bytes);
-
   engine::gpu::VulkanContext& ctx_;
   probes::MapLayout layout_;
   engine::gpu::GpuBuffer points_, ranges_, depth_, probes_, targets_, samples_, stats_;
