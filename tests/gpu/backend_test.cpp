@@ -7,6 +7,7 @@
 
 #include "engine/image/metrics.h"
 #include "eval/method_runs.h"
+#include "gpu/vulkan_ddgi_kernels.h"
 #include "gpu_fixture.h"
 
 using namespace transgi;
@@ -45,5 +46,34 @@ TEST(VulkanBackend, ACornellBoxGiFrameEqualsTheCpuBackends) {
   ASSERT_GT(mean, 1e-3) << "the Cornell box's GI should not be black";
   const double rmse = engine::image::rmse_clamped(cpu.gi, gpu.gi);
   std::printf("Cornell box, 16 frames, 48x48: GI RMSE between backends %.3g, mean GI %.4f (%s)\n", rmse, mean, gpu.backend.c_str());
+  EXPECT_LT(rmse, 1e-4 * mean) << "expected the backends within 1e-4 of the mean GI, got RMSE " << rmse;
+}
+
+// DDGI on both backends (its probe rays traced through the GPU BVH, the blend
+// as a kernel): the Cornell box's GI after 16 updates.
+TEST(VulkanBackend, ACornellBoxDdgiFrameEqualsTheCpuBackends) {
+  GPU_TEST_CONTEXT_OR_SKIP(ctx);
+  auto run = [&](bool gpu) {
+    eval::DdgiRunOptions d;
+    d.frames = 16;
+    d.progress = false;
+    d.render.direct_spp = 0;
+    d.settings.rays_per_probe = 64;
+    d.settings.warmup_frames = 8;
+    d.placement.mode = runtime::ProbeVolumeMode::Scene;
+    d.placement.scene_dims = glm::ivec3(6);
+    std::string why;
+    if (gpu) d.kernels = gpu::make_ddgi_kernels("vulkan", "", &why);
+    EXPECT_TRUE(!gpu || d.kernels) << why;
+    eval::LoadedScene scene = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/test_scenes/cornell_box/scene.gltf", "", 2);
+    return eval::run_ddgi(scene, 48, 48, d);
+  };
+  const eval::MethodRun cpu = run(false), gpu = run(true);
+  double mean = 0;
+  for (const auto& p : cpu.gi.pixels) mean += (p.r + p.g + p.b) / 3.0;
+  mean /= static_cast<double>(cpu.gi.pixels.size());
+  ASSERT_GT(mean, 1e-3);
+  const double rmse = engine::image::rmse_clamped(cpu.gi, gpu.gi);
+  std::printf("Cornell box DDGI, 16 updates, 48x48: GI RMSE between backends %.3g, mean GI %.4f\n", rmse, mean);
   EXPECT_LT(rmse, 1e-4 * mean) << "expected the backends within 1e-4 of the mean GI, got RMSE " << rmse;
 }

@@ -52,7 +52,7 @@ struct SkylessLights {
 };
 
 void update_volumes(View<Get<DdgiProbeVolume>> volumes, View<Get<DdgiCascades>> cascades, Res<rt::RtScene> rt, Res<render::SceneLights> lights,
-                    Res<DdgiSettings> settings, ResMut<DdgiFrame> frame, Local<SkylessLights> skyless) {
+                    Res<DdgiSettings> settings, ResMut<DdgiFrame> frame, Res<DdgiBackend> backend, Local<SkylessLights> skyless) {
   const render::LightSet* set = &lights->set;
   const scene::Environment* sky = lights->set.environment();
   if (settings->escaped == EscapedRays::Environment && sky) {
@@ -70,12 +70,17 @@ void update_volumes(View<Get<DdgiProbeVolume>> volumes, View<Get<DdgiCascades>> 
     total.blend_ms += s.blend_ms;
   };
   volumes.each([&](DdgiProbeVolume& v) {
-    if (v.volume) add(v.volume->update(*rt, *set, sky));
+    if (!v.volume) return;
+    v.volume->set_kernels(backend->kernels);
+    add(v.volume->update(*rt, *set, sky));
   });
   cascades.each([&](DdgiCascades& c) {
     const auto& fields = c.state.fields;
-    for (std::size_t k = 0; k < fields.size(); ++k)
-      if (fields[k]) add(fields[k]->update(*rt, *set, sky, k + 1 < fields.size() ? fields[k + 1].get() : nullptr));
+    for (std::size_t k = 0; k < fields.size(); ++k) {
+      if (!fields[k]) continue;
+      fields[k]->set_kernels(backend->kernels);
+      add(fields[k]->update(*rt, *set, sky, k + 1 < fields.size() ? fields[k + 1].get() : nullptr));
+    }
   });
   frame->probe_stats = total;
   frame->times.probe_trace = total.trace_ms;
@@ -122,6 +127,7 @@ void DdgiPlugin::build(app::App& app) {
   if (!w.has_resource<DdgiSettings>()) w.insert_resource<DdgiSettings>(settings_);
   if (!w.has_resource<DdgiRenderOptions>()) w.insert_resource<DdgiRenderOptions>(options_);
   if (!w.has_resource<DdgiFrame>()) w.insert_resource<DdgiFrame>();
+  if (!w.has_resource<DdgiBackend>()) w.insert_resource<DdgiBackend>();
   app.add_system(Phase::PrepareRender, "ddgi::sync_volumes", sync_volumes);
   app.add_system(Phase::Render, "ddgi::update_volumes", update_volumes);
   app.add_system(Phase::Render, "ddgi::render", render_frame);

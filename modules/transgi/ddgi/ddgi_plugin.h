@@ -11,6 +11,7 @@
 //                 images and stage times are this frame's.
 #include <memory>
 
+#include "ddgi/ddgi_kernels.h"
 #include "ddgi/ddgi_volume.h"
 #include "probes/cascade_follow.h"
 #include "engine/app/app.h"
@@ -44,6 +45,13 @@ struct DdgiRenderOptions {
 
 struct DdgiStageTimes {
   double probe_trace = 0, probe_blend = 0, shading = 0, direct = 0;
+};
+
+// Where the DDGI volumes trace and blend: null kernels = the CPU (the
+// default); a GPU backend is set here by whoever made it (the CLI's
+// --backend vulkan), and every volume follows it from its next update.
+struct DdgiBackend {
+  std::shared_ptr<DdgiKernels> kernels;
 };
 
 struct DdgiFrame {

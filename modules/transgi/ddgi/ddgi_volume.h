@@ -7,9 +7,14 @@
 // power-cosine blending with hysteresis, and Chebyshev + wrap-shading
 // interpolation of irradiance at a shading point.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "ddgi/octahedral.h"
+namespace transgi::ddgi {
+class DdgiKernels;
+}  // namespace transgi::ddgi
+
 #include "engine/render/light_set.h"
 #include "engine/rt/rt_scene.h"
 #include "engine/scene/environment.h"
@@ -94,6 +99,10 @@ class DdgiVolume {
   DdgiFrameStats update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
                         const engine::scene::Environment* sky = nullptr, const DdgiVolume* outer = nullptr);
 
+  // Runs the probe rays' tracing and the blend through `kernels` (a GPU
+  // backend) from the next update on; null = the CPU functions.
+  void set_kernels(std::shared_ptr<DdgiKernels> kernels) { kernels_ = std::move(kernels); }
+
   // Irradiance at a surface point with unit normal n, seen along view_dir
   // (from the eye towards the point), as RTXGI's DDGIGetVolumeIrradiance.
   // `lit`, if given, says whether any active probe weighed in (false: every
@@ -121,6 +130,7 @@ class DdgiVolume {
   [[nodiscard]] std::size_t memory_bytes() const;
 
  private:
+  std::shared_ptr<DdgiKernels> kernels_;
   probes::ProbeGrid grid_;
   probes::ProbeGrid placed_;
   DdgiSettings settings_;

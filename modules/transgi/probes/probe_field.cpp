@@ -247,48 +247,20 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   std::vector<std::size_t> first_ray;
   if (rt::RayBatchTracer* tracer = kernels_ ? kernels_->tracer() : nullptr) {
     std::vector<rt::Ray> rays;
-    std::vector<int> ray_probe;
     first_ray.assign(static_cast<std::size_t>(probes), 0);
     for (int q = 0; q < probes; ++q) {
       if (!traced[static_cast<std::size_t>(q)]) continue;
       first_ray[static_cast<std::size_t>(q)] = rays.size();
       for (int i = 0; i < M; ++i) rays.push_back(rt::Ray{grid.position(q), ray_direction(i)});
     }
-    std::vector<rt::Hit> found_hits(rays.size());
-    std::vector<std::uint8_t> found(rays.size());
-    if (tracer->intersect(scene, rays, found_hits, found)) {
-      std::vector<PendingProbeRay> pending(rays.size());
-      jobs::parallel_for(0, probes, 1, [&](int b, int e) {
-        for (int q = b; q < e; ++q) {
-          if (!traced[static_cast<std::size_t>(q)]) continue;
-          for (int i = 0; i < M; ++i) {
-            const std::size_t k = first_ray[static_cast<std::size_t>(q)] + static_cast<std::size_t>(i);
-            math::Pcg32 rng = ray_rng(q, i);
-            pending[k] = begin_probe_ray(scene, lights, ray_direction(i), found[k] ? &found_hits[k] : nullptr, rng);
-          }
-        }
-      });
-      std::vector<rt::Ray> shadows;
-      std::vector<std::size_t> shadow_of;
-      for (std::size_t k = 0; k < pending.size(); ++k)
-        if (pending[k].needs_shadow) {
-          shadows.push_back(pending[k].shadow);
-          shadow_of.push_back(k);
-        }
-      std::vector<std::uint8_t> blocked(shadows.size());
-      if (!tracer->occluded(scene, shadows, blocked))
-        for (std::size_t j = 0; j < shadows.size(); ++j) blocked[j] = scene.occluded(shadows[j]) ? 1 : 0;
-      std::vector<std::uint8_t> blocked_at(pending.size(), 0);
-      for (std::size_t j = 0; j < shadows.size(); ++j) blocked_at[shadow_of[j]] = blocked[j];
-      shaded.resize(pending.size());
-      jobs::parallel_for(0, static_cast<int>(pending.size()), 256, [&](int b, int e) {
-        for (int k = b; k < e; ++k)
-          shaded[static_cast<std::size_t>(k)] =
-              finish_probe_ray(pending[static_cast<std::size_t>(k)], blocked_at[static_cast<std::size_t>(k)] != 0, feedback);
-      });
-    } else {
-      first_ray.clear();
-    }
+    // Ray k belongs to probe k / M (traced probes only, in order).
+    std::vector<int> probe_of;
+    for (int q = 0; q < probes; ++q)
+      if (traced[static_cast<std::size_t>(q)]) probe_of.push_back(q);
+    const auto rng_of = [&](std::size_t k) {
+      return ray_rng(probe_of[k / static_cast<std::size_t>(M)], static_cast<int>(k % static_cast<std::size_t>(M)));
+    };
+    if (!shade_probe_rays_batched(scene, lights, *tracer, rays, rng_of, feedback, shaded)) first_ray.clear();
   }
   jobs::parallel_for(0, probes, 1, [&](int b, int e) {
     for (int q = b; q < e; ++q) {

@@ -2,16 +2,20 @@
 // What every probe technique here shares (TransGI's SH probes and the DDGI
 // baseline): the ray set, and the shading of a probe ray's hit, so that the
 // two differ only in how they store, filter and interpolate light.
+#include <cstdint>
 #include <limits>
+#include <span>
 #include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "engine/jobs/parallel_for.h"
 #include "engine/math/rng.h"
 #include "engine/render/light_set.h"
 #include "engine/render/surface.h"
+#include "engine/rt/ray_batch_tracer.h"
 #include "engine/rt/rt_scene.h"
 
 namespace transgi::probes {
@@ -92,6 +96,45 @@ ProbeRayHit shade_probe_ray(const engine::rt::RtScene& scene, const engine::rend
   const PendingProbeRay p = begin_probe_ray(scene, lights, dir, traced, rng);
   const bool blocked = p.needs_shadow && scene.occluded(p.shadow);
   return finish_probe_ray(p, blocked, std::forward<Feedback>(feedback));
+}
+
+// A batch of probe rays traced by `tracer` (a backend's, e.g. the GPU's):
+// their closest hits in one call, each hit's first half of the shading, the
+// shadow rays in a second call, then the rest. rng_of(k) is ray k's
+// generator; out[k] its result, equal to trace_probe_ray's for the same hit.
+// Returns false, out untouched, where the tracer declines the scene.
+template <class RngOf, class Feedback>
+bool shade_probe_rays_batched(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                              engine::rt::RayBatchTracer& tracer, std::span<const engine::rt::Ray> rays, RngOf&& rng_of,
+                              Feedback&& feedback, std::vector<ProbeRayHit>& out) {
+  using namespace engine;
+  std::vector<rt::Hit> hits(rays.size());
+  std::vector<std::uint8_t> found(rays.size());
+  if (!tracer.intersect(scene, rays, hits, found)) return false;
+  std::vector<PendingProbeRay> pending(rays.size());
+  jobs::parallel_for<std::size_t>(0, rays.size(), 64, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      math::Pcg32 rng = rng_of(k);
+      pending[k] = begin_probe_ray(scene, lights, rays[k].direction, found[k] ? &hits[k] : nullptr, rng);
+    }
+  });
+  std::vector<rt::Ray> shadows;
+  std::vector<std::size_t> shadow_of;
+  for (std::size_t k = 0; k < pending.size(); ++k)
+    if (pending[k].needs_shadow) {
+      shadows.push_back(pending[k].shadow);
+      shadow_of.push_back(k);
+    }
+  std::vector<std::uint8_t> blocked(shadows.size());
+  if (!tracer.occluded(scene, shadows, blocked))
+    for (std::size_t j = 0; j < shadows.size(); ++j) blocked[j] = scene.occluded(shadows[j]) ? 1 : 0;
+  std::vector<std::uint8_t> blocked_at(pending.size(), 0);
+  for (std::size_t j = 0; j < shadows.size(); ++j) blocked_at[shadow_of[j]] = blocked[j];
+  out.resize(pending.size());
+  jobs::parallel_for<std::size_t>(0, pending.size(), 256, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) out[k] = finish_probe_ray(pending[k], blocked_at[k] != 0, feedback);
+  });
+  return true;
 }
 
 // Traces and shades one probe ray.
