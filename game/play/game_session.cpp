@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "ddgi/ddgi_plugin.h"
+#include "gpu/vulkan_ddgi_kernels.h"
 #include "engine/core/log.h"
 #include "engine/render/camera_rays.h"
 #include "engine/render/light_plugin.h"
@@ -112,6 +113,7 @@ void GameSession::set_method(GameMethod m) {
   if (m == GameMethod::Ddgi && !app_->has_plugin("transgi::DdgiPlugin")) {
     app_->add_plugin<transgi::ddgi::DdgiPlugin>();  // on first use: its probes cost time every frame
     w.emplace<transgi::ddgi::DdgiProbeVolume>(w.spawn(), transgi::ddgi::DdgiProbeVolume{});
+    if (ddgi_backend_ != "cpu") set_backend(ddgi_backend_);  // the backend chosen before DDGI was first shown
   }
   if (auto* d = w.try_resource<transgi::ddgi::DdgiFrame>()) {
     d->camera = camera_;
@@ -122,6 +124,23 @@ void GameSession::set_method(GameMethod m) {
   gi.width = m == GameMethod::TransGI ? options_.width : 0;
   gi.height = m == GameMethod::TransGI ? options_.height : 0;
   reference_->tracer.reset();
+}
+
+void GameSession::set_backend(const std::string& backend) {
+  if (backend != "cpu" && backend != "vulkan") throw std::runtime_error("backend: expected cpu or vulkan, got '" + backend + "'");
+  engine::ecs::World& w = world();
+  auto& settings = w.resource<transgi::runtime::TransGISettings>();
+  settings.backend = backend == "vulkan" ? transgi::runtime::Backend::Vulkan : transgi::runtime::Backend::Cpu;
+  ddgi_backend_ = backend;
+  if (auto* d = w.try_resource<transgi::ddgi::DdgiBackend>()) {
+    std::string why;
+    d->kernels = transgi::gpu::make_ddgi_kernels(backend, settings.gpu_device, &why);
+  }
+}
+
+std::string GameSession::backend_status() {
+  const auto& f = world().resource<transgi::runtime::GiFrame>();
+  return f.backend + (f.backend_fallback.empty() ? "" : " (" + f.backend_fallback + ")");
 }
 
 int GameSession::reference_spp() const { return reference_->tracer ? reference_->tracer->samples_per_pixel() : 0; }
@@ -190,6 +209,8 @@ void GameSession::apply(const ReplayEvent& e) {
     set_method(e.name == "ddgi" ? GameMethod::Ddgi : e.name == "reference" ? GameMethod::Reference : GameMethod::TransGI);
   } else if (e.kind == "view") {
     set_view(e.name);
+  } else if (e.kind == "backend") {
+    set_backend(e.name);
   } else if (e.kind == "gizmo_mode") editor_.mode = e.name == "rotate" ? GizmoMode::Rotate : GizmoMode::Translate;
   else if (e.kind == "gizmo_grab") {
     const auto px = handle_grab_pixel(world(), editor_, view(), parse_handle(e.name));

@@ -46,6 +46,11 @@ class GameSession {
   [[nodiscard]] const engine::image::ImageRGB& image() const;
   // Switch the method and pass (full | gi | direct); both take effect at the next frame.
   void set_method(GameMethod m);
+  // Where GI's probe work runs ("cpu" or "vulkan"), for TransGI and DDGI
+  // alike; from the next frame. Without a Vulkan device the CPU goes on and
+  // backend_status() says why.
+  void set_backend(const std::string& backend);
+  [[nodiscard]] std::string backend_status();
   void set_view(const std::string& view);
   [[nodiscard]] GameMethod method() const { return method_; }
   [[nodiscard]] const std::string& view_name() const { return options_.view; }
@@ -66,6 +71,7 @@ class GameSession {
   engine::ecs::Entity camera_;
   EditorState editor_;
   GameMethod method_ = GameMethod::TransGI;
+  std::string ddgi_backend_ = "cpu";  // applied to DDGI when its plugin is first added
   struct Reference;
   std::unique_ptr<Reference> reference_;
   void render_reference();

@@ -11,7 +11,7 @@ namespace game {
 
 std::vector<ReplayEvent> parse_replay(const std::string& text, const std::string& name) {
   static const std::set<std::string> kNamed = {"key_down", "key_up", "key_press", "mouse_down", "mouse_up",
-                                               "select", "gizmo_grab", "gizmo_mode", "method", "view"};
+                                               "select", "gizmo_grab", "gizmo_mode", "method", "view", "backend"};
   static const std::set<std::string> kXY = {"mouse_move", "mouse_move_by"};
   std::vector<ReplayEvent> out;
   std::istringstream in(text);
@@ -40,6 +40,8 @@ std::vector<ReplayEvent> parse_replay(const std::string& text, const std::string
         bad("gizmo_mode: expected translate or rotate, got '" + e.name + "'");
       if (e.kind == "method" && e.name != "transgi" && e.name != "ddgi" && e.name != "reference")
         bad("method: expected transgi, ddgi or reference, got '" + e.name + "'");
+      if (e.kind == "backend" && e.name != "cpu" && e.name != "vulkan")
+        bad("backend: expected cpu or vulkan, got '" + e.name + "'");
       if (e.kind == "view" && e.name != "full" && e.name != "gi" && e.name != "direct")
         bad("view: expected full, gi or direct, got '" + e.name + "'");
       if (e.kind == "gizmo_grab" && !std::set<std::string>{"x", "y", "z", "xy", "yz", "zx", "rx", "ry", "rz"}.contains(e.name))

@@ -14,6 +14,7 @@
 //   gizmo_mode translate|rotate
 //   method transgi|ddgi|reference   what the view shows
 //   view full|gi|direct             which pass
+//   backend cpu|vulkan             where GI's probe work runs (issue 12)
 #include <filesystem>
 #include <string>
 #include <vector>

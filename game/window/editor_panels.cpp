@@ -163,6 +163,10 @@ void EditorUi::gi_settings() {
   changed |= ImGui::Checkbox("edge-aware upsampling", &edit.realtime.edge_aware);
   changed |= ImGui::SliderInt("probe budget / frame", &edit.probes.update_budget, 0, 512);
   if (changed) *s = edit;
+  // The backend at run time (issue 12): Vulkan, lavapipe where there is no GPU.
+  int backend = s->backend == transgi::runtime::Backend::Vulkan ? 1 : 0;
+  if (ImGui::Combo("GI backend", &backend, "cpu\0vulkan\0")) session_.set_backend(backend == 1 ? "vulkan" : "cpu");
+  ImGui::TextWrapped("runs on: %s", session_.backend_status().c_str());
   int index = 0;
   for (const auto& field : transgi::runtime::probe_fields(w)) {
     const auto& g = field->settings().grid;

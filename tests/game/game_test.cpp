@@ -25,6 +25,7 @@
 #include "engine/script/script_runtime.h"
 #include "engine/scene/scene_assets.h"
 #include "engine/scene/sun.h"
+#include "engine/image/metrics.h"
 #include "play/game_session.h"
 #include "replay/replay.h"
 
@@ -359,4 +360,44 @@ TEST(GameSession, TheTimeOfDayTurnsTheLevelsSunAndPutsItOutAtNight) {
   EXPECT_EQ(world.get<engine::scene::PunctualLight>(*sun).intensity, 0.0f) << "the sun is out below the horizon";
   EXPECT_NEAR(world.resource<engine::scene::SceneAssets>().environment->strength(), 0.35f * day_sky, 1e-5f * day_sky)
       << "the sky at night strength";
+}
+
+// Issue 12: the backend switches at run time, by a replayed event as by the
+// editor's combo: TransGI's probes (and DDGI's, shown next) run on Vulkan
+// from the next frame, the image stays what a session that kept the CPU
+// shows after the same frames, and the switch back works.
+TEST(GameSession, TheGiBackendSwitchesAtRunTime) {
+  auto still_session = [] {
+    auto s = std::make_unique<game::GameSession>(level_options(64, 36));
+    idle(*s, 1);
+    EXPECT_TRUE(s->world().resource<engine::script::ScriptRuntime>().set_property(s->world(), s->find("DayNight"), "running", false));
+    idle(*s, 2);
+    return s;
+  };
+  auto kept = still_session(), switched = still_session();
+  EXPECT_EQ(switched->backend_status(), "cpu");
+  switched->begin_input();
+  switched->apply({0, "backend", "vulkan", {}, 1});
+  idle(*switched, 3);
+  idle(*kept, 3);
+  const std::string status = switched->backend_status();
+  std::printf("after the switch: %s\n", status.c_str());
+  if (status.rfind("vulkan", 0) != 0) {
+    // No Vulkan device here: the CPU goes on and says why.
+    EXPECT_NE(status.find("Vulkan backend unavailable"), std::string::npos) << status;
+    GTEST_SKIP() << "no Vulkan device: " << status;
+  }
+  const double rmse = engine::image::rmse_clamped(switched->image(), kept->image());
+  std::printf("switched against kept on the CPU, same frames: RMSE %.3g\n", rmse);
+  EXPECT_LT(rmse, 1e-3) << "the same level, lit the same, on the other backend";
+  switched->begin_input();
+  switched->apply({0, "method", "ddgi", {}, 2});
+  idle(*switched, 2);
+  EXPECT_EQ(switched->image().width, 64);
+  switched->begin_input();
+  switched->apply({0, "backend", "cpu", {}, 3});
+  switched->apply({0, "method", "transgi", {}, 3});
+  idle(*switched, 2);
+  EXPECT_EQ(switched->backend_status(), "cpu");
+  EXPECT_THROW(switched->apply({0, "backend", "metal", {}, 4}), std::runtime_error);
 }
