@@ -12,7 +12,7 @@ probes::SharingStats VulkanProbeKernels::rasterize(const probes::ProbeGrid& grid
   if (!r) r = std::make_unique<VulkanRadianceRaster>(*ctx_, layout);
   double ms = 0;
   const auto stats = r->rasterize(grid, points, own_depth, settings, out, targets, &ms);
-  gpu_ms_ += std::max(0.0, ms);
+  raster_ms_ += std::max(0.0, ms);
   return stats;
 }
 
@@ -21,7 +21,7 @@ void VulkanProbeKernels::project(const probes::MapProjector& projector, std::spa
   const auto& l = projector.layout();
   auto& p = projectors_[{l.width, l.height}];
   if (!p) p = std::make_unique<VulkanShProjector>(*ctx_, projector);
-  gpu_ms_ += std::max(0.0, p->project(radiance, out));
+  project_ms_ += std::max(0.0, p->project(radiance, out));
 }
 
 }  // namespace transgi::gpu

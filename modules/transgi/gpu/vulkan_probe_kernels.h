@@ -27,15 +27,23 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   engine::rt::RayBatchTracer* tracer() override { return &tracer_; }
   [[nodiscard]] const char* name() const override { return "vulkan"; }
   [[nodiscard]] const engine::gpu::VulkanContext& context() const { return *ctx_; }
-  // GPU milliseconds of the kernels since the last call (timestamps).
-  double take_gpu_ms() { return std::exchange(gpu_ms_, 0.0) + tracer_.take_gpu_ms(); }
+  // GPU milliseconds per stage since the last call (timestamps).
+  struct StageMs {
+    double trace = 0, raster = 0, projection = 0;
+    [[nodiscard]] double total() const { return trace + raster + projection; }
+  };
+  StageMs take_stage_ms() {
+    StageMs s{tracer_.take_gpu_ms(), raster_ms_, project_ms_};
+    raster_ms_ = project_ms_ = 0.0;
+    return s;
+  }
 
  private:
   std::shared_ptr<engine::gpu::VulkanContext> ctx_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanRadianceRaster>> rasters_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanShProjector>> projectors_;
   engine::gpu::GpuRayTracer tracer_;
-  double gpu_ms_ = 0.0;
+  double raster_ms_ = 0.0, project_ms_ = 0.0;
 };
 
 }  // namespace transgi::gpu

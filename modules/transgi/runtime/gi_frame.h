@@ -49,7 +49,11 @@ struct GiFrame {
   // device), and why not the one asked for, if it could not.
   std::string backend = "cpu";
   std::string backend_fallback;
-  double gpu_ms = 0.0;  // the backend's GPU time (timestamps) between the last two probe updates
+  // The backend's GPU time by timestamps between the last two probe updates,
+  // per stage: ray tracing (probe rays, their shadow rays, the G-buffer and
+  // its shadow rays), the radiance raster, the SH projection.
+  double gpu_trace_ms = 0.0, gpu_raster_ms = 0.0, gpu_projection_ms = 0.0;
+  [[nodiscard]] double gpu_ms() const { return gpu_trace_ms + gpu_raster_ms + gpu_projection_ms; }
 };
 
 }  // namespace transgi::runtime

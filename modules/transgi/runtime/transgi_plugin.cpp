@@ -90,7 +90,11 @@ void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> casc
     }
   });
   frame->probe_stats = total;
-  frame->gpu_ms = backend->kernels ? static_cast<gpu::VulkanProbeKernels&>(*backend->kernels).take_gpu_ms() : 0.0;
+  const gpu::VulkanProbeKernels::StageMs gpu_ms =
+      backend->kernels ? static_cast<gpu::VulkanProbeKernels&>(*backend->kernels).take_stage_ms() : gpu::VulkanProbeKernels::StageMs{};
+  frame->gpu_trace_ms = gpu_ms.trace;
+  frame->gpu_raster_ms = gpu_ms.raster;
+  frame->gpu_projection_ms = gpu_ms.projection;
   ++frame->probe_frames;
 }
 
