@@ -3,6 +3,7 @@
 // probes::ProbeKernels: the probe rays' tracing and the per-probe blend. A
 // DdgiVolume without kernels runs the CPU functions (the oracle); the
 // Vulkan backend is gpu/vulkan_ddgi_kernels.h.
+#include <span>
 #include <vector>
 
 #include "ddgi/ddgi_blend.h"
@@ -20,6 +21,10 @@ class DdgiKernels {
   virtual void blend(std::vector<OctahedralMap<glm::vec3>>& irradiance, std::vector<OctahedralMap<glm::vec2>>& distance,
                      const std::vector<std::vector<RayRecord>>& records, const DdgiSettings& settings, float hysteresis,
                      bool clamp_brightness, float max_distance) = 0;
+  // DdgiVolume::irradiance at each point (out[i]; 0 where no active probe
+  // weighs in). Returns false, out untouched, where the backend cannot.
+  virtual bool irradiance(const DdgiVolume& volume, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
+                          std::span<const glm::vec3> view_dirs, std::span<glm::vec3> out) = 0;
   [[nodiscard]] virtual const char* name() const = 0;
 };
 

@@ -90,7 +90,7 @@ void update_volumes(View<Get<DdgiProbeVolume>> volumes, View<Get<DdgiCascades>> 
 
 void render_frame(CameraView cameras, View<Get<const DdgiProbeVolume>> volumes, View<Get<const DdgiCascades>> cascades,
                   Res<rt::RtScene> rt, Res<render::SceneLights> lights, Res<DdgiRenderOptions> options, ResMut<DdgiFrame> frame,
-                  Local<render::TemporalAccumulation> history) {
+                  Res<DdgiBackend> backend, Local<render::TemporalAccumulation> history) {
   if (frame->width <= 0 || frame->height <= 0) return;
   const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
   if (!rays) throw std::runtime_error("ddgi::render: DdgiFrame asks for an image but the world has no camera");
@@ -106,7 +106,8 @@ void render_frame(CameraView cameras, View<Get<const DdgiProbeVolume>> volumes, 
   if (all.empty()) throw std::runtime_error("ddgi::render: no DdgiProbeVolume or DdgiCascades in the world");
   const std::uint64_t seed = options->seed + frame->frames;
   auto t0 = Clock::now();
-  frame->gi = render::accumulate(*history, render_ddgi_gi(*rt, all, *rays, frame->width, frame->height, {.spp = options->gbuffer_spp, .seed = seed}),
+  frame->gi = render::accumulate(*history, render_ddgi_gi(*rt, all, *rays, frame->width, frame->height, {.spp = options->gbuffer_spp, .seed = seed},
+                                                                backend->kernels.get()),
                                  render::view_key(rays->to_world(), frame->width, frame->height, lights->geometry_version, lights->version),
                                  options->temporal_window);
   frame->times.shading = ms_since(t0);

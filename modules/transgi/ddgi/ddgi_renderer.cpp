@@ -24,11 +24,62 @@ glm::vec3 irradiance_from(std::span<const DdgiVolume* const> volumes, const glm:
   return second_lit ? m.weight[0] * e + m.weight[1] * e2 : e;
 }
 
+namespace {
+
+// The batched path: every sample's ray traced by the backend, its surface
+// made here, the irradiance looked up by the backend. False where the
+// backend declines; then the per-pixel path below runs.
+bool render_batched(const engine::rt::RtScene& scene, const DdgiVolume& volume, const engine::render::CameraRays& camera,
+                    int width, int height, const DdgiRenderSettings& s, DdgiKernels& kernels, engine::image::ImageRGB& img) {
+  using namespace engine;
+  rt::RayBatchTracer* tracer = kernels.tracer();
+  if (!tracer) return false;
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height), spp = static_cast<std::size_t>(s.spp);
+  std::vector<rt::Ray> rays(pixels * spp);
+  jobs::parallel_for<std::size_t>(0, pixels, 256, [&](std::size_t b, std::size_t e) {
+    for (std::size_t pixel = b; pixel < e; ++pixel)
+      for (std::size_t si = 0; si < spp; ++si) {
+        math::Pcg32 rng = math::make_rng(s.seed, pixel, si);
+        const glm::vec2 u(rng.next_float(), rng.next_float());
+        rays[pixel * spp + si] = camera.generate_filtered(static_cast<int>(pixel % static_cast<std::size_t>(width)),
+                                                          static_cast<int>(pixel / static_cast<std::size_t>(width)), u, s.filter_width);
+      }
+  });
+  std::vector<rt::Hit> hits(rays.size());
+  std::vector<std::uint8_t> found(rays.size());
+  if (!tracer->intersect(scene, rays, hits, found)) return false;
+  std::vector<glm::vec3> position(rays.size()), normal(rays.size()), view(rays.size()), albedo(rays.size(), glm::vec3(0.0f));
+  jobs::parallel_for<std::size_t>(0, rays.size(), 256, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      if (!found[k]) continue;
+      const render::Surface surf = render::make_surface(scene, hits[k], rays[k].direction);
+      position[k] = surf.position;
+      normal[k] = surf.shading_normal;
+      view[k] = rays[k].direction;
+      albedo[k] = material::diffuse_albedo(surf.brdf) * math::kInvPi;
+    }
+  });
+  std::vector<glm::vec3> e(rays.size());
+  if (!kernels.irradiance(volume, position, normal, view, e)) return false;
+  for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
+    glm::vec3 sum(0.0f);
+    for (std::size_t si = 0; si < spp; ++si) {
+      const std::size_t k = pixel * spp + si;
+      if (found[k]) sum += albedo[k] * e[k];
+    }
+    img.pixels[pixel] = sum / static_cast<float>(s.spp);
+  }
+  return true;
+}
+
+}  // namespace
+
 engine::image::ImageRGB render_ddgi_gi(const engine::rt::RtScene& scene, std::span<const DdgiVolume* const> volumes,
                                        const engine::render::CameraRays& camera, int width, int height,
-                                       const DdgiRenderSettings& s) {
+                                       const DdgiRenderSettings& s, DdgiKernels* kernels) {
   using namespace engine;
   image::ImageRGB img(width, height);
+  if (kernels && volumes.size() == 1 && render_batched(scene, *volumes[0], camera, width, height, s, *kernels, img)) return img;
   jobs::parallel_for(0, height, 1, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < width; ++x) {

@@ -1,11 +1,13 @@
 #pragma once
 // DDGI's probe rays and blend on a Vulkan device (ddgi::DdgiKernels).
+#include <algorithm>
 #include <memory>
 #include <string>
 
 #include "ddgi/ddgi_kernels.h"
 #include "engine/gpu/gpu_ray_tracer.h"
 #include "gpu/vulkan_ddgi_blend.h"
+#include "gpu/vulkan_ddgi_irradiance.h"
 
 namespace transgi::gpu {
 
@@ -20,12 +22,19 @@ class VulkanDdgiKernels : public ddgi::DdgiKernels {
              bool clamp_brightness, float max_distance) override {
     blend_.blend(irradiance, distance, records, settings, hysteresis, clamp_brightness, max_distance);
   }
+  bool irradiance(const ddgi::DdgiVolume& volume, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
+                  std::span<const glm::vec3> view_dirs, std::span<glm::vec3> out) override {
+    const GpuDdgiIrradiance r = irradiance_.irradiance(volume, positions, normals, view_dirs);
+    std::copy(r.irradiance.begin(), r.irradiance.end(), out.begin());
+    return true;
+  }
   [[nodiscard]] const char* name() const override { return name_.c_str(); }
 
  private:
   std::shared_ptr<engine::gpu::VulkanContext> ctx_;
   engine::gpu::GpuRayTracer tracer_;
   VulkanDdgiBlend blend_;
+  VulkanDdgiIrradiance irradiance_{*ctx_};
   std::string name_;
 };
 
