@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "ddgi/ddgi_plugin.h"
+#include "gpu/shader_path.h"
 #include "gpu/vulkan_ddgi_kernels.h"
 #include "engine/core/log.h"
 #include "engine/render/camera_rays.h"
@@ -138,6 +139,18 @@ void GameSession::set_backend(const std::string& backend) {
   }
 }
 
+std::vector<std::string> GameSession::reload_shaders() {
+  engine::ecs::World& w = world();
+  const std::vector<std::string> errors = transgi::gpu::check_module_shaders();
+  auto& log = w.resource<engine::core::Log>();
+  for (const auto& e : errors) log.error("shaders", e);
+  if (!errors.empty()) return errors;
+  ++w.resource<transgi::runtime::TransGISettings>().shader_generation;
+  set_backend(ddgi_backend_);  // DDGI's kernels, made again
+  log.info("shaders", "reloaded from " + transgi::gpu::shader_dir().string());
+  return errors;
+}
+
 std::string GameSession::backend_status() {
   const auto& f = world().resource<transgi::runtime::GiFrame>();
   return f.backend + (f.backend_fallback.empty() ? "" : " (" + f.backend_fallback + ")");
@@ -211,6 +224,8 @@ void GameSession::apply(const ReplayEvent& e) {
     set_view(e.name);
   } else if (e.kind == "backend") {
     set_backend(e.name);
+  } else if (e.kind == "reload_shaders") {
+    reload_shaders();
   } else if (e.kind == "gizmo_mode") editor_.mode = e.name == "rotate" ? GizmoMode::Rotate : GizmoMode::Translate;
   else if (e.kind == "gizmo_grab") {
     const auto px = handle_grab_pixel(world(), editor_, view(), parse_handle(e.name));

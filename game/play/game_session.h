@@ -51,6 +51,11 @@ class GameSession {
   // backend_status() says why.
   void set_backend(const std::string& backend);
   [[nodiscard]] std::string backend_status();
+  // Shader hot reload: compiles shaders/ (or $TRANSGI_SHADER_DIR) again; if
+  // all compile, the GPU kernels are rebuilt from them at the next frame,
+  // else each error goes to the log as "file:line: error: ..." and the
+  // running kernels stay. Returns the errors.
+  std::vector<std::string> reload_shaders();
   void set_view(const std::string& view);
   [[nodiscard]] GameMethod method() const { return method_; }
   [[nodiscard]] const std::string& view_name() const { return options_.view; }

@@ -15,6 +15,7 @@
 //   method transgi|ddgi|reference   what the view shows
 //   view full|gi|direct             which pass
 //   backend cpu|vulkan             where GI's probe work runs (issue 12)
+//   reload_shaders                  compile shaders/ again; rebuild the GPU kernels if all compile
 #include <filesystem>
 #include <string>
 #include <vector>

@@ -64,6 +64,7 @@ void EditorUi::menu_bar() {
       if (ImGui::MenuItem(pass, nullptr, session_.view_name() == pass)) session_.set_view(pass);
     ImGui::Separator();
     ImGui::MenuItem("Editor panels", "F1", &show_editor_);
+    if (ImGui::MenuItem("Reload shaders", "F5")) reload_shaders();
     ImGui::MenuItem("Stats overlay", nullptr, &show_stats_);
     ImGui::MenuItem("Probes", nullptr, &show_probes_);
     ImGui::SliderFloat("Exposure", &exposure_, -4.0f, 4.0f, "%.1f stops");
@@ -76,7 +77,14 @@ void EditorUi::menu_bar() {
     if (in.was_pressed("T") && !in.is_down("ctrl")) ed.mode = GizmoMode::Translate;
     if (in.was_pressed("R") && !in.is_down("ctrl")) ed.mode = GizmoMode::Rotate;
     if (in.is_down("ctrl") && in.was_pressed("S")) save_level();
+    if (in.was_pressed("F5")) reload_shaders();
   }
+}
+
+void EditorUi::reload_shaders() {
+  const auto errors = session_.reload_shaders();
+  // The first error in the menu bar; all of them are in the log panel.
+  status_ = errors.empty() ? "shaders reloaded" : errors.front().substr(0, errors.front().find('\n'));
 }
 
 void EditorUi::stats_overlay(const ViewRect& view) {

@@ -51,6 +51,7 @@ class EditorUi {
   void draw_light_icons(const ViewRect& view);
   void draw_probes(const ViewRect& view);
   void save_level();
+  void reload_shaders();  // F5: shader hot reload, errors to the log
 
   GameSession& session_;
   float exposure_ = 0.0f;

@@ -2,6 +2,8 @@
 // field), and a headless session in which a replayed gizmo drag moves the
 // chosen object by what the cursor asked and the GI near it changes.
 #include <gtest/gtest.h>
+
+#include <sstream>
 #include <unistd.h>
 
 #include <cmath>
@@ -27,6 +29,7 @@
 #include "engine/scene/sun.h"
 #include "engine/image/metrics.h"
 #include "play/game_session.h"
+#include "runtime/settings.h"
 #include "replay/replay.h"
 
 namespace fs = std::filesystem;
@@ -400,4 +403,37 @@ TEST(GameSession, TheGiBackendSwitchesAtRunTime) {
   idle(*switched, 2);
   EXPECT_EQ(switched->backend_status(), "cpu");
   EXPECT_THROW(switched->apply({0, "backend", "metal", {}, 4}), std::runtime_error);
+}
+
+// Shader hot reload: a broken edit reports file:line and keeps the running
+// kernels; the fixed file reloads and the kernels are rebuilt from it.
+TEST(GameSession, ShaderHotReloadReportsFileAndLineAndKeepsTheKernelsOnError) {
+  const fs::path dir = fs::temp_directory_path() / "transgi_hot_reload";
+  fs::remove_all(dir);
+  fs::copy(fs::path(TRANSGI_SOURCE_DIR) / "shaders", dir);
+  setenv("TRANSGI_SHADER_DIR", dir.c_str(), 1);
+  {
+    game::GameSession s(level_options(32, 18));
+    idle(s, 1);
+    {
+      std::ifstream in(dir / "sh_projection.comp");
+      std::stringstream text;
+      text << in.rdbuf();
+      std::string src = text.str();
+      src.replace(src.find("void main() {"), 13, "void main() {\n  undeclared_in_hot_reload = 1;");
+      std::ofstream(dir / "sh_projection.comp") << src;
+    }
+    const auto errors = s.reload_shaders();
+    ASSERT_EQ(errors.size(), 1u);
+    EXPECT_NE(errors[0].find("sh_projection.comp:"), std::string::npos) << errors[0];
+    EXPECT_NE(errors[0].find("undeclared_in_hot_reload"), std::string::npos) << errors[0];
+    const auto gen = s.world().resource<transgi::runtime::TransGISettings>().shader_generation;
+    fs::copy_file(fs::path(TRANSGI_SOURCE_DIR) / "shaders" / "sh_projection.comp", dir / "sh_projection.comp",
+                  fs::copy_options::overwrite_existing);
+    EXPECT_TRUE(s.reload_shaders().empty());
+    EXPECT_EQ(s.world().resource<transgi::runtime::TransGISettings>().shader_generation, gen + 1) << "a good reload rebuilds the kernels";
+    idle(s, 1);
+  }
+  unsetenv("TRANSGI_SHADER_DIR");
+  fs::remove_all(dir);
 }

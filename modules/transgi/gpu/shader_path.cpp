@@ -1,6 +1,7 @@
 #include "gpu/shader_path.h"
 
 #include <cstdlib>
+#include <exception>
 
 namespace transgi::gpu {
 
@@ -15,6 +16,22 @@ std::vector<std::uint32_t> compile_module_shader(const char* name, std::vector<e
   options.include_dirs.push_back(dir);
   options.defines = std::move(defines);
   return engine::gpu::compile_compute_shader(dir / name, options);
+}
+
+std::vector<std::string> check_module_shaders() {
+  std::vector<std::string> errors;
+  const auto dir = shader_dir();
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    if (entry.path().extension() != ".comp") continue;
+    try {
+      compile_module_shader(entry.path().filename().string().c_str());
+    } catch (const std::exception& e) {
+      errors.emplace_back(e.what());
+    }
+  }
+  if (ec) errors.push_back(dir.string() + ": cannot list the shader folder: " + ec.message());
+  return errors;
 }
 
 }  // namespace transgi::gpu

@@ -50,6 +50,10 @@ struct TransGISettings {
   // Vulkan device name (substring) for Backend::Vulkan; empty = the
   // ENGINE_GPU_DEVICE variable, then a discrete GPU first, lavapipe last.
   std::string gpu_device;
+  // Bumped to rebuild the GPU kernels from the shader folder as it is now
+  // (hot reload; gpu::check_module_shaders first, so a broken edit keeps
+  // the running kernels).
+  std::uint32_t shader_generation = 0;
   shading::RealtimeGiSettings realtime;  // read when gi_path is Realtime
   // Probe rays, map size, sharing, accumulation, interpolation and skips
   // (see ProbeFieldSettings and the structs it holds; its `grid` is ignored:

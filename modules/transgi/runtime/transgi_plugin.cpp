@@ -43,6 +43,7 @@ void request_light_settings(Res<TransGISettings> settings, ResMut<render::LightS
 struct ProbeBackend {
   Backend made_for = Backend::Cpu;
   std::string device;
+  std::uint32_t shader_generation = 0;
   std::shared_ptr<probes::ProbeKernels> kernels;  // null: the CPU functions
   std::string fallback;
 };
@@ -51,8 +52,9 @@ void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> casc
                    Res<render::SceneLights> lights, Res<TransGISettings> settings, ResMut<GiFrame> frame,
                    ResMut<ProbeBackend> backend) {
   if (settings->freeze_probes) return;
-  if (backend->made_for != settings->backend || backend->device != settings->gpu_device) {
-    *backend = ProbeBackend{settings->backend, settings->gpu_device, nullptr, ""};
+  if (backend->made_for != settings->backend || backend->device != settings->gpu_device ||
+      backend->shader_generation != settings->shader_generation) {
+    *backend = ProbeBackend{settings->backend, settings->gpu_device, settings->shader_generation, nullptr, ""};
     if (settings->backend == Backend::Vulkan) {
       engine::gpu::GpuOptions options;
       options.device = settings->gpu_device;
