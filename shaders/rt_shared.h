@@ -30,12 +30,40 @@ struct BvhNodeGpu {
 };
 
 // A triangle in leaf order: its three corners in object space and the
-// mesh's own index of it (the primitive id a hit reports).
+// mesh's own index of it (the primitive id a hit reports). alpha_material:
+// kRtOpaque, or the RtAlphaMaterialGpu whose cut-out it is tested against.
 struct TriangleGpu {
   float p0_x, p0_y, p0_z;
   uint primitive;
-  float p1_x, p1_y, p1_z, pad0;
-  float p2_x, p2_y, p2_z, pad1;
+  float p1_x, p1_y, p1_z;
+  uint alpha_material;
+  float p2_x, p2_y, p2_z, pad0;
+};
+
+RT_CONST uint kRtOpaque = 0xffffffffu;
+
+// Alpha-masked materials (glTF alphaMode MASK), tested at every candidate
+// hit as Embree's filter does (RtScene, alpha_passes): alpha = factor x the
+// texture's nearest texel alpha (when it has one and the mesh has UVs),
+// kept where alpha >= cutoff.
+struct RtAlphaMaterialGpu {
+  float alpha;       // base_color_factor.a
+  float cutoff;
+  int texture;       // RtAlphaTextureGpu index, -1 = none
+  uint pad0;
+};
+
+struct RtAlphaTextureGpu {
+  uint offset;       // first byte in the alpha bytes (4 a uint)
+  int width, height;
+  uint wrap;         // wrap_s | wrap_t << 8 (scene::Wrap: 0 repeat, 1 clamp, 2 mirrored)
+};
+
+// A masked triangle's texture coordinates (in leaf order, like TriangleGpu).
+struct RtTriangleUvGpu {
+  float u0, v0, u1, v1;
+  float u2, v2;
+  uint has_uv, pad0;
 };
 
 // World to object space for a similarity (rotation, uniform scale,
@@ -64,8 +92,10 @@ struct HitGpu {
 #ifdef __cplusplus
 static_assert(sizeof(BvhNodeGpu) == 32 && offsetof(BvhNodeGpu, first) == 12 && offsetof(BvhNodeGpu, count) == 28,
               "BvhNodeGpu layout");
-static_assert(sizeof(TriangleGpu) == 48 && offsetof(TriangleGpu, primitive) == 12 && offsetof(TriangleGpu, p2_x) == 32,
-              "TriangleGpu layout");
+static_assert(sizeof(TriangleGpu) == 48 && offsetof(TriangleGpu, primitive) == 12 && offsetof(TriangleGpu, alpha_material) == 28 &&
+              offsetof(TriangleGpu, p2_x) == 32, "TriangleGpu layout");
+static_assert(sizeof(RtAlphaMaterialGpu) == 16 && sizeof(RtAlphaTextureGpu) == 16 && sizeof(RtTriangleUvGpu) == 32 &&
+              offsetof(RtTriangleUvGpu, has_uv) == 24, "alpha-test records");
 static_assert(sizeof(InstanceGpu) == 64 && offsetof(InstanceGpu, blas_root) == 48 && offsetof(InstanceGpu, mesh) == 60,
               "InstanceGpu layout");
 static_assert(sizeof(RayGpu) == 32 && offsetof(RayGpu, dir_x) == 16, "RayGpu layout");

@@ -1,18 +1,55 @@
 // Closest-hit queries against a two-level BVH (rt_shared.h), for devices
 // without VK_KHR_ray_query (lavapipe 22.3 has none). The includer defines
-// RT_SET and RT_BINDING (the first of four consecutive bindings: TLAS nodes,
-// instances, BLAS nodes, triangles) before including this file.
+// RT_SET and RT_BINDING (the first of eight consecutive bindings: TLAS nodes,
+// instances, BLAS nodes, triangles, then the alpha test's triangle UVs,
+// materials, texel bytes and textures) before including this file.
 //
 // Arithmetic follows Embree's conventions, not its exact floating point:
 // t in (tmin, tmax], hits from both sides, barycentrics (u, v) such that the
-// point is (1 - u - v) p0 + u p1 + v p2. Alpha-masked materials are not
-// tested here yet (every triangle is opaque).
+// point is (1 - u - v) p0 + u p1 + v p2; alpha-masked triangles are cut out
+// where their texture says, as Embree's filter does.
 #include "rt_shared.h"
 
 layout(std430, set = RT_SET, binding = RT_BINDING) readonly buffer RtTlas { BvhNodeGpu rt_tlas[]; };
 layout(std430, set = RT_SET, binding = RT_BINDING + 1) readonly buffer RtInstances { InstanceGpu rt_instances[]; };
 layout(std430, set = RT_SET, binding = RT_BINDING + 2) readonly buffer RtBlas { BvhNodeGpu rt_blas[]; };
 layout(std430, set = RT_SET, binding = RT_BINDING + 3) readonly buffer RtTriangles { TriangleGpu rt_triangles[]; };
+layout(std430, set = RT_SET, binding = RT_BINDING + 4) readonly buffer RtTriangleUvs { RtTriangleUvGpu rt_triangle_uvs[]; };
+layout(std430, set = RT_SET, binding = RT_BINDING + 5) readonly buffer RtAlphaMaterials { RtAlphaMaterialGpu rt_alpha_materials[]; };
+layout(std430, set = RT_SET, binding = RT_BINDING + 6) readonly buffer RtAlphaBytes { uint rt_alpha_bytes[]; };
+layout(std430, set = RT_SET, binding = RT_BINDING + 7) readonly buffer RtAlphaTextures { RtAlphaTextureGpu rt_alpha_textures[]; };
+
+// scene::wrap_index.
+int rt_wrap(int i, int n, uint mode) {
+  if (mode == 1u) return clamp(i, 0, n - 1);
+  if (mode == 2u) {
+    const int period = 2 * n;
+    int m = i % period;
+    if (m < 0) m += period;
+    return m < n ? m : period - 1 - m;
+  }
+  int m = i % n;
+  return m < 0 ? m + n : m;
+}
+
+// RtScene's alpha_passes for triangle `index` (in leaf order) at (u, v).
+bool rt_alpha_passes(TriangleGpu tri, uint index, float u, float v) {
+  const RtAlphaMaterialGpu m = rt_alpha_materials[tri.alpha_material];
+  float alpha = m.alpha;
+  const RtTriangleUvGpu t = rt_triangle_uvs[index];
+  if (m.texture >= 0 && t.has_uv != 0u) {
+    const vec2 uv = (1.0 - u - v) * vec2(t.u0, t.v0) + u * vec2(t.u1, t.v1) + v * vec2(t.u2, t.v2);
+    const RtAlphaTextureGpu tex = rt_alpha_textures[m.texture];
+    if (!isnan(uv.x) && !isinf(uv.x) && !isnan(uv.y) && !isinf(uv.y)) {
+      const vec2 r = uv - 4096.0 * trunc(uv / 4096.0);  // std::fmod
+      const int x = rt_wrap(int(floor(r.x * float(tex.width))), tex.width, tex.wrap & 0xffu);
+      const int y = rt_wrap(int(floor(r.y * float(tex.height))), tex.height, tex.wrap >> 8);
+      const uint byte_index = tex.offset + uint(y * tex.width + x);
+      alpha *= float((rt_alpha_bytes[byte_index >> 2] >> ((byte_index & 3u) * 8u)) & 0xffu) / 255.0;
+    }
+  }
+  return alpha >= m.cutoff;
+}
 
 // 1 / d without infinities that would make 0 * inf = NaN in the slab test.
 vec3 rt_safe_inverse(vec3 d) {
@@ -47,7 +84,7 @@ uint rt_children(float ta, float tb, uint a, uint b, inout uint next, out uint l
 }
 
 // Moeller-Trumbore; updates t, u, v and returns true for a closer hit.
-bool rt_triangle(TriangleGpu tri, vec3 o, vec3 d, float tmin, inout float t, inout float u, inout float v) {
+bool rt_triangle(TriangleGpu tri, uint index, vec3 o, vec3 d, float tmin, inout float t, inout float u, inout float v) {
   const vec3 p0 = vec3(tri.p0_x, tri.p0_y, tri.p0_z);
   const vec3 e1 = vec3(tri.p1_x, tri.p1_y, tri.p1_z) - p0;
   const vec3 e2 = vec3(tri.p2_x, tri.p2_y, tri.p2_z) - p0;
@@ -63,6 +100,7 @@ bool rt_triangle(TriangleGpu tri, vec3 o, vec3 d, float tmin, inout float t, ino
   if (bv < 0.0 || bu + bv > 1.0) return false;
   const float th = dot(e2, qv) * inv_det;
   if (!(th > tmin && th <= t)) return false;
+  if (tri.alpha_material != kRtOpaque && !rt_alpha_passes(tri, index, bu, bv)) return false;
   t = th;
   u = bu;
   v = bv;
@@ -84,8 +122,9 @@ void rt_traverse_blas(uint inst, vec3 wo, vec3 wd, float tmin, inout HitGpu hit)
     const BvhNodeGpu n = rt_blas[node];
     if (n.count > 0u) {
       for (uint k = 0u; k < n.count; ++k) {
-        const TriangleGpu tri = rt_triangles[I.triangle_offset + n.first + k];
-        if (rt_triangle(tri, o, d, tmin, hit.t, hit.u, hit.v)) {
+        const uint index = I.triangle_offset + n.first + k;
+        const TriangleGpu tri = rt_triangles[index];
+        if (rt_triangle(tri, index, o, d, tmin, hit.t, hit.u, hit.v)) {
           hit.instance = I.id;
           hit.primitive = tri.primitive;
           hit.mesh = I.mesh;

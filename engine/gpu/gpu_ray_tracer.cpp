@@ -6,7 +6,7 @@
 namespace engine::gpu {
 
 bool GpuRayTracer::follow(const rt::RtScene& scene) {
-  if (!scene.assets() || !GpuRtScene::traces_exactly(*scene.assets())) return false;
+  if (!scene.assets()) return false;
   if (!rt_) rt_ = std::make_unique<GpuRtScene>(ctx_);
   // Another scene, or a new commit (something moved): the TLAS follows.
   if (synced_ != &scene || commits_ != scene.stats().top_level_commits) {

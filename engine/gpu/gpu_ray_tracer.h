@@ -1,8 +1,8 @@
 #pragma once
 // rt::RayBatchTracer on a Vulkan device: a GpuRtScene that follows the
 // RtScene (synced whenever its top level was committed again) and traces
-// each batch in one dispatch. Declines scenes with alpha-masked materials,
-// which the GPU traversal does not test yet.
+// each batch in one dispatch, alpha-masked materials cut out as Embree's
+// filter does. Declines only a scene without assets.
 #include <memory>
 #include <vector>
 

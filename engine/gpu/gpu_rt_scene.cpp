@@ -32,17 +32,11 @@ GpuRtScene::GpuRtScene(VulkanContext& ctx) : ctx_(ctx) {
   const auto dir = engine_shader_dir();
   ShaderCompileOptions options;
   options.include_dirs.push_back(dir);
-  query_ = std::make_unique<ComputePipeline>(ctx, compile_compute_shader(dir / "rt_query.comp", options), 6,
+  query_ = std::make_unique<ComputePipeline>(ctx, compile_compute_shader(dir / "rt_query.comp", options), 2 + kBindings,
                                              static_cast<std::uint32_t>(sizeof(std::uint32_t)));
 }
 
 GpuRtScene::~GpuRtScene() = default;
-
-bool GpuRtScene::traces_exactly(const scene::SceneAssets& assets) {
-  for (const auto& m : assets.materials)
-    if (m.alpha_mode == material::AlphaMode::Mask) return false;
-  return true;
-}
 
 void GpuRtScene::sync(const rt::RtScene& rt) {
   synced_ = &rt;
@@ -51,6 +45,35 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
     generation_ = assets->generation;
     std::vector<BvhNodeGpu> nodes;
     std::vector<TriangleGpu> tris;
+    std::vector<RtTriangleUvGpu> uvs;
+    // The alpha test's materials and textures: only the masked ones.
+    std::vector<RtAlphaMaterialGpu> alpha_materials;
+    std::vector<RtAlphaTextureGpu> alpha_textures;
+    std::vector<std::uint32_t> alpha_bytes;
+    std::vector<std::uint32_t> alpha_of_material(assets->materials.size(), kRtOpaque);
+    std::vector<int> alpha_of_texture(assets->textures.size(), -1);
+    for (std::size_t mi = 0; mi < assets->materials.size(); ++mi) {
+      const material::Material& m = assets->materials[mi];
+      if (m.alpha_mode != material::AlphaMode::Mask) continue;
+      int tex = -1;
+      const int ti = m.base_color_texture;
+      if (ti >= 0 && static_cast<std::size_t>(ti) < assets->textures.size()) {
+        if (alpha_of_texture[static_cast<std::size_t>(ti)] < 0) {
+          const scene::Texture& t = assets->textures[static_cast<std::size_t>(ti)];
+          const std::size_t texels = static_cast<std::size_t>(t.width) * static_cast<std::size_t>(t.height);
+          const std::size_t first = alpha_bytes.size() * 4;
+          alpha_bytes.resize((first + texels + 3) / 4, 0u);
+          for (std::size_t i = 0; i < texels; ++i)
+            alpha_bytes[(first + i) / 4] |= static_cast<std::uint32_t>(t.rgba[i * 4 + 3]) << ((first + i) % 4 * 8);
+          alpha_of_texture[static_cast<std::size_t>(ti)] = static_cast<int>(alpha_textures.size());
+          alpha_textures.push_back({static_cast<std::uint32_t>(first), t.width, t.height,
+                                    static_cast<std::uint32_t>(t.wrap_s) | static_cast<std::uint32_t>(t.wrap_t) << 8});
+        }
+        tex = alpha_of_texture[static_cast<std::size_t>(ti)];
+      }
+      alpha_of_material[mi] = static_cast<std::uint32_t>(alpha_materials.size());
+      alpha_materials.push_back({m.base_color_factor.a, m.alpha_cutoff, tex, 0});
+    }
     blas_root_.assign(assets->meshes.size(), 0);
     triangle_offset_.assign(assets->meshes.size(), 0);
     for (std::size_t m = 0; m < assets->meshes.size(); ++m) {
@@ -68,10 +91,26 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
       for (std::uint32_t item : bvh.order) {
         const glm::uvec3 tri = mesh.triangles[item];
         const glm::vec3 a = mesh.positions[tri.x], b = mesh.positions[tri.y], c = mesh.positions[tri.z];
-        tris.push_back({a.x, a.y, a.z, item, b.x, b.y, b.z, 0, c.x, c.y, c.z, 0});
+        const std::uint32_t mat = item < mesh.triangle_material.size() ? mesh.triangle_material[item] : 0;
+        const std::uint32_t alpha = mat < alpha_of_material.size() ? alpha_of_material[mat] : kRtOpaque;
+        tris.push_back({a.x, a.y, a.z, item, b.x, b.y, b.z, alpha, c.x, c.y, c.z, 0});
+        RtTriangleUvGpu uv{};
+        if (!mesh.uvs.empty()) {
+          uv = {mesh.uvs[tri.x].x, mesh.uvs[tri.x].y, mesh.uvs[tri.y].x, mesh.uvs[tri.y].y,
+                mesh.uvs[tri.z].x, mesh.uvs[tri.z].y, 1u, 0u};
+        }
+        uvs.push_back(uv);
       }
       ++stats_.blas_builds;
     }
+    if (uvs.empty()) uvs.push_back({});
+    if (alpha_materials.empty()) alpha_materials.push_back({});
+    if (alpha_textures.empty()) alpha_textures.push_back({});
+    if (alpha_bytes.empty()) alpha_bytes.push_back(0);
+    upload_to(ctx_, triangle_uvs_, uvs);
+    upload_to(ctx_, alpha_materials_, alpha_materials);
+    upload_to(ctx_, alpha_bytes_, alpha_bytes);
+    upload_to(ctx_, alpha_textures_, alpha_textures);
     if (nodes.empty()) nodes.push_back(to_gpu(rt::BvhNode{}));
     if (tris.empty()) tris.push_back({});
     upload_to(ctx_, blas_, nodes);
@@ -115,6 +154,10 @@ void GpuRtScene::bind(ComputePipeline& pipeline, std::uint32_t first) const {
   pipeline.bind(first + 1, instances_);
   pipeline.bind(first + 2, blas_);
   pipeline.bind(first + 3, triangles_);
+  pipeline.bind(first + 4, triangle_uvs_);
+  pipeline.bind(first + 5, alpha_materials_);
+  pipeline.bind(first + 6, alpha_bytes_);
+  pipeline.bind(first + 7, alpha_textures_);
 }
 
 void GpuRtScene::intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hits, std::span<std::uint8_t> found,

@@ -30,7 +30,8 @@ class GpuRtScene {
   // Mirrors rt's instances (and, for a new asset generation, its meshes).
   void sync(const rt::RtScene& rt);
 
-  // Binds the TLAS, instances, BLAS and triangles at first .. first + 3.
+  // Binds the TLAS, instances, BLAS, triangles and the alpha test's four
+  // buffers at first .. first + 7 (rt_traversal.glsl's order).
   void bind(ComputePipeline& pipeline, std::uint32_t first) const;
 
   // Closest hits of a batch of rays (shaders/rt_query.comp) in the scene as
@@ -40,9 +41,8 @@ class GpuRtScene {
   void intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hits, std::span<std::uint8_t> found,
                  double* gpu_ms = nullptr);
 
-  // Whether every triangle is opaque to the traversal: alpha-masked
-  // materials are not tested on the GPU yet, so such scenes trace on the CPU.
-  [[nodiscard]] static bool traces_exactly(const scene::SceneAssets& assets);
+  // Bindings bind() fills.
+  static constexpr std::uint32_t kBindings = 8;
 
   [[nodiscard]] const GpuRtStats& stats() const { return stats_; }
 
@@ -52,6 +52,7 @@ class GpuRtScene {
   std::uint64_t generation_ = 0;
   std::vector<std::uint32_t> blas_root_, triangle_offset_;  // per mesh
   GpuBuffer tlas_, instances_, blas_, triangles_;
+  GpuBuffer triangle_uvs_, alpha_materials_, alpha_bytes_, alpha_textures_;
   GpuBuffer rays_, hits_;
   std::unique_ptr<ComputePipeline> query_;
   GpuRtStats stats_;

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <vector>
 
+#include <glm/gtc/quaternion.hpp>
+
 #include "engine/gpu/gpu_rt_scene.h"
 #include "engine/math/rng.h"
 #include "engine/rt/bvh_builder.h"
@@ -201,4 +203,84 @@ TEST(GpuRtTraversal, AMovedInstanceIsFoundWhereItMovedAfterASync) {
   EXPECT_EQ(h[0].instance, want.instance);
   EXPECT_EQ(h[0].entity, want.entity) << "a GPU hit names its entity as Embree's does";
   EXPECT_NEAR(h[0].t, want.t, 1e-4f * want.t) << "the sphere's front at z = -3.5 + 0.7";
+}
+
+// Alpha-masked content (foliage, blinds, fences): a quad whose 8 x 8 texture
+// cuts out a checker of holes, its UVs running to 3 so the texture repeats,
+// and a second one mirrored, in front of a wall. Every ray must hit what
+// Embree's alpha filter lets it hit.
+TEST(GpuRtTraversal, AlphaMaskedTrianglesAreCutOutAsEmbreesFilterDoes) {
+  GPU_TEST_CONTEXT_OR_SKIP(ctx);
+  scene::SceneAssets assets;
+  assets.generation = scene::next_scene_generation();
+  scene::MeshAsset wall = scene::make_quad({4.0f, 4.0f}, 0);
+  wall.compute_bounds();
+  scene::MeshAsset screen = scene::make_quad({2.0f, 2.0f}, 1);
+  for (auto& uv : screen.uvs) uv *= 3.0f;
+  screen.compute_bounds();
+  scene::MeshAsset mirrored = screen;
+  for (auto& m : mirrored.triangle_material) m = 2;
+  assets.meshes = {std::make_shared<scene::MeshAsset>(wall), std::make_shared<scene::MeshAsset>(screen),
+                   std::make_shared<scene::MeshAsset>(mirrored)};
+  assets.materials.resize(3);
+  for (int i : {1, 2}) {
+    assets.materials[static_cast<std::size_t>(i)].alpha_mode = material::AlphaMode::Mask;
+    assets.materials[static_cast<std::size_t>(i)].alpha_cutoff = 0.5f;
+    assets.materials[static_cast<std::size_t>(i)].base_color_texture = i - 1;
+  }
+  for (int i = 0; i < 2; ++i) {
+    scene::Texture t;
+    t.width = t.height = 8;
+    t.rgba.assign(8 * 8 * 4, 255);
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x) t.rgba[static_cast<std::size_t>(y * 8 + x) * 4 + 3] = (x + y) % 2 ? 0 : (x % 3 ? 255 : 120);
+    t.wrap_s = i == 0 ? scene::Wrap::Repeat : scene::Wrap::MirroredRepeat;
+    t.wrap_t = i == 0 ? scene::Wrap::Repeat : scene::Wrap::ClampToEdge;
+    assets.textures.push_back(t);
+  }
+  rt::RtScene rt;
+  rt.set_assets(&assets);
+  transform::Similarity at_wall, at_screen, at_mirrored;
+  // make_quad lies in the XZ plane: turned to face +Z, towards the rays.
+  const glm::quat upright = glm::angleAxis(1.5707963f, glm::vec3(1.0f, 0.0f, 0.0f));
+  at_wall.translation = glm::vec3(0.0f, 0.0f, -2.0f);
+  at_wall.rotation = upright;
+  at_screen.translation = glm::vec3(-1.0f, 0.0f, 0.0f);
+  at_screen.rotation = upright;
+  at_mirrored.translation = glm::vec3(1.5f, 0.5f, 0.5f);
+  at_mirrored.rotation = glm::angleAxis(0.4f, glm::vec3(0.0f, 1.0f, 0.0f)) * upright;
+  rt.upsert_instance(ecs::Entity{0, 0}, 0, at_wall);
+  rt.upsert_instance(ecs::Entity{1, 0}, 1, at_screen);
+  rt.upsert_instance(ecs::Entity{2, 0}, 2, at_mirrored);
+  rt.commit();
+
+  math::Pcg32 rng(6, 6);
+  std::vector<rt::Ray> rays;
+  for (int i = 0; i < 8000; ++i) {
+    const glm::vec3 target(6.0f * rng.next_float() - 3.0f, 4.0f * rng.next_float() - 2.0f, 0.0f);
+    const glm::vec3 origin(2.0f * rng.next_float() - 1.0f, 2.0f * rng.next_float() - 1.0f, 5.0f);
+    rays.push_back(rt::Ray{origin, glm::normalize(target - origin)});
+  }
+  gpu::GpuRtScene gpu_rt(*ctx);
+  gpu_rt.sync(rt);
+  std::vector<rt::Hit> got(rays.size());
+  std::vector<std::uint8_t> found(rays.size());
+  gpu_rt.intersect(rays, got, found);
+  std::size_t through = 0, on_screens = 0, disagree = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    rt::Hit want;
+    const bool hit = rt.intersect(rays[i], want);
+    if (hit && want.instance == 0) ++through;  // reached the wall: a hole, or missed the screens
+    if (hit && want.instance != 0) ++on_screens;
+    if (hit != (found[i] != 0) || (hit && (want.instance != got[i].instance || want.primitive != got[i].primitive))) {
+      if (disagree < 5)
+        ADD_FAILURE() << "ray " << i << ": Embree " << (hit ? "hit instance " + std::to_string(want.instance) : std::string("missed"))
+                      << ", GPU " << (found[i] ? "hit instance " + std::to_string(got[i].instance) : std::string("missed"));
+      ++disagree;
+    }
+  }
+  std::printf("alpha: %zu rays, %zu on the screens, %zu to the wall, %zu disagree\n", rays.size(), on_screens, through, disagree);
+  EXPECT_LE(disagree, rays.size() / 500) << "rays at a texel's edge may round either way";
+  EXPECT_GT(on_screens, 1000u);
+  EXPECT_GT(through, 1000u);
 }
