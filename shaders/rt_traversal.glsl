@@ -108,7 +108,8 @@ bool rt_triangle(TriangleGpu tri, uint index, vec3 o, vec3 d, float tmin, inout 
 }
 
 // The BLAS of one instance, in its object space (the similarity keeps t).
-void rt_traverse_blas(uint inst, vec3 wo, vec3 wd, float tmin, inout HitGpu hit) {
+// any_hit: stop at the first hit (shadow rays), not the closest.
+void rt_traverse_blas(uint inst, vec3 wo, vec3 wd, float tmin, bool any_hit, inout HitGpu hit) {
   const InstanceGpu I = rt_instances[inst];
   const vec4 r0 = vec4(I.r0_x, I.r0_y, I.r0_z, I.r0_w), r1 = vec4(I.r1_x, I.r1_y, I.r1_z, I.r1_w),
              r2 = vec4(I.r2_x, I.r2_y, I.r2_z, I.r2_w);
@@ -128,6 +129,7 @@ void rt_traverse_blas(uint inst, vec3 wo, vec3 wd, float tmin, inout HitGpu hit)
           hit.instance = I.id;
           hit.primitive = tri.primitive;
           hit.mesh = I.mesh;
+          if (any_hit) return;
         }
       }
     } else {
@@ -143,8 +145,9 @@ void rt_traverse_blas(uint inst, vec3 wo, vec3 wd, float tmin, inout HitGpu hit)
   }
 }
 
-// Closest hit of the ray in world space; hit.instance == kRtNoHit if none.
-HitGpu rt_intersect(vec3 o, vec3 d, float tmin, float tmax) {
+// Closest hit of the ray in world space (any hit with any_hit: the answer to
+// "is anything there" at less traversal); hit.instance == kRtNoHit if none.
+HitGpu rt_intersect(vec3 o, vec3 d, float tmin, float tmax, bool any_hit) {
   HitGpu hit;
   hit.t = tmax;
   hit.u = 0.0;
@@ -162,7 +165,10 @@ HitGpu rt_intersect(vec3 o, vec3 d, float tmin, float tmax) {
   while (true) {
     const BvhNodeGpu n = rt_tlas[node];
     if (n.count > 0u) {
-      for (uint k = 0u; k < n.count; ++k) rt_traverse_blas(n.first + k, o, d, tmin, hit);
+      for (uint k = 0u; k < n.count; ++k) {
+        rt_traverse_blas(n.first + k, o, d, tmin, any_hit, hit);
+        if (any_hit && hit.instance != kRtNoHit) return hit;
+      }
     } else {
       const uint a = n.first, b = a + 1u;
       uint later;

@@ -28,9 +28,8 @@ bool GpuRayTracer::intersect(const rt::RtScene& scene, std::span<const rt::Ray> 
 
 bool GpuRayTracer::occluded(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<std::uint8_t> blocked) {
   if (!follow(scene)) return false;
-  scratch_.resize(rays.size());
   double ms = 0;
-  rt_->intersect(rays, scratch_, blocked, &ms);
+  rt_->occluded(rays, blocked, &ms);
   gpu_ms_ += std::max(0.0, ms);
   return true;
 }

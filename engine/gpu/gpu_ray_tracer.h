@@ -17,8 +17,7 @@ class GpuRayTracer : public rt::RayBatchTracer {
 
   bool intersect(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<rt::Hit> hits,
                  std::span<std::uint8_t> found) override;
-  // A closest-hit query within tmax (the traversal has no any-hit early out
-  // yet): the same answer, at a closest hit's cost.
+  // Stops each ray's traversal at its first hit.
   bool occluded(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<std::uint8_t> blocked) override;
   // GPU milliseconds of the traces since the last call (timestamps).
   double take_gpu_ms();
@@ -30,7 +29,6 @@ class GpuRayTracer : public rt::RayBatchTracer {
   std::size_t commits_ = 0;
   bool follow(const rt::RtScene& scene);  // syncs when needed; false: declines the scene
   double gpu_ms_ = 0.0;
-  std::vector<rt::Hit> scratch_;
 };
 
 }  // namespace engine::gpu

@@ -33,7 +33,7 @@ GpuRtScene::GpuRtScene(VulkanContext& ctx) : ctx_(ctx) {
   ShaderCompileOptions options;
   options.include_dirs.push_back(dir);
   query_ = std::make_unique<ComputePipeline>(ctx, compile_compute_shader(dir / "rt_query.comp", options), 2 + kBindings,
-                                             static_cast<std::uint32_t>(sizeof(std::uint32_t)));
+                                             static_cast<std::uint32_t>(2 * sizeof(std::uint32_t)));
 }
 
 GpuRtScene::~GpuRtScene() = default;
@@ -160,12 +160,7 @@ void GpuRtScene::bind(ComputePipeline& pipeline, std::uint32_t first) const {
   pipeline.bind(first + 7, alpha_textures_);
 }
 
-void GpuRtScene::intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hits, std::span<std::uint8_t> found,
-                           double* gpu_ms) {
-  if (hits.size() != rays.size() || found.size() != rays.size())
-    throw GpuError("GpuRtScene::intersect: " + std::to_string(rays.size()) + " rays, " + std::to_string(hits.size()) +
-                   " hits, " + std::to_string(found.size()) + " flags");
-  if (rays.empty()) return;
+std::vector<HitGpu> GpuRtScene::run_query(std::span<const rt::Ray> rays, bool any_hit, double* gpu_ms) {
   std::vector<RayGpu> in(rays.size());
   for (std::size_t i = 0; i < rays.size(); ++i) {
     const rt::Ray& r = rays[i];
@@ -178,12 +173,23 @@ void GpuRtScene::intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hit
   query_->bind(0, rays_);
   query_->bind(1, hits_);
   bind(*query_, 2);
-  const auto count = static_cast<std::uint32_t>(rays.size());
-  const double ms = ctx_.submit_and_wait(
-      [&](VkCommandBuffer cmd) { query_->record_dispatch(cmd, (count + kRtGroupSize - 1) / kRtGroupSize, 1, 1, &count); });
+  const std::uint32_t push[2] = {static_cast<std::uint32_t>(rays.size()), any_hit ? 1u : 0u};
+  const double ms = ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
+    query_->record_dispatch(cmd, (push[0] + kRtGroupSize - 1) / kRtGroupSize, 1, 1, push);
+  });
   if (gpu_ms) *gpu_ms = ms;
   std::vector<HitGpu> out(rays.size());
   hits_.download(std::span<HitGpu>(out));
+  return out;
+}
+
+void GpuRtScene::intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hits, std::span<std::uint8_t> found,
+                           double* gpu_ms) {
+  if (hits.size() != rays.size() || found.size() != rays.size())
+    throw GpuError("GpuRtScene::intersect: " + std::to_string(rays.size()) + " rays, " + std::to_string(hits.size()) +
+                   " hits, " + std::to_string(found.size()) + " flags");
+  if (rays.empty()) return;
+  const std::vector<HitGpu> out = run_query(rays, false, gpu_ms);
   for (std::size_t i = 0; i < rays.size(); ++i) {
     found[i] = out[i].instance != kRtNoHit ? 1 : 0;
     if (!found[i]) continue;
@@ -195,6 +201,14 @@ void GpuRtScene::intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hit
     hits[i].barycentric = {out[i].u, out[i].v};
     hits[i].t = out[i].t;
   }
+}
+
+void GpuRtScene::occluded(std::span<const rt::Ray> rays, std::span<std::uint8_t> blocked, double* gpu_ms) {
+  if (blocked.size() != rays.size())
+    throw GpuError("GpuRtScene::occluded: " + std::to_string(rays.size()) + " rays, " + std::to_string(blocked.size()) + " flags");
+  if (rays.empty()) return;
+  const std::vector<HitGpu> out = run_query(rays, true, gpu_ms);
+  for (std::size_t i = 0; i < rays.size(); ++i) blocked[i] = out[i].instance != kRtNoHit ? 1 : 0;
 }
 
 }  // namespace engine::gpu

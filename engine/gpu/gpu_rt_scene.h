@@ -14,6 +14,7 @@
 #include "engine/gpu/gpu_buffer.h"
 #include "engine/gpu/vulkan_context.h"
 #include "engine/rt/rt_scene.h"
+#include "rt_shared.h"
 
 namespace engine::gpu {
 
@@ -40,6 +41,9 @@ class GpuRtScene {
   // take them.
   void intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hits, std::span<std::uint8_t> found,
                  double* gpu_ms = nullptr);
+  // Shadow rays: blocked[i] = whether anything lies on ray i within
+  // (tmin, tmax]; traversal stops at the first hit.
+  void occluded(std::span<const rt::Ray> rays, std::span<std::uint8_t> blocked, double* gpu_ms = nullptr);
 
   // Bindings bind() fills.
   static constexpr std::uint32_t kBindings = 8;
@@ -47,6 +51,9 @@ class GpuRtScene {
   [[nodiscard]] const GpuRtStats& stats() const { return stats_; }
 
  private:
+  // The query kernel over a batch; any_hit: stop at the first hit.
+  std::vector<HitGpu> run_query(std::span<const rt::Ray> rays, bool any_hit, double* gpu_ms);
+
   VulkanContext& ctx_;
   const rt::RtScene* synced_ = nullptr;
   std::uint64_t generation_ = 0;
