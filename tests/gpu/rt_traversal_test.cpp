@@ -60,6 +60,11 @@ void build_world(RtWorld& w) {
   w.rt.commit();
 }
 
+// A point inside build_world's room (its walls at +-5, +-3, +-4).
+glm::vec3 point_in_room(math::Pcg32& rng) {
+  return glm::vec3(9.6f * rng.next_float() - 4.8f, 5.6f * rng.next_float() - 2.8f, 7.6f * rng.next_float() - 3.8f);
+}
+
 glm::vec3 random_direction(math::Pcg32& rng) {
   const float z = 2.0f * rng.next_float() - 1.0f, phi = 6.2831853f * rng.next_float();
   const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
@@ -114,7 +119,7 @@ TEST(GpuRtTraversal, FindsTheSameClosestHitsAsEmbree) {
   std::vector<rt::Ray> rays;
   for (int i = 0; i < 10000; ++i) {
     rt::Ray r;
-    r.origin = glm::vec3(9.6f * rng.next_float() - 4.8f, 5.6f * rng.next_float() - 2.8f, 7.6f * rng.next_float() - 3.8f);
+    r.origin = point_in_room(rng);
     r.direction = random_direction(rng) * (0.5f + rng.next_float());  // not unit: t is in its units
     if (i % 10 == 0) r.tmax = 2.0f * rng.next_float();                  // short rays end before some hits
     rays.push_back(r);
@@ -191,7 +196,7 @@ TEST(GpuRtTraversal, AnyHitShadowRaysGiveEmbreesOccludedAnswers) {
   std::vector<rt::Ray> rays;
   for (int i = 0; i < 10000; ++i) {
     rt::Ray r;
-    r.origin = glm::vec3(9.6f * rng.next_float() - 4.8f, 5.6f * rng.next_float() - 2.8f, 7.6f * rng.next_float() - 3.8f);
+    r.origin = point_in_room(rng);
     r.direction = random_direction(rng);
     rt::Hit h;
     const bool hit = w.rt.intersect(r, h);

@@ -87,75 +87,42 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
 
   auto t0 = Clock::now();
   std::vector<std::vector<RayRecord>> records(static_cast<std::size_t>(probes));
-  std::atomic<std::size_t> rays{0};
   std::vector<std::uint8_t> saw_light(static_cast<std::size_t>(probes), 0);
-  auto ray_rng = [&](int q, int i) {
+  const auto ray_rng = [&](int q, int i) {
     return math::make_rng(settings_.seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
   };
-  auto ray_direction = [&](int i) { return glm::normalize(rotation * directions_[static_cast<std::size_t>(i)]); };
   const auto feedback = [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3& towards_probe) {
     if (outer && (glm::any(glm::lessThan(p, grid_.min)) || glm::any(glm::greaterThan(p, grid_.max))))
       return outer->irradiance(p, n, -towards_probe);
     return frame_ > 0 ? irradiance(p, n, -towards_probe) : glm::vec3(0.0f);
   };
-  auto record = [&](const probes::ProbeRayHit& h, const glm::vec3& dir, RayRecord& r) {
-    r.direction = dir;
-    if (!h.hit) {
-      r.radiance = settings_.escaped == EscapedRays::Environment && sky ? sky->radiance(dir) : glm::vec3(0.0f);
-      r.distance = kMissDistance;
-    } else if (h.back_face) {
-      r.radiance = glm::vec3(0.0f);
-      r.distance = kBackfaceDistanceScale * h.distance;
-    } else {
-      r.radiance = h.radiance;
-      r.distance = h.distance;
+  std::vector<glm::vec3> ray_directions(static_cast<std::size_t>(M));
+  for (int i = 0; i < M; ++i) ray_directions[static_cast<std::size_t>(i)] = glm::normalize(rotation * directions_[static_cast<std::size_t>(i)]);
+  std::vector<int> tracing;
+  for (int q = 0; q < probes; ++q)
+    if (active_[static_cast<std::size_t>(q)]) {
+      tracing.push_back(q);
+      records[static_cast<std::size_t>(q)].resize(static_cast<std::size_t>(M));
     }
-  };
-  // A backend's tracer takes every active probe's rays in one batch.
-  std::vector<probes::ProbeRayHit> batched;
-  std::vector<int> batch_probe;
-  if (engine::rt::RayBatchTracer* tracer = kernels_ ? kernels_->tracer() : nullptr) {
-    std::vector<rt::Ray> ray_list;
-    for (int q = 0; q < probes; ++q) {
-      if (!active_[static_cast<std::size_t>(q)]) continue;
-      batch_probe.push_back(q);
-      for (int i = 0; i < M; ++i) ray_list.push_back(rt::Ray{placed_.position(q), ray_direction(i)});
-    }
-    const auto rng_of = [&](std::size_t k) {
-      return ray_rng(batch_probe[k / static_cast<std::size_t>(M)], static_cast<int>(k % static_cast<std::size_t>(M)));
-    };
-    if (!probes::shade_probe_rays_batched(scene, lights, *tracer, ray_list, rng_of, feedback, batched)) batch_probe.clear();
-  }
-  if (!batch_probe.empty()) {
-    for (std::size_t j = 0; j < batch_probe.size(); ++j) {
-      const auto q = static_cast<std::size_t>(batch_probe[j]);
-      records[q].resize(static_cast<std::size_t>(M));
-      for (int i = 0; i < M; ++i) {
-        const probes::ProbeRayHit& h = batched[j * static_cast<std::size_t>(M) + static_cast<std::size_t>(i)];
-        if (h.saw_light) saw_light[q] = 1;
-        record(h, ray_direction(i), records[q][static_cast<std::size_t>(i)]);
-      }
-      rays.fetch_add(static_cast<std::size_t>(M), std::memory_order_relaxed);
-    }
-  } else {
-    jobs::parallel_for(0, probes, 1, [&](int b, int e) {
-      for (int q = b; q < e; ++q) {
-        if (!active_[static_cast<std::size_t>(q)]) continue;
-        auto& out = records[static_cast<std::size_t>(q)];
-        out.resize(static_cast<std::size_t>(M));
-        const glm::vec3 origin = placed_.position(q);
-        for (int i = 0; i < M; ++i) {
-          math::Pcg32 rng = ray_rng(q, i);
-          const glm::vec3 dir = ray_direction(i);
-          const probes::ProbeRayHit h = probes::trace_probe_ray(scene, lights, origin, dir, rng, feedback);
-          if (h.saw_light) saw_light[static_cast<std::size_t>(q)] = 1;
-          record(h, dir, out[static_cast<std::size_t>(i)]);
+  probes::trace_probe_rays(
+      scene, lights, kernels_ ? kernels_->tracer() : nullptr, tracing, ray_directions,
+      [&](int q) { return placed_.position(q); }, ray_rng, feedback, [&](int q, int i, const probes::ProbeRayHit& h) {
+        if (h.saw_light) saw_light[static_cast<std::size_t>(q)] = 1;
+        const glm::vec3& dir = ray_directions[static_cast<std::size_t>(i)];
+        RayRecord& r = records[static_cast<std::size_t>(q)][static_cast<std::size_t>(i)];
+        r.direction = dir;
+        if (!h.hit) {
+          r.radiance = settings_.escaped == EscapedRays::Environment && sky ? sky->radiance(dir) : glm::vec3(0.0f);
+          r.distance = kMissDistance;
+        } else if (h.back_face) {
+          r.radiance = glm::vec3(0.0f);
+          r.distance = kBackfaceDistanceScale * h.distance;
+        } else {
+          r.radiance = h.radiance;
+          r.distance = h.distance;
         }
-        rays.fetch_add(static_cast<std::size_t>(M), std::memory_order_relaxed);
-      }
-    });
-  }
-  stats.rays = rays.load();
+      });
+  stats.rays = tracing.size() * static_cast<std::size_t>(M);
   stats.trace_ms = ms_since(t0);
 
   if (classify_now) {

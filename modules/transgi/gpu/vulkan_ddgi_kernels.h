@@ -1,6 +1,7 @@
 #pragma once
 // DDGI's probe rays and blend on a Vulkan device (ddgi::DdgiKernels).
 #include <algorithm>
+#include <exception>
 #include <memory>
 #include <string>
 
@@ -45,9 +46,13 @@ inline std::shared_ptr<ddgi::DdgiKernels> make_ddgi_kernels(const std::string& b
   if (backend != "vulkan") return nullptr;
   engine::gpu::GpuOptions options;
   options.device = device;
-  auto ctx = engine::gpu::VulkanContext::create(options, why);
-  if (!ctx) return nullptr;
-  return std::make_shared<VulkanDdgiKernels>(std::shared_ptr<engine::gpu::VulkanContext>(std::move(ctx)));
+  try {  // as make_probe_kernels: a device or shader failure falls back to the CPU with its reason
+    if (auto ctx = engine::gpu::VulkanContext::create(options, why))
+      return std::make_shared<VulkanDdgiKernels>(std::shared_ptr<engine::gpu::VulkanContext>(std::move(ctx)));
+  } catch (const std::exception& e) {
+    if (why) *why = e.what();
+  }
+  return nullptr;
 }
 
 }  // namespace transgi::gpu

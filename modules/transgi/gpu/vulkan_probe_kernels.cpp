@@ -1,5 +1,7 @@
 #include "gpu/vulkan_probe_kernels.h"
 
+#include <exception>
+
 namespace transgi::gpu {
 
 probes::SharingStats VulkanProbeKernels::rasterize(const probes::ProbeGrid& grid, const probes::MapLayout& layout,
@@ -22,6 +24,18 @@ void VulkanProbeKernels::project(const probes::MapProjector& projector, std::spa
   auto& p = projectors_[{l.width, l.height}];
   if (!p) p = std::make_unique<VulkanShProjector>(*ctx_, projector);
   project_ms_ += std::max(0.0, p->project(radiance, out));
+}
+
+std::shared_ptr<VulkanProbeKernels> make_probe_kernels(const std::string& device, std::string* why) {
+  engine::gpu::GpuOptions options;
+  options.device = device;
+  try {
+    if (auto ctx = engine::gpu::VulkanContext::create(options, why))
+      return std::make_shared<VulkanProbeKernels>(std::shared_ptr<engine::gpu::VulkanContext>(std::move(ctx)));
+  } catch (const std::exception& e) {
+    if (why) *why = e.what();
+  }
+  return nullptr;
 }
 
 }  // namespace transgi::gpu

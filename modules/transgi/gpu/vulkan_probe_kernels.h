@@ -4,6 +4,7 @@
 // kernels for each map size are made on first use.
 #include <map>
 #include <memory>
+#include <string>
 #include <utility>
 
 #include "engine/gpu/gpu_ray_tracer.h"
@@ -16,7 +17,8 @@ namespace transgi::gpu {
 
 class VulkanProbeKernels : public probes::ProbeKernels {
  public:
-  explicit VulkanProbeKernels(std::shared_ptr<engine::gpu::VulkanContext> ctx) : ctx_(std::move(ctx)), tracer_(*ctx_) {}
+  explicit VulkanProbeKernels(std::shared_ptr<engine::gpu::VulkanContext> ctx)
+      : ctx_(std::move(ctx)), tracer_(*ctx_), name_("vulkan (" + ctx_->info().name + ")") {}
 
   probes::SharingStats rasterize(const probes::ProbeGrid& grid, const probes::MapLayout& layout,
                                  const std::vector<std::vector<probes::ShadedPoint>>& points,
@@ -25,8 +27,7 @@ class VulkanProbeKernels : public probes::ProbeKernels {
                                  std::span<const std::uint8_t> targets) override;
   void project(const probes::MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out) override;
   engine::rt::RayBatchTracer* tracer() override { return &tracer_; }
-  [[nodiscard]] const char* name() const override { return "vulkan"; }
-  [[nodiscard]] const engine::gpu::VulkanContext& context() const { return *ctx_; }
+  [[nodiscard]] const char* name() const override { return name_.c_str(); }
   // GPU milliseconds per stage since the last call (timestamps).
   struct StageMs {
     double trace = 0, raster = 0, projection = 0;
@@ -43,7 +44,12 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   std::map<std::pair<int, int>, std::unique_ptr<VulkanRadianceRaster>> rasters_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanShProjector>> projectors_;
   engine::gpu::GpuRayTracer tracer_;
+  std::string name_;
   double raster_ms_ = 0.0, project_ms_ = 0.0;
 };
+
+// The Vulkan kernels on the chosen device (empty: ENGINE_GPU_DEVICE, then
+// the ranked default), or null with *why set where no device can be had.
+std::shared_ptr<VulkanProbeKernels> make_probe_kernels(const std::string& device, std::string* why);
 
 }  // namespace transgi::gpu

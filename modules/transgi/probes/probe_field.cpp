@@ -229,8 +229,17 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   std::vector<float> nearest(static_cast<std::size_t>(probes), std::numeric_limits<float>::infinity());
   std::atomic<std::size_t> hits{0}, nonfinite_rays{0};
   std::vector<float> direct_frame(static_cast<std::size_t>(probes) * 75, 0.0f);
-  auto ray_direction = [&](int i) { return glm::normalize(rotation * fibonacci_[static_cast<std::size_t>(i)]); };
-  auto ray_rng = [&](int q, int i) {
+  // This frame's ray set, and the probes that trace it.
+  std::vector<glm::vec3> directions(static_cast<std::size_t>(M));
+  for (int i = 0; i < M; ++i) directions[static_cast<std::size_t>(i)] = glm::normalize(rotation * fibonacci_[static_cast<std::size_t>(i)]);
+  std::vector<int> tracing;
+  for (int q = 0; q < probes; ++q)
+    if (traced[static_cast<std::size_t>(q)]) {
+      tracing.push_back(q);
+      points[static_cast<std::size_t>(q)].reserve(static_cast<std::size_t>(M));
+      saw_light_[static_cast<std::size_t>(q)] = 0;
+    }
+  const auto ray_rng = [&](int q, int i) {
     return math::make_rng(seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
   };
   // Indirect light from last frame's probes at a probe ray's hit (multi-bounce feedback).
@@ -239,48 +248,13 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
       return outer->irradiance(p, n);
     return frame_ > 0 ? irradiance(p, n) : glm::vec3(0.0f);
   };
-  // With a backend's ray tracer, every traced probe's rays go to it in one
-  // batch, then their shadow rays in another; shaded[first_ray[q] + i] is
-  // probe q's ray i. Where it declines the scene, Embree traces ray by ray
-  // in the loop below (first_ray empty).
-  std::vector<ProbeRayHit> shaded;
-  std::vector<std::size_t> first_ray;
-  if (rt::RayBatchTracer* tracer = kernels_ ? kernels_->tracer() : nullptr) {
-    std::vector<rt::Ray> rays;
-    first_ray.assign(static_cast<std::size_t>(probes), 0);
-    for (int q = 0; q < probes; ++q) {
-      if (!traced[static_cast<std::size_t>(q)]) continue;
-      first_ray[static_cast<std::size_t>(q)] = rays.size();
-      for (int i = 0; i < M; ++i) rays.push_back(rt::Ray{grid.position(q), ray_direction(i)});
-    }
-    // Ray k belongs to probe k / M (traced probes only, in order).
-    std::vector<int> probe_of;
-    for (int q = 0; q < probes; ++q)
-      if (traced[static_cast<std::size_t>(q)]) probe_of.push_back(q);
-    const auto rng_of = [&](std::size_t k) {
-      return ray_rng(probe_of[k / static_cast<std::size_t>(M)], static_cast<int>(k % static_cast<std::size_t>(M)));
-    };
-    if (!shade_probe_rays_batched(scene, lights, *tracer, rays, rng_of, feedback, shaded)) first_ray.clear();
-  }
-  jobs::parallel_for(0, probes, 1, [&](int b, int e) {
-    for (int q = b; q < e; ++q) {
-      if (!traced[static_cast<std::size_t>(q)]) continue;
-      float* direct = direct_frame.data() + static_cast<std::size_t>(q) * 75;
-      const glm::vec3 origin = grid.position(q);
-      auto& out = points[static_cast<std::size_t>(q)];
-      out.reserve(static_cast<std::size_t>(M));
-      bool saw_light = false;
-      for (int i = 0; i < M; ++i) {
-        const glm::vec3 dir = ray_direction(i);
-        ProbeRayHit h;
-        if (first_ray.empty()) {
-          math::Pcg32 rng = ray_rng(q, i);
-          h = trace_probe_ray(scene, lights, origin, dir, rng, feedback);
-        } else {
-          h = shaded[first_ray[static_cast<std::size_t>(q)] + static_cast<std::size_t>(i)];
-        }
+  trace_probe_rays(
+      scene, lights, kernels_ ? kernels_->tracer() : nullptr, tracing, directions, [&](int q) { return grid.position(q); },
+      ray_rng, feedback, [&](int q, int i, const ProbeRayHit& h) {
+        const glm::vec3& dir = directions[static_cast<std::size_t>(i)];
         if (h.emitted != glm::vec3(0.0f)) {
           // Monte Carlo projection over a near-uniform set: 4 pi / M per ray.
+          float* direct = direct_frame.data() + static_cast<std::size_t>(q) * 75;
           const math::ShBasis y = math::sh_eval(dir);
           const glm::vec3 e4 = h.emitted * (4.0f * math::kPi / static_cast<float>(M));
           for (int c = 0; c < 3; ++c)
@@ -298,12 +272,9 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
           backfaces[static_cast<std::size_t>(q)] += h.back_face ? 1 : 0;
           nearest[static_cast<std::size_t>(q)] = std::min(nearest[static_cast<std::size_t>(q)], h.distance);
         }
-        saw_light = saw_light || h.saw_light;
-        out.push_back(sp);
-      }
-      saw_light_[static_cast<std::size_t>(q)] = saw_light ? 1 : 0;
-    }
-  });
+        if (h.saw_light) saw_light_[static_cast<std::size_t>(q)] = 1;
+        points[static_cast<std::size_t>(q)].push_back(sp);
+      });
   for (std::uint8_t t : traced) stats.traced += t;
   stats.rays = static_cast<std::size_t>(stats.traced) * static_cast<std::size_t>(M);
   stats.hits = hits.load();

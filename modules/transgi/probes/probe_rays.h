@@ -98,11 +98,19 @@ ProbeRayHit shade_probe_ray(const engine::rt::RtScene& scene, const engine::rend
   return finish_probe_ray(p, blocked, std::forward<Feedback>(feedback));
 }
 
-// A batch of probe rays traced by `tracer` (a backend's, e.g. the GPU's):
-// their closest hits in one call, each hit's first half of the shading, the
-// shadow rays in a second call, then the rest. rng_of(k) is ray k's
-// generator; out[k] its result, equal to trace_probe_ray's for the same hit.
-// Returns false, out untouched, where the tracer declines the scene.
+// Traces and shades one probe ray.
+template <class Feedback>
+ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, const glm::vec3& origin,
+                            const glm::vec3& dir, engine::math::Pcg32& rng, Feedback&& feedback) {
+  engine::rt::Hit hit;
+  const bool found = scene.intersect(engine::rt::Ray{origin, dir}, hit);
+  return shade_probe_ray(scene, lights, dir, found ? &hit : nullptr, rng, std::forward<Feedback>(feedback));
+}
+
+// A batch of probe rays traced by `tracer`: their closest hits in one call,
+// each hit's first half of the shading, the shadow rays in a second call,
+// then the rest. rng_of(k) is ray k's generator. Returns false, out
+// untouched, where the tracer declines the scene.
 template <class RngOf, class Feedback>
 bool shade_probe_rays_batched(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
                               engine::rt::RayBatchTracer& tracer, std::span<const engine::rt::Ray> rays, RngOf&& rng_of,
@@ -137,13 +145,48 @@ bool shade_probe_rays_batched(const engine::rt::RtScene& scene, const engine::re
   return true;
 }
 
-// Traces and shades one probe ray.
-template <class Feedback>
-ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, const glm::vec3& origin,
-                            const glm::vec3& dir, engine::math::Pcg32& rng, Feedback&& feedback) {
-  engine::rt::Hit hit;
-  const bool found = scene.intersect(engine::rt::Ray{origin, dir}, hit);
-  return shade_probe_ray(scene, lights, dir, found ? &hit : nullptr, rng, std::forward<Feedback>(feedback));
+
+// Every listed probe's rays, traced and shaded, handed to consume(q, i, hit)
+// for ray i of probe q, which leaves origin_of(q) along directions[i] with
+// generator rng_of(q, i). One probe's rays are consumed in order, on one
+// thread, so consume may write that probe's data without locks. With
+// `tracer` (a backend's, e.g. the GPU's) the rays and then their shadow
+// rays go to it in two batches; without one, or where it declines the
+// scene, Embree traces them ray by ray and each is consumed as it is shaded.
+// A ray's result is trace_probe_ray's for the same hit either way. TransGI's
+// probe field and the DDGI baseline both trace through here.
+template <class OriginOf, class RngOf, class Feedback, class Consume>
+void trace_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                      engine::rt::RayBatchTracer* tracer, std::span<const int> probes, std::span<const glm::vec3> directions,
+                      OriginOf&& origin_of, RngOf&& rng_of, Feedback&& feedback, Consume&& consume) {
+  const std::size_t m = directions.size();
+  const int n = static_cast<int>(probes.size());
+  if (tracer) {
+    std::vector<engine::rt::Ray> rays;
+    rays.reserve(probes.size() * m);
+    for (const int q : probes)
+      for (const glm::vec3& d : directions) rays.push_back(engine::rt::Ray{origin_of(q), d});
+    const auto rng_of_ray = [&](std::size_t k) { return rng_of(probes[k / m], static_cast<int>(k % m)); };
+    std::vector<ProbeRayHit> shaded;
+    if (shade_probe_rays_batched(scene, lights, *tracer, rays, rng_of_ray, feedback, shaded)) {
+      engine::jobs::parallel_for(0, n, 1, [&](int b, int e) {
+        for (int j = b; j < e; ++j)
+          for (std::size_t i = 0; i < m; ++i)
+            consume(probes[static_cast<std::size_t>(j)], static_cast<int>(i), shaded[static_cast<std::size_t>(j) * m + i]);
+      });
+      return;
+    }
+  }
+  engine::jobs::parallel_for(0, n, 1, [&](int b, int e) {
+    for (int j = b; j < e; ++j) {
+      const int q = probes[static_cast<std::size_t>(j)];
+      const glm::vec3 origin = origin_of(q);
+      for (std::size_t i = 0; i < m; ++i) {
+        engine::math::Pcg32 rng = rng_of(q, static_cast<int>(i));
+        consume(q, static_cast<int>(i), trace_probe_ray(scene, lights, origin, directions[i], rng, feedback));
+      }
+    }
+  });
 }
 
 }  // namespace transgi::probes

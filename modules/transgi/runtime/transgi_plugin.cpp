@@ -44,7 +44,7 @@ struct ProbeBackend {
   Backend made_for = Backend::Cpu;
   std::string device;
   std::uint32_t shader_generation = 0;
-  std::shared_ptr<probes::ProbeKernels> kernels;  // null: the CPU functions
+  std::shared_ptr<gpu::VulkanProbeKernels> kernels;  // null: the CPU functions
   std::string fallback;
 };
 
@@ -56,21 +56,12 @@ void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> casc
       backend->shader_generation != settings->shader_generation) {
     *backend = ProbeBackend{settings->backend, settings->gpu_device, settings->shader_generation, nullptr, ""};
     if (settings->backend == Backend::Vulkan) {
-      engine::gpu::GpuOptions options;
-      options.device = settings->gpu_device;
       std::string why;
-      try {
-        if (auto ctx = engine::gpu::VulkanContext::create(options, &why))
-          backend->kernels = std::make_shared<gpu::VulkanProbeKernels>(std::shared_ptr<engine::gpu::VulkanContext>(std::move(ctx)));
-      } catch (const std::exception& e) {
-        why = e.what();
-      }
+      backend->kernels = gpu::make_probe_kernels(settings->gpu_device, &why);
       if (!backend->kernels) backend->fallback = "Vulkan backend unavailable, the CPU runs the probes: " + why;
     }
   }
-  frame->backend = backend->kernels ? std::string("vulkan (") +
-                                          static_cast<gpu::VulkanProbeKernels&>(*backend->kernels).context().info().name + ")"
-                                    : "cpu";
+  frame->backend = backend->kernels ? backend->kernels->name() : "cpu";
   frame->backend_fallback = backend->fallback;
   probes::ProbeFrameStats total;
   volumes.each([&](ProbeVolume& v) {
@@ -92,8 +83,7 @@ void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> casc
     }
   });
   frame->probe_stats = total;
-  const gpu::VulkanProbeKernels::StageMs gpu_ms =
-      backend->kernels ? static_cast<gpu::VulkanProbeKernels&>(*backend->kernels).take_stage_ms() : gpu::VulkanProbeKernels::StageMs{};
+  const gpu::VulkanProbeKernels::StageMs gpu_ms = backend->kernels ? backend->kernels->take_stage_ms() : gpu::VulkanProbeKernels::StageMs{};
   frame->gpu_trace_ms = gpu_ms.trace;
   frame->gpu_raster_ms = gpu_ms.raster;
   frame->gpu_projection_ms = gpu_ms.projection;
