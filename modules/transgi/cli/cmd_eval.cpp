@@ -40,7 +40,8 @@ int run_eval(const std::vector<std::string>& argv) {
   const Args args("eval", argv,
                   {"scene", "model", "out", "width", "height", "spp", "frames", "ddgi-frames", "ddgi-warmup", "probe-grid",
                    "gbuffer-spp", "camera", "threads", "cache", "seed", "reference-error", "temporal", "probe-volume", "cascades",
-                   "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "cascade-map-width"},
+                   "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "cascade-map-width", "near-field-rays", "near-field-reach",
+                   "near-field-filter"},
                   {"decompose", "allow-unbaked"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const std::filesystem::path out = args.str("out");
@@ -60,6 +61,7 @@ int run_eval(const std::vector<std::string>& argv) {
   t.settings.direct_spp = 0;  // both setups take direct light from the reference
   t.settings.seed = seed;
   t.settings.probes.seed = seed + 1;
+  near_field_from(args, t.settings.near_field);
   // Both methods alike: the GI image of the last N frames averaged, each with
   // its own jittered G-buffer sample (a still view's temporal antialiasing).
   const int temporal = static_cast<int>(args.integer("temporal", 1, 1024, 1));

@@ -34,7 +34,9 @@ void usage() {
                "  render also takes --sun-elevation DEG --sun-azimuth DEG (turns the scene's directional light)\n"
                "  render, eval and bench-frame also take: --probe-volume cascades|scene|authored (default cascades; a scene small\n"
                "           enough for 2 m cells gets one grid over it) [--cascades N] [--cascade-cell M] [--cascade-look-ahead F]\n"
-               "           [--cascade-fit-scene M], and --allow-unbaked (meshes added after the bake are shaded diffusely)\n");
+               "           [--cascade-fit-scene M], and --allow-unbaked (meshes added after the bake are shaded diffusely)\n"
+               "  render and eval (quality path) also take --near-field-rays N (default 16; 0 = off) --near-field-reach CELLS\n"
+               "           --near-field-filter RADIUS: contact light by short rays where probes cannot see it\n");
 }
 }  // namespace
 

@@ -22,7 +22,14 @@ runtime::TransGISettings runtime_settings_from(const Args& args, const char* def
                          : runtime::DirectLight::Stochastic;
   s.backend = args.choice("backend", {"cpu", "vulkan"}, "cpu") == "vulkan" ? runtime::Backend::Vulkan : runtime::Backend::Cpu;
   s.gpu_device = args.str("device", std::string());
+  near_field_from(args, s.near_field);
   return s;
+}
+
+void near_field_from(const Args& args, shading::NearFieldRays& n) {
+  n.rays = static_cast<int>(args.integer("near-field-rays", 0, 1024, n.rays));
+  n.reach_cells = static_cast<float>(args.number("near-field-reach", 0.01, 16.0, n.reach_cells));
+  n.filter_radius = static_cast<int>(args.integer("near-field-filter", 0, 16, n.filter_radius));
 }
 
 runtime::ProbePlacement probe_placement_from(const Args& args, runtime::ProbeVolumeMode default_mode) {

@@ -1,7 +1,7 @@
 #pragma once
 // The run-time options render and bench-frame share: --preset, --gi-scale,
 // --probe-budget, --map-width, --direct and --backend cpu|vulkan (with
-// --device NAME), applied on top of the preset.
+// --device NAME) and the near field's, applied on top of the preset.
 #include "cli/args.h"
 #include "runtime/probe_placement.h"
 #include "runtime/settings.h"
@@ -9,6 +9,10 @@
 namespace transgi::cli {
 
 runtime::TransGISettings runtime_settings_from(const Args& args, const char* default_preset);
+
+// --near-field-rays N, --near-field-reach CELLS, --near-field-filter RADIUS
+// over `n` (eval builds its settings without a preset, so it calls this alone).
+void near_field_from(const Args& args, shading::NearFieldRays& n);
 
 // --probe-volume cascades|scene|authored, --probe-grid N (scene), --cascades N,
 // --cascade-cell METRES (cascades; --probe-budget, read by

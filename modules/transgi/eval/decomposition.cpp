@@ -67,6 +67,8 @@ std::vector<DecompositionRow> decompose_transgi(LoadedScene& scene, const image:
   add("TransGI (the run's probes, network, 1 G-buffer sample)", "base", render_frozen(scene, width, height, keep));
   add("mirror path off (SH-4 transfer on mirrors, as the paper)", "no_mirror",
       render_frozen(scene, width, height, [](runtime::TransGISettings& s) { s.mirror.max_roughness = -1; }));
+  add("near-field rays off (probes alone, as the paper)", "no_near_field",
+      render_frozen(scene, width, height, [](runtime::TransGISettings& s) { s.near_field.rays = 0; }));
   add("network -> ground-truth transfer", "gt_transfer", render_frozen(scene, width, height, gt));
   add("G-buffer 1 -> " + std::to_string(o.gbuffer_spp) + " samples per pixel", "gbuffer_spp", render_frozen(scene, width, height, spp));
 

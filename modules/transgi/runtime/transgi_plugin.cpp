@@ -219,6 +219,9 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
     }
     probes::interpolate_fields(fields, p, n, out);
   };
+  rs.near_field = settings->near_field;
+  if (!fields.empty())
+    rs.probe_spacing_at = [&](const glm::vec3& p) { return probes::fields_at(fields, p).field[0]->placement().min_spacing(); };
   const shading::TransferRenderResult r = shading::render_transfer(
       *rt, *assets, model ? *model : kNoModel, *rays, frame->width, frame->height, light_at, nullptr, settings->transfer, rs);
 
@@ -253,6 +256,7 @@ TransGISettings realtime_preset() {
   s.probes.update_budget = 192;
   s.direct_light = DirectLight::Deterministic;
   s.probes.fixed_pattern = true;  // with the deterministic direct light: no seed anywhere in the image
+  s.near_field.rays = 0;          // a quality-path pass: the real-time path has no near field yet
   return s;
 }
 

@@ -184,6 +184,30 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
       shaded[diffuse_only[j]] = smp.diffuse * math::kInvPi * sh_irradiance(world, smp.normal_world);
     }
   });
+  // The contact light the probes miss (near_field.h), filtered across
+  // similar neighbours, through each sample's diffuse albedo; the total is
+  // clamped at zero, as sh_irradiance is.
+  if (s.near_field.rays > 0 && s.probe_spacing_at) {
+    std::vector<glm::vec3> near(n, glm::vec3(0.0f));
+    const auto estimate = [&](std::span<const std::size_t> which, bool skip_self) {
+      jobs::parallel_for<std::size_t>(0, which.size(), 16, [&](std::size_t b, std::size_t e) {
+        float world[75];
+        for (std::size_t j = b; j < e; ++j) {
+          const Sample& smp = samples[which[j]];
+          light_at(smp.position, smp.normal_world, world);
+          math::Pcg32 rng = math::make_rng(s.seed ^ 0x4EA2F1ull, which[j], 0);
+          const float reach = s.near_field.reach_cells * s.probe_spacing_at(smp.position);
+          near[which[j]] = near_field_irradiance(scene, s.lights, smp, world, reach, skip_self, s.near_field.rays, light_at, rng);
+        }
+      });
+    };
+    estimate(hits, true);  // their transfer already holds their own object
+    estimate(diffuse_only, false);
+    const std::vector<glm::vec3> filtered = filter_near_field(samples, width, height, s.spp, near, s.near_field.filter_radius);
+    for (const std::vector<std::size_t>* which : {&hits, &diffuse_only})
+      for (const std::size_t i : *which)
+        shaded[i] = glm::max(shaded[i] + samples[i].diffuse * math::kInvPi * filtered[i], glm::vec3(0.0f));
+  }
   jobs::parallel_for<std::size_t>(0, mirrors.size(), 64, [&](std::size_t b, std::size_t e) {
     for (std::size_t j = b; j < e; ++j) {
       math::Pcg32 rng = math::make_rng(s.seed ^ 0x4D1Bull, mirrors[j], 0);

@@ -15,6 +15,7 @@
 #include "engine/rt/rt_scene.h"
 #include "model/transfer_model.h"
 #include "shading/gbuffer.h"
+#include "shading/near_field.h"
 #include "shading/sh_light.h"
 
 namespace transgi::shading {
@@ -54,7 +55,11 @@ struct TransferRenderSettings {
   std::uint64_t seed = 0;
   float filter_width = 1.5f;
   MirrorRay mirror{};
-  const engine::render::LightSet* lights = nullptr;  // for the mirror ray's next-event samples (null: none)
+  const engine::render::LightSet* lights = nullptr;  // for the mirror ray's and near field's next-event samples (null: none)
+  // Contact light by short rays (near_field.h); read where probe_spacing_at
+  // is set: the smallest probe spacing of the grid that lights a point.
+  NearFieldRays near_field{};
+  std::function<float(const glm::vec3&)> probe_spacing_at = nullptr;
 };
 
 // The light leaving a point of a near-mirror towards the viewer, as GI: its

@@ -1,0 +1,88 @@
+#include "shading/near_field.h"
+
+#include <cmath>
+
+#include "engine/jobs/parallel_for.h"
+#include "engine/math/sampling.h"
+#include "engine/math/sh.h"
+#include "engine/rt/ray.h"
+#include "probes/probe_rays.h"
+#include "shading/sh_light.h"
+
+namespace transgi::shading {
+
+glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::render::LightSet* lights,
+                                const GSample& s, const float* light_sh, float reach, bool skip_self, int rays,
+                                const NearLightAt& light_at, engine::math::Pcg32& rng) {
+  using namespace engine;
+  if (!s.hit || rays <= 0 || !(reach > 0)) return glm::vec3(0.0f);
+  static const render::LightSet kNoLights;
+  const render::LightSet& light_set = lights ? *lights : kNoLights;
+  const math::Frame frame = math::Frame::from_normal(s.normal_world);
+  const glm::vec3 origin = rt::offset_ray_origin(s.position, s.geometric_normal, scene.offset_scale());
+  const auto feedback = [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3&) {
+    float sh[75];
+    light_at(p, n, sh);
+    return sh_irradiance(sh, n);
+  };
+  glm::vec3 sum(0.0f);
+  // Stratified over a sqrt(rays) x sqrt(rays) grid of the unit square where
+  // it divides evenly, else plain random.
+  const int side = static_cast<int>(std::lround(std::sqrt(static_cast<float>(rays))));
+  const bool stratified = side * side == rays;
+  for (int k = 0; k < rays; ++k) {
+    glm::vec2 u(rng.next_float(), rng.next_float());
+    if (stratified) u = (glm::vec2(static_cast<float>(k % side), static_cast<float>(k / side)) + u) / static_cast<float>(side);
+    const glm::vec3 dir = frame.to_world(math::sample_cosine_hemisphere(u));
+    if (glm::dot(dir, s.geometric_normal) <= 0) continue;
+    rt::Hit hit;
+    if (!scene.intersect(rt::Ray{origin, dir, 0.0f, reach}, hit)) continue;
+    if (skip_self && hit.entity == s.entity) continue;
+    const probes::ProbeRayHit h = probes::shade_probe_ray(scene, light_set, dir, &hit, rng, feedback);
+    const math::ShBasis y = math::sh_eval(dir);
+    glm::vec3 probe_radiance(0.0f);
+    for (int c = 0; c < 3; ++c)
+      for (int i = 0; i < math::kShCount; ++i) probe_radiance[c] += light_sh[c * math::kShCount + i] * y[static_cast<std::size_t>(i)];
+    sum += h.radiance - probe_radiance;
+  }
+  const glm::vec3 e = sum * (math::kPi / static_cast<float>(rays));
+  return std::isfinite(e.r + e.g + e.b) ? e : glm::vec3(0.0f);
+}
+
+std::vector<glm::vec3> filter_near_field(std::span<const GSample> samples, int width, int height, int spp,
+                                         std::span<const glm::vec3> values, int radius) {
+  std::vector<glm::vec3> out(values.size(), glm::vec3(0.0f));
+  const auto at = [&](int x, int y, int k) { return (static_cast<std::size_t>(y) * width + x) * spp + k; };
+  engine::jobs::parallel_for(0, height, 4, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < width; ++x)
+        for (int k = 0; k < spp; ++k) {
+          const GSample& c = samples[at(x, y, k)];
+          if (!c.hit) continue;
+          glm::vec3 sum(0.0f);
+          float weight = 0;
+          for (int dy = -radius; dy <= radius; ++dy)
+            for (int dx = -radius; dx <= radius; ++dx) {
+              const int nx = x + dx, ny = y + dy;
+              if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
+              for (int j = 0; j < spp; ++j) {
+                const std::size_t i = at(nx, ny, j);
+                const GSample& s = samples[i];
+                if (!s.hit) continue;
+                const float dz = (s.depth - c.depth) / (0.05f * c.depth);
+                const float wz = 1.0f - dz * dz;
+                const float cn = glm::dot(s.normal_world, c.normal_world);
+                if (!(wz > 0) || !(cn > 0)) continue;
+                const float cn2 = cn * cn, cn4 = cn2 * cn2;
+                const float w = wz * cn4 * cn4;
+                sum += w * values[i];
+                weight += w;
+              }
+            }
+          out[at(x, y, k)] = weight > 0 ? sum / weight : glm::vec3(0.0f);
+        }
+  });
+  return out;
+}
+
+}  // namespace transgi::shading

@@ -1,0 +1,66 @@
+#pragma once
+// Contact light that probes cannot hold. A probe's radiance map is what the
+// scene looks like from the probe, up to a cell away from the surface being
+// shaded. Near another object (a cup on a sunlit table, a chair by a sunlit
+// floor) the surface sees that object over a far larger solid angle than any
+// probe does, so probe interpolation loses the light, however dense the grid
+// (docs/results.md, issue 16). A few short rays per sample find what lies
+// within `reach` of the surface and put its radiance (its direct light plus
+// its own probe GI, as a probe ray's hit is shaded) in place of what the
+// probes' SH said for those directions. Screen-space and short-range
+// world-space traces in front of a radiance cache are the same idea in
+// production engines (Lumen's near field).
+#include <functional>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "engine/math/rng.h"
+#include "engine/render/light_set.h"
+#include "engine/rt/rt_scene.h"
+#include "shading/gbuffer.h"
+
+namespace transgi::shading {
+
+struct NearFieldRays {
+  // Cosine-distributed rays per sample. Higher = less noise in the contact
+  // light, at the cost of that many rays (and shadow rays) per sample. 0 =
+  // off: probes alone, the paper's setting.
+  int rays = 0;
+  // How far a ray looks, in probe cells (the smallest spacing of the grid
+  // holding the sample). Higher = more of the probes' parallax replaced, at
+  // the cost of longer rays and more hits to shade. Beyond about a cell the
+  // probes see what the surface sees.
+  float reach_cells = 1.0f;
+  // The estimates are averaged over a (2 r + 1)^2 pixel window, weighted by
+  // depth and normal similarity (filter_near_field). Higher = less noise, at
+  // the cost of contact light smeared along a surface. 0 = unfiltered.
+  int filter_radius = 2;
+  bool operator==(const NearFieldRays&) const = default;
+};
+
+// World SH light (75 values) at a point with a normal, as the probes give it.
+using NearLightAt = std::function<void(const glm::vec3& position, const glm::vec3& normal, float* out75)>;
+
+// The irradiance to add at `s` (world space, about its shading normal): for
+// each of `rays` cosine-distributed directions that hit another surface
+// within `reach`, pi / rays x (that hit's radiance towards s, minus the
+// probes' SH radiance `light_sh` in that direction). Hits on the sample's
+// own entity are skipped where `skip_self` (its transfer already holds
+// them). Zero where nothing is near. May be negative per channel: the
+// caller clamps the shaded total.
+glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::render::LightSet* lights,
+                                const GSample& s, const float* light_sh, float reach, bool skip_self, int rays,
+                                const NearLightAt& light_at, engine::math::Pcg32& rng);
+
+// Joint-bilateral average of per-sample values (samples[p * spp + k] is
+// sample k of pixel p, row-major, width x height pixels) over the samples of
+// the (2 radius + 1)^2 pixels around each: weight max(0, 1 - (dz / 0.05 z)^2)
+// x max(0, n . n')^8 against the centre sample's depth and normal, so no
+// value crosses a silhouette or a crease. Samples that missed get and give
+// nothing (zero out). A constant over one surface stays that constant.
+std::vector<glm::vec3> filter_near_field(std::span<const GSample> samples, int width, int height, int spp,
+                                         std::span<const glm::vec3> values, int radius);
+
+}  // namespace transgi::shading

@@ -1,0 +1,153 @@
+// Contact light by short rays (shading/near_field.h). Known answer: a point
+// at height h facing down over a Lambertian floor of albedo a, lit from
+// straight above by a sun of E lux, with probes that say the radiance is L0
+// from everywhere. The floor's radiance is L = a E / pi + a L0 (its direct
+// light plus its own probe irradiance pi L0 through a / pi). Within reach R
+// the point sees the floor over the cone cos(theta) > h / R, whose cosine-
+// weighted solid angle is pi (1 - (h / R)^2); there the short rays replace
+// L0 by L:  dE = pi (1 - (h / R)^2) (L - L0).
+#include <cmath>
+#include <cstdio>
+
+#include <gtest/gtest.h>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "engine/app/app.h"
+#include "engine/math/rng.h"
+#include "engine/math/sh.h"
+#include "engine/render/light_set.h"
+#include "engine/rt/rt_plugin.h"
+#include "engine/scene/components.h"
+#include "engine/scene/procedural.h"
+#include "lambert.h"
+#include "shading/near_field.h"
+
+using namespace engine;
+using namespace transgi;
+
+namespace {
+
+struct SunlitFloor {
+  static constexpr float kAlbedo = 0.5f, kLux = 2.0f;
+  app::App app{app::AppOptions{.jobs = {.threads = 2}}};
+  ecs::Entity floor;
+  SunlitFloor() {
+    scene::SceneAssets a;
+    a.generation = scene::next_scene_generation();
+    a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({100, 100}, 0))};
+    a.materials = {lambert(glm::vec3(kAlbedo))};
+    app.world().insert_resource<scene::SceneAssets>(std::move(a));
+    app.add_plugin<rt::RtPlugin>();
+    ecs::World& w = app.world();
+    floor = w.spawn();
+    w.emplace<transform::Transform>(floor);
+    w.emplace<scene::MeshInstance>(floor, scene::MeshInstance{0});
+    const ecs::Entity sun = w.spawn();
+    transform::Transform st;
+    st.rotation = glm::quatLookAt(glm::vec3(0, -1, 0), glm::vec3(0, 0, 1));  // travelling straight down
+    w.emplace<transform::Transform>(sun, st);
+    w.emplace<scene::PunctualLight>(sun, scene::PunctualLight{.type = scene::PunctualLight::Type::Directional, .intensity = kLux});
+    app.update();
+  }
+  const rt::RtScene& rt() { return app.world().resource<rt::RtScene>(); }
+};
+
+// A point of some other object at height h, facing the floor.
+shading::GSample facing_down(float h) {
+  shading::GSample s;
+  s.hit = true;
+  s.position = glm::vec3(0.3f, h, -0.2f);
+  s.normal_world = s.geometric_normal = glm::vec3(0, -1, 0);
+  s.wo_world = glm::vec3(0, -1, 0);
+  s.depth = 1.0f;
+  return s;
+}
+
+// SH of a radiance L0 from every direction: only the constant band.
+std::array<float, 75> uniform_sh(float l0) {
+  std::array<float, 75> sh{};
+  const float y00 = math::sh_eval(glm::vec3(0, 0, 1))[0];
+  for (int c = 0; c < 3; ++c) sh[static_cast<std::size_t>(c * 25)] = l0 / y00;
+  return sh;
+}
+
+glm::vec3 estimate(SunlitFloor& scene, const shading::GSample& s, float l0, float reach, bool skip_self, int rays) {
+  const render::LightSet lights(scene.rt(), render::gather_punctual_lights(scene.app.world()), nullptr);
+  const std::array<float, 75> sh = uniform_sh(l0);
+  const shading::NearLightAt light_at = [&](const glm::vec3&, const glm::vec3&, float* out) { std::copy(sh.begin(), sh.end(), out); };
+  math::Pcg32 rng = math::make_rng(7, 0, 0);
+  return shading::near_field_irradiance(scene.rt(), &lights, s, sh.data(), reach, skip_self, rays, light_at, rng);
+}
+
+}  // namespace
+
+TEST(NearField, APointOverASunlitFloorGetsTheFloorsLightInsideItsReach) {
+  SunlitFloor scene;
+  const float a = SunlitFloor::kAlbedo, e = SunlitFloor::kLux, pi = glm::pi<float>();
+  for (const auto& [h, reach, l0] : {std::tuple{0.1f, 1.0f, 0.0f}, std::tuple{0.5f, 1.0f, 0.0f}, std::tuple{0.1f, 1.0f, 0.2f},
+                                     std::tuple{0.3f, 2.0f, 0.7f}}) {
+    const float floor_radiance = a * e / pi + a * l0;
+    const float c = h / reach;
+    const float expected = pi * (1 - c * c) * (floor_radiance - l0);
+    const glm::vec3 got = estimate(scene, facing_down(h), l0, reach, false, 4096);
+    std::printf("h %.2f reach %.1f L0 %.2f: dE expected pi (1 - (h/R)^2) (L - L0) = %.5f, got %.5f %.5f %.5f\n", h, reach,
+                l0, expected, got.r, got.g, got.b);
+    // 64 x 64 stratified cosine rays: the cone's edge crosses about 64 strata,
+    // each off by at most its own share (1/4096): under 2 % of the cone.
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], expected, 0.02f * std::abs(expected) + 1e-6f) << "channel " << k;
+  }
+}
+
+TEST(NearField, TheSamplesOwnObjectAndWhatLiesBeyondReachAddNothing) {
+  SunlitFloor scene;
+  shading::GSample s = facing_down(0.2f);
+  const glm::vec3 near = estimate(scene, s, 0.0f, 1.0f, true, 64);
+  EXPECT_GT(near.g, 0.5f) << "another object's floor is contact light";
+  s.entity = scene.floor;  // the floor's own point: its transfer holds it
+  EXPECT_EQ(estimate(scene, s, 0.0f, 1.0f, true, 64), glm::vec3(0.0f));
+  s.entity = {};
+  EXPECT_EQ(estimate(scene, s, 0.0f, 0.19f, false, 64), glm::vec3(0.0f)) << "the floor is 0.2 away, the reach 0.19";
+  EXPECT_EQ(estimate(scene, s, 0.0f, 1.0f, false, 0), glm::vec3(0.0f)) << "no rays: off";
+  // Facing up, away from the floor, no ray can meet it.
+  s.normal_world = s.geometric_normal = glm::vec3(0, 1, 0);
+  EXPECT_EQ(estimate(scene, s, 0.0f, 1.0f, false, 64), glm::vec3(0.0f));
+}
+
+TEST(NearField, TheFilterKeepsAConstantAndNeverCrossesADepthStep) {
+  // 8 x 4 pixels, 2 samples each: the left half at depth 1, the right at
+  // depth 2 (a silhouette), one pixel missed.
+  const int w = 8, h = 4, spp = 2;
+  std::vector<shading::GSample> samples(static_cast<std::size_t>(w * h * spp));
+  std::vector<glm::vec3> values(samples.size());
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int k = 0; k < spp; ++k) {
+        const std::size_t i = static_cast<std::size_t>((y * w + x) * spp + k);
+        samples[i].hit = !(x == 2 && y == 1);
+        samples[i].normal_world = glm::vec3(0, 0, 1);
+        samples[i].depth = x < 4 ? 1.0f : 2.0f;
+        values[i] = x < 4 ? glm::vec3(1, 2, 3) : glm::vec3(0.25f);
+      }
+  const std::vector<glm::vec3> out = shading::filter_near_field(samples, w, h, spp, values, 2);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const glm::vec3 expected = samples[i].hit ? values[i] : glm::vec3(0.0f);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(out[i][c], expected[c], 1e-6f) << "sample " << i << " channel " << c;
+  }
+  // A crease: normals at right angles do not mix either; noise on one
+  // surface is averaged (the centre of 25 pixels of alternating 0 and 2 is
+  // within 2/25 of 1).
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    samples[i].hit = true;
+    samples[i].depth = 1.0f;
+    const int x = static_cast<int>(i / spp) % w;
+    samples[i].normal_world = x < 4 ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0);
+    values[i] = x < 4 ? glm::vec3(static_cast<float>((i / spp) % 2) * 2.0f) : glm::vec3(5.0f);
+  }
+  const std::vector<glm::vec3> crease = shading::filter_near_field(samples, w, h, spp, values, 2);
+  for (std::size_t i = 0; i < crease.size(); ++i) {
+    const int x = static_cast<int>(i / spp) % w;
+    if (x >= 4) EXPECT_FLOAT_EQ(crease[i].r, 5.0f) << "sample " << i;
+    else EXPECT_NEAR(crease[i].r, 1.0f, 0.34f) << "sample " << i;
+  }
+}
