@@ -80,8 +80,11 @@ void main() {
                 if (q != target && guard && (p.flags & kRasterSameSide) != 0u && dot(vec3(pt.nx, pt.ny, pt.nz), u) > 0.0) {
                   texel = kRejected;
                 } else if (q != target && guard && (p.flags & kRasterHasDepth) != 0u) {
-                  const float own = unpackHalf2x16(depth[base + uint(texel)]).x * probes[target].depth_unit;
-                  if (!isnan(own) && !isinf(own) && dist > own * (1.0 + p.relative_tolerance) + p.absolute_tolerance)
+                  const vec2 moments = unpackHalf2x16(depth[base + uint(texel)]);
+                  const float unit = probes[target].depth_unit;
+                  const float own = moments.x * unit, spread = sqrt(moments.y * unit * unit);
+                  if (!isnan(own) && !isinf(own) &&
+                      dist > own * (1.0 + p.relative_tolerance) + p.absolute_tolerance * unit + p.spread_tolerance * spread)
                     texel = kRejected;
                 }
               }

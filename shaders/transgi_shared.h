@@ -96,8 +96,7 @@ TRANSGI_CONST uint kRasterHasOffsets = 8u;
 
 struct RasterPush {
   ProbeGridGpu grid;
-  float relative_tolerance, absolute_tolerance;
-  int pad0;
+  float relative_tolerance, absolute_tolerance, spread_tolerance;  // probes::SharingSettings
   uint flags;
   uint map_width, map_height, texels, pad1;
 };
@@ -153,7 +152,8 @@ static_assert(sizeof(DdgiPush) == 96 && offsetof(DdgiPush, normal_bias) == 64 &&
               offsetof(DdgiPush, irradiance_size) == 80, "DdgiPush layout");
 static_assert(sizeof(DdgiPointGpu) == 48 && offsetof(DdgiPointGpu, nx) == 16 && offsetof(DdgiPointGpu, vx) == 32,
               "DdgiPointGpu layout");
-static_assert(sizeof(RasterPush) == 96 && offsetof(RasterPush, flags) == 76 && offsetof(RasterPush, texels) == 88,
+static_assert(sizeof(RasterPush) == 96 && offsetof(RasterPush, spread_tolerance) == 72 && offsetof(RasterPush, flags) == 76 &&
+                  offsetof(RasterPush, texels) == 88,
               "RasterPush layout");
 static_assert(sizeof(ShadedPointGpu) == 64 && offsetof(ShadedPointGpu, rx) == 16 && offsetof(ShadedPointGpu, nx) == 48,
               "ShadedPointGpu layout");

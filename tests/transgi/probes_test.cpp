@@ -212,6 +212,34 @@ TEST(RadianceSharing, DepthGuardStopsALeakThroughAWall) {
   EXPECT_EQ(faithful[0].sum[static_cast<std::size_t>(t)], glm::vec3(50.1f)) << "the paper-faithful mode leaks";
 }
 
+TEST(RadianceSharing, ACoarseTexelOverTwoDepthsKeepsTheFarSurfacesPoints) {
+  // Probe 0's texel towards +x holds own hits at 1 and 3 (a chair before a
+  // wall): depth mean 2, sd 1. A neighbour's point on the wall (distance 2.9
+  // from probe 0) belongs in that texel; one at 4 lies behind the wall.
+  // Against the mean alone (spread 0) the wall's point was dropped and the
+  // texel took the chair's light for the whole of it.
+  const ProbeGrid g{{0, 0, 0}, {0.5f, 0, 0}, {2, 1, 1}};
+  const MapLayout m{32, 16};
+  const int t = m.texel_of({1, 0, 0});
+  std::vector<ProbeMapState> states(2);
+  for (auto& s : states) s.reset(m.texel_count());
+  states[0].depth.set(static_cast<std::size_t>(t), 2.0f, 1.0f);
+  const std::vector<const DepthMap*> depth = {&states[0].depth, &states[1].depth};
+  std::vector<std::vector<ShadedPoint>> pts(2);
+  pts[1].push_back({{2.9f, 0, 0}, glm::vec3(1.0f), {1, 0, 0}, 2.4f, {-1, 0, 0}});
+  pts[1].push_back({{4.0f, 0, 0}, glm::vec3(100.0f), {1, 0, 0}, 3.5f, {-1, 0, 0}});
+  std::vector<FrameSamples> out;
+  // Threshold 2 x 1.1 + 0.05 (x the depth unit, 1 here) + k x 1: 2.25 at k = 0, 3.25 at k = 1.
+  SharingSettings s;
+  ASSERT_EQ(s.spread_tolerance, 1.0f);
+  rasterize_shared(g, m, pts, depth, s, out);
+  EXPECT_EQ(out[0].count[static_cast<std::size_t>(t)], 1.0f) << "the wall's point only";
+  EXPECT_EQ(out[0].sum[static_cast<std::size_t>(t)], glm::vec3(1.0f));
+  s.spread_tolerance = 0;
+  rasterize_shared(g, m, pts, depth, s, out);
+  EXPECT_EQ(out[0].count[static_cast<std::size_t>(t)], 0.0f) << "against the mean alone both are dropped";
+}
+
 // rasterize_shared computes each neighbour's point geometry as vectors; the
 // reference one point at a time. Same arithmetic, no contraction: every
 // texel's sum and count and both counters are the same bits, with escaped

@@ -41,7 +41,7 @@ int run_eval(const std::vector<std::string>& argv) {
                   {"scene", "model", "out", "width", "height", "spp", "frames", "ddgi-frames", "ddgi-warmup", "probe-grid",
                    "gbuffer-spp", "camera", "threads", "cache", "seed", "reference-error", "temporal", "probe-volume", "cascades",
                    "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "cascade-map-width", "near-field-rays", "near-field-reach",
-                   "near-field-filter"},
+                   "near-field-filter", "map-width"},
                   {"decompose", "allow-unbaked"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const std::filesystem::path out = args.str("out");
@@ -62,6 +62,8 @@ int run_eval(const std::vector<std::string>& argv) {
   t.settings.seed = seed;
   t.settings.probes.seed = seed + 1;
   near_field_from(args, t.settings.near_field);
+  t.settings.probes.map.width = static_cast<int>(args.integer("map-width", 4, 4096, t.settings.probes.map.width));
+  t.settings.probes.map.height = std::max(2, t.settings.probes.map.width / 2);
   // Both methods alike: the GI image of the last N frames averaged, each with
   // its own jittered G-buffer sample (a still view's temporal antialiasing).
   const int temporal = static_cast<int>(args.integer("temporal", 1, 1024, 1));

@@ -67,6 +67,7 @@ probes::SharingStats VulkanRadianceRaster::rasterize(const probes::ProbeGrid& gr
   push.grid = probe_grid_gpu(grid);
   push.relative_tolerance = s.relative_tolerance;
   push.absolute_tolerance = s.absolute_tolerance;
+  push.spread_tolerance = s.spread_tolerance;
   const bool guard = s.mode == probes::SharingMode::DepthGuard;
   push.flags = (guard ? kRasterDepthGuard : 0u) | (s.same_side ? kRasterSameSide : 0u) | (has_depth ? kRasterHasDepth : 0u) |
                (grid.offsets.empty() ? 0u : kRasterHasOffsets);

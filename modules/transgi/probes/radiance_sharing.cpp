@@ -127,7 +127,8 @@ SharingStats rasterize(const ProbeGrid& grid, const MapLayout& layout, const std
           }
           if (q != p && s.mode == SharingMode::DepthGuard && depth) {
             const float own = depth->mean(t);
-            if (std::isfinite(own) && dist[i] > own * (1.0f + s.relative_tolerance) + s.absolute_tolerance) {
+            if (std::isfinite(own) && dist[i] > own * (1.0f + s.relative_tolerance) + s.absolute_tolerance * depth->unit +
+                                                    s.spread_tolerance * std::sqrt(depth->variance(t))) {
               ++rej;
               continue;
             }
