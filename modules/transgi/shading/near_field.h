@@ -36,7 +36,7 @@ struct NearFieldRays {
   // The estimates are averaged over a (2 r + 1)^2 pixel window, weighted by
   // depth and normal similarity (filter_near_field). Higher = less noise, at
   // the cost of contact light smeared along a surface. 0 = unfiltered.
-  int filter_radius = 2;
+  int filter_radius = 4;
   bool operator==(const NearFieldRays&) const = default;
 };
 
