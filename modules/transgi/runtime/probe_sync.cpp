@@ -55,12 +55,12 @@ void sync_probe_volumes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res
 }
 
 probes::ProbeFieldSettings cascade_field_settings(const probes::ProbeFieldSettings& base, const probes::CascadeSettings& c,
-                                                  int k, const glm::ivec3& origin) {
+                                                  int k, const glm::ivec3& origin, GiPath path) {
   probes::ProbeFieldSettings s = base;
   s.grid = probes::cascade_grid(c, k, origin);
   s.update_budget = base.update_budget > 0 ? std::max(1, base.update_budget >> k) : 0;
   s.blend_cells = c.blend_cells;
-  if (c.map_width > 0) s.map = probes::MapLayout{c.map_width, std::max(2, c.map_width / 2)};
+  if (c.map_width > 0 && path == GiPath::Realtime) s.map = probes::MapLayout{c.map_width, std::max(2, c.map_width / 2)};
   return s;
 }
 
@@ -73,7 +73,7 @@ void sync_probe_cascades(View<Get<const scene::Camera, const transform::WorldTra
   sets.each([&](ProbeCascades& set) {
     const probes::CascadeSettings& c = set.cascades;
     const auto wanted = [&](const probes::ProbeGrid& grid, int k) {
-      probes::ProbeFieldSettings s = k >= 0 ? cascade_field_settings(settings->probes, c, k, glm::ivec3(0)) : settings->probes;
+      probes::ProbeFieldSettings s = k >= 0 ? cascade_field_settings(settings->probes, c, k, glm::ivec3(0), settings->gi_path) : settings->probes;
       s.grid = grid;
       s.blend_cells = c.blend_cells;
       return s;

@@ -39,8 +39,9 @@ void sync_probe_cascades(
     engine::schedule::ResMut<GiFrame> frame, engine::schedule::Local<SeenVersions> seen);
 
 // A cascade's field settings: the run-time probe settings on cascade k's grid
-// at `origin`, with its share of the budget and its blend band.
+// at `origin`, with its share of the budget and its blend band; on the
+// real-time path, with the cascades' own (smaller) maps.
 probes::ProbeFieldSettings cascade_field_settings(const probes::ProbeFieldSettings& base, const probes::CascadeSettings& c,
-                                                  int k, const glm::ivec3& origin);
+                                                  int k, const glm::ivec3& origin, GiPath path);
 
 }  // namespace transgi::runtime
