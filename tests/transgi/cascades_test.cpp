@@ -19,6 +19,7 @@
 #include "probes/cascades.h"
 #include "engine/scene/gltf_loader.h"
 #include "runtime/probe_placement.h"
+#include "runtime/probe_sync.h"
 #include "runtime/transgi_plugin.h"
 
 using namespace transgi;
@@ -452,4 +453,22 @@ TEST(CascadeBlend, MoreFieldsThanTheStackHoldsStillReachTheOnesPastSixteen) {
   const glm::vec3 p(std::ldexp(1.0f, 16) - 1.0f, 0.0f, 0.0f);  // inside field 16 (half 65,536), outside 15
   const FieldMix m = fields_at(fields, p);
   EXPECT_EQ(m.field[0], fields[16]) << "got field " << (std::find(fields.begin(), fields.end(), m.field[0]) - fields.begin());
+}
+
+// The cascades' small maps are the real-time path's memory choice; the
+// quality path keeps the run-time settings' maps, whose finer texels are
+// closer to the oracle's mean (docs/results.md, issue 16).
+TEST(CascadeMaps, SmallMapsOnTheRealTimePathThePresetsOnTheQualityPath) {
+  probes::ProbeFieldSettings base;
+  base.map = probes::MapLayout{100, 50};
+  probes::CascadeSettings c;
+  ASSERT_EQ(c.map_width, 32);
+  const auto realtime = runtime::cascade_field_settings(base, c, 1, glm::ivec3(0), runtime::GiPath::Realtime);
+  EXPECT_EQ(realtime.map.width, 32);
+  EXPECT_EQ(realtime.map.height, 16);
+  const auto quality = runtime::cascade_field_settings(base, c, 1, glm::ivec3(0), runtime::GiPath::Quality);
+  EXPECT_EQ(quality.map.width, 100);
+  EXPECT_EQ(quality.map.height, 50);
+  c.map_width = 0;  // 0 = the preset's on both paths
+  EXPECT_EQ(runtime::cascade_field_settings(base, c, 1, glm::ivec3(0), runtime::GiPath::Realtime).map.width, 100);
 }
