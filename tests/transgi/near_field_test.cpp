@@ -21,7 +21,10 @@
 #include "engine/scene/components.h"
 #include "engine/scene/procedural.h"
 #include "lambert.h"
+#include "probes/probe_field.h"
 #include "shading/near_field.h"
+#include "shading/realtime_gi.h"
+#include "shading/transfer_renderer.h"
 
 using namespace engine;
 using namespace transgi;
@@ -80,6 +83,13 @@ glm::vec3 estimate(SunlitFloor& scene, const shading::GSample& s, float l0, floa
   return shading::near_field_irradiance(scene.rt(), &lights, s, sh.data(), reach, skip_self, rays, light_at, rng);
 }
 
+// The filter's guide: normal and depth per sample, 0 depth for a miss.
+std::vector<glm::vec4> guide_of(const std::vector<shading::GSample>& samples) {
+  std::vector<glm::vec4> g;
+  for (const auto& s : samples) g.push_back(s.hit ? glm::vec4(s.normal_world, s.depth) : glm::vec4(0.0f));
+  return g;
+}
+
 }  // namespace
 
 TEST(NearField, APointOverASunlitFloorGetsTheFloorsLightInsideItsReach) {
@@ -129,7 +139,7 @@ TEST(NearField, TheFilterKeepsAConstantAndNeverCrossesADepthStep) {
         samples[i].depth = x < 4 ? 1.0f : 2.0f;
         values[i] = x < 4 ? glm::vec3(1, 2, 3) : glm::vec3(0.25f);
       }
-  const std::vector<glm::vec3> out = shading::filter_near_field(samples, w, h, spp, values, 2);
+  const std::vector<glm::vec3> out = shading::filter_near_field(guide_of(samples), w, h, spp, values, 2);
   for (std::size_t i = 0; i < out.size(); ++i) {
     const glm::vec3 expected = samples[i].hit ? values[i] : glm::vec3(0.0f);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(out[i][c], expected[c], 1e-6f) << "sample " << i << " channel " << c;
@@ -144,10 +154,101 @@ TEST(NearField, TheFilterKeepsAConstantAndNeverCrossesADepthStep) {
     samples[i].normal_world = x < 4 ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0);
     values[i] = x < 4 ? glm::vec3(static_cast<float>((i / spp) % 2) * 2.0f) : glm::vec3(5.0f);
   }
-  const std::vector<glm::vec3> crease = shading::filter_near_field(samples, w, h, spp, values, 2);
+  const std::vector<glm::vec3> crease = shading::filter_near_field(guide_of(samples), w, h, spp, values, 2);
   for (std::size_t i = 0; i < crease.size(); ++i) {
     const int x = static_cast<int>(i / spp) % w;
     if (x >= 4) EXPECT_FLOAT_EQ(crease[i].r, 5.0f) << "sample " << i;
     else EXPECT_NEAR(crease[i].r, 1.0f, 0.34f) << "sample " << i;
   }
+}
+
+// The real-time path's near field (on its half-resolution grid, filtered
+// there) against the quality path's (every pixel): a wall standing on a
+// sunlit floor, probes holding no light, so the wall's GI is its contact
+// light alone. The mean over the wall's lowest half metre agrees within
+// 10 % (64 rays a sample on both; measured 4.5 % apart: the real-time grid
+// samples every second pixel and its filter reaches twice as far, on a light
+// that falls steeply with height), and the wall's top gets none.
+TEST(NearField, TheRealTimePathAgreesWithTheQualityPath) {
+  app::App app(app::AppOptions{.jobs = {.threads = 2}});
+  scene::SceneAssets a;
+  a.generation = scene::next_scene_generation();
+  a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({10, 10}, 0)),
+              std::make_shared<scene::MeshAsset>(scene::make_quad({2, 1}, 1))};
+  a.materials = {lambert(glm::vec3(0.5f)), lambert(glm::vec3(0.8f))};
+  app.world().insert_resource<scene::SceneAssets>(std::move(a));
+  app.add_plugin<rt::RtPlugin>();
+  ecs::World& w = app.world();
+  const ecs::Entity floor = w.spawn();
+  w.emplace<transform::Transform>(floor);
+  w.emplace<scene::MeshInstance>(floor, scene::MeshInstance{0});
+  const ecs::Entity wall = w.spawn();  // 4 x 2 m, standing on the floor at z = -1, facing +z
+  transform::Transform wt = transform::Transform::from_translation({0, 1, -1});
+  wt.rotation = glm::angleAxis(glm::half_pi<float>(), glm::vec3(1, 0, 0));
+  w.emplace<transform::Transform>(wall, wt);
+  w.emplace<scene::MeshInstance>(wall, scene::MeshInstance{1});
+  const ecs::Entity sun = w.spawn();
+  transform::Transform st;
+  st.rotation = glm::quatLookAt(glm::vec3(0, -1, 0), glm::vec3(0, 0, 1));  // straight down: the wall is edge-on
+  w.emplace<transform::Transform>(sun, st);
+  w.emplace<scene::PunctualLight>(sun, scene::PunctualLight{.type = scene::PunctualLight::Type::Directional, .intensity = 2.0f});
+  const ecs::Entity camera = w.spawn();
+  transform::Transform cam = transform::Transform::from_translation({0, 1, 2});
+  cam.rotation = glm::quatLookAt(glm::vec3(0, 0, -1), glm::vec3(0, 1, 0));
+  w.emplace<transform::Transform>(camera, cam);
+  w.emplace<scene::Camera>(camera, scene::Camera{.yfov_radians = 0.9f});
+  app.update();
+
+  const auto& rt = w.resource<rt::RtScene>();
+  const auto& assets = w.resource<scene::SceneAssets>();
+  const render::LightSet lights(rt, render::gather_punctual_lights(w), nullptr);
+  const int size = 48;
+  const render::CameraRays rays(w.get<scene::Camera>(camera), w.get<transform::WorldTransform>(camera), size, size);
+  probes::ProbeFieldSettings ps;  // never updated: it holds no light
+  ps.grid = probes::ProbeGrid{{-2, 0.1f, -0.9f}, {2, 2.1f, 1.1f}, {5, 3, 3}};
+  ps.map = probes::MapLayout{8, 4};
+  const probes::ProbeField field(ps);
+  const probes::ProbeField* fields[] = {&field};
+  const shading::NearFieldRays near{.rays = 64, .reach_cells = 1.0f, .filter_radius = 2};
+  const shading::LightAt no_light = [](const glm::vec3&, const glm::vec3&, float* out) { std::fill_n(out, 75, 0.0f); };
+
+  shading::TransferRenderSettings s;
+  s.spp = 1;
+  s.has_transfer = [](ecs::Entity) { return false; };
+  s.lights = &lights;
+  s.near_field = near;
+  s.probe_spacing_at = [&](const glm::vec3&) { return ps.grid.min_spacing(); };
+  const model::TransferModel no_model;
+  shading::TransferRenderResult quality;
+  shading::GBuffer g;
+  image::ImageRGB realtime;
+  app.jobs().run([&] {
+    quality = shading::render_transfer(rt, assets, no_model, rays, size, size, no_light, nullptr,
+                                       shading::TransferSource::Network, s);
+    shading::trace_gbuffer(rt, assets, rays, size, size, g);
+    realtime = shading::shade_gi_realtime(g, rt, assets, nullptr, nullptr, {}, fields, shading::RealtimeGiSettings{}, nullptr,
+                                          nullptr, nullptr, &lights, shading::MirrorRay{.max_roughness = -1}, near);
+  });
+  // The wall's pixels: rows where the camera ray meets it, below its middle.
+  double sum_q = 0, sum_r = 0, low = 0, high = 0;
+  int n = 0;
+  for (int y = 0; y < size; ++y)
+    for (int x = size / 4; x < 3 * size / 4; ++x) {
+      const shading::GSample& smp = g.samples[static_cast<std::size_t>(y * size + x)];
+      if (!smp.hit || !(smp.entity == wall)) continue;
+      if (smp.position.y < 0.5f) {
+        sum_q += quality.image.at(x, y).g;
+        sum_r += realtime.at(x, y).g;
+        ++n;
+        if (smp.position.y < 0.25f) low += realtime.at(x, y).g;
+      } else if (smp.position.y > 1.5f) {
+        high += realtime.at(x, y).g;
+      }
+    }
+  ASSERT_GT(n, 50) << "the camera must see the wall's lower half";
+  std::printf("wall below 0.5 m, %d pixels: mean GI quality %.5f, real-time %.5f\n", n, sum_q / n, sum_r / n);
+  EXPECT_GT(sum_q / n, 0.01) << "contact light from the sunlit floor";
+  EXPECT_NEAR(sum_r / n, sum_q / n, 0.10 * sum_q / n);
+  EXPECT_GT(low, 0.0);
+  EXPECT_EQ(high, 0.0) << "above the reach (one 1 m cell) of the floor, nothing";
 }

@@ -147,11 +147,12 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   shading::RealtimeGiStats st;
   image::ImageRGB probe_direct;
   frame.gi = shading::shade_gi_realtime(g, rt, assets, model.get(), model ? packed.decoder.get() : nullptr, has_transfer, fields,
-                                        settings.realtime, &st, deterministic ? &probe_direct : nullptr, &packed.scratch, &lights, settings.mirror);
+                                        settings.realtime, &st, deterministic ? &probe_direct : nullptr, &packed.scratch, &lights, settings.mirror,
+                                        settings.near_field);
   GiStageTimes& t = frame.times;
   t.network_input = 0;  // inside the fused kernel, counted as inference
   t.inference = st.inference_ms;
-  t.sh_multiplication = st.rotate_ms + st.light_ms;
+  t.sh_multiplication = st.rotate_ms + st.light_ms + st.near_ms;
   t.upsample = st.upsample_ms;
   frame.shaded_samples = st.grid_samples + st.edge_samples;
   frame.inferred_samples = st.inferred;
@@ -256,7 +257,7 @@ TransGISettings realtime_preset() {
   s.probes.update_budget = 192;
   s.direct_light = DirectLight::Deterministic;
   s.probes.fixed_pattern = true;  // with the deterministic direct light: no seed anywhere in the image
-  s.near_field.rays = 0;          // a quality-path pass: the real-time path has no near field yet
+  s.near_field.rays = 0;          // off: at 640x360 it costs more than the frame's budget (docs/runtime.md)
   return s;
 }
 

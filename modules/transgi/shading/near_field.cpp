@@ -49,7 +49,7 @@ glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::
   return std::isfinite(e.r + e.g + e.b) ? e : glm::vec3(0.0f);
 }
 
-std::vector<glm::vec3> filter_near_field(std::span<const GSample> samples, int width, int height, int spp,
+std::vector<glm::vec3> filter_near_field(std::span<const glm::vec4> guide, int width, int height, int spp,
                                          std::span<const glm::vec3> values, int radius) {
   std::vector<glm::vec3> out(values.size(), glm::vec3(0.0f));
   const auto at = [&](int x, int y, int k) { return (static_cast<std::size_t>(y) * width + x) * spp + k; };
@@ -57,8 +57,8 @@ std::vector<glm::vec3> filter_near_field(std::span<const GSample> samples, int w
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < width; ++x)
         for (int k = 0; k < spp; ++k) {
-          const GSample& c = samples[at(x, y, k)];
-          if (!c.hit) continue;
+          const glm::vec4& c = guide[at(x, y, k)];
+          if (!(c.w > 0)) continue;
           glm::vec3 sum(0.0f);
           float weight = 0;
           for (int dy = -radius; dy <= radius; ++dy)
@@ -67,11 +67,11 @@ std::vector<glm::vec3> filter_near_field(std::span<const GSample> samples, int w
               if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
               for (int j = 0; j < spp; ++j) {
                 const std::size_t i = at(nx, ny, j);
-                const GSample& s = samples[i];
-                if (!s.hit) continue;
-                const float dz = (s.depth - c.depth) / (0.05f * c.depth);
+                const glm::vec4& s = guide[i];
+                if (!(s.w > 0)) continue;
+                const float dz = (s.w - c.w) / (0.05f * c.w);
                 const float wz = 1.0f - dz * dz;
-                const float cn = glm::dot(s.normal_world, c.normal_world);
+                const float cn = s.x * c.x + s.y * c.y + s.z * c.z;
                 if (!(wz > 0) || !(cn > 0)) continue;
                 const float cn2 = cn * cn, cn4 = cn2 * cn2;
                 const float w = wz * cn4 * cn4;

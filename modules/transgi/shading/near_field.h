@@ -54,13 +54,14 @@ glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::
                                 const GSample& s, const float* light_sh, float reach, bool skip_self, int rays,
                                 const NearLightAt& light_at, engine::math::Pcg32& rng);
 
-// Joint-bilateral average of per-sample values (samples[p * spp + k] is
-// sample k of pixel p, row-major, width x height pixels) over the samples of
-// the (2 radius + 1)^2 pixels around each: weight max(0, 1 - (dz / 0.05 z)^2)
-// x max(0, n . n')^8 against the centre sample's depth and normal, so no
-// value crosses a silhouette or a crease. Samples that missed get and give
-// nothing (zero out). A constant over one surface stays that constant.
-std::vector<glm::vec3> filter_near_field(std::span<const GSample> samples, int width, int height, int spp,
+// Joint-bilateral average of per-sample values over the samples of the
+// (2 radius + 1)^2 pixels around each. guide[p * spp + k] is sample k of
+// pixel p (row-major, width x height): world normal (xyz) and depth (w; 0 =
+// a miss). Weight max(0, 1 - (dz / 0.05 z)^2) x max(0, n . n')^8 against
+// the centre sample's depth and normal, so no value crosses a silhouette or
+// a crease. Misses get and give nothing (zero out). A constant over one
+// surface stays that constant.
+std::vector<glm::vec3> filter_near_field(std::span<const glm::vec4> guide, int width, int height, int spp,
                                          std::span<const glm::vec3> values, int radius);
 
 }  // namespace transgi::shading

@@ -173,7 +173,8 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
                                           std::span<const probes::ProbeField* const> fields,
                                           const RealtimeGiSettings& settings, RealtimeGiStats* stats_out,
                                           engine::image::ImageRGB* direct_out, RealtimeGiScratch* scratch,
-                                          const engine::render::LightSet* mirror_lights, const MirrorRay& mirror) {
+                                          const engine::render::LightSet* mirror_lights, const MirrorRay& mirror,
+                                          const NearFieldRays& near_field) {
   RealtimeGiStats stats;
   engine::image::ImageRGB image(g.width, g.height);
   if (direct_out) *direct_out = engine::image::ImageRGB(g.width, g.height);
@@ -319,6 +320,35 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     value[i] = glm::vec3(0.0f);
     if (with_direct) value_direct[i] = glm::vec3(0.0f);
     ++stats.nonfinite_samples;
+  }
+
+  if (near_field.rays > 0) {
+    t0 = Clock::now();
+    std::vector<std::uint8_t> through_network(decode.size(), 0);
+    for (const std::size_t i : net) through_network[i] = 1;  // their transfer holds their own object
+    const NearLightAt light_at = [&](const glm::vec3& p, const glm::vec3& n, float* out) { probes::interpolate_fields(fields, p, n, out); };
+    std::vector<glm::vec3> contact(up.cell_pixel.size(), glm::vec3(0.0f));
+    engine::jobs::parallel_for<std::size_t>(0, contact.size(), 16, [&](std::size_t b, std::size_t e) {
+      float world[75];
+      for (std::size_t c = b; c < e; ++c) {
+        const std::size_t p = up.cell_pixel[c], slot = slot_of_pixel[p];
+        if (slot == kNone) continue;
+        const GSample& s = g.samples[p];
+        light_at(s.position, s.normal_world, world);
+        engine::math::Pcg32 rng = engine::math::make_rng(0x4EA2F1ull, p, 0);  // fixed: the real-time image has no seed
+        const float reach = near_field.reach_cells * probes::fields_at(fields, s.position).field[0]->placement().min_spacing();
+        contact[c] = near_field_irradiance(scene, mirror_lights, s, world, reach, through_network[slot] != 0, near_field.rays,
+                                           light_at, rng);
+      }
+    });
+    const std::vector<glm::vec3> filtered =
+        filter_near_field(up.cell_guide, up.grid_w, up.grid_h, 1, contact, near_field.filter_radius);
+    for (std::size_t c = 0; c < filtered.size(); ++c) {
+      const std::size_t p = up.cell_pixel[c], slot = slot_of_pixel[p];
+      if (slot == kNone) continue;
+      value[slot] = glm::max(value[slot] + g.samples[p].diffuse * engine::math::kInvPi * filtered[c], glm::vec3(0.0f));
+    }
+    stats.near_ms = ms_since(t0);
   }
 
   t0 = Clock::now();

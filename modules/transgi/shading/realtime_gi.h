@@ -23,6 +23,7 @@
 #include "probes/probe_field.h"
 #include "shading/fused_decoder.h"
 #include "shading/gbuffer.h"
+#include "shading/near_field.h"
 #include "shading/transfer_renderer.h"
 
 namespace transgi::shading {
@@ -96,6 +97,7 @@ struct RealtimeGiStats {
   double light_ms = 0;      // probe interpolation per decoded pixel
   double inference_ms = 0;  // latent gather, inputs, fused decoder + SH dot
   double upsample_ms = 0;   // choosing samples, joint bilateral upsampling
+  double near_ms = 0;       // near-field rays on the decoded grid (off in the real-time preset)
   std::size_t grid_samples = 0, edge_samples = 0;  // decoded: on the grid, on their own
   std::size_t inferred = 0, diffuse = 0;           // of those: through the network, diffuse fallback
   std::size_t rotations = 0;                        // distinct object rotations this frame
@@ -110,7 +112,10 @@ struct RealtimeGiStats {
 // diffusely: albedo / pi x irradiance. With direct_out, the probes' direct
 // sky and emitter light goes through the same transfer (or irradiance) and
 // upsampling into it: the real-time direct light from everything but
-// punctual lights and the split sun (see realtime_direct.h).
+// punctual lights and the split sun (see realtime_direct.h). With
+// near_field.rays > 0, each decoded grid cell also gets the near field's
+// contact light (near_field.h; mirror_lights light its hits), filtered over
+// the grid; edge pixels decoded on their own do not.
 engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
                                           const engine::scene::SceneAssets& assets, const model::TransferModel* model,
                                           const FusedDecoder* decoder,
@@ -119,6 +124,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
                                           const RealtimeGiSettings& settings, RealtimeGiStats* stats = nullptr,
                                           engine::image::ImageRGB* direct_out = nullptr,
                                           RealtimeGiScratch* scratch = nullptr,
-                                          const engine::render::LightSet* mirror_lights = nullptr, const MirrorRay& mirror = {});
+                                          const engine::render::LightSet* mirror_lights = nullptr, const MirrorRay& mirror = {},
+                                          const NearFieldRays& near_field = {});
 
 }  // namespace transgi::shading

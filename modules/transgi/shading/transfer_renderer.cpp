@@ -203,7 +203,10 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
     };
     estimate(hits, true);  // their transfer already holds their own object
     estimate(diffuse_only, false);
-    const std::vector<glm::vec3> filtered = filter_near_field(samples, width, height, s.spp, near, s.near_field.filter_radius);
+    std::vector<glm::vec4> guide(n, glm::vec4(0.0f));
+    for (std::size_t i = 0; i < n; ++i)
+      if (samples[i].hit) guide[i] = glm::vec4(samples[i].normal_world, std::max(samples[i].depth, 1e-30f));
+    const std::vector<glm::vec3> filtered = filter_near_field(guide, width, height, s.spp, near, s.near_field.filter_radius);
     for (const std::vector<std::size_t>* which : {&hits, &diffuse_only})
       for (const std::size_t i : *which)
         shaded[i] = glm::max(shaded[i] + samples[i].diffuse * math::kInvPi * filtered[i], glm::vec3(0.0f));
