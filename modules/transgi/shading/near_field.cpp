@@ -8,6 +8,7 @@
 #include "engine/rt/ray.h"
 #include "probes/probe_rays.h"
 #include "shading/sh_light.h"
+#include "shading/upsampling.h"
 
 namespace transgi::shading {
 
@@ -49,6 +50,12 @@ glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::
   return std::isfinite(e.r + e.g + e.b) ? e : glm::vec3(0.0f);
 }
 
+namespace {
+// The upsampling's default similarity (RealtimeGiSettings).
+constexpr float kDepthTolerance = 0.05f;
+constexpr int kNormalPower = 8;
+}  // namespace
+
 std::vector<glm::vec3> filter_near_field(std::span<const glm::vec4> guide, int width, int height, int spp,
                                          std::span<const glm::vec3> values, int radius) {
   std::vector<glm::vec3> out(values.size(), glm::vec3(0.0f));
@@ -67,14 +74,8 @@ std::vector<glm::vec3> filter_near_field(std::span<const glm::vec4> guide, int w
               if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
               for (int j = 0; j < spp; ++j) {
                 const std::size_t i = at(nx, ny, j);
-                const glm::vec4& s = guide[i];
-                if (!(s.w > 0)) continue;
-                const float dz = (s.w - c.w) / (0.05f * c.w);
-                const float wz = 1.0f - dz * dz;
-                const float cn = s.x * c.x + s.y * c.y + s.z * c.z;
-                if (!(wz > 0) || !(cn > 0)) continue;
-                const float cn2 = cn * cn, cn4 = cn2 * cn2;
-                const float w = wz * cn4 * cn4;
+                const float w = guide_similarity(c, guide[i], kDepthTolerance, kNormalPower);
+                if (!(w > 0)) continue;
                 sum += w * values[i];
                 weight += w;
               }

@@ -164,7 +164,21 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
       to_object.emplace(samples[i].entity,
                         math::ShRotation(glm::transpose(glm::mat3_cast(scene.instance_of(samples[i].entity)->to_world.rotation))));
   std::vector<glm::vec3> shaded(n, glm::vec3(0.0f));
-  jobs::parallel_for<std::size_t>(0, hits.size(), 256, [&](std::size_t b, std::size_t e) {
+  // The contact light the probes miss (near_field.h), estimated from the
+  // same world light as the shading, filtered across similar neighbours,
+  // then added through each sample's diffuse albedo; the total is clamped
+  // at zero, as sh_irradiance is.
+  const bool with_near = s.near_field.rays > 0 && s.probe_spacing_at;
+  std::vector<glm::vec3> near(with_near ? n : 0, glm::vec3(0.0f));
+  const auto estimate_near = [&](std::size_t i, const float* world, bool skip_self) {
+    if (!with_near) return;
+    const Sample& smp = samples[i];
+    math::Pcg32 rng = math::make_rng(s.seed ^ 0x4EA2F1ull, i, 0);
+    const float reach = s.near_field.reach_cells * s.probe_spacing_at(smp.position);
+    near[i] = near_field_irradiance(scene, s.lights, smp, world, reach, skip_self, s.near_field.rays, light_at, rng);
+  };
+  const std::size_t grain = with_near ? 16 : 256;
+  jobs::parallel_for<std::size_t>(0, hits.size(), grain, [&](std::size_t b, std::size_t e) {
     float world[75], object[75];
     for (std::size_t j = b; j < e; ++j) {
       const Sample& smp = samples[hits[j]];
@@ -174,35 +188,19 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
       ShRgb light;
       std::copy(object, object + 75, light.begin());
       shaded[hits[j]] = shade(light, transfer.data() + j * bake::kTransferValues);
+      estimate_near(hits[j], world, true);  // its transfer already holds its own object
     }
   });
-  jobs::parallel_for<std::size_t>(0, diffuse_only.size(), 256, [&](std::size_t b, std::size_t e) {
+  jobs::parallel_for<std::size_t>(0, diffuse_only.size(), grain, [&](std::size_t b, std::size_t e) {
     float world[75];
     for (std::size_t j = b; j < e; ++j) {
       const Sample& smp = samples[diffuse_only[j]];
       light_at(smp.position, smp.normal_world, world);
       shaded[diffuse_only[j]] = smp.diffuse * math::kInvPi * sh_irradiance(world, smp.normal_world);
+      estimate_near(diffuse_only[j], world, false);
     }
   });
-  // The contact light the probes miss (near_field.h), filtered across
-  // similar neighbours, through each sample's diffuse albedo; the total is
-  // clamped at zero, as sh_irradiance is.
-  if (s.near_field.rays > 0 && s.probe_spacing_at) {
-    std::vector<glm::vec3> near(n, glm::vec3(0.0f));
-    const auto estimate = [&](std::span<const std::size_t> which, bool skip_self) {
-      jobs::parallel_for<std::size_t>(0, which.size(), 16, [&](std::size_t b, std::size_t e) {
-        float world[75];
-        for (std::size_t j = b; j < e; ++j) {
-          const Sample& smp = samples[which[j]];
-          light_at(smp.position, smp.normal_world, world);
-          math::Pcg32 rng = math::make_rng(s.seed ^ 0x4EA2F1ull, which[j], 0);
-          const float reach = s.near_field.reach_cells * s.probe_spacing_at(smp.position);
-          near[which[j]] = near_field_irradiance(scene, s.lights, smp, world, reach, skip_self, s.near_field.rays, light_at, rng);
-        }
-      });
-    };
-    estimate(hits, true);  // their transfer already holds their own object
-    estimate(diffuse_only, false);
+  if (with_near) {
     std::vector<glm::vec4> guide(n, glm::vec4(0.0f));
     for (std::size_t i = 0; i < n; ++i)
       if (samples[i].hit) guide[i] = glm::vec4(samples[i].normal_world, std::max(samples[i].depth, 1e-30f));

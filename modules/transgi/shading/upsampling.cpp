@@ -16,12 +16,7 @@ namespace {
 float similarity(const glm::vec4& p, const glm::vec4& q, const detail::PlanRow& r) {
   if (!(q.w > 0)) return 0.0f;
   if (!r.edge_aware) return 1.0f;
-  const float dz = (q.w - p.w) / (r.depth_tolerance * std::max(p.w, 1e-6f));
-  const float depth = std::max(0.0f, 1.0f - dz * dz);  // zero beyond the tolerance: silhouettes cut hard
-  float n = std::max(0.0f, p.x * q.x + p.y * q.y + p.z * q.z), normal = 1.0f;
-  for (int e = r.normal_power; e > 0; e >>= 1, n *= n)  // n^power by squaring
-    if (e & 1) normal *= n;
-  return depth * normal;
+  return guide_similarity(p, q, r.depth_tolerance, r.normal_power);
 }
 
 }  // namespace

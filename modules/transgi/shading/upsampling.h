@@ -9,6 +9,7 @@
 // weights. It runs once a frame over every output pixel, so it has a vector
 // kernel (AVX-512, 16 pixels at once) beside the scalar reference; the two
 // give bit-identical plans (tested), and the scalar one is the definition.
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -19,6 +20,20 @@
 namespace transgi::shading {
 
 struct RealtimeGiSettings;
+
+// How alike guide q is to guide p (world normal xyz, depth w; w = 0 is a
+// miss, alike to nothing): max(0, 1 - (dz / (depth_tolerance z))^2) x
+// max(0, n . n')^normal_power. The upsampling's weights, and the near
+// field's filter (near_field.h).
+inline float guide_similarity(const glm::vec4& p, const glm::vec4& q, float depth_tolerance, int normal_power) {
+  if (!(q.w > 0)) return 0.0f;
+  const float dz = (q.w - p.w) / (depth_tolerance * std::max(p.w, 1e-6f));
+  const float depth = std::max(0.0f, 1.0f - dz * dz);  // zero beyond the tolerance: silhouettes cut hard
+  float n = std::max(0.0f, p.x * q.x + p.y * q.y + p.z * q.z), normal = 1.0f;
+  for (int e = normal_power; e > 0; e >>= 1, n *= n)  // n^power by squaring
+    if (e & 1) normal *= n;
+  return depth * normal;
+}
 
 struct UpsamplingPlan {
   int width = 0, height = 0;   // output pixels
