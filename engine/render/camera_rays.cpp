@@ -21,15 +21,6 @@ CameraRays::CameraRays(const scene::Camera& camera, const transform::Similarity&
   tan_half_x_ = tan_half_y_ * aspect;
 }
 
-rt::Ray CameraRays::generate(glm::vec2 film) const {
-  const float sx = (2.0f * film.x / static_cast<float>(width_) - 1.0f) * tan_half_x_;
-  const float sy = (1.0f - 2.0f * film.y / static_cast<float>(height_)) * tan_half_y_;
-  rt::Ray r;
-  r.origin = origin_;
-  r.direction = glm::normalize(rotation_ * glm::vec3(sx, sy, -1.0f));
-  return r;
-}
-
 rt::Ray CameraRays::generate_filtered(int x, int y, glm::vec2 u, float filter_width) const {
   const glm::vec2 centre(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
   return generate(centre + sample_pixel_filter(u, filter_width));

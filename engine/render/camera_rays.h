@@ -13,10 +13,31 @@ namespace engine::render {
 struct CameraRays {
   CameraRays(const scene::Camera& camera, const transform::Similarity& to_world, int width, int height);
   // film = pixel coordinates with sub-pixel offset, e.g. (x + 0.5, y + 0.5).
-  [[nodiscard]] rt::Ray generate(glm::vec2 film) const;
+  // Inline: the G-buffer and the GI history call it once per pixel.
+  [[nodiscard]] rt::Ray generate(glm::vec2 film) const {
+    const float sx = (2.0f * film.x / static_cast<float>(width_) - 1.0f) * tan_half_x_;
+    const float sy = (1.0f - 2.0f * film.y / static_cast<float>(height_)) * tan_half_y_;
+    rt::Ray r;
+    r.origin = origin_;
+    r.direction = glm::normalize(rotation_ * glm::vec3(sx, sy, -1.0f));
+    return r;
+  }
   // A ray through pixel (x, y) offset by the pixel filter (see below), from
   // two uniform numbers u.
   [[nodiscard]] rt::Ray generate_filtered(int x, int y, glm::vec2 u, float filter_width) const;
+  // The film coordinates where world point p appears (generate's inverse:
+  // generate(*project(p)) points at p); nullopt behind the camera.
+  [[nodiscard]] std::optional<glm::vec2> project(const glm::vec3& p) const {
+    const glm::vec3 d = p - origin_;
+    // rotation_ is orthonormal: its transpose is its inverse.
+    const glm::vec3 local(glm::dot(rotation_[0], d), glm::dot(rotation_[1], d), glm::dot(rotation_[2], d));
+    if (!(local.z < 0)) return std::nullopt;
+    const float sx = local.x / -local.z, sy = local.y / -local.z;
+    return glm::vec2((sx / tan_half_x_ + 1.0f) * 0.5f * static_cast<float>(width_),
+                     (1.0f - sy / tan_half_y_) * 0.5f * static_cast<float>(height_));
+  }
+  [[nodiscard]] int width() const { return width_; }
+  [[nodiscard]] int height() const { return height_; }
   [[nodiscard]] glm::vec3 position() const { return origin_; }
   [[nodiscard]] const transform::Similarity& to_world() const { return to_world_; }
   // A pixel's angular size at the image centre (radians): the spread of a

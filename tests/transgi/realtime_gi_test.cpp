@@ -5,52 +5,20 @@
 // test can fail.
 #include <gtest/gtest.h>
 
-#include "lambert.h"
+#include "edge_scene.h"
 
 #include <cmath>
 #include <cstdio>
 
-#include "engine/app/app.h"
 #include "engine/render/light_set.h"
-#include "engine/rt/rt_plugin.h"
-#include "engine/scene/procedural.h"
 #include "probes/probe_field.h"
 #include "shading/realtime_gi.h"
 
 using namespace transgi;
 using namespace engine;
+using transgi_test::EdgeScene;
 
 namespace {
-
-// A saturated orange box in front of a blue wall, on a grey floor, under a
-// uniform sky: every silhouette separates two colours, so GI that bleeds
-// across one shows as the wrong hue.
-struct EdgeScene {
-  app::App app{app::AppOptions{.jobs = {.threads = 2}}};
-  EdgeScene() {
-    scene::SceneAssets a;
-    a.generation = scene::next_scene_generation();
-    a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({4, 4}, 0)),
-                std::make_shared<scene::MeshAsset>(scene::make_box(glm::vec3(0.4f), false, 1)),
-                std::make_shared<scene::MeshAsset>(scene::make_quad({4, 2}, 2))};
-    a.materials = {lambert(glm::vec3(0.6f)), lambert({0.95f, 0.4f, 0.05f}), lambert({0.05f, 0.2f, 0.9f})};
-    a.environment = scene::uniform_environment(glm::vec3(1.0f));
-    app.world().insert_resource<scene::SceneAssets>(std::move(a));
-    app.add_plugin<rt::RtPlugin>();
-    auto spawn = [&](std::uint32_t mesh, glm::vec3 at, glm::quat rotation) {
-      transform::Transform t = transform::Transform::from_translation(at);
-      t.rotation = rotation;
-      const ecs::Entity e = app.world().spawn();
-      app.world().emplace<transform::Transform>(e, t);
-      app.world().emplace<scene::MeshInstance>(e, scene::MeshInstance{mesh});
-    };
-    spawn(0, glm::vec3(0.0f), glm::quat(1, 0, 0, 0));
-    spawn(1, {0, 0.4f, 0}, glm::angleAxis(0.5f, glm::vec3(0, 1, 0)));
-    // The wall: the quad (in XZ, facing +Y) stood up at z = -2, facing +Z.
-    spawn(2, {0, 2, -2}, glm::angleAxis(1.5707963f, glm::vec3(1, 0, 0)));
-    app.update();
-  }
-};
 
 // Mean |difference| over pixels whose 3x3 neighbourhood spans a depth step
 // of more than 10 % (silhouettes), and over the rest.

@@ -76,7 +76,7 @@ ecs::Entity pick_moving_object(ecs::World& world, const std::string& name) {
 int run_bench_frame(const std::vector<std::string>& argv) {
   const Args args("bench-frame", argv,
                   {"scene", "model", "width", "height", "frames", "warmup", "preset", "csv", "object", "threads", "camera",
-                   "direct-spp", "gi-scale", "probe-budget", "backend", "device", "near-field-rays", "near-field-reach", "near-field-filter", "direct", "gi-out", "reference-out", "reference-spp", "map-width",
+                   "direct-spp", "gi-scale", "gi-reuse", "probe-budget", "probe-settle", "backend", "device", "near-field-rays", "near-field-reach", "near-field-filter", "direct", "gi-out", "reference-out", "reference-spp", "map-width",
                    "probe-volume", "probe-grid", "cascades", "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "cascade-map-width"},
                   {"allow-unbaked"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
@@ -160,9 +160,9 @@ int run_bench_frame(const std::vector<std::string>& argv) {
     std::printf(" %s %.2f;", names[k], percentile(v, 0.5));
   }
   std::printf("\n");
-  std::printf("last frame: %zu pixels decoded (%zu grid, %zu edge), %zu rotations, %d probes traced\n",
+  std::printf("last frame: %zu pixels decoded (%zu grid, %zu edge), %zu grid cells reused from the frame before, %zu rotations, %d probes traced\n",
               frame.realtime.grid_samples + frame.realtime.edge_samples, frame.realtime.grid_samples,
-              frame.realtime.edge_samples, frame.realtime.rotations, frame.probe_stats.traced);
+              frame.realtime.edge_samples, frame.realtime.reused_cells, frame.realtime.rotations, frame.probe_stats.traced);
   world.view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& set) {
     if (set.state.fitted_to_scene) std::printf("cascades: the scene is small enough for one grid over its bounds (--cascade-fit-scene)\n");
     for (std::size_t k = 0; k < set.state.fields.size() && k < frame.cascade_stats.size(); ++k) {

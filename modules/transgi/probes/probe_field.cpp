@@ -218,7 +218,8 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   last_traced_.resize(static_cast<std::size_t>(probes), 0);
   needs_classify_.resize(static_cast<std::size_t>(probes), 0);
   changed_.resize(static_cast<std::size_t>(probes), 0);
-  const bool budgeted = settings_.update_budget > 0 && !classify;
+  const bool settling = frame_ < static_cast<std::uint64_t>(std::max(0, settings_.settle_frames));
+  const bool budgeted = settings_.update_budget > 0 && !classify && !settling;
   if (budgeted) select_within_budget(traced);
 
   // 1. Scatter and shade (reads the previous frame's SH for the feedback bounce).

@@ -94,6 +94,12 @@ struct ProbeFieldSettings {
   // frame, at the cost of each probe refreshing only every active/budget
   // frames, so lighting responds that many times slower.
   int update_budget = 0;
+  // With a budget: the field's first settle_frames updates trace every
+  // active probe, as a loading screen would, so a level starts with its
+  // multi-bounce light converged (each update of a probe adds a bounce)
+  // instead of reaching it over hundreds of budgeted frames. Higher = a
+  // better-settled start, at the cost of that many slow first frames.
+  int settle_frames = 0;
   // With a budget: a probe whose last update detected a lighting change (a
   // sun that moved, a lamp switched) goes before the merely stale, so the
   // budget follows the change. On = GI settles sooner after a light moves,

@@ -254,7 +254,9 @@ TransGISettings realtime_preset() {
   // for less probe time (docs/performance.md); docs/results.md found 50x25 on
   // the Pareto front already.
   s.probes.map = probes::MapLayout{50, 25};
-  s.probes.update_budget = 192;
+  s.probes.update_budget = 128;
+  s.probes.settle_frames = 24;
+  s.realtime.reuse_history = true;
   s.direct_light = DirectLight::Deterministic;
   s.probes.fixed_pattern = true;  // with the deterministic direct light: no seed anywhere in the image
   s.near_field.rays = 0;          // off: at 640x360 it costs more than the frame's budget (docs/runtime.md)

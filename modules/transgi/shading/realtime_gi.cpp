@@ -3,6 +3,7 @@
 #include "probes/cascades.h"
 
 #include <chrono>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -14,6 +15,7 @@
 
 #include "engine/jobs/parallel_for.h"
 #include "engine/math/sampling.h"
+#include "shading/gi_history.h"
 #include "shading/realtime_direct.h"
 #include "shading/sh_light.h"
 #include "shading/transfer_inference.h"
@@ -38,6 +40,12 @@ struct RealtimeGiScratch::Impl {
   // Per network sample: where it is and its world normal, copied while its
   // GSample is in cache so the light fill does not miss on it a second time.
   std::vector<glm::vec3> net_position, net_normal;
+  // Checkerboard reuse (RealtimeGiSettings::reuse_history): the previous
+  // frame's cells, each cell's source, and this frame's cell values.
+  GiHistory history;
+  std::vector<std::int32_t> source;
+  std::vector<std::uint8_t> fresh;
+  std::vector<glm::vec3> cell_value, cell_value_direct;
 };
 RealtimeGiScratch::RealtimeGiScratch() : impl(std::make_unique<Impl>()) {}
 RealtimeGiScratch::~RealtimeGiScratch() = default;
@@ -105,6 +113,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
                    engine::rt::RayBatchTracer* tracer) {
   g.width = width;
   g.height = height;
+  g.camera = camera;
   g.samples.resize(static_cast<std::size_t>(width) * height);
   g.guide.resize(g.samples.size());
   g.metal_roughness.resize(g.samples.size());
@@ -202,7 +211,15 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     slot_of_pixel[p] = decode.size();
     decode.push_back(p);
   };
-  for (std::size_t p : up.cell_pixel) want(p);
+  // With reuse, the cells that take the previous frame's value are not decoded.
+  // (Not with the near field, whose contact light is estimated afresh on every cell.)
+  const bool reuse = settings.reuse_history && scratch != nullptr && g.camera.has_value() && near_field.rays <= 0;
+  if (reuse)
+    sc.history.plan(up, g, scene, sc.source);
+  else
+    sc.history.clear();
+  for (std::size_t c = 0; c < up.cell_pixel.size(); ++c)
+    if (!reuse || sc.source[c] == GiHistory::kDecode) want(up.cell_pixel[c]);
   stats.grid_samples = decode.size();
   for (std::size_t p = 0; p < g.samples.size(); ++p)
     if (up.kind[p] == UpsamplingPlan::kOwn) want(p);
@@ -320,6 +337,40 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     value[i] = glm::vec3(0.0f);
     if (with_direct) value_direct[i] = glm::vec3(0.0f);
     ++stats.nonfinite_samples;
+  }
+
+  if (reuse) {
+    // The reused cells' values after the decoded ones, a reused cell's slot
+    // at its cell index past them, so the cells are independent (no cell's
+    // pixel is another's); then every cell's value is the next frame's history.
+    const std::size_t cells = up.cell_pixel.size(), base = value.size();
+    value.resize(base + cells);
+    if (with_direct) value_direct.resize(base + cells);
+    sc.cell_value.resize(cells);
+    sc.cell_value_direct.resize(with_direct ? cells : 0);
+    sc.fresh.resize(cells);
+    std::atomic<std::size_t> reused{0};
+    engine::jobs::parallel_for<std::size_t>(0, cells, 4096, [&](std::size_t b, std::size_t e) {
+      std::size_t n = 0;
+      for (std::size_t c = b; c < e; ++c) {
+        const std::int32_t src = sc.source[c];
+        const std::size_t p = up.cell_pixel[c];
+        std::size_t slot = slot_of_pixel[p];
+        if (src != GiHistory::kDecode && slot == kNone) {
+          slot = slot_of_pixel[p] = base + c;
+          value[slot] = sc.history.value(src);
+          if (with_direct) value_direct[slot] = sc.history.value_direct(src);
+          ++n;
+        }
+        const bool hit = slot != kNone;
+        sc.cell_value[c] = hit ? value[slot] : glm::vec3(0.0f);
+        if (with_direct) sc.cell_value_direct[c] = hit ? value_direct[slot] : glm::vec3(0.0f);
+        sc.fresh[c] = hit && src == GiHistory::kDecode;
+      }
+      reused.fetch_add(n, std::memory_order_relaxed);
+    });
+    stats.reused_cells = reused.load();
+    sc.history.store(sc.cell_value, sc.cell_value_direct, sc.fresh);
   }
 
   if (near_field.rays > 0) {

@@ -14,6 +14,7 @@
 // rotation, batched inference); tests compare the two.
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -48,6 +49,14 @@ struct RealtimeGiSettings {
   float min_weight = 0.05f;
   // Off = plain bilinear upsampling (only to show what the guidance prevents).
   bool edge_aware = true;
+  // On = each frame decodes one colour of a checkerboard of grid cells that
+  // swaps every frame, and the other colour takes the previous frame's value
+  // of the same surface point, carried through camera and object motion
+  // (gi_history.h): about half the inference and light time, at the cost of
+  // GI up to one frame late on those cells. Needs the scratch that carries
+  // history from frame to frame; without it, or with the near field on,
+  // every cell is decoded.
+  bool reuse_history = false;
 
   bool operator==(const RealtimeGiSettings&) const = default;
 };
@@ -66,6 +75,9 @@ struct GBuffer {
   // Per pixel: the entity hit (null for a miss), so routing samples by object
   // reads 8 bytes a pixel rather than a GSample; written by trace_gbuffer.
   std::vector<engine::ecs::Entity> entity;
+  // The camera the G-buffer was traced from (trace_gbuffer), so the next
+  // frame can find where a surface point was seen (gi_history.h).
+  std::optional<engine::render::CameraRays> camera;
 };
 
 // One ray through each pixel centre, in parallel over rows.
@@ -99,6 +111,7 @@ struct RealtimeGiStats {
   double upsample_ms = 0;   // choosing samples, joint bilateral upsampling
   double near_ms = 0;       // near-field rays on the decoded grid (off in the real-time preset)
   std::size_t grid_samples = 0, edge_samples = 0;  // decoded: on the grid, on their own
+  std::size_t reused_cells = 0;                     // grid cells that took the previous frame's value
   std::size_t inferred = 0, diffuse = 0;           // of those: through the network, diffuse fallback
   std::size_t rotations = 0;                        // distinct object rotations this frame
   // Decoded samples whose GI came out non-finite (a NaN latent or weight, an

@@ -1,0 +1,151 @@
+#include "shading/gi_history.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "engine/jobs/parallel_for.h"
+#include "shading/realtime_gi.h"
+
+namespace transgi::shading {
+
+namespace {
+// Cosine of the largest angle between the object-space normals of a cell and
+// the previous cell it takes its value from.
+constexpr float kMinNormalCos = 0.9f;
+constexpr float kNormalScale = 32767.0f;
+}  // namespace
+
+void GiHistory::clear() {
+  prev_ = Cells{};
+  cur_ = Cells{};
+  frame_ = 0;
+}
+
+void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::rt::RtScene& scene, std::vector<std::int32_t>& source) {
+  using engine::ecs::Entity;
+  using engine::transform::Similarity;
+  const std::size_t cells = up.cell_pixel.size();
+  cur_.width = up.width;
+  cur_.height = up.height;
+  cur_.grid_w = up.grid_w;
+  cur_.grid_h = up.grid_h;
+  cur_.sx = up.sx;
+  cur_.sy = up.sy;
+  cur_.camera = g.camera;
+  cur_.key.resize(cells);
+  source.assign(cells, kDecode);
+  // The objects in view, numbered; a handful, so found by a linear search
+  // once per run of cells on one object.
+  cur_.objects.clear();
+  object_of_cell_.resize(cells);
+  {
+    Entity last{};
+    std::uint32_t last_index = kNoObject;
+    for (std::size_t c = 0; c < cells; ++c) {
+      if (!(up.cell_guide[c].w > 0)) {
+        object_of_cell_[c] = kNoObject;
+        continue;
+      }
+      const Entity e = g.entity[up.cell_pixel[c]];
+      if (!(e == last) || last_index == kNoObject) {
+        last = e;
+        last_index = kNoObject;
+        for (std::size_t k = 0; k < cur_.objects.size() && last_index == kNoObject; ++k)
+          if (cur_.objects[k].first == e) last_index = static_cast<std::uint32_t>(k);
+        if (last_index == kNoObject) {
+          const engine::rt::InstanceRecord* inst = scene.instance_of(e);
+          last_index = static_cast<std::uint32_t>(cur_.objects.size());
+          cur_.objects.emplace_back(e, inst ? inst->to_world : Similarity{});
+        }
+      }
+      object_of_cell_[c] = last_index;
+    }
+  }
+  // Per object in view: to its own frame now, and where it was last frame
+  // (its number then), if it was in view.
+  struct Motion {
+    Similarity to_object, prev_to_world;
+    std::uint32_t prev_object = kNoObject;
+  };
+  const bool comparable = g.camera && prev_.camera && prev_.grid_w == up.grid_w && prev_.grid_h == up.grid_h &&
+                          prev_.width == up.width && prev_.height == up.height && prev_.key.size() == cells;
+  std::vector<Motion> motion(cur_.objects.size());
+  for (std::size_t k = 0; k < motion.size(); ++k) {
+    motion[k].to_object = cur_.objects[k].second.inverse();
+    for (std::size_t q = 0; comparable && q < prev_.objects.size(); ++q)
+      if (prev_.objects[q].first == cur_.objects[k].first) {
+        motion[k].prev_object = static_cast<std::uint32_t>(q);
+        motion[k].prev_to_world = prev_.objects[q].second;
+      }
+  }
+  const float spread = g.camera ? g.camera->pixel_spread() : 0.0f;
+  const float cell_pixels = std::max(up.sx, up.sy);
+  const unsigned parity = static_cast<unsigned>(frame_ & 1);
+  auto body = [&](std::size_t b, std::size_t e_end) {
+    for (std::size_t c = b; c < e_end; ++c) {
+      Key& key = cur_.key[c];
+      const std::uint32_t object = object_of_cell_[c];
+      if (object == kNoObject) {
+        key = Key{};
+        continue;
+      }
+      const Motion& m = motion[object];
+      // From the cell's guide and its camera ray, not its GSample: the
+      // cells' 16-byte guides are in cache, their GSamples far apart.
+      const glm::vec4& guide = up.cell_guide[c];
+      const std::size_t pixel = up.cell_pixel[c];
+      const engine::rt::Ray ray = g.camera->generate({static_cast<float>(pixel % static_cast<std::size_t>(g.width)) + 0.5f,
+                                                      static_cast<float>(pixel / static_cast<std::size_t>(g.width)) + 0.5f});
+      const float depth = guide.w;
+      const glm::vec3 p_obj = m.to_object.apply_point(ray.origin + depth * ray.direction);
+      const glm::vec3 n_obj = m.to_object.apply_direction(glm::vec3(guide));
+      key.object_position = p_obj;
+      key.object = object;
+      for (int a = 0; a < 3; ++a) key.normal[a] = static_cast<std::int16_t>(std::clamp(n_obj[a], -1.0f, 1.0f) * kNormalScale);  // truncation: 3e-5 off at most
+      key.fresh = 0;
+      const int i = static_cast<int>(c % static_cast<std::size_t>(up.grid_w)), j = static_cast<int>(c / static_cast<std::size_t>(up.grid_w));
+      if (m.prev_object == kNoObject || ((static_cast<unsigned>(i + j) + parity) & 1) == 0) continue;  // this frame's colour: decoded
+      const std::optional<glm::vec2> film = prev_.camera->project(m.prev_to_world.apply_point(p_obj));
+      if (!film) continue;
+      // The previous cells around the film point (cell centres at integers).
+      const float u = film->x / prev_.sx - 0.5f, v = film->y / prev_.sy - 0.5f;
+      if (!(u > -1.0f && v > -1.0f && u < static_cast<float>(prev_.grid_w) && v < static_cast<float>(prev_.grid_h))) continue;
+      const int i0 = static_cast<int>(u + 1.0f) - 1, j0 = static_cast<int>(v + 1.0f) - 1;  // floor, as u, v > -1
+      // Within a cell's footprint at the point's depth, in object units.
+      const float reach = depth * spread * cell_pixels * m.to_object.scale;
+      float best = reach * reach;
+      std::int32_t pick = kDecode;
+      for (int dj = 0; dj < 2; ++dj)
+        for (int di = 0; di < 2; ++di) {
+          const int pi = i0 + di, pj = j0 + dj;
+          if (pi < 0 || pj < 0 || pi >= prev_.grid_w || pj >= prev_.grid_h) continue;
+          const std::size_t q = static_cast<std::size_t>(pj) * static_cast<std::size_t>(prev_.grid_w) + static_cast<std::size_t>(pi);
+          const Key& k = prev_.key[q];
+          if (!k.fresh || k.object != m.prev_object) continue;
+          const float cos_normal =
+              (static_cast<float>(k.normal[0]) * n_obj.x + static_cast<float>(k.normal[1]) * n_obj.y + static_cast<float>(k.normal[2]) * n_obj.z) /
+              kNormalScale;
+          if (cos_normal < kMinNormalCos) continue;
+          const glm::vec3 d = k.object_position - p_obj;
+          const float d2 = glm::dot(d, d);
+          if (d2 <= best) {
+            best = d2;
+            pick = static_cast<std::int32_t>(q);
+          }
+        }
+      source[c] = pick;
+    }
+  };
+  engine::jobs::parallel_for<std::size_t>(0, cells, 1024, body);
+}
+
+void GiHistory::store(std::vector<glm::vec3>& value, std::vector<glm::vec3>& value_direct, const std::vector<std::uint8_t>& fresh) {
+  std::swap(cur_.value, value);
+  std::swap(cur_.value_direct, value_direct);
+  if (cur_.value_direct.size() != cur_.value.size()) cur_.value_direct.assign(cur_.value.size(), glm::vec3(0.0f));
+  for (std::size_t c = 0; c < cur_.key.size() && c < fresh.size(); ++c) cur_.key[c].fresh = fresh[c];
+  std::swap(prev_, cur_);
+  ++frame_;
+}
+
+}  // namespace transgi::shading

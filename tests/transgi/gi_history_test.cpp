@@ -1,0 +1,199 @@
+// Checkerboard reuse of the real-time GI (gi_history.h). The reference is
+// the same frame with every cell decoded (reuse_history off): with the probes
+// held still, a cell that reuses the previous frame's value of the same
+// surface point must give what decoding gives, and a cell whose point the
+// previous frame did not see must be decoded.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "edge_scene.h"
+#include "engine/render/light_set.h"
+#include "probes/probe_field.h"
+#include "shading/gi_history.h"
+#include "shading/realtime_gi.h"
+#include "shading/upsampling.h"
+
+using namespace transgi;
+using namespace engine;
+using transgi_test::EdgeScene;
+
+namespace {
+
+constexpr int kW = 96, kH = 64;
+
+transform::Similarity camera_at(glm::vec3 position) {
+  return transform::Similarity{.translation = position, .rotation = glm::angleAxis(-0.2f, glm::vec3(1, 0, 0))};
+}
+
+struct Lit {
+  EdgeScene& s;
+  const rt::RtScene& rt;
+  const scene::SceneAssets& assets;
+  probes::ProbeField field;
+  explicit Lit(EdgeScene& scene)
+      : s(scene), rt(scene.app.world().resource<rt::RtScene>()), assets(scene.app.world().resource<scene::SceneAssets>()),
+        field(settings()) {
+    const render::LightSet lights(rt, {}, &*assets.environment);
+    s.app.jobs().run([&] {
+      for (int f = 0; f < 30; ++f) field.update(rt, lights);
+    });
+  }
+  static probes::ProbeFieldSettings settings() {
+    probes::ProbeFieldSettings ps;
+    ps.grid = probes::ProbeGrid::centred_in({-4, 0, -2}, {4, 3, 4}, {6, 3, 6});
+    return ps;
+  }
+  // One frame from `camera`: with reuse through `scratch`, and every cell decoded.
+  struct Frame {
+    shading::GBuffer g;
+    image::ImageRGB reused, decoded;
+    shading::RealtimeGiStats stats;
+  };
+  Frame frame(const transform::Similarity& camera, shading::RealtimeGiScratch& scratch) {
+    Frame f;
+    const render::CameraRays rays(scene::Camera{}, camera, kW, kH);
+    const probes::ProbeField* fields[] = {&field};
+    s.app.jobs().run([&] {
+      f.g = shading::trace_gbuffer(rt, assets, rays, kW, kH);
+      shading::RealtimeGiSettings rs;
+      f.decoded = shading::shade_gi_realtime(f.g, rt, assets, nullptr, nullptr, {}, fields, rs);
+      rs.reuse_history = true;
+      f.reused = shading::shade_gi_realtime(f.g, rt, assets, nullptr, nullptr, {}, fields, rs, &f.stats, nullptr, &scratch);
+    });
+    return f;
+  }
+};
+
+double mean_of(const image::ImageRGB& im) {
+  double m = 0;
+  for (const auto& p : im.pixels) m += (p.r + p.g + p.b) / 3.0;
+  return m / static_cast<double>(im.pixels.size());
+}
+
+// Largest and mean |reused - decoded| over the pixels that see `entity` (any if null).
+struct Diff {
+  double max = 0, mean = 0;
+  int pixels = 0;
+};
+Diff diff_on(const Lit::Frame& f, ecs::Entity entity) {
+  Diff d;
+  for (std::size_t p = 0; p < f.g.samples.size(); ++p) {
+    if (!f.g.samples[p].hit || (!(entity == ecs::Entity{}) && !(f.g.entity[p] == entity))) continue;
+    const glm::vec3 e = glm::abs(f.reused.pixels[p] - f.decoded.pixels[p]);
+    const double v = std::max({e.r, e.g, e.b});
+    d.max = std::max(d.max, v);
+    d.mean += v;
+    ++d.pixels;
+  }
+  if (d.pixels) d.mean /= d.pixels;
+  return d;
+}
+
+}  // namespace
+
+// A still camera on a still scene: after the first frame, half the cells
+// take last frame's values, and the image is the decoded one bit for bit.
+TEST(GiHistory, AStillViewReusesHalfTheCellsAndGivesTheDecodedImage) {
+  EdgeScene s;
+  Lit lit(s);
+  shading::RealtimeGiScratch scratch;
+  const Lit::Frame first = lit.frame(camera_at({0.3f, 1.2f, 3.5f}), scratch);
+  EXPECT_EQ(first.stats.reused_cells, 0u) << "the first frame has no history";
+  for (int f = 0; f < 3; ++f) {
+    const Lit::Frame next = lit.frame(camera_at({0.3f, 1.2f, 3.5f}), scratch);
+    const std::size_t cells = next.stats.grid_samples + next.stats.reused_cells;
+    std::printf("frame %d: %zu cells decoded, %zu reused\n", f + 1, next.stats.grid_samples, next.stats.reused_cells);
+    EXPECT_GE(next.stats.reused_cells, cells * 45 / 100) << "expected about half of " << cells << " cells reused";
+    EXPECT_LE(next.stats.reused_cells, cells * 55 / 100);
+    const Diff d = diff_on(next, {});
+    EXPECT_EQ(d.max, 0.0) << "expected the decoded image exactly; largest difference " << d.max << " (mean GI " << mean_of(next.decoded) << ")";
+  }
+}
+
+// The box moves between frames. Cells on it find their points through its
+// motion (reused, and close to decoding); the floor it uncovers, which the
+// previous frame saw as box, is decoded, not given the box's value. The box
+// is black (no GI), so a floor cell that took a box value would be off by
+// the floor's whole GI.
+TEST(GiHistory, AMovingObjectReusesThroughItsMotionAndWhatItUncoversIsDecoded) {
+  EdgeScene s(glm::vec3(0.0f));
+  Lit lit(s);
+  shading::RealtimeGiScratch scratch;
+  const transform::Similarity camera = camera_at({0.3f, 1.2f, 3.5f});
+  lit.frame(camera, scratch);
+  lit.frame(camera, scratch);
+  const ecs::Entity box = s.box;
+  s.app.world().get_mut<transform::Transform>(box).translation.x += 0.15f;
+  s.app.world().get_mut<transform::Transform>(box).rotation = glm::angleAxis(0.6f, glm::vec3(0, 1, 0));
+  s.app.update();
+  const Lit::Frame moved = lit.frame(camera, scratch);
+  const Diff on_floor = diff_on(moved, s.floor), on_wall = diff_on(moved, s.wall), on_box = diff_on(moved, box);
+  const double floor_gi = mean_of(moved.decoded);
+  std::printf("after the move: %zu cells reused; |reused - decoded| max on floor %.3g, wall %.3g, box %.3g (mean GI %.4f)\n",
+              moved.stats.reused_cells, on_floor.max, on_wall.max, on_box.max, floor_gi);
+  ASSERT_GT(floor_gi, 0.02) << "the scene must have GI";
+  EXPECT_EQ(on_floor.max, 0.0) << "still floor cells reuse exactly, and uncovered ones are decoded";
+  EXPECT_EQ(on_wall.max, 0.0);
+  EXPECT_LE(on_box.max, 1e-6) << "the black box has no GI either way";
+}
+
+// The history on its own: the box moves 0.3 m and turns, several cells'
+// footprints, so its cells can only find their points through its motion.
+// Each reused cell must name a previous cell on the same object, and most
+// of the box's cells of this frame's reuse colour must find one.
+TEST(GiHistory, CellsFindTheirPointsThroughTheObjectsMotion) {
+  EdgeScene s;
+  const auto& rt = s.app.world().resource<rt::RtScene>();
+  const auto& assets = s.app.world().resource<scene::SceneAssets>();
+  const render::CameraRays rays(scene::Camera{}, camera_at({0.3f, 1.2f, 3.5f}), kW, kH);
+  shading::GiHistory history;
+  shading::RealtimeGiSettings rs;
+  std::vector<std::int32_t> source;
+  shading::GBuffer g;
+  shading::UpsamplingPlan up;
+  std::vector<ecs::Entity> before;
+  s.app.jobs().run([&] {
+    g = shading::trace_gbuffer(rt, assets, rays, kW, kH);
+    shading::plan_upsampling(g.guide, kW, kH, rs, up);
+    history.plan(up, g, rt, source);
+  });
+  for (const std::int32_t c : source) ASSERT_EQ(c, shading::GiHistory::kDecode) << "no history yet";
+  // Values that name their cell, so a reuse shows where it came from.
+  std::vector<glm::vec3> value(up.cell_pixel.size()), direct;
+  std::vector<std::uint8_t> fresh(up.cell_pixel.size());
+  for (std::size_t c = 0; c < value.size(); ++c) {
+    value[c] = glm::vec3(static_cast<float>(c));
+    fresh[c] = up.cell_guide[c].w > 0;
+    before.push_back(fresh[c] ? g.entity[up.cell_pixel[c]] : ecs::Entity{});
+  }
+  history.store(value, direct, fresh);
+  auto& t = s.app.world().get_mut<transform::Transform>(s.box);
+  t.translation.x += 0.3f;
+  t.rotation = glm::angleAxis(0.9f, glm::vec3(0, 1, 0));
+  s.app.update();
+  s.app.jobs().run([&] {
+    g = shading::trace_gbuffer(rt, assets, rays, kW, kH);
+    shading::plan_upsampling(g.guide, kW, kH, rs, up);
+    history.plan(up, g, rt, source);
+  });
+  int box_tries = 0, box_reused = 0, reused = 0;
+  for (std::size_t c = 0; c < source.size(); ++c) {
+    if (!(up.cell_guide[c].w > 0)) continue;
+    const ecs::Entity e = g.entity[up.cell_pixel[c]];
+    const int i = static_cast<int>(c % static_cast<std::size_t>(up.grid_w)), j = static_cast<int>(c / static_cast<std::size_t>(up.grid_w));
+    const bool reuse_colour = (i + j + 1) % 2 == 1;  // frame 1 decodes cells with i + j odd, tries to reuse the rest
+    if (e == s.box && reuse_colour) ++box_tries;
+    if (source[c] == shading::GiHistory::kDecode) continue;
+    ++reused;
+    ASSERT_TRUE(reuse_colour) << "cell " << c << " is this frame's colour and must be decoded";
+    const auto from = static_cast<std::size_t>(history.value(source[c]).x);
+    ASSERT_EQ(from, static_cast<std::size_t>(source[c]));
+    EXPECT_TRUE(before[from] == e) << "cell " << c << " took a value from cell " << from << " on another object";
+    if (e == s.box) ++box_reused;
+  }
+  std::printf("%d cells reused; the box: %d of its %d reuse-colour cells\n", reused, box_reused, box_tries);
+  ASSERT_GT(box_tries, 20);
+  EXPECT_GT(box_reused, box_tries * 6 / 10) << "expected most of the box's cells to find their points through its motion";
+}
