@@ -1,10 +1,26 @@
 #include "engine/app/app.h"
 
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
+
 #include <chrono>
 
 namespace engine::app {
 
+namespace {
+void keep_freed_memory() {
+#ifdef __GLIBC__
+  // Blocks up to glibc's largest threshold (32 MB on 64-bit) come from the
+  // heap, and the heap is not trimmed below 512 MB of free space.
+  mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
+  mallopt(M_TRIM_THRESHOLD, 512 * 1024 * 1024);
+#endif
+}
+}  // namespace
+
 App::App(AppOptions options) : options_(options), jobs_(options.jobs) {
+  if (options_.keep_freed_memory) keep_freed_memory();
   world_.insert_resource<Time>();
   world_.resource<Time>().delta_seconds = options_.fixed_delta_seconds > 0 ? options_.fixed_delta_seconds : 0.0;
   world_.insert_resource<AppExit>();

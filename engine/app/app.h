@@ -33,6 +33,14 @@ struct AppOptions {
   jobs::JobSystemOptions jobs;
   // Fixed simulated step; 0 = use measured wall-clock time per frame.
   double fixed_delta_seconds = 1.0 / 60.0;
+  // Frames allocate and free the same large buffers (images, per-frame
+  // arrays). glibc hands a freed block over 128 KB back to the OS at once and
+  // faults it in again, zeroed, when the next frame asks: 1.4 ms of a 640x360
+  // real-time TransGI frame on 2 cores (docs/performance.md). On = keep freed
+  // memory in the process for the next frame (glibc's mmap and trim
+  // thresholds, process-wide), at the cost of a resident size that does not
+  // shrink after a peak.
+  bool keep_freed_memory = true;
 };
 
 class App {
