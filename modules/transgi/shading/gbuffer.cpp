@@ -35,8 +35,11 @@ void make_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAs
   const glm::uvec3 t = mesh.triangles[hit.primitive];
   const float b1 = hit.barycentric.x, b2 = hit.barycentric.y, b0 = 1 - b1 - b2;
   glm::vec3 nobj = glm::normalize(b0 * mesh.normals[t.x] + b1 * mesh.normals[t.y] + b2 * mesh.normals[t.z]);
+  // One normalisation per direction: rotations keep unit vectors unit, so
+  // the object-space view and the world normals need none of their own.
+  const glm::vec3 wo_world = glm::normalize(-ray.direction);
   const glm::quat inv = glm::conjugate(inst.to_world.rotation);
-  const glm::vec3 wo = glm::normalize(inv * -ray.direction);
+  const glm::vec3 wo = inv * wo_world;
   if (glm::dot(nobj, wo) < 0) nobj = -nobj;  // seen from the back of a two-sided surface
   glm::vec2 uv(0.0f);
   if (!mesh.uvs.empty()) uv = b0 * mesh.uvs[t.x] + b1 * mesh.uvs[t.y] + b2 * mesh.uvs[t.z];
@@ -50,10 +53,11 @@ void make_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAs
   out.wo_obj = wo;
   const std::uint32_t material = mesh.triangle_material[hit.primitive];
   out.position = ray.origin + hit.t * ray.direction;
-  out.normal_world = glm::normalize(inst.to_world.apply_direction(nobj));
-  out.wo_world = glm::normalize(-ray.direction);
+  out.normal_world = inst.to_world.apply_direction(nobj);
+  out.wo_world = wo_world;
   glm::vec3 ng = glm::cross(mesh.positions[t.y] - mesh.positions[t.x], mesh.positions[t.z] - mesh.positions[t.x]);
-  ng = glm::length(ng) > 0 ? glm::normalize(inst.to_world.apply_direction(glm::normalize(ng))) : out.normal_world;
+  const float ng_length = glm::length(ng);
+  ng = ng_length > 0 ? inst.to_world.apply_direction(ng / ng_length) : out.normal_world;
   const float footprint = spread > 0 && assets.materials[material].is_textured()
                               ? render::uv_footprint(mesh, hit.primitive, inst.to_world.scale, hit.t * spread, glm::dot(ng, out.wo_world))
                               : 0.0f;
