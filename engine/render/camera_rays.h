@@ -36,6 +36,11 @@ struct CameraRays {
     return glm::vec2((sx / tan_half_x_ + 1.0f) * 0.5f * static_cast<float>(width_),
                      (1.0f - sy / tan_half_y_) * 0.5f * static_cast<float>(height_));
   }
+  // tan of half the field of view, horizontally and vertically: generate()
+  // maps film (x, y) to the camera-space direction
+  // ((2x / width - 1) tan_half_x, (1 - 2y / height) tan_half_y, -1).
+  [[nodiscard]] float tan_half_x() const { return tan_half_x_; }
+  [[nodiscard]] float tan_half_y() const { return tan_half_y_; }
   [[nodiscard]] int width() const { return width_; }
   [[nodiscard]] int height() const { return height_; }
   [[nodiscard]] glm::vec3 position() const { return origin_; }

@@ -72,9 +72,10 @@ double mean_of(const image::ImageRGB& im) {
   return m / static_cast<double>(im.pixels.size());
 }
 
-// Largest and mean |reused - decoded| over the pixels that see `entity` (any if null).
+// Largest and mean |reused - decoded| over the pixels that see `entity` (any
+// if null), and the decoded image's mean over them.
 struct Diff {
-  double max = 0, mean = 0;
+  double max = 0, mean = 0, gi = 0;
   int pixels = 0;
 };
 Diff diff_on(const Lit::Frame& f, ecs::Entity entity) {
@@ -85,9 +86,13 @@ Diff diff_on(const Lit::Frame& f, ecs::Entity entity) {
     const double v = std::max({e.r, e.g, e.b});
     d.max = std::max(d.max, v);
     d.mean += v;
+    d.gi += (f.decoded.pixels[p].r + f.decoded.pixels[p].g + f.decoded.pixels[p].b) / 3.0;
     ++d.pixels;
   }
-  if (d.pixels) d.mean /= d.pixels;
+  if (d.pixels) {
+    d.mean /= d.pixels;
+    d.gi /= d.pixels;
+  }
   return d;
 }
 
@@ -196,4 +201,34 @@ TEST(GiHistory, CellsFindTheirPointsThroughTheObjectsMotion) {
   std::printf("%d cells reused; the box: %d of its %d reuse-colour cells\n", reused, box_reused, box_tries);
   ASSERT_GT(box_tries, 20);
   EXPECT_GT(box_reused, box_tries * 6 / 10) << "expected most of the box's cells to find their points through its motion";
+}
+
+// The camera moves: a small step reuses through reprojection, close to what
+// decoding gives (the reused point lies within a cell of the pixel's); after
+// a cut to another view, what it still reuses (floor both views saw) is as
+// close.
+TEST(GiHistory, AMovingCameraReusesThroughReprojectionAndACutOnlyWhatBothViewsSaw) {
+  EdgeScene s;
+  Lit lit(s);
+  shading::RealtimeGiScratch scratch;
+  lit.frame(camera_at({0.3f, 1.2f, 3.5f}), scratch);
+  lit.frame(camera_at({0.3f, 1.2f, 3.5f}), scratch);
+  const Lit::Frame step = lit.frame(camera_at({0.33f, 1.21f, 3.47f}), scratch);
+  const std::size_t cells = step.stats.grid_samples + step.stats.reused_cells;
+  const Diff d = diff_on(step, {});
+  const double gi = d.gi;
+  std::printf("a 4 cm step: %zu of %zu cells reused; mean |reused - decoded| %.3g (mean GI on them %.4f)\n", step.stats.reused_cells,
+              cells, d.mean, gi);
+  EXPECT_GE(step.stats.reused_cells, cells * 35 / 100) << "expected most of the reuse colour to reproject";
+  EXPECT_LT(d.mean, 0.02 * gi) << "expected within 2 % of the mean GI on average";
+  const Lit::Frame cut = lit.frame(transform::Similarity{.translation = {-3.0f, 2.5f, -1.0f},
+                                                         .rotation = glm::angleAxis(-1.9f, glm::vec3(0, 1, 0))},
+                                   scratch);
+  const std::size_t cut_cells = cut.stats.grid_samples + cut.stats.reused_cells;
+  const Diff cut_diff = diff_on(cut, {});
+  const double cut_gi = cut_diff.gi;
+  std::printf("a cut: %zu of %zu cells reused; mean |reused - decoded| %.3g, max %.3g (mean GI %.4f)\n", cut.stats.reused_cells,
+              cut_cells, cut_diff.mean, cut_diff.max, cut_gi);
+  EXPECT_LT(cut.stats.reused_cells, cut_cells / 2) << "a cut cannot reuse half its cells";
+  EXPECT_LT(cut_diff.mean, 0.02 * cut_gi) << "expected within 2 % of the mean GI on average";
 }

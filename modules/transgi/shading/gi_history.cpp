@@ -61,26 +61,50 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
       object_of_cell_[c] = last_index;
     }
   }
-  // Per object in view: to its own frame now, and where it was last frame
-  // (its number then), if it was in view.
+  // Per object in view, as matrices so a cell costs a few multiply-adds:
+  // from a cell's camera-space direction (sx, sy, -1) and depth to the point
+  // in the object's frame (c0 + depth / |dir| A dir); the world normal into
+  // that frame; and, if the object was in view last frame (its number then),
+  // from that point to last frame's camera space (prev_m p + prev_t).
   struct Motion {
-    Similarity to_object, prev_to_world;
+    glm::mat3 a{1.0f}, normal{1.0f}, prev_m{1.0f};
+    glm::vec3 c0{0.0f}, prev_t{0.0f};
+    float to_object_scale = 1.0f;
     std::uint32_t prev_object = kNoObject;
   };
   const bool comparable = g.camera && prev_.camera && prev_.grid_w == up.grid_w && prev_.grid_h == up.grid_h &&
                           prev_.width == up.width && prev_.height == up.height && prev_.key.size() == cells;
+  if (!g.camera) return;  // nothing to place the cells with: every cell is decoded
+  const engine::render::CameraRays& cam = *g.camera;
+  const glm::mat3 cam_rotation = glm::mat3_cast(cam.to_world().rotation);
   std::vector<Motion> motion(cur_.objects.size());
   for (std::size_t k = 0; k < motion.size(); ++k) {
-    motion[k].to_object = cur_.objects[k].second.inverse();
+    Motion& m = motion[k];
+    const Similarity& to_world = cur_.objects[k].second;
+    m.normal = glm::mat3_cast(glm::conjugate(to_world.rotation));
+    m.to_object_scale = 1.0f / to_world.scale;
+    m.a = m.to_object_scale * (m.normal * cam_rotation);
+    m.c0 = m.to_object_scale * (m.normal * (cam.position() - to_world.translation));
     for (std::size_t q = 0; comparable && q < prev_.objects.size(); ++q)
       if (prev_.objects[q].first == cur_.objects[k].first) {
-        motion[k].prev_object = static_cast<std::uint32_t>(q);
-        motion[k].prev_to_world = prev_.objects[q].second;
+        const Similarity& prev_to_world = prev_.objects[q].second;
+        const glm::mat3 prev_camera_from_world = glm::transpose(glm::mat3_cast(prev_.camera->to_world().rotation));
+        m.prev_object = static_cast<std::uint32_t>(q);
+        m.prev_m = prev_to_world.scale * (prev_camera_from_world * glm::mat3_cast(prev_to_world.rotation));
+        m.prev_t = prev_camera_from_world * (prev_to_world.translation - prev_.camera->position());
       }
   }
-  const float spread = g.camera ? g.camera->pixel_spread() : 0.0f;
+  const float spread = cam.pixel_spread();
   const float cell_pixels = std::max(up.sx, up.sy);
   const unsigned parity = static_cast<unsigned>(frame_ & 1);
+  // Film to camera space now, and last frame's camera space to its cells.
+  const float dx = 2.0f * cam.tan_half_x() / static_cast<float>(cam.width()), dy = -2.0f * cam.tan_half_y() / static_cast<float>(cam.height());
+  const float x0 = -cam.tan_half_x(), y0 = cam.tan_half_y();
+  const float prev_kx = comparable ? 0.5f * static_cast<float>(prev_.camera->width()) / prev_.camera->tan_half_x() / prev_.sx : 0.0f;
+  const float prev_ky = comparable ? 0.5f * static_cast<float>(prev_.camera->height()) / prev_.camera->tan_half_y() / prev_.sy : 0.0f;
+  const float prev_u0 = comparable ? 0.5f * static_cast<float>(prev_.camera->width()) / prev_.sx - 0.5f : 0.0f;
+  const float prev_v0 = comparable ? 0.5f * static_cast<float>(prev_.camera->height()) / prev_.sy - 0.5f : 0.0f;
+  const std::size_t width = static_cast<std::size_t>(g.width);
   auto body = [&](std::size_t b, std::size_t e_end) {
     for (std::size_t c = b; c < e_end; ++c) {
       Key& key = cur_.key[c];
@@ -94,25 +118,25 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
       // cells' 16-byte guides are in cache, their GSamples far apart.
       const glm::vec4& guide = up.cell_guide[c];
       const std::size_t pixel = up.cell_pixel[c];
-      const engine::rt::Ray ray = g.camera->generate({static_cast<float>(pixel % static_cast<std::size_t>(g.width)) + 0.5f,
-                                                      static_cast<float>(pixel / static_cast<std::size_t>(g.width)) + 0.5f});
+      const glm::vec3 dir(x0 + dx * (static_cast<float>(pixel % width) + 0.5f), y0 + dy * (static_cast<float>(pixel / width) + 0.5f), -1.0f);
       const float depth = guide.w;
-      const glm::vec3 p_obj = m.to_object.apply_point(ray.origin + depth * ray.direction);
-      const glm::vec3 n_obj = m.to_object.apply_direction(glm::vec3(guide));
+      const glm::vec3 p_obj = m.c0 + (depth / std::sqrt(glm::dot(dir, dir))) * (m.a * dir);
+      const glm::vec3 n_obj = m.normal * glm::vec3(guide);
       key.object_position = p_obj;
       key.object = object;
       for (int a = 0; a < 3; ++a) key.normal[a] = static_cast<std::int16_t>(std::clamp(n_obj[a], -1.0f, 1.0f) * kNormalScale);  // truncation: 3e-5 off at most
       key.fresh = 0;
       const int i = static_cast<int>(c % static_cast<std::size_t>(up.grid_w)), j = static_cast<int>(c / static_cast<std::size_t>(up.grid_w));
       if (m.prev_object == kNoObject || ((static_cast<unsigned>(i + j) + parity) & 1) == 0) continue;  // this frame's colour: decoded
-      const std::optional<glm::vec2> film = prev_.camera->project(m.prev_to_world.apply_point(p_obj));
-      if (!film) continue;
-      // The previous cells around the film point (cell centres at integers).
-      const float u = film->x / prev_.sx - 0.5f, v = film->y / prev_.sy - 0.5f;
+      const glm::vec3 local = m.prev_m * p_obj + m.prev_t;
+      if (!(local.z < 0)) continue;  // behind last frame's camera
+      // The previous cells around where the point was seen (cell centres at integers).
+      const float inv = -1.0f / local.z;
+      const float u = prev_u0 + prev_kx * local.x * inv, v = prev_v0 - prev_ky * local.y * inv;
       if (!(u > -1.0f && v > -1.0f && u < static_cast<float>(prev_.grid_w) && v < static_cast<float>(prev_.grid_h))) continue;
       const int i0 = static_cast<int>(u + 1.0f) - 1, j0 = static_cast<int>(v + 1.0f) - 1;  // floor, as u, v > -1
       // Within a cell's footprint at the point's depth, in object units.
-      const float reach = depth * spread * cell_pixels * m.to_object.scale;
+      const float reach = depth * spread * cell_pixels * m.to_object_scale;
       float best = reach * reach;
       std::int32_t pick = kDecode;
       for (int dj = 0; dj < 2; ++dj)
