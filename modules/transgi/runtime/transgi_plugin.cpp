@@ -144,10 +144,14 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
     batched_direct = shading::shade_direct_realtime(packed.gbuffer, rt, lights, rays, &frame.direct_stats, tracer);
   const shading::GBuffer& g = packed.gbuffer;
   frame.times.gbuffer = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  // The direct light of punctual lights and the sun first: the probes' share
+  // is added to it as the GI is upsampled.
+  t0 = std::chrono::steady_clock::now();
+  if (deterministic) frame.direct = direct ? direct->take(&frame.direct_stats) : std::move(*batched_direct);
+  const double take_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   shading::RealtimeGiStats st;
-  image::ImageRGB probe_direct;
   frame.gi = shading::shade_gi_realtime(g, rt, assets, model.get(), model ? packed.decoder.get() : nullptr, has_transfer, fields,
-                                        settings.realtime, &st, deterministic ? &probe_direct : nullptr, &packed.scratch, &lights, settings.mirror,
+                                        settings.realtime, &st, deterministic ? &frame.direct : nullptr, &packed.scratch, &lights, settings.mirror,
                                         settings.near_field);
   GiStageTimes& t = frame.times;
   t.network_input = 0;  // inside the fused kernel, counted as inference
@@ -158,14 +162,10 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   frame.inferred_samples = st.inferred;
   frame.realtime = st;
 
-  if (deterministic) {
-    t0 = std::chrono::steady_clock::now();
-    frame.direct = direct ? direct->take(&frame.direct_stats) : std::move(*batched_direct);
-    shading::add_image(frame.direct, probe_direct);
-    t.direct = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  } else {
+  if (deterministic)
+    t.direct = take_ms;
+  else
     add_stochastic_direct(rt, lights, rays, settings.direct_spp, seed, frame);
-  }
   compose_full(frame);
 }
 

@@ -186,7 +186,9 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
                                           const NearFieldRays& near_field) {
   RealtimeGiStats stats;
   engine::image::ImageRGB image(g.width, g.height);
-  if (direct_out) *direct_out = engine::image::ImageRGB(g.width, g.height);
+  // The probes' direct light is added to what direct_out holds (the rest of
+  // the frame's direct light): one pass over it, not an image and a sum.
+  if (direct_out && (direct_out->width != g.width || direct_out->height != g.height)) *direct_out = engine::image::ImageRGB(g.width, g.height);
   if (fields.empty() || g.samples.empty()) {
     if (stats_out) *stats_out = stats;
     return image;
@@ -415,7 +417,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
         if (up.kind[p] == UpsamplingPlan::kMiss) continue;
         if (up.kind[p] == UpsamplingPlan::kOwn) {
           image.pixels[p] = value[slot_of_pixel[p]];
-          if (with_direct) direct_out->pixels[p] = value_direct[slot_of_pixel[p]];
+          if (with_direct) direct_out->pixels[p] += value_direct[slot_of_pixel[p]];
           continue;
         }
         glm::vec3 sum(0.0f), sum_direct(0.0f);
@@ -427,7 +429,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
           if (with_direct) sum_direct += w * value_direct[slot];
         }
         image.pixels[p] = sum;
-        if (with_direct) direct_out->pixels[p] = sum_direct;
+        if (with_direct) direct_out->pixels[p] += sum_direct;
       }
   });
   stats.upsample_ms = plan_ms + ms_since(t0);

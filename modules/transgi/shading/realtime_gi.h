@@ -124,8 +124,10 @@ struct RealtimeGiStats {
 // which has_transfer is false, or all of them if model is null, are shaded
 // diffusely: albedo / pi x irradiance. With direct_out, the probes' direct
 // sky and emitter light goes through the same transfer (or irradiance) and
-// upsampling into it: the real-time direct light from everything but
-// punctual lights and the split sun (see realtime_direct.h). With
+// upsampling and is added to it (an image of g's size holding the rest of
+// the direct light, or else made one of zeros): the real-time direct light
+// from everything but punctual lights and the split sun (see
+// realtime_direct.h). With
 // near_field.rays > 0, each decoded grid cell also gets the near field's
 // contact light (near_field.h; mirror_lights light its hits), filtered over
 // the grid; edge pixels decoded on their own do not.
