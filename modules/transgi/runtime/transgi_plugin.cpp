@@ -249,10 +249,13 @@ TransGISettings realtime_preset() {
   TransGISettings s;
   s.gi_path = GiPath::Realtime;
   s.gbuffer_spp = 1;
-  // 50x25 maps and 192 probes a frame: on the sample level with an object
-  // moving, GI RMSE 0.0092 against 0.0206 for 100x50 maps and 128 probes,
-  // for less probe time (docs/performance.md); docs/results.md found 50x25 on
-  // the Pareto front already.
+  // 50x25 maps: on the sample level with an object moving, GI RMSE 0.0092
+  // against 0.0206 for 100x50 maps and 128 probes, for less probe time
+  // (docs/performance.md); docs/results.md found 50x25 on the Pareto front.
+  // 128 probes a frame after 24 frames that update all of them (a level
+  // starts converged): 0.00954, as good as 192 probes, 4 ms sooner; and half
+  // the GI cells decoded a frame, the rest reused (docs/performance.md,
+  // 2026-11-24 afternoon).
   s.probes.map = probes::MapLayout{50, 25};
   s.probes.update_budget = 128;
   s.probes.settle_frames = 24;
