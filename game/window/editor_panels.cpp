@@ -161,6 +161,7 @@ void EditorUi::gi_settings() {
   changed |= ImGui::SliderFloat("depth tolerance", &edit.realtime.depth_tolerance, 0.01f, 0.5f, "%.2f");
   changed |= ImGui::SliderInt("normal power", &edit.realtime.normal_power, 1, 64);
   changed |= ImGui::Checkbox("edge-aware upsampling", &edit.realtime.edge_aware);
+  changed |= ImGui::Checkbox("reuse last frame's GI (checkerboard)", &edit.realtime.reuse_history);
   changed |= ImGui::SliderInt("probe budget / frame", &edit.probes.update_budget, 0, 512);
   if (changed) *s = edit;
   // The backend at run time (issue 12): Vulkan, lavapipe where there is no GPU.
