@@ -118,26 +118,22 @@ TEST(ProbeBudget, AChangedRegionIsUpdatedFirst) {
 // probes traced the same rays), so the settling is a full update.
 TEST(ProbeBudget, SettlingFramesTraceEveryProbeThenTheBudgetHolds) {
   BudgetFloor floor(0.5f);
-  FloorUnderSky& s = floor.scene;
-  const auto& rt = floor.rt();
-  const render::LightSet& lights = floor.lights;
   ProbeFieldSettings settings = floor.settings();
   settings.skip.skip_converged = false;
-  settings.update_budget = 0;
-  ProbeField unbudgeted(settings);
+  ProbeField unbudgeted(settings);  // no budget
   settings.update_budget = 5;
   settings.settle_frames = 3;
   ProbeField settled(settings);
-  s.app.jobs().run([&] {
+  floor.scene.app.jobs().run([&] {
     for (int f = 0; f < 3; ++f) {
-      EXPECT_EQ(settled.update(rt, lights).traced, 32) << "settling frame " << f;
-      unbudgeted.update(rt, lights);
+      EXPECT_EQ(settled.update(floor.rt(), floor.lights).traced, 32) << "settling frame " << f;
+      unbudgeted.update(floor.rt(), floor.lights);
     }
   });
   for (int p = 0; p < 32; ++p)
     for (int k = 0; k < 75; ++k)
       ASSERT_EQ(settled.light_sh(p)[k], unbudgeted.light_sh(p)[k]) << "probe " << p << " value " << k;
-  s.app.jobs().run([&] {
-    for (int f = 3; f < 8; ++f) EXPECT_EQ(settled.update(rt, lights).traced, 5) << "frame " << f << " is past the settling";
+  floor.scene.app.jobs().run([&] {
+    for (int f = 3; f < 8; ++f) EXPECT_EQ(settled.update(floor.rt(), floor.lights).traced, 5) << "frame " << f << " is past the settling";
   });
 }
