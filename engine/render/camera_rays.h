@@ -13,7 +13,7 @@ namespace engine::render {
 struct CameraRays {
   CameraRays(const scene::Camera& camera, const transform::Similarity& to_world, int width, int height);
   // film = pixel coordinates with sub-pixel offset, e.g. (x + 0.5, y + 0.5).
-  // Inline: the G-buffer and the GI history call it once per pixel.
+  // Inline: the G-buffer calls it once per pixel.
   [[nodiscard]] rt::Ray generate(glm::vec2 film) const {
     const float sx = (2.0f * film.x / static_cast<float>(width_) - 1.0f) * tan_half_x_;
     const float sy = (1.0f - 2.0f * film.y / static_cast<float>(height_)) * tan_half_y_;
