@@ -7,11 +7,23 @@
 #include "engine/gpu/vulkan_context.h"
 
 namespace engine::gpu {
+namespace {
 
-GpuBuffer::GpuBuffer(VulkanContext& ctx, std::size_t bytes) : device_(ctx.device()), bytes_(bytes < 4 ? 4 : bytes) {
+void memory_barrier(VkCommandBuffer cmd, VkPipelineStageFlags src_stage, VkAccessFlags src, VkPipelineStageFlags dst_stage,
+                    VkAccessFlags dst) {
+  VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  b.srcAccessMask = src;
+  b.dstAccessMask = dst;
+  vkCmdPipelineBarrier(cmd, src_stage, dst_stage, 0, 1, &b, 0, nullptr, 0, nullptr);
+}
+
+}  // namespace
+
+GpuBuffer::GpuBuffer(VulkanContext& ctx, std::size_t bytes, Placement placement)
+    : ctx_(&ctx), device_(ctx.device()), bytes_(bytes < 4 ? 4 : bytes) {
   VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   bci.size = bytes_;
-  bci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  bci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   ENGINE_VK_CHECK(vkCreateBuffer(device_, &bci, nullptr, &buffer_));
   try {
@@ -19,11 +31,24 @@ GpuBuffer::GpuBuffer(VulkanContext& ctx, std::size_t bytes) : device_(ctx.device
     vkGetBufferMemoryRequirements(device_, buffer_, &req);
     VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     mai.allocationSize = req.size;
-    mai.memoryTypeIndex =
-        ctx.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-    ENGINE_VK_CHECK(vkAllocateMemory(device_, &mai, nullptr, &memory_));
+    const auto types = ctx.buffer_memory_types(req.memoryTypeBits, placement == Placement::Mapped);
+    if (types.empty()) throw GpuError("no Vulkan memory type for a storage buffer on " + ctx.info().name);
+    // A small BAR heap (256 MB without resizable BAR) fills up: the next
+    // type, host memory, still works, only slower.
+    VkResult r = VK_ERROR_OUT_OF_DEVICE_MEMORY;
+    for (std::size_t t = 0; t < types.size() && r != VK_SUCCESS; ++t) {
+      mai.memoryTypeIndex = types[t];
+      r = vkAllocateMemory(device_, &mai, nullptr, &memory_);
+      if (r != VK_SUCCESS && r != VK_ERROR_OUT_OF_DEVICE_MEMORY && r != VK_ERROR_OUT_OF_HOST_MEMORY) break;
+    }
+    if (r != VK_SUCCESS) throw GpuError("vkAllocateMemory of " + std::to_string(req.size) + " bytes failed: " + vk_result_name(r));
     ENGINE_VK_CHECK(vkBindBufferMemory(device_, buffer_, memory_, 0));
-    ENGINE_VK_CHECK(vkMapMemory(device_, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_));
+    VkPhysicalDeviceMemoryProperties mem;
+    vkGetPhysicalDeviceMemoryProperties(ctx.physical_device(), &mem);
+    constexpr VkMemoryPropertyFlags kMappable = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    const bool stage = placement == Placement::DeviceOnly && ctx.info().stage_device_only;
+    if ((mem.memoryTypes[mai.memoryTypeIndex].propertyFlags & kMappable) == kMappable && !stage)
+      ENGINE_VK_CHECK(vkMapMemory(device_, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_));
   } catch (...) {
     release();
     throw;
@@ -37,6 +62,7 @@ GpuBuffer::GpuBuffer(GpuBuffer&& o) noexcept { *this = std::move(o); }
 GpuBuffer& GpuBuffer::operator=(GpuBuffer&& o) noexcept {
   if (this != &o) {
     release();
+    ctx_ = std::exchange(o.ctx_, nullptr);
     device_ = std::exchange(o.device_, VK_NULL_HANDLE);
     buffer_ = std::exchange(o.buffer_, VK_NULL_HANDLE);
     memory_ = std::exchange(o.memory_, VK_NULL_HANDLE);
@@ -59,12 +85,41 @@ void GpuBuffer::release() {
 
 void GpuBuffer::write_bytes(const void* src, std::size_t n) {
   if (n > bytes_) throw GpuError("GpuBuffer: upload of " + std::to_string(n) + " bytes into " + std::to_string(bytes_));
-  if (n) std::memcpy(mapped_, src, n);
+  if (!n) return;
+  if (mapped_) {
+    std::memcpy(mapped_, src, n);
+    return;
+  }
+  GpuBuffer staging(*ctx_, n);
+  std::memcpy(staging.mapped_, src, n);
+  const VkBufferCopy region{0, 0, n};
+  ctx_->submit_and_wait([&](VkCommandBuffer cmd) {
+    vkCmdCopyBuffer(cmd, staging.buffer_, buffer_, 1, &region);
+    // Later submissions' kernels and copies see the data.
+    memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                   VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT);
+  });
 }
 
 void GpuBuffer::read_bytes(void* dst, std::size_t n) const {
   if (n > bytes_) throw GpuError("GpuBuffer: download of " + std::to_string(n) + " bytes from " + std::to_string(bytes_));
-  if (n) std::memcpy(dst, mapped_, n);
+  if (!n) return;
+  if (mapped_) {
+    std::memcpy(dst, mapped_, n);
+    return;
+  }
+  GpuBuffer staging(*ctx_, n);
+  const VkBufferCopy region{0, 0, n};
+  ctx_->submit_and_wait([&](VkCommandBuffer cmd) {
+    memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                   VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                   VK_ACCESS_TRANSFER_READ_BIT);
+    vkCmdCopyBuffer(cmd, buffer_, staging.buffer_, 1, &region);
+    memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+                   VK_ACCESS_HOST_READ_BIT);
+  });
+  std::memcpy(dst, staging.mapped_, n);
 }
 
 }  // namespace engine::gpu

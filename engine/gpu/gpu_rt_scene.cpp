@@ -20,11 +20,16 @@ std::filesystem::path engine_shader_dir() {
 }
 
 template <class T>
-void upload_to(VulkanContext& ctx, GpuBuffer& b, const std::vector<T>& v) {
+void upload_to(VulkanContext& ctx, GpuBuffer& b, const std::vector<T>& v,
+               GpuBuffer::Placement placement = GpuBuffer::Placement::Mapped) {
   const std::size_t bytes = v.size() * sizeof(T);
-  if (b.handle() == VK_NULL_HANDLE || b.size() < bytes) b = GpuBuffer(ctx, bytes);
+  if (b.handle() == VK_NULL_HANDLE || b.size() < bytes) b = GpuBuffer(ctx, bytes, placement);
   b.upload(std::span<const T>(v));
 }
+
+// Every ray reads the scene many times and the CPU changes it at most once a
+// frame (the TLAS): device memory, not a PCIe fetch per node.
+constexpr GpuBuffer::Placement kStatic = GpuBuffer::Placement::DeviceOnly;
 
 }  // namespace
 
@@ -107,14 +112,14 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
     if (alpha_materials.empty()) alpha_materials.push_back({});
     if (alpha_textures.empty()) alpha_textures.push_back({});
     if (alpha_bytes.empty()) alpha_bytes.push_back(0);
-    upload_to(ctx_, triangle_uvs_, uvs);
-    upload_to(ctx_, alpha_materials_, alpha_materials);
-    upload_to(ctx_, alpha_bytes_, alpha_bytes);
-    upload_to(ctx_, alpha_textures_, alpha_textures);
+    upload_to(ctx_, triangle_uvs_, uvs, kStatic);
+    upload_to(ctx_, alpha_materials_, alpha_materials, kStatic);
+    upload_to(ctx_, alpha_bytes_, alpha_bytes, kStatic);
+    upload_to(ctx_, alpha_textures_, alpha_textures, kStatic);
     if (nodes.empty()) nodes.push_back(to_gpu(rt::BvhNode{}));
     if (tris.empty()) tris.push_back({});
-    upload_to(ctx_, blas_, nodes);
-    upload_to(ctx_, triangles_, tris);
+    upload_to(ctx_, blas_, nodes, kStatic);
+    upload_to(ctx_, triangles_, tris, kStatic);
     stats_.blas_nodes = nodes.size();
     stats_.triangles = tris.size();
   }
@@ -142,8 +147,8 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
                          rt_[1][2], rt_[2][2], off.z, blas_root_[r.mesh], triangle_offset_[r.mesh], ids[item], r.mesh});
   }
   if (instances.empty()) instances.push_back({});
-  upload_to(ctx_, tlas_, nodes);
-  upload_to(ctx_, instances_, instances);
+  upload_to(ctx_, tlas_, nodes, kStatic);
+  upload_to(ctx_, instances_, instances, kStatic);
   stats_.tlas_nodes = nodes.size();
   stats_.instances = live.size();
 }

@@ -1,5 +1,6 @@
 #include "engine/gpu/vulkan_context.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -125,6 +126,24 @@ std::unique_ptr<VulkanContext> VulkanContext::create(const GpuOptions& options, 
   ctx->info_.driver = std::string(p12.driverName) + " " + p12.driverInfo;
   ctx->info_.shader_float16 = f12.shaderFloat16 == VK_TRUE;
   ctx->info_.max_shared_memory = props.limits.maxComputeSharedMemorySize;
+  ctx->info_.buffer_memory = options.buffer_memory;
+  ctx->info_.stage_device_only = options.stage_device_only;
+  VkPhysicalDeviceMemoryProperties mem;
+  vkGetPhysicalDeviceMemoryProperties(ctx->physical_, &mem);
+  for (std::uint32_t i = 0; i < mem.memoryTypeCount; ++i) {
+    const VkMemoryPropertyFlags f = mem.memoryTypes[i].propertyFlags;
+    constexpr VkMemoryPropertyFlags kWanted =
+        VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    if ((f & kWanted) == kWanted)
+      ctx->info_.mappable_device_local_bytes =
+          std::max<std::uint64_t>(ctx->info_.mappable_device_local_bytes, mem.memoryHeaps[mem.memoryTypes[i].heapIndex].size);
+  }
+  if (const char* env = std::getenv("ENGINE_GPU_MEMORY")) {
+    if (std::strcmp(env, "cached") == 0) ctx->info_.buffer_memory = BufferMemory::Cached;
+    else if (std::strcmp(env, "write-combined") == 0) ctx->info_.buffer_memory = BufferMemory::WriteCombined;
+    else if (std::strcmp(env, "bar") == 0) ctx->info_.buffer_memory = BufferMemory::Bar;
+    else return fail(std::string("ENGINE_GPU_MEMORY=") + env + ": expected cached, write-combined or bar");
+  }
 
   // Enable only what the kernels use, so a device without float16 still runs
   // the fp32 variants.
@@ -190,6 +209,45 @@ std::uint32_t VulkanContext::memory_type(std::uint32_t type_bits, VkMemoryProper
   for (std::uint32_t i = 0; i < mem.memoryTypeCount; ++i)
     if ((type_bits & (1u << i)) && (mem.memoryTypes[i].propertyFlags & flags) == flags) return i;
   throw GpuError("no Vulkan memory type with flags " + std::to_string(flags) + " on " + info_.name);
+}
+
+std::string describe(const DeviceInfo& info) {
+  const char* buffers = info.buffer_memory == BufferMemory::Cached          ? "cached host"
+                        : info.buffer_memory == BufferMemory::WriteCombined ? "write-combined host"
+                                                                            : "BAR device-local";
+  char bar[64] = "none";
+  if (info.mappable_device_local_bytes > 0)
+    std::snprintf(bar, sizeof bar, "%.1f GiB", static_cast<double>(info.mappable_device_local_bytes) / (1u << 30));
+  return "vulkan (" + info.name + "; " + info.driver + "; mapped buffers: " + buffers + "; mappable device-local heap: " +
+         bar + ")";
+}
+
+std::vector<std::uint32_t> VulkanContext::buffer_memory_types(std::uint32_t type_bits, bool mapped) const {
+  VkPhysicalDeviceMemoryProperties mem;
+  vkGetPhysicalDeviceMemoryProperties(physical_, &mem);
+  constexpr VkMemoryPropertyFlags kMappable = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  // Lower rank = better; -1 = unusable.
+  auto rank = [&](VkMemoryPropertyFlags f) -> int {
+    const bool mappable = (f & kMappable) == kMappable;
+    const bool local = f & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+    const bool cached = f & VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
+    if (!mapped) return local ? (mappable ? 1 : 0) : 2;
+    if (!mappable) return -1;
+    switch (info_.buffer_memory) {
+      case BufferMemory::Cached: return (cached ? 0 : 2) + (local ? 1 : 0);
+      case BufferMemory::WriteCombined: return (cached ? 2 : 0) + (local ? 1 : 0);
+      case BufferMemory::Bar: return (local ? 0 : 2) + (cached ? 1 : 0);
+    }
+    return -1;
+  };
+  std::vector<std::pair<int, std::uint32_t>> ranked;
+  for (std::uint32_t i = 0; i < mem.memoryTypeCount; ++i)
+    if (type_bits & (1u << i))
+      if (const int r = rank(mem.memoryTypes[i].propertyFlags); r >= 0) ranked.emplace_back(r, i);
+  std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<std::uint32_t> out;
+  for (const auto& [r, i] : ranked) out.push_back(i);
+  return out;
 }
 
 double VulkanContext::submit_and_wait(const std::function<void(VkCommandBuffer)>& record) {

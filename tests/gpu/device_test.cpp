@@ -100,6 +100,30 @@ TEST(GpuBuffer, RoundTripsBytesAndRefusesAnOversizedUpload) {
   EXPECT_THROW(b.upload(std::span<const float>(big)), GpuError);
 }
 
+// A discrete GPU's path: device memory the CPU cannot map, written and read
+// through staging copies (forced here, since lavapipe maps everything).
+TEST(GpuBuffer, ADeviceOnlyBufferRoundTripsThroughStagingCopies) {
+  std::string why;
+  VulkanContext* ctx = gpu_test::staging_context(&why);
+  if (!ctx) GTEST_SKIP() << "no Vulkan device: " << why;
+  GpuBuffer b(*ctx, 1000 * sizeof(std::uint32_t), GpuBuffer::Placement::DeviceOnly);
+  std::vector<std::uint32_t> in(1000), out(1000, 0u);
+  for (std::uint32_t i = 0; i < 1000; ++i) in[i] = i * 2654435761u;
+  b.upload(std::span<const std::uint32_t>(in));
+  b.download(std::span<std::uint32_t>(out));
+  EXPECT_EQ(in, out);
+  // A shorter upload changes only its prefix.
+  const std::vector<std::uint32_t> head = {7u, 8u, 9u};
+  b.upload(std::span<const std::uint32_t>(head));
+  b.download(std::span<std::uint32_t>(out));
+  EXPECT_EQ(out[0], 7u);
+  EXPECT_EQ(out[2], 9u);
+  EXPECT_EQ(out[3], in[3]);
+  std::vector<std::uint32_t> big(1001);
+  EXPECT_THROW(b.upload(std::span<const std::uint32_t>(big)), GpuError);
+  EXPECT_EQ(ctx->validation_errors(), 0);
+}
+
 TEST(VulkanContext, SaysWhichDeviceItRunsOnAndWhetherValidationIsOn) {
   GPU_TEST_CONTEXT_OR_SKIP(ctx);
   const auto& info = ctx->info();

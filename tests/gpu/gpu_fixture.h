@@ -23,6 +23,20 @@ inline engine::gpu::VulkanContext* context(std::string* why) {
   return ctx.get();
 }
 
+// A second context whose DeviceOnly buffers always go through staging
+// copies (GpuOptions::stage_device_only), as on a discrete GPU.
+inline engine::gpu::VulkanContext* staging_context(std::string* why) {
+  static std::string why_not;
+  static std::unique_ptr<engine::gpu::VulkanContext> ctx = [] {
+    engine::gpu::GpuOptions options;
+    options.validation = true;
+    options.stage_device_only = true;
+    return engine::gpu::VulkanContext::create(options, &why_not);
+  }();
+  *why = why_not;
+  return ctx.get();
+}
+
 }  // namespace gpu_test
 
 #define GPU_TEST_CONTEXT_OR_SKIP(name)                                   \

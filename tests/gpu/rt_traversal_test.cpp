@@ -221,8 +221,9 @@ TEST(GpuRtTraversal, AnyHitShadowRaysGiveEmbreesOccludedAnswers) {
 }
 
 // Moving an instance needs only a sync (no BLAS rebuild), and the hits follow.
-TEST(GpuRtTraversal, AMovedInstanceIsFoundWhereItMovedAfterASync) {
-  GPU_TEST_CONTEXT_OR_SKIP(ctx);
+namespace {
+
+void expect_a_moved_instance_found_where_it_moved(engine::gpu::VulkanContext* ctx) {
   RtWorld w;
   build_world(w);
   gpu::GpuRtScene gpu_rt(*ctx);
@@ -243,6 +244,23 @@ TEST(GpuRtTraversal, AMovedInstanceIsFoundWhereItMovedAfterASync) {
   EXPECT_EQ(h[0].instance, want.instance);
   EXPECT_EQ(h[0].entity, want.entity) << "a GPU hit names its entity as Embree's does";
   EXPECT_NEAR(h[0].t, want.t, 1e-4f * want.t) << "the sphere's front at z = -3.5 + 0.7";
+}
+
+}  // namespace
+
+TEST(GpuRtTraversal, AMovedInstanceIsFoundWhereItMovedAfterASync) {
+  GPU_TEST_CONTEXT_OR_SKIP(ctx);
+  expect_a_moved_instance_found_where_it_moved(ctx);
+}
+
+// The scene in device memory written through staging copies, as on a
+// discrete GPU: the TLAS re-upload after the move must land too.
+TEST(GpuRtTraversal, AMovedInstanceIsFoundThroughStagedDeviceBuffers) {
+  std::string why;
+  engine::gpu::VulkanContext* ctx = gpu_test::staging_context(&why);
+  if (!ctx) GTEST_SKIP() << "no Vulkan device: " << why;
+  expect_a_moved_instance_found_where_it_moved(ctx);
+  EXPECT_EQ(ctx->validation_errors(), 0);
 }
 
 // Alpha-masked content (foliage, blinds, fences): a quad whose 8 x 8 texture

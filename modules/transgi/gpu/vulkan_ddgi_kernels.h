@@ -15,7 +15,7 @@ namespace transgi::gpu {
 class VulkanDdgiKernels : public ddgi::DdgiKernels {
  public:
   explicit VulkanDdgiKernels(std::shared_ptr<engine::gpu::VulkanContext> ctx)
-      : ctx_(std::move(ctx)), tracer_(*ctx_), blend_(*ctx_), name_("vulkan (" + ctx_->info().name + ")") {}
+      : ctx_(std::move(ctx)), tracer_(*ctx_), blend_(*ctx_), name_(engine::gpu::describe(ctx_->info())) {}
 
   engine::rt::RayBatchTracer* tracer() override { return &tracer_; }
   void blend(std::vector<ddgi::OctahedralMap<glm::vec3>>& irradiance, std::vector<ddgi::OctahedralMap<glm::vec2>>& distance,

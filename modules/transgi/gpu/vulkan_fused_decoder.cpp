@@ -17,7 +17,7 @@ VulkanFusedDecoder::VulkanFusedDecoder(engine::gpu::VulkanContext& ctx, const mo
     throw std::invalid_argument("VulkanFusedDecoder: the kernel holds layers up to " + std::to_string(kFusedMaxWidth) +
                                 " wide with 75 outputs; got " + std::to_string(l.inputs) + " -> " +
                                 std::to_string(l.width) + " -> " + std::to_string(l.outputs));
-  params_ = engine::gpu::GpuBuffer(ctx, mlp.params().size() * sizeof(float));
+  params_ = engine::gpu::GpuBuffer(ctx, mlp.params().size() * sizeof(float), engine::gpu::GpuBuffer::Placement::DeviceOnly);
   params_.upload(std::span<const float>(mlp.params()));
   if (weights == FusedWeights::Fp16 && !ctx.info().shader_float16)
     throw engine::gpu::GpuError("VulkanFusedDecoder: fp16 weights asked for, but " + ctx.info().name + " has no shaderFloat16");

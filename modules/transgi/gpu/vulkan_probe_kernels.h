@@ -18,7 +18,7 @@ namespace transgi::gpu {
 class VulkanProbeKernels : public probes::ProbeKernels {
  public:
   explicit VulkanProbeKernels(std::shared_ptr<engine::gpu::VulkanContext> ctx)
-      : ctx_(std::move(ctx)), tracer_(*ctx_), name_("vulkan (" + ctx_->info().name + ")") {}
+      : ctx_(std::move(ctx)), tracer_(*ctx_), name_(engine::gpu::describe(ctx_->info())) {}
 
   probes::SharingStats rasterize(const probes::ProbeGrid& grid, const probes::MapLayout& layout,
                                  const std::vector<std::vector<probes::ShadedPoint>>& points,

@@ -13,7 +13,7 @@ VulkanShProjector::VulkanShProjector(engine::gpu::VulkanContext& ctx, const prob
     : ctx_(ctx), texels_(projector.layout().texel_count()) {
   static_assert(engine::math::kShCount == static_cast<int>(kShCoefficients));
   const auto& b = projector.basis_integrals();
-  basis_ = engine::gpu::GpuBuffer(ctx, b.size() * kShCoefficients * sizeof(float));
+  basis_ = engine::gpu::GpuBuffer(ctx, b.size() * kShCoefficients * sizeof(float), engine::gpu::GpuBuffer::Placement::DeviceOnly);
   basis_.upload(std::span<const float>(b.front().data(), b.size() * kShCoefficients));
   pipeline_ = std::make_unique<engine::gpu::ComputePipeline>(ctx, compile_module_shader("sh_projection.comp"), 3,
                                                               static_cast<std::uint32_t>(sizeof(ProjectPush)));
