@@ -83,6 +83,11 @@ void GpuBuffer::release() {
   mapped_ = nullptr;
 }
 
+void GpuBuffer::check_mapped(std::size_t bytes) const {
+  if (!mapped_) throw GpuError("GpuBuffer: mapped_as on a buffer the CPU cannot map");
+  if (bytes > bytes_) throw GpuError("GpuBuffer: mapped_as of " + std::to_string(bytes) + " bytes in " + std::to_string(bytes_));
+}
+
 void GpuBuffer::write_bytes(const void* src, std::size_t n) {
   if (n > bytes_) throw GpuError("GpuBuffer: upload of " + std::to_string(n) + " bytes into " + std::to_string(bytes_));
   if (!n) return;
@@ -115,9 +120,7 @@ void GpuBuffer::read_bytes(void* dst, std::size_t n) const {
     memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                    VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                    VK_ACCESS_TRANSFER_READ_BIT);
-    vkCmdCopyBuffer(cmd, buffer_, staging.buffer_, 1, &region);
-    memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
-                   VK_ACCESS_HOST_READ_BIT);
+    vkCmdCopyBuffer(cmd, buffer_, staging.buffer_, 1, &region);  // submit_and_wait makes it visible to the host
   });
   std::memcpy(dst, staging.mapped_, n);
 }

@@ -32,6 +32,14 @@ class GpuBuffer {
 
   [[nodiscard]] VkBuffer handle() const { return buffer_; }
   [[nodiscard]] std::size_t size() const { return bytes_; }
+  // The mapped memory as `count` T's, for callers that fill or read it in
+  // parallel without a copy. Throws GpuError on an unmapped buffer or one
+  // too small.
+  template <class T>
+  [[nodiscard]] std::span<T> mapped_as(std::size_t count) const {
+    check_mapped(count * sizeof(T));
+    return {static_cast<T*>(mapped_), count};
+  }
 
   // Throws GpuError if the data does not fit. On an unmapped DeviceOnly
   // buffer each call is a staging copy that waits for the queue: never call
@@ -45,6 +53,7 @@ class GpuBuffer {
   void write_bytes(const void* src, std::size_t n);
   void read_bytes(void* dst, std::size_t n) const;
   void release();
+  void check_mapped(std::size_t bytes) const;
 
   VulkanContext* ctx_ = nullptr;
   VkDevice device_ = VK_NULL_HANDLE;

@@ -4,6 +4,7 @@
 
 #include "engine/gpu/gpu_error.h"
 #include "engine/gpu/shader_compiler.h"
+#include "engine/jobs/parallel_for.h"
 #include "engine/rt/bvh_builder.h"
 #include "rt_shared.h"
 
@@ -30,6 +31,7 @@ void upload_to(VulkanContext& ctx, GpuBuffer& b, const std::vector<T>& v,
 // Every ray reads the scene many times and the CPU changes it at most once a
 // frame (the TLAS): device memory, not a PCIe fetch per node.
 constexpr GpuBuffer::Placement kStatic = GpuBuffer::Placement::DeviceOnly;
+constexpr std::size_t kRaysPerTask = 4096;
 
 }  // namespace
 
@@ -165,27 +167,26 @@ void GpuRtScene::bind(ComputePipeline& pipeline, std::uint32_t first) const {
   pipeline.bind(first + 7, alpha_textures_);
 }
 
-std::vector<HitGpu> GpuRtScene::run_query(std::span<const rt::Ray> rays, bool any_hit, double* gpu_ms) {
-  std::vector<RayGpu> in(rays.size());
-  for (std::size_t i = 0; i < rays.size(); ++i) {
-    const rt::Ray& r = rays[i];
-    in[i] = {r.origin.x, r.origin.y, r.origin.z, r.tmin, r.direction.x, r.direction.y, r.direction.z, r.tmax};
-  }
-  const std::size_t hit_bytes = rays.size() * sizeof(HitGpu);
-  const bool grew = rays_.handle() == VK_NULL_HANDLE || rays_.size() < in.size() * sizeof(RayGpu);
-  upload_to(ctx_, rays_, in);
-  if (grew || hits_.size() < hit_bytes) hits_ = GpuBuffer(ctx_, hit_bytes);
+std::span<const HitGpu> GpuRtScene::run_query(std::span<const rt::Ray> rays, bool any_hit, double* gpu_ms) {
+  const std::size_t n = rays.size();
+  if (rays_.handle() == VK_NULL_HANDLE || rays_.size() < n * sizeof(RayGpu)) rays_ = GpuBuffer(ctx_, n * sizeof(RayGpu));
+  if (hits_.handle() == VK_NULL_HANDLE || hits_.size() < n * sizeof(HitGpu)) hits_ = GpuBuffer(ctx_, n * sizeof(HitGpu));
+  const std::span<RayGpu> in = rays_.mapped_as<RayGpu>(n);
+  jobs::parallel_for<std::size_t>(0, n, kRaysPerTask, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const rt::Ray& r = rays[i];
+      in[i] = {r.origin.x, r.origin.y, r.origin.z, r.tmin, r.direction.x, r.direction.y, r.direction.z, r.tmax};
+    }
+  });
   query_->bind(0, rays_);
   query_->bind(1, hits_);
   bind(*query_, 2);
-  const std::uint32_t push[2] = {static_cast<std::uint32_t>(rays.size()), any_hit ? 1u : 0u};
+  const std::uint32_t push[2] = {static_cast<std::uint32_t>(n), any_hit ? 1u : 0u};
   const double ms = ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
     query_->record_dispatch(cmd, (push[0] + kRtGroupSize - 1) / kRtGroupSize, 1, 1, push);
   });
   if (gpu_ms) *gpu_ms = ms;
-  std::vector<HitGpu> out(rays.size());
-  hits_.download(std::span<HitGpu>(out));
-  return out;
+  return hits_.mapped_as<const HitGpu>(n);
 }
 
 void GpuRtScene::intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hits, std::span<std::uint8_t> found,
@@ -194,26 +195,31 @@ void GpuRtScene::intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hit
     throw GpuError("GpuRtScene::intersect: " + std::to_string(rays.size()) + " rays, " + std::to_string(hits.size()) +
                    " hits, " + std::to_string(found.size()) + " flags");
   if (rays.empty()) return;
-  const std::vector<HitGpu> out = run_query(rays, false, gpu_ms);
-  for (std::size_t i = 0; i < rays.size(); ++i) {
-    found[i] = out[i].instance != kRtNoHit ? 1 : 0;
-    if (!found[i]) continue;
-    const rt::InstanceRecord* record = synced_ ? synced_->instance(out[i].instance) : nullptr;
-    hits[i].entity = record ? record->entity : ecs::Entity{};
-    hits[i].instance = out[i].instance;
-    hits[i].mesh = out[i].mesh;
-    hits[i].primitive = out[i].primitive;
-    hits[i].barycentric = {out[i].u, out[i].v};
-    hits[i].t = out[i].t;
-  }
+  const std::span<const HitGpu> out = run_query(rays, false, gpu_ms);
+  jobs::parallel_for<std::size_t>(0, rays.size(), kRaysPerTask, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const HitGpu h = out[i];
+      found[i] = h.instance != kRtNoHit ? 1 : 0;
+      if (!found[i]) continue;
+      const rt::InstanceRecord* record = synced_ ? synced_->instance(h.instance) : nullptr;
+      hits[i].entity = record ? record->entity : ecs::Entity{};
+      hits[i].instance = h.instance;
+      hits[i].mesh = h.mesh;
+      hits[i].primitive = h.primitive;
+      hits[i].barycentric = {h.u, h.v};
+      hits[i].t = h.t;
+    }
+  });
 }
 
 void GpuRtScene::occluded(std::span<const rt::Ray> rays, std::span<std::uint8_t> blocked, double* gpu_ms) {
   if (blocked.size() != rays.size())
     throw GpuError("GpuRtScene::occluded: " + std::to_string(rays.size()) + " rays, " + std::to_string(blocked.size()) + " flags");
   if (rays.empty()) return;
-  const std::vector<HitGpu> out = run_query(rays, true, gpu_ms);
-  for (std::size_t i = 0; i < rays.size(); ++i) blocked[i] = out[i].instance != kRtNoHit ? 1 : 0;
+  const std::span<const HitGpu> out = run_query(rays, true, gpu_ms);
+  jobs::parallel_for<std::size_t>(0, rays.size(), kRaysPerTask, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) blocked[i] = out[i].instance != kRtNoHit ? 1 : 0;
+  });
 }
 
 }  // namespace engine::gpu

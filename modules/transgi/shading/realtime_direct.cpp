@@ -1,5 +1,6 @@
 #include "shading/realtime_direct.h"
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <vector>
@@ -147,10 +148,15 @@ engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt
     shader.set_batch({&per_tile, nullptr, nullptr});
     each_tile();
     first.resize(per_tile.size());
+    std::size_t count = 0;
     for (std::size_t t = 0; t < per_tile.size(); ++t) {
-      first[t] = rays.size();
-      rays.insert(rays.end(), per_tile[t].begin(), per_tile[t].end());
+      first[t] = count;
+      count += per_tile[t].size();
     }
+    rays.resize(count);
+    engine::jobs::parallel_for<std::size_t>(0, per_tile.size(), 256, [&](std::size_t b, std::size_t e) {
+      for (std::size_t t = b; t < e; ++t) std::copy(per_tile[t].begin(), per_tile[t].end(), rays.begin() + static_cast<std::ptrdiff_t>(first[t]));
+    });
     blocked.resize(rays.size());
     if (!tracer->occluded(scene, rays, blocked))
       engine::jobs::parallel_for<std::size_t>(0, rays.size(), 256, [&](std::size_t b, std::size_t e) {

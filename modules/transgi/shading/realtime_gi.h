@@ -78,6 +78,14 @@ struct GBuffer {
   // The camera the G-buffer was traced from (trace_gbuffer), so the next
   // frame can find where a surface point was seen (gi_history.h).
   std::optional<engine::render::CameraRays> camera;
+  // A GPU backend's batch (trace_gbuffer with a tracer), kept between frames
+  // so 1080p's 2 M rays and hits are not allocated and zeroed every frame.
+  struct Batch {
+    std::vector<engine::rt::Ray> rays;
+    std::vector<engine::rt::Hit> hits;
+    std::vector<std::uint8_t> found;
+    std::vector<std::size_t> tile_first;
+  } batch;
 };
 
 // One ray through each pixel centre, in parallel over rows.
