@@ -1,9 +1,11 @@
 #include "gpu/vulkan_radiance_raster.h"
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 #include <string>
 
+#include "engine/jobs/parallel_for.h"
 #include "gpu/probe_grid_gpu.h"
 #include "gpu/shader_path.h"
 #include "transgi_shared.h"
@@ -31,32 +33,42 @@ probes::SharingStats VulkanRadianceRaster::rasterize(const probes::ProbeGrid& gr
                                 ", " + std::to_string(targets.size()) + " target flags");
   out.resize(count);
 
-  std::vector<ShadedPointGpu> flat;
+  // Inputs go straight into the mapped buffers and results come straight out,
+  // in parallel over probes: tens of MB of depth maps and samples a frame,
+  // which serial copies made cost several times the kernel on an H100.
   std::vector<std::uint32_t> begin(count + 1, 0);
-  for (std::size_t q = 0; q < count; ++q) {
-    begin[q] = static_cast<std::uint32_t>(flat.size());
-    for (const auto& pt : points[q])
-      flat.push_back({pt.position.x, pt.position.y, pt.position.z, pt.distance, pt.radiance.x, pt.radiance.y,
-                      pt.radiance.z, 0, pt.direction.x, pt.direction.y, pt.direction.z, 0, pt.normal.x, pt.normal.y,
-                      pt.normal.z, 0});
-  }
-  begin[count] = static_cast<std::uint32_t>(flat.size());
+  for (std::size_t q = 0; q < count; ++q) begin[q + 1] = begin[q] + static_cast<std::uint32_t>(points[q].size());
   // A depth guard needs every probe's map; a probe without one (null) reads
   // as "never hit" (NaN), which the guard lets through, as the CPU does.
   const bool has_depth = !own_depth.empty();
-  std::vector<probes::DepthMap::Texel> depth(has_depth ? count * texels : 1);
+  const std::size_t depth_texels = has_depth ? count * texels : 1;
   std::vector<ProbeGpu> info(count);
   std::vector<std::uint32_t> target_flags(count, 1);
   for (std::size_t q = 0; q < count; ++q) {
     const probes::DepthMap* d = has_depth ? own_depth[q] : nullptr;
-    if (d && d->texels.size() == texels) std::memcpy(&depth[q * texels], d->texels.data(), texels * sizeof(depth[0]));
     const glm::vec3 off = grid.offsets.empty() ? glm::vec3(0.0f) : grid.offsets[q];
     info[q] = {off.x, off.y, off.z, d ? d->unit : 1.0f, 0, 0, 0, 0};
     if (!targets.empty()) target_flags[q] = targets[q] ? 1u : 0u;
   }
-  engine::gpu::bind_at_least(ctx_, *pipeline_, 0, points_, flat.size() * sizeof(ShadedPointGpu)).upload(std::span<const ShadedPointGpu>(flat));
+  using DepthTexel = probes::DepthMap::Texel;
+  const auto flat = engine::gpu::bind_at_least(ctx_, *pipeline_, 0, points_, std::max<std::size_t>(1, begin[count]) * sizeof(ShadedPointGpu))
+                        .mapped_as<ShadedPointGpu>(begin[count]);
+  const auto depth = engine::gpu::bind_at_least(ctx_, *pipeline_, 2, depth_, depth_texels * sizeof(DepthTexel))
+                         .mapped_as<DepthTexel>(depth_texels);
+  engine::jobs::parallel_for<std::size_t>(0, count, 8, [&](std::size_t q0, std::size_t q1) {
+    for (std::size_t q = q0; q < q1; ++q) {
+      std::size_t i = begin[q];
+      for (const auto& pt : points[q])
+        flat[i++] = {pt.position.x, pt.position.y, pt.position.z, pt.distance, pt.radiance.x, pt.radiance.y,
+                     pt.radiance.z, 0, pt.direction.x, pt.direction.y, pt.direction.z, 0, pt.normal.x, pt.normal.y,
+                     pt.normal.z, 0};
+      if (!has_depth) continue;
+      const probes::DepthMap* d = own_depth[q];
+      if (d && d->texels.size() == texels) std::memcpy(&depth[q * texels], d->texels.data(), texels * sizeof(DepthTexel));
+      else std::fill_n(&depth[q * texels], texels, DepthTexel{});
+    }
+  });
   engine::gpu::bind_at_least(ctx_, *pipeline_, 1, ranges_, begin.size() * sizeof(std::uint32_t)).upload(std::span<const std::uint32_t>(begin));
-  engine::gpu::bind_at_least(ctx_, *pipeline_, 2, depth_, depth.size() * sizeof(depth[0])).upload(std::span<const probes::DepthMap::Texel>(depth));
   engine::gpu::bind_at_least(ctx_, *pipeline_, 3, probes_, info.size() * sizeof(ProbeGpu)).upload(std::span<const ProbeGpu>(info));
   engine::gpu::bind_at_least(ctx_, *pipeline_, 4, targets_, target_flags.size() * sizeof(std::uint32_t)).upload(std::span<const std::uint32_t>(target_flags));
   engine::gpu::bind_at_least(ctx_, *pipeline_, 5, samples_, count * texels * 4 * sizeof(float));
@@ -78,18 +90,19 @@ probes::SharingStats VulkanRadianceRaster::rasterize(const probes::ProbeGrid& gr
       [&](VkCommandBuffer cmd) { pipeline_->record_dispatch(cmd, static_cast<std::uint32_t>(count), 1, 1, &push); });
   if (gpu_ms) *gpu_ms = ms;
 
-  std::vector<float> samples(count * texels * 4);
-  samples_.download(std::span<float>(samples));
-  for (std::size_t q = 0; q < count; ++q) {
-    if (!target_flags[q]) continue;
-    auto& fs = out[q];
-    fs.reset(static_cast<int>(texels));
-    for (std::size_t t = 0; t < texels; ++t) {
-      const float* v = &samples[(q * texels + t) * 4];
-      fs.sum[t] = glm::vec3(v[0], v[1], v[2]);
-      fs.count[t] = v[3];
+  const auto samples = samples_.mapped_as<const float>(count * texels * 4);
+  engine::jobs::parallel_for<std::size_t>(0, count, 8, [&](std::size_t q0, std::size_t q1) {
+    for (std::size_t q = q0; q < q1; ++q) {
+      if (!target_flags[q]) continue;
+      auto& fs = out[q];
+      fs.reset(static_cast<int>(texels));
+      for (std::size_t t = 0; t < texels; ++t) {
+        const float* v = &samples[(q * texels + t) * 4];
+        fs.sum[t] = glm::vec3(v[0], v[1], v[2]);
+        fs.count[t] = v[3];
+      }
     }
-  }
+  });
   std::uint32_t stats[2];
   stats_.download(std::span<std::uint32_t>(stats));
   return {stats[0], stats[1]};
