@@ -21,6 +21,13 @@ using uint = std::uint32_t;
 TRANSGI_CONST uint kFusedGroupSize = 64u;     // points per workgroup, one per invocation
 TRANSGI_CONST uint kFusedMaxWidth = 128u;     // widest layer a kernel holds per invocation
 TRANSGI_CONST uint kFusedRowsPerChunk = 32u;  // weight rows staged in shared memory at once: 32 x 128 fp32 = 16 KB
+// The tiled variant (fused_inference_tiled.comp): a workgroup holds a tile of
+// points' activations in shared memory, and each invocation keeps a 4-row x
+// 16-point block of sums in registers.
+TRANSGI_CONST uint kFusedTiledGroupSize = 128u;     // invocations per workgroup
+TRANSGI_CONST uint kFusedTiledPoints = 64u;         // points per workgroup: 128 x 64 fp32 activations = 32 KB
+TRANSGI_CONST uint kFusedTiledRowsPerLane = 4u;     // output rows per invocation (32 lanes x 4 = 128 rows)
+TRANSGI_CONST uint kFusedTiledPointsPerLane = 16u;  // points per invocation (4 groups of lanes x 16 = 64)
 TRANSGI_CONST uint kShCoefficients = 25u;     // degree-4 SH
 TRANSGI_CONST uint kTransferOutputs = 75u;    // 25 x RGB
 
@@ -171,6 +178,9 @@ static_assert(offsetof(FusedPush, count) == 0 && offsetof(FusedPush, inputs) == 
               offsetof(FusedPush, hidden_layers) == 12 && offsetof(FusedPush, outputs) == 16,
               "FusedPush field offsets");
 static_assert(kFusedRowsPerChunk * kFusedMaxWidth * 4 <= 16384, "the weight chunk must fit the 16 KB we plan for");
+static_assert(kFusedTiledGroupSize / 32 * kFusedTiledPointsPerLane == kFusedTiledPoints &&
+                  32 * kFusedTiledRowsPerLane == kFusedMaxWidth,
+              "the tiled kernel's lanes must cover its tile's points and the widest layer's rows");
 }  // namespace transgi::gpu
 #endif
 

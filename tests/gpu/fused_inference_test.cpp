@@ -12,6 +12,7 @@
 #include "../transgi/random_mlp.h"
 #include "gpu_fixture.h"
 #include "shading/fused_decoder.h"
+#include "transgi_shared.h"
 
 using namespace transgi;
 
@@ -33,7 +34,8 @@ std::vector<float> cpu_shade(const model::Mlp& mlp, const std::vector<float>& in
 
 // 333 points: five full workgroups and a partial one, so idle lanes and the
 // tail are exercised. Returns the worst error over the batch's largest value.
-static float worst_relative_error(engine::gpu::VulkanContext& ctx, gpu::FusedWeights weights, float tolerance) {
+static float worst_relative_error(engine::gpu::VulkanContext& ctx, gpu::FusedWeights weights, float tolerance,
+                                  gpu::FusedKernel kernel = gpu::FusedKernel::PerPoint) {
   const int n = 333;
   const model::Mlp mlp = random_mlp(model::MlpLayout{}, 42);
   engine::math::Pcg32 rng(9, 3);
@@ -42,7 +44,8 @@ static float worst_relative_error(engine::gpu::VulkanContext& ctx, gpu::FusedWei
   for (std::size_t i = 0; i < light.size(); ++i) light[i] = (i % 25 == 0 ? 1.0f : 0.3f) * (2 * rng.next_float() - 0.5f);
 
   const std::vector<float> want = cpu_shade(mlp, inputs, light, n);
-  gpu::VulkanFusedDecoder gpu_decoder(ctx, mlp, weights);
+  gpu::VulkanFusedDecoder gpu_decoder(ctx, mlp, weights, kernel);
+  EXPECT_EQ(gpu_decoder.tiled(), kernel == gpu::FusedKernel::Tiled);
   std::vector<float> got(want.size(), -7.0f);
   gpu_decoder.shade(inputs, light, got);
 
@@ -71,6 +74,16 @@ TEST(VulkanFusedInference, Fp32WeightsEqualTheCpuScalarStage) {
   std::printf("fused, fp32 weights: worst error %.2g of the largest value\n", worst);
 }
 
+// The tiled kernel (64 points a workgroup, sums in another order): the same
+// bound; 333 points leave its last tile 13 points short.
+TEST(VulkanFusedInference, TheTiledKernelEqualsTheCpuScalarStage) {
+  GPU_TEST_CONTEXT_OR_SKIP(ctx);
+  if (ctx->info().max_shared_memory < gpu::kFusedMaxWidth * gpu::kFusedTiledPoints * 4)
+    GTEST_SKIP() << ctx->info().name << " has " << ctx->info().max_shared_memory << " bytes of shared memory";
+  const float worst = worst_relative_error(*ctx, gpu::FusedWeights::Fp32, 1e-4f, gpu::FusedKernel::Tiled);
+  std::printf("fused, tiled kernel: worst error %.2g of the largest value\n", worst);
+}
+
 // fp16 weights (devices with shaderFloat16): each weight rounded to 11
 // significant bits; within 1e-2 of the largest value, the bound issue 10
 // set for the CPU's bf16 kernel.
@@ -96,15 +109,18 @@ TEST(VulkanFusedInference, UnitTransferSumsTheLightPerChannel) {
   const int n = 70;
   std::vector<float> inputs(static_cast<std::size_t>(n) * 16, 0.5f), light(static_cast<std::size_t>(n) * 75);
   for (std::size_t i = 0; i < light.size(); ++i) light[i] = static_cast<float>(i % 75) * 0.01f + static_cast<float>(i / 75) * 0.001f;
-  gpu::VulkanFusedDecoder gpu_decoder(*ctx, mlp);
-  std::vector<float> rgb(static_cast<std::size_t>(n) * 3);
-  gpu_decoder.shade(inputs, light, rgb);
-  for (int i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) {
-      double want = 0;
-      for (int k = 0; k < 25; ++k) want += light[static_cast<std::size_t>(i) * 75 + static_cast<std::size_t>(c) * 25 + k];
-      EXPECT_NEAR(rgb[static_cast<std::size_t>(i) * 3 + c], want, 1e-5 * want) << "point " << i << " channel " << c;
-    }
+  for (const auto kernel : {gpu::FusedKernel::PerPoint, gpu::FusedKernel::Auto}) {
+    gpu::VulkanFusedDecoder gpu_decoder(*ctx, mlp, gpu::FusedWeights::Auto, kernel);
+    std::vector<float> rgb(static_cast<std::size_t>(n) * 3);
+    gpu_decoder.shade(inputs, light, rgb);
+    for (int i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c) {
+        double want = 0;
+        for (int k = 0; k < 25; ++k) want += light[static_cast<std::size_t>(i) * 75 + static_cast<std::size_t>(c) * 25 + k];
+        EXPECT_NEAR(rgb[static_cast<std::size_t>(i) * 3 + c], want, 1e-5 * want)
+            << (gpu_decoder.tiled() ? "tiled" : "per-point") << " kernel, point " << i << " channel " << c;
+      }
+  }
 }
 
 TEST(VulkanFusedInference, RefusesALayoutWiderThanTheKernelHoldsAndMismatchedSizes) {

@@ -1,6 +1,7 @@
 #include "gpu/vulkan_fused_decoder.h"
 
 #include <stdexcept>
+#include <vector>
 #include <string>
 
 #include "engine/gpu/gpu_error.h"
@@ -9,7 +10,26 @@
 
 namespace transgi::gpu {
 
-VulkanFusedDecoder::VulkanFusedDecoder(engine::gpu::VulkanContext& ctx, const model::Mlp& mlp, FusedWeights weights)
+namespace {
+
+// The tiled kernel's weights: per layer transposed to in x out, then the biases.
+std::vector<float> transposed_params(const model::Mlp& mlp) {
+  const model::MlpLayout& l = mlp.layout();
+  std::vector<float> out(mlp.params().size());
+  for (int layer = 0; layer < l.layer_count(); ++layer) {
+    const std::size_t w = l.weight_offset(layer), b = l.bias_offset(layer);
+    const auto n_in = static_cast<std::size_t>(l.in_of(layer)), n_out = static_cast<std::size_t>(l.out_of(layer));
+    for (std::size_t o = 0; o < n_out; ++o)
+      for (std::size_t k = 0; k < n_in; ++k) out[w + k * n_out + o] = mlp.params()[w + o * n_in + k];
+    for (std::size_t o = 0; o < n_out; ++o) out[b + o] = mlp.params()[b + o];
+  }
+  return out;
+}
+
+}  // namespace
+
+VulkanFusedDecoder::VulkanFusedDecoder(engine::gpu::VulkanContext& ctx, const model::Mlp& mlp, FusedWeights weights,
+                                       FusedKernel kernel)
     : ctx_(ctx), layout_(mlp.layout()) {
   const auto& l = layout_;
   if (l.outputs != static_cast<int>(kTransferOutputs) || l.width > static_cast<int>(kFusedMaxWidth) ||
@@ -17,16 +37,26 @@ VulkanFusedDecoder::VulkanFusedDecoder(engine::gpu::VulkanContext& ctx, const mo
     throw std::invalid_argument("VulkanFusedDecoder: the kernel holds layers up to " + std::to_string(kFusedMaxWidth) +
                                 " wide with 75 outputs; got " + std::to_string(l.inputs) + " -> " +
                                 std::to_string(l.width) + " -> " + std::to_string(l.outputs));
-  params_ = engine::gpu::GpuBuffer(ctx, mlp.params().size() * sizeof(float), engine::gpu::GpuBuffer::Placement::DeviceOnly);
-  params_.upload(std::span<const float>(mlp.params()));
+  const std::uint32_t tiled_shared = kFusedMaxWidth * kFusedTiledPoints * sizeof(float);
+  tiled_ = kernel == FusedKernel::Tiled ||
+           (kernel == FusedKernel::Auto && weights != FusedWeights::Fp16 && ctx.info().max_shared_memory >= tiled_shared);
+  if (tiled_ && weights == FusedWeights::Fp16)
+    throw engine::gpu::GpuError("VulkanFusedDecoder: the tiled kernel reads fp32 weights; fp16 asked for");
+  if (tiled_ && ctx.info().max_shared_memory < tiled_shared)
+    throw engine::gpu::GpuError("VulkanFusedDecoder: the tiled kernel needs " + std::to_string(tiled_shared) +
+                                " bytes of shared memory; " + ctx.info().name + " has " +
+                                std::to_string(ctx.info().max_shared_memory));
   if (weights == FusedWeights::Fp16 && !ctx.info().shader_float16)
     throw engine::gpu::GpuError("VulkanFusedDecoder: fp16 weights asked for, but " + ctx.info().name + " has no shaderFloat16");
-  fp16_ = weights == FusedWeights::Fp16 || (weights == FusedWeights::Auto && ctx.info().shader_float16);
+  fp16_ = !tiled_ && (weights == FusedWeights::Fp16 || (weights == FusedWeights::Auto && ctx.info().shader_float16));
+  params_ = engine::gpu::GpuBuffer(ctx, mlp.params().size() * sizeof(float), engine::gpu::GpuBuffer::Placement::DeviceOnly);
+  if (tiled_) params_.upload(std::span<const float>(transposed_params(mlp)));
+  else params_.upload(std::span<const float>(mlp.params()));
   std::vector<engine::gpu::ShaderDefine> defines = {{"FUSED_INPUTS", std::to_string(l.inputs) + "u"},
                                                     {"FUSED_WIDTH", std::to_string(l.width) + "u"},
                                                     {"FUSED_HIDDEN", std::to_string(l.hidden_layers) + "u"}};
   if (fp16_) defines.push_back({"FUSED_F16_WEIGHTS", "1"});
-  const auto spirv = compile_module_shader("fused_inference.comp", std::move(defines));
+  const auto spirv = compile_module_shader(tiled_ ? "fused_inference_tiled.comp" : "fused_inference.comp", std::move(defines));
   pipeline_ = std::make_unique<engine::gpu::ComputePipeline>(ctx, spirv, 4, static_cast<std::uint32_t>(sizeof(FusedPush)));
   pipeline_->bind(0, params_);
 }
@@ -54,7 +84,8 @@ double VulkanFusedDecoder::shade(std::span<const float> inputs, std::span<const 
   light_.upload(light);
   FusedPush push{static_cast<uint>(n), static_cast<uint>(layout_.inputs), static_cast<uint>(layout_.width),
                  static_cast<uint>(layout_.hidden_layers), static_cast<uint>(layout_.outputs), 0, 0, 0};
-  const auto groups = static_cast<std::uint32_t>((n + kFusedGroupSize - 1) / kFusedGroupSize);
+  const std::size_t per_group = tiled_ ? kFusedTiledPoints : kFusedGroupSize;
+  const auto groups = static_cast<std::uint32_t>((n + per_group - 1) / per_group);
   const double ms = ctx_.submit_and_wait([&](VkCommandBuffer cmd) { pipeline_->record_dispatch(cmd, groups, 1, 1, &push); });
   rgb_.download(rgb);
   return ms;

@@ -1,6 +1,6 @@
 #pragma once
 // The fused transfer inference as a Vulkan compute kernel
-// (shaders/fused_inference.comp): the same contract as
+// (shaders/fused_inference.comp, fused_inference_tiled.comp): the same contract as
 // shading::FusedDecoder::shade_tile, for any number of points at once.
 // The CPU's scalar backend is its oracle (tests/transgi/gpu_fused_test.cpp).
 #include <memory>
@@ -20,12 +20,23 @@ enum class FusedWeights {
   Fp16,  // GpuError on a device without shaderFloat16
 };
 
+// Which kernel decodes. Both follow the same contract and the same CPU oracle.
+enum class FusedKernel {
+  Auto,      // Tiled where the device has the 32 KB of shared memory it needs, else PerPoint
+  PerPoint,  // fused_inference.comp: one invocation per point; the simple twin, and the one with fp16 weights
+  Tiled,     // fused_inference_tiled.comp: 64 points per workgroup in shared memory; fp32 weights
+};
+
 class VulkanFusedDecoder {
  public:
   // Throws std::invalid_argument for a layout the kernel cannot hold (wider
   // than kFusedMaxWidth, or not 75 outputs), GpuError for Vulkan failures.
-  VulkanFusedDecoder(engine::gpu::VulkanContext& ctx, const model::Mlp& mlp, FusedWeights weights = FusedWeights::Auto);
+  // `weights` applies to the per-point kernel; the tiled one reads fp32
+  // (GpuError if Fp16 is asked of it).
+  VulkanFusedDecoder(engine::gpu::VulkanContext& ctx, const model::Mlp& mlp, FusedWeights weights = FusedWeights::Auto,
+                     FusedKernel kernel = FusedKernel::Auto);
   [[nodiscard]] bool fp16_weights() const { return fp16_; }
+  [[nodiscard]] bool tiled() const { return tiled_; }
 
   // rgb (n x 3) = sum_o decoder(inputs[i])[o] * light[i][o]; inputs n x 16,
   // light n x 75. Returns the kernel's GPU time in ms (-1 without timestamps).
@@ -37,6 +48,7 @@ class VulkanFusedDecoder {
   engine::gpu::VulkanContext& ctx_;
   model::MlpLayout layout_;
   bool fp16_ = false;
+  bool tiled_ = false;
   engine::gpu::GpuBuffer params_;
   engine::gpu::GpuBuffer inputs_, light_, rgb_;
   std::size_t capacity_ = 0;

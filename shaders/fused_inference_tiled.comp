@@ -1,0 +1,102 @@
+#version 460
+// Fused transfer inference, tiled for GPUs (issue 12): the same contract as
+// fused_inference.comp, which stays as its simple twin. That kernel gives
+// each invocation one point and its 2 x 128 activations, which a GPU keeps in
+// slow per-thread memory (2.5 ms for 57,600 points on an H100). Here a
+// workgroup decodes 64 points at once: their activations sit in shared
+// memory as [row][point], and invocation (g, q) sums output rows 4g..4g+3
+// for points 16q..16q+15 in 64 registers. Per input row it loads 4 weights
+// (every invocation of a warp reads neighbouring ones) and 4 vec4s of
+// activations (the same for the whole warp: a broadcast) for 64 FMAs.
+// Weights are fp32 and transposed by the host (in x out per layer), so the 4
+// a lane needs are adjacent. The 75 outputs go to shared memory and one lane
+// per point dots them with its light SH.
+#extension GL_GOOGLE_include_directive : require
+#include "transgi_shared.h"
+
+layout(local_size_x = kFusedTiledGroupSize) in;
+
+// Per layer: weights transposed (in x out, row-major), then the biases.
+layout(std430, set = 0, binding = 0) readonly buffer Params { float params[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Inputs { float inputs[]; };  // count x inputs
+layout(std430, set = 0, binding = 2) readonly buffer Light { float light[]; };    // count x 75, [c * 25 + k]
+layout(std430, set = 0, binding = 3) writeonly buffer Rgb { float rgb[]; };       // count x 3
+
+layout(push_constant) uniform PushBlock { FusedPush p; };
+
+// The host compiles the kernel for its network's layout, so loop bounds are
+// constants; without the defines (the build's syntax check) the push
+// constants give it.
+#ifdef FUSED_WIDTH
+#define N_INPUTS FUSED_INPUTS
+#define N_WIDTH FUSED_WIDTH
+#define N_HIDDEN FUSED_HIDDEN
+#else
+#define N_INPUTS p.inputs
+#define N_WIDTH p.width
+#define N_HIDDEN p.hidden_layers
+#endif
+#define RPL kFusedTiledRowsPerLane
+#define PPL kFusedTiledPointsPerLane
+#define TILE kFusedTiledPoints
+
+// [row][point]; vec4 = 4 neighbouring points.
+shared vec4 act[kFusedMaxWidth * TILE / 4];
+
+void main() {
+  const uint lane = gl_LocalInvocationID.x;
+  const uint g = lane % 32u;  // row group: rows RPL*g ..
+  const uint q = lane / 32u;  // point group: points PPL*q .. (one per warp of 32)
+  const uint base = gl_WorkGroupID.x * TILE;
+
+  for (uint t = lane; t < N_INPUTS * TILE; t += kFusedTiledGroupSize) {
+    const uint pt = t % TILE, k = t / TILE;
+    act[(k * TILE + pt) / 4][pt % 4] = base + pt < p.count ? inputs[(base + pt) * N_INPUTS + k] : 0.0;
+  }
+  barrier();
+
+  uint offset = 0;
+  for (uint layer = 0; layer <= N_HIDDEN; ++layer) {
+    const uint n_in = layer == 0 ? N_INPUTS : N_WIDTH;
+    const bool last = layer == N_HIDDEN;
+    const uint n_out = last ? kTransferOutputs : N_WIDTH;
+    const uint bias_offset = offset + n_in * n_out;
+    vec4 acc[RPL][PPL / 4];
+    for (uint j = 0; j < RPL; ++j)
+      for (uint v = 0; v < PPL / 4; ++v) acc[j][v] = vec4(0.0);
+    for (uint k = 0; k < n_in; ++k) {
+      float w[RPL];
+      for (uint j = 0; j < RPL; ++j) {
+        const uint r = RPL * g + j;
+        w[j] = r < n_out ? params[offset + k * n_out + r] : 0.0;
+      }
+      for (uint v = 0; v < PPL / 4; ++v) {
+        const vec4 a = act[(k * TILE + PPL * q) / 4 + v];
+        for (uint j = 0; j < RPL; ++j) acc[j][v] += w[j] * a;
+      }
+    }
+    barrier();  // every lane has read this layer's inputs
+    for (uint j = 0; j < RPL; ++j) {
+      const uint r = RPL * g + j;
+      if (r >= n_out) continue;
+      const float bias = params[bias_offset + r];
+      for (uint v = 0; v < PPL / 4; ++v) {
+        const vec4 s = acc[j][v] + bias;
+        act[(r * TILE + PPL * q) / 4 + v] = last ? s : max(s, vec4(0.0));
+      }
+    }
+    barrier();
+    offset = bias_offset + n_out;
+  }
+
+  // Transfer coefficients are rows 0..74 of act; one lane per point.
+  if (lane < TILE && base + lane < p.count) {
+    const uint i = base + lane;
+    vec3 gi = vec3(0.0);
+    for (uint o = 0; o < kTransferOutputs; ++o)
+      gi[o / kShCoefficients] += act[(o * TILE + lane) / 4][lane % 4] * light[i * kTransferOutputs + o];
+    rgb[i * 3 + 0] = gi.r;
+    rgb[i * 3 + 1] = gi.g;
+    rgb[i * 3 + 2] = gi.b;
+  }
+}
