@@ -8,16 +8,18 @@
 // for points 16q..16q+15 in 64 registers. Per input row it loads 4 weights
 // (every invocation of a warp reads neighbouring ones) and 4 vec4s of
 // activations (the same for the whole warp: a broadcast) for 64 FMAs.
-// Weights are fp32 and transposed by the host (in x out per layer), so the 4
-// a lane needs are adjacent. The 75 outputs go to shared memory and one lane
-// per point dots them with its light SH.
+// Weights are fp32, transposed by the host (in x out per layer) and padded,
+// so the 4 a lane needs are one vec4. The 75 outputs go to shared memory,
+// where they are dotted with the light SH.
 #extension GL_GOOGLE_include_directive : require
 #include "transgi_shared.h"
 
 layout(local_size_x = kFusedTiledGroupSize) in;
 
-// Per layer: weights transposed (in x out, row-major), then the biases.
-layout(std430, set = 0, binding = 0) readonly buffer Params { float params[]; };
+// Per layer: weights transposed (in x out, row-major) with each row of outputs
+// padded with zeros to a multiple of 4, then the biases, padded likewise
+// (fused_tiled_params on the host): a lane's 4 weights are one vec4.
+layout(std430, set = 0, binding = 0) readonly buffer Params { vec4 params[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Inputs { float inputs[]; };  // count x inputs
 layout(std430, set = 0, binding = 2) readonly buffer Light { float light[]; };    // count x 75, [c * 25 + k]
 layout(std430, set = 0, binding = 3) writeonly buffer Rgb { float rgb[]; };       // count x 3
@@ -49,9 +51,10 @@ void main() {
   const uint q = lane / 32u;  // point group: points PPL*q .. (one per warp of 32)
   const uint base = gl_WorkGroupID.x * TILE;
 
+  // Consecutive lanes read consecutive floats (coalesced).
   for (uint t = lane; t < N_INPUTS * TILE; t += kFusedTiledGroupSize) {
-    const uint pt = t % TILE, k = t / TILE;
-    act[(k * TILE + pt) / 4][pt % 4] = base + pt < p.count ? inputs[(base + pt) * N_INPUTS + k] : 0.0;
+    const uint pt = t / N_INPUTS, k = t % N_INPUTS;
+    act[(k * TILE + pt) / 4][pt % 4] = base + pt < p.count ? inputs[base * N_INPUTS + t] : 0.0;
   }
   barrier();
 
@@ -60,41 +63,47 @@ void main() {
     const uint n_in = layer == 0 ? N_INPUTS : N_WIDTH;
     const bool last = layer == N_HIDDEN;
     const uint n_out = last ? kTransferOutputs : N_WIDTH;
-    const uint bias_offset = offset + n_in * n_out;
+    const uint out4 = (n_out + 3u) / 4u;  // padded row length in vec4s
+    const uint bias_offset = offset + n_in * out4;
     vec4 acc[RPL][PPL / 4];
     for (uint j = 0; j < RPL; ++j)
       for (uint v = 0; v < PPL / 4; ++v) acc[j][v] = vec4(0.0);
     for (uint k = 0; k < n_in; ++k) {
-      float w[RPL];
-      for (uint j = 0; j < RPL; ++j) {
-        const uint r = RPL * g + j;
-        w[j] = r < n_out ? params[offset + k * n_out + r] : 0.0;
-      }
+      const vec4 w = g < out4 ? params[offset + k * out4 + g] : vec4(0.0);
       for (uint v = 0; v < PPL / 4; ++v) {
         const vec4 a = act[(k * TILE + PPL * q) / 4 + v];
         for (uint j = 0; j < RPL; ++j) acc[j][v] += w[j] * a;
       }
     }
     barrier();  // every lane has read this layer's inputs
+    const vec4 bias4 = g < out4 ? params[bias_offset + g] : vec4(0.0);
     for (uint j = 0; j < RPL; ++j) {
       const uint r = RPL * g + j;
       if (r >= n_out) continue;
-      const float bias = params[bias_offset + r];
+      const float bias = bias4[j];
       for (uint v = 0; v < PPL / 4; ++v) {
         const vec4 s = acc[j][v] + bias;
         act[(r * TILE + PPL * q) / 4 + v] = last ? s : max(s, vec4(0.0));
       }
     }
     barrier();
-    offset = bias_offset + n_out;
+    offset = bias_offset + out4;
   }
 
-  // Transfer coefficients are rows 0..74 of act; one lane per point.
+  // Transfer coefficients are rows 0..74 of act. Each is multiplied by its
+  // light coefficient in place, the lanes walking the tile's light in memory
+  // order (coalesced; light is the kernel's largest input), then one lane
+  // per point adds its 75 products.
+  for (uint t = lane; t < TILE * kTransferOutputs; t += kFusedTiledGroupSize) {
+    const uint pt = t / kTransferOutputs, o = t % kTransferOutputs;
+    const uint a = (o * TILE + pt) / 4;
+    act[a][pt % 4] *= base + pt < p.count ? light[base * kTransferOutputs + t] : 0.0;
+  }
+  barrier();
   if (lane < TILE && base + lane < p.count) {
     const uint i = base + lane;
     vec3 gi = vec3(0.0);
-    for (uint o = 0; o < kTransferOutputs; ++o)
-      gi[o / kShCoefficients] += act[(o * TILE + lane) / 4][lane % 4] * light[i * kTransferOutputs + o];
+    for (uint o = 0; o < kTransferOutputs; ++o) gi[o / kShCoefficients] += act[(o * TILE + lane) / 4][lane % 4];
     rgb[i * 3 + 0] = gi.r;
     rgb[i * 3 + 1] = gi.g;
     rgb[i * 3 + 2] = gi.b;

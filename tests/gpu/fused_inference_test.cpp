@@ -35,9 +35,10 @@ std::vector<float> cpu_shade(const model::Mlp& mlp, const std::vector<float>& in
 // 333 points: five full workgroups and a partial one, so idle lanes and the
 // tail are exercised. Returns the worst error over the batch's largest value.
 static float worst_relative_error(engine::gpu::VulkanContext& ctx, gpu::FusedWeights weights, float tolerance,
-                                  gpu::FusedKernel kernel = gpu::FusedKernel::PerPoint) {
+                                  gpu::FusedKernel kernel = gpu::FusedKernel::PerPoint,
+                                  model::MlpLayout layout = model::MlpLayout{}) {
   const int n = 333;
-  const model::Mlp mlp = random_mlp(model::MlpLayout{}, 42);
+  const model::Mlp mlp = random_mlp(layout, 42);
   engine::math::Pcg32 rng(9, 3);
   std::vector<float> inputs(static_cast<std::size_t>(n) * 16), light(static_cast<std::size_t>(n) * 75);
   for (float& x : inputs) x = 2 * rng.next_float() - 1;
@@ -82,6 +83,10 @@ TEST(VulkanFusedInference, TheTiledKernelEqualsTheCpuScalarStage) {
     GTEST_SKIP() << ctx->info().name << " has " << ctx->info().max_shared_memory << " bytes of shared memory";
   const float worst = worst_relative_error(*ctx, gpu::FusedWeights::Fp32, 1e-4f, gpu::FusedKernel::Tiled);
   std::printf("fused, tiled kernel: worst error %.2g of the largest value\n", worst);
+  // A width that is no multiple of 4 (the padded weight rows) and two hidden layers.
+  const float narrow = worst_relative_error(*ctx, gpu::FusedWeights::Fp32, 1e-4f, gpu::FusedKernel::Tiled,
+                                            model::MlpLayout{16, 30, 2, 75});
+  std::printf("fused, tiled kernel, 16 -> 30 x 2 -> 75: worst error %.2g of the largest value\n", narrow);
 }
 
 // fp16 weights (devices with shaderFloat16): each weight rounded to 11

@@ -12,16 +12,21 @@ namespace transgi::gpu {
 
 namespace {
 
-// The tiled kernel's weights: per layer transposed to in x out, then the biases.
-std::vector<float> transposed_params(const model::Mlp& mlp) {
+// The tiled kernel's weights: per layer transposed to in x out with each
+// row of outputs zero-padded to a multiple of 4, then the biases padded
+// likewise (fused_inference_tiled.comp reads them as vec4s).
+std::vector<float> fused_tiled_params(const model::Mlp& mlp) {
   const model::MlpLayout& l = mlp.layout();
-  std::vector<float> out(mlp.params().size());
+  std::vector<float> out;
   for (int layer = 0; layer < l.layer_count(); ++layer) {
     const std::size_t w = l.weight_offset(layer), b = l.bias_offset(layer);
     const auto n_in = static_cast<std::size_t>(l.in_of(layer)), n_out = static_cast<std::size_t>(l.out_of(layer));
-    for (std::size_t o = 0; o < n_out; ++o)
-      for (std::size_t k = 0; k < n_in; ++k) out[w + k * n_out + o] = mlp.params()[w + o * n_in + k];
-    for (std::size_t o = 0; o < n_out; ++o) out[b + o] = mlp.params()[b + o];
+    const std::size_t padded = (n_out + 3) / 4 * 4, first = out.size();
+    out.resize(first + (n_in + 1) * padded, 0.0f);
+    for (std::size_t o = 0; o < n_out; ++o) {
+      for (std::size_t k = 0; k < n_in; ++k) out[first + k * padded + o] = mlp.params()[w + o * n_in + k];
+      out[first + n_in * padded + o] = mlp.params()[b + o];
+    }
   }
   return out;
 }
@@ -49,9 +54,9 @@ VulkanFusedDecoder::VulkanFusedDecoder(engine::gpu::VulkanContext& ctx, const mo
   if (weights == FusedWeights::Fp16 && !ctx.info().shader_float16)
     throw engine::gpu::GpuError("VulkanFusedDecoder: fp16 weights asked for, but " + ctx.info().name + " has no shaderFloat16");
   fp16_ = !tiled_ && (weights == FusedWeights::Fp16 || (weights == FusedWeights::Auto && ctx.info().shader_float16));
-  params_ = engine::gpu::GpuBuffer(ctx, mlp.params().size() * sizeof(float), engine::gpu::GpuBuffer::Placement::DeviceOnly);
-  if (tiled_) params_.upload(std::span<const float>(transposed_params(mlp)));
-  else params_.upload(std::span<const float>(mlp.params()));
+  const std::vector<float> params = tiled_ ? fused_tiled_params(mlp) : mlp.params();
+  params_ = engine::gpu::GpuBuffer(ctx, params.size() * sizeof(float), engine::gpu::GpuBuffer::Placement::DeviceOnly);
+  params_.upload(std::span<const float>(params));
   std::vector<engine::gpu::ShaderDefine> defines = {{"FUSED_INPUTS", std::to_string(l.inputs) + "u"},
                                                     {"FUSED_WIDTH", std::to_string(l.width) + "u"},
                                                     {"FUSED_HIDDEN", std::to_string(l.hidden_layers) + "u"}};
