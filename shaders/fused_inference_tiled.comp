@@ -68,8 +68,21 @@ void main() {
     vec4 acc[RPL][PPL / 4];
     for (uint j = 0; j < RPL; ++j)
       for (uint v = 0; v < PPL / 4; ++v) acc[j][v] = vec4(0.0);
-    for (uint k = 0; k < n_in; ++k) {
-      const vec4 w = g < out4 ? params[offset + k * out4 + g] : vec4(0.0);
+    // Four input rows at a time: their four weight loads are in flight
+    // together rather than each waited for before its 64 FMAs.
+    const bool lane_has_rows = g < out4;
+    uint k = 0;
+    for (; k + 4u <= n_in; k += 4u) {
+      vec4 w[4];
+      for (uint u = 0; u < 4u; ++u) w[u] = lane_has_rows ? params[offset + (k + u) * out4 + g] : vec4(0.0);
+      for (uint u = 0; u < 4u; ++u)
+        for (uint v = 0; v < PPL / 4; ++v) {
+          const vec4 a = act[((k + u) * TILE + PPL * q) / 4 + v];
+          for (uint j = 0; j < RPL; ++j) acc[j][v] += w[u][j] * a;
+        }
+    }
+    for (; k < n_in; ++k) {
+      const vec4 w = lane_has_rows ? params[offset + k * out4 + g] : vec4(0.0);
       for (uint v = 0; v < PPL / 4; ++v) {
         const vec4 a = act[(k * TILE + PPL * q) / 4 + v];
         for (uint j = 0; j < RPL; ++j) acc[j][v] += w[j] * a;
