@@ -34,6 +34,6 @@ bool GpuRayTracer::occluded(const rt::RtScene& scene, std::span<const rt::Ray> r
   return true;
 }
 
-double GpuRayTracer::take_gpu_ms() { return std::exchange(gpu_ms_, 0.0); }
+double GpuRayTracer::take_device_ms() { return std::exchange(gpu_ms_, 0.0); }
 
 }  // namespace engine::gpu

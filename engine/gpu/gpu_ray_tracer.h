@@ -20,7 +20,7 @@ class GpuRayTracer : public rt::RayBatchTracer {
   // Stops each ray's traversal at its first hit.
   bool occluded(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<std::uint8_t> blocked) override;
   // GPU milliseconds of the traces since the last call (timestamps).
-  double take_gpu_ms();
+  double take_device_ms() override;
 
  private:
   VulkanContext& ctx_;

@@ -22,6 +22,9 @@ class RayBatchTracer {
   // Shadow rays: blocked[i] = whether anything lies on ray i within
   // (tmin, tmax]. Returns false, touching nothing, where it declines.
   virtual bool occluded(const RtScene& scene, std::span<const Ray> rays, std::span<std::uint8_t> blocked) = 0;
+  // Device milliseconds the traces took since the last call (0 where the
+  // backend cannot time them), so each stage that traces can take its own.
+  virtual double take_device_ms() { return 0.0; }
 };
 
 }  // namespace engine::rt

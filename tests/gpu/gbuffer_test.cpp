@@ -39,7 +39,7 @@ TEST(GpuGBuffer, EqualsEmbreesPacketsOnTheCornellBox) {
     shading::trace_gbuffer(rt, assets, rays, width, height, want);
     shading::trace_gbuffer(rt, assets, rays, width, height, got, nullptr, &tracer);
   });
-  ASSERT_GT(tracer.take_gpu_ms(), 0.0) << "the GPU tracer must have traced";
+  ASSERT_GT(tracer.take_device_ms(), 0.0) << "the GPU tracer must have traced";
   std::size_t hits = 0, differ = 0, ties = 0, bad = 0;
   for (std::size_t i = 0; i < want.samples.size(); ++i) {
     const auto& a = want.samples[i];

@@ -34,7 +34,7 @@ class VulkanProbeKernels : public probes::ProbeKernels {
     [[nodiscard]] double total() const { return trace + raster + projection; }
   };
   StageMs take_stage_ms() {
-    StageMs s{tracer_.take_gpu_ms(), raster_ms_, project_ms_};
+    StageMs s{tracer_.take_device_ms(), raster_ms_, project_ms_};
     raster_ms_ = project_ms_ = 0.0;
     return s;
   }

@@ -49,11 +49,12 @@ struct GiFrame {
   // device), and why not the one asked for, if it could not.
   std::string backend = "cpu";
   std::string backend_fallback;
-  // The backend's GPU time by timestamps between the last two probe updates,
-  // per stage: ray tracing (probe rays, their shadow rays, the G-buffer and
-  // its shadow rays), the radiance raster, the SH projection.
-  double gpu_trace_ms = 0.0, gpu_raster_ms = 0.0, gpu_projection_ms = 0.0;
-  [[nodiscard]] double gpu_ms() const { return gpu_trace_ms + gpu_raster_ms + gpu_projection_ms; }
+  // The backend's GPU time by timestamps, per stage: the real-time
+  // G-buffer's camera rays and its direct light's shadow rays; ray tracing
+  // since (probe rays and their shadow rays, and any other batch traced
+  // since the last G-buffer); the radiance raster; the SH projection.
+  double gpu_gbuffer_ms = 0.0, gpu_trace_ms = 0.0, gpu_raster_ms = 0.0, gpu_projection_ms = 0.0;
+  [[nodiscard]] double gpu_ms() const { return gpu_gbuffer_ms + gpu_trace_ms + gpu_raster_ms + gpu_projection_ms; }
 };
 
 }  // namespace transgi::runtime

@@ -142,6 +142,9 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   std::optional<engine::image::ImageRGB> batched_direct;
   if (deterministic && tracer)
     batched_direct = shading::shade_direct_realtime(packed.gbuffer, rt, lights, rays, &frame.direct_stats, tracer);
+  // The device's time for the camera and shadow rays just traced; the probe
+  // update takes the rest (GiFrame::gpu_trace_ms).
+  frame.gpu_gbuffer_ms = tracer ? tracer->take_device_ms() : 0.0;
   const shading::GBuffer& g = packed.gbuffer;
   frame.times.gbuffer = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   // The direct light of punctual lights and the sun first: the probes' share
@@ -204,6 +207,7 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
     const LatentMesh* l = latents.try_read<LatentMesh>(e);
     return l && model && l->model == model;
   };
+  frame->gpu_gbuffer_ms = 0.0;
   if (settings->gi_path == GiPath::Realtime) {
     render_realtime(*rays, model, rs.has_transfer, fields, *rt, *assets, lights->set, *settings, rs.seed, *packed, *frame,
                     backend->kernels ? backend->kernels->tracer() : nullptr);
