@@ -24,6 +24,8 @@ layout(std430, set = 0, binding = 0) readonly buffer Params { float params[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Inputs { float inputs[]; };  // count x inputs
 layout(std430, set = 0, binding = 2) readonly buffer Light { float light[]; };    // count x 75, [c * 25 + k]
 layout(std430, set = 0, binding = 3) writeonly buffer Rgb { float rgb[]; };       // count x 3
+layout(std430, set = 0, binding = 4) readonly buffer Light2 { float light2[]; };  // with p.second: a second light
+layout(std430, set = 0, binding = 5) writeonly buffer Rgb2 { float rgb2[]; };     // with p.second
 
 layout(push_constant) uniform PushBlock { FusedPush p; };
 
@@ -48,7 +50,7 @@ void main() {
   float a[kFusedMaxWidth];
   float b[kFusedMaxWidth];
   for (uint k = 0; k < N_INPUTS; ++k) a[k] = in_range ? inputs[i * N_INPUTS + k] : 0.0;
-  vec3 gi = vec3(0.0);
+  vec3 gi = vec3(0.0), gi2 = vec3(0.0);
 
   uint offset = 0;
   const uint layers = N_HIDDEN + 1;
@@ -71,6 +73,7 @@ void main() {
           b[o] = max(s, 0.0);
         } else if (in_range) {
           gi[o / kShCoefficients] += s * light[i * kTransferOutputs + o];
+          if (p.second != 0u) gi2[o / kShCoefficients] += s * light2[i * kTransferOutputs + o];
         }
       }
     }
@@ -82,5 +85,10 @@ void main() {
     rgb[i * 3 + 0] = gi.r;
     rgb[i * 3 + 1] = gi.g;
     rgb[i * 3 + 2] = gi.b;
+    if (p.second != 0u) {
+      rgb2[i * 3 + 0] = gi2.r;
+      rgb2[i * 3 + 1] = gi2.g;
+      rgb2[i * 3 + 2] = gi2.b;
+    }
   }
 }

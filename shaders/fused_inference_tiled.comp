@@ -23,6 +23,8 @@ layout(std430, set = 0, binding = 0) readonly buffer Params { vec4 params[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Inputs { float inputs[]; };  // count x inputs
 layout(std430, set = 0, binding = 2) readonly buffer Light { float light[]; };    // count x 75, [c * 25 + k]
 layout(std430, set = 0, binding = 3) writeonly buffer Rgb { float rgb[]; };       // count x 3
+layout(std430, set = 0, binding = 4) readonly buffer Light2 { float light2[]; };  // with p.second: a second light
+layout(std430, set = 0, binding = 5) writeonly buffer Rgb2 { float rgb2[]; };     // with p.second
 
 layout(push_constant) uniform PushBlock { FusedPush p; };
 
@@ -103,7 +105,36 @@ void main() {
     offset = bias_offset + out4;
   }
 
-  // Transfer coefficients are rows 0..74 of act. Each is multiplied by its
+  // Transfer coefficients are rows 0..74 of act. A second light first: half
+  // a tile's worth at a time is copied (coalesced) into the rows the
+  // transfer leaves free, then one lane per point dots it with the transfer.
+  if (p.second != 0u) {
+    const uint half_tile = TILE / 2u;
+    const uint scratch = kTransferOutputs * TILE;  // first free float of act
+    for (uint h = 0; h < 2u; ++h) {
+      const uint first = base + h * half_tile;
+      for (uint t = lane; t < half_tile * kTransferOutputs; t += kFusedTiledGroupSize) {
+        const uint pt = t / kTransferOutputs;
+        const uint a = scratch + t;
+        act[a / 4][a % 4] = first + pt < p.count ? light2[first * kTransferOutputs + t] : 0.0;
+      }
+      barrier();
+      if (lane < half_tile && first + lane < p.count) {
+        const uint pt = h * half_tile + lane;
+        vec3 gi2 = vec3(0.0);
+        for (uint o = 0; o < kTransferOutputs; ++o) {
+          const uint a = scratch + lane * kTransferOutputs + o;
+          gi2[o / kShCoefficients] += act[(o * TILE + pt) / 4][pt % 4] * act[a / 4][a % 4];
+        }
+        const uint i = first + lane;
+        rgb2[i * 3 + 0] = gi2.r;
+        rgb2[i * 3 + 1] = gi2.g;
+        rgb2[i * 3 + 2] = gi2.b;
+      }
+      barrier();
+    }
+  }
+  // Each transfer coefficient is multiplied by its
   // light coefficient in place, the lanes walking the tile's light in memory
   // order (coalesced; light is the kernel's largest input), then one lane
   // per point adds its 75 products.

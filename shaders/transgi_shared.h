@@ -37,7 +37,7 @@ struct FusedPush {
   uint width;          // hidden width (<= kFusedMaxWidth)
   uint hidden_layers;  // ReLU layers before the linear output
   uint outputs;        // kTransferOutputs
-  uint pad0;
+  uint second;         // 1: also dot the transfer with Light2 into Rgb2
   uint pad1;
   uint pad2;
 };
@@ -175,12 +175,15 @@ static_assert(sizeof(InterpolationGpu) == 80 && offsetof(InterpolationGpu, weigh
 static_assert(sizeof(ProjectPush) == 16 && offsetof(ProjectPush, texels) == 4, "ProjectPush layout");
 static_assert(sizeof(FusedPush) == 32, "FusedPush must match its std430/push-constant layout");
 static_assert(offsetof(FusedPush, count) == 0 && offsetof(FusedPush, inputs) == 4 && offsetof(FusedPush, width) == 8 &&
-              offsetof(FusedPush, hidden_layers) == 12 && offsetof(FusedPush, outputs) == 16,
+              offsetof(FusedPush, hidden_layers) == 12 && offsetof(FusedPush, outputs) == 16 &&
+                  offsetof(FusedPush, second) == 20,
               "FusedPush field offsets");
 static_assert(kFusedRowsPerChunk * kFusedMaxWidth * 4 <= 16384, "the weight chunk must fit the 16 KB we plan for");
 static_assert(kFusedTiledGroupSize / 32 * kFusedTiledPointsPerLane == kFusedTiledPoints &&
                   32 * kFusedTiledRowsPerLane == kFusedMaxWidth,
               "the tiled kernel's lanes must cover its tile's points and the widest layer's rows");
+static_assert((kTransferOutputs + kTransferOutputs / 2) * kFusedTiledPoints <= kFusedMaxWidth * kFusedTiledPoints,
+              "the tiled kernel's shared activations must hold the transfer and half a tile of a second light");
 }  // namespace transgi::gpu
 #endif
 

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "lambert.h"
+#include "transfer_fixtures.h"
 
 #include <cmath>
 #include <cstdio>
@@ -29,17 +30,6 @@ using namespace transgi;
 using namespace engine;
 
 namespace {
-
-// A grey floor with an orange cube on it, lit by a low sun (no sky): all GI
-// is light bounced between the two.
-scene::SceneAssets floor_and_cube() {
-  scene::SceneAssets a;
-  a.generation = scene::next_scene_generation();
-  a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({3, 3}, 0)),
-              std::make_shared<scene::MeshAsset>(scene::make_box(glm::vec3(0.5f), false, 1))};
-  a.materials = {lambert(glm::vec3(0.7f)), lambert({0.9f, 0.5f, 0.2f})};
-  return a;
-}
 
 std::shared_ptr<const model::TransferModel> tiny_bake(const scene::SceneAssets& assets, jobs::JobSystem& jobs) {
   bake::DatasetSettings ds;
@@ -119,32 +109,6 @@ runtime::TransGISettings small_settings() {
   s.direct_spp = 0;
   s.gbuffer_spp = 4;
   return s;
-}
-
-// A decoder of the given width with random latents, and biases too, so
-// every layer's bias path is exercised.
-model::TransferModel random_model(const scene::SceneAssets& assets, int width, math::Pcg32& rng) {
-  auto m = bake::make_untrained_model(assets, 7, model::MlpLayout{.width = width, .hidden_layers = 3}, 11);
-  for (auto& mesh : m.meshes)
-    for (float& v : mesh.latents.values) v = 2.0f * rng.next_float() - 1.0f;
-  for (float& v : m.decoder.params()) v += 0.05f * (2.0f * rng.next_float() - 1.0f);
-  return m;
-}
-
-// Shading points spread over the two meshes, with random albedo and directions.
-std::vector<shading::TransferQuery> random_queries(const scene::SceneAssets& assets, std::size_t n, math::Pcg32& rng) {
-  std::vector<shading::TransferQuery> queries(n);
-  for (auto& q : queries) {
-    q.mesh = rng.next_float() < 0.5f ? 0u : 1u;
-    q.triangle = static_cast<std::uint32_t>(rng.next_float() * static_cast<float>(assets.meshes[q.mesh]->triangles.size())) %
-                 static_cast<std::uint32_t>(assets.meshes[q.mesh]->triangles.size());
-    const float b1 = rng.next_float(), b2 = rng.next_float() * (1 - b1);
-    q.barycentric = {b1, b2};
-    q.albedo = {rng.next_float(), rng.next_float(), rng.next_float()};
-    q.normal = math::sample_uniform_sphere({rng.next_float(), rng.next_float()});
-    q.wo = math::sample_uniform_sphere({rng.next_float(), rng.next_float()});
-  }
-  return queries;
 }
 
 }  // namespace

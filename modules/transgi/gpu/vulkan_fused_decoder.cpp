@@ -1,10 +1,12 @@
 #include "gpu/vulkan_fused_decoder.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <vector>
 #include <string>
 
 #include "engine/gpu/gpu_error.h"
+#include "engine/jobs/parallel_for.h"
 #include "gpu/shader_path.h"
 #include "transgi_shared.h"
 
@@ -62,19 +64,38 @@ VulkanFusedDecoder::VulkanFusedDecoder(engine::gpu::VulkanContext& ctx, const mo
                                                     {"FUSED_HIDDEN", std::to_string(l.hidden_layers) + "u"}};
   if (fp16_) defines.push_back({"FUSED_F16_WEIGHTS", "1"});
   const auto spirv = compile_module_shader(tiled_ ? "fused_inference_tiled.comp" : "fused_inference.comp", std::move(defines));
-  pipeline_ = std::make_unique<engine::gpu::ComputePipeline>(ctx, spirv, 4, static_cast<std::uint32_t>(sizeof(FusedPush)));
+  pipeline_ = std::make_unique<engine::gpu::ComputePipeline>(ctx, spirv, 6, static_cast<std::uint32_t>(sizeof(FusedPush)));
   pipeline_->bind(0, params_);
+  reserve(1, false);
 }
 
-void VulkanFusedDecoder::reserve(std::size_t n) {
-  if (n <= capacity_) return;
-  capacity_ = n;
-  inputs_ = engine::gpu::GpuBuffer(ctx_, n * static_cast<std::size_t>(layout_.inputs) * sizeof(float));
-  light_ = engine::gpu::GpuBuffer(ctx_, n * kTransferOutputs * sizeof(float));
-  rgb_ = engine::gpu::GpuBuffer(ctx_, n * 3 * sizeof(float));
-  pipeline_->bind(1, inputs_);
-  pipeline_->bind(2, light_);
-  pipeline_->bind(3, rgb_);
+void VulkanFusedDecoder::reserve(std::size_t n, bool second) {
+  if (n > capacity_) {
+    capacity_ = n;
+    inputs_ = engine::gpu::GpuBuffer(ctx_, n * static_cast<std::size_t>(layout_.inputs) * sizeof(float));
+    light_ = engine::gpu::GpuBuffer(ctx_, n * kTransferOutputs * sizeof(float));
+    rgb_ = engine::gpu::GpuBuffer(ctx_, n * 3 * sizeof(float));
+    pipeline_->bind(1, inputs_);
+    pipeline_->bind(2, light_);
+    pipeline_->bind(3, rgb_);
+  }
+  // The second light's buffers: a placeholder until one is asked for (every
+  // binding needs a buffer), then grown with the rest.
+  const std::size_t n2 = second ? capacity_ : 1;
+  if (light2_.handle() == VK_NULL_HANDLE || light2_.size() < n2 * kTransferOutputs * sizeof(float)) {
+    light2_ = engine::gpu::GpuBuffer(ctx_, n2 * kTransferOutputs * sizeof(float));
+    rgb2_ = engine::gpu::GpuBuffer(ctx_, n2 * 3 * sizeof(float));
+    pipeline_->bind(4, light2_);
+    pipeline_->bind(5, rgb2_);
+  }
+}
+
+double VulkanFusedDecoder::dispatch(std::size_t n, bool second) {
+  FusedPush push{static_cast<uint>(n), static_cast<uint>(layout_.inputs), static_cast<uint>(layout_.width),
+                 static_cast<uint>(layout_.hidden_layers), static_cast<uint>(layout_.outputs), second ? 1u : 0u, 0, 0};
+  const std::size_t per_group = tiled_ ? kFusedTiledPoints : kFusedGroupSize;
+  const auto groups = static_cast<std::uint32_t>((n + per_group - 1) / per_group);
+  return ctx_.submit_and_wait([&](VkCommandBuffer cmd) { pipeline_->record_dispatch(cmd, groups, 1, 1, &push); });
 }
 
 double VulkanFusedDecoder::shade(std::span<const float> inputs, std::span<const float> light, std::span<float> rgb) {
@@ -84,15 +105,34 @@ double VulkanFusedDecoder::shade(std::span<const float> inputs, std::span<const 
     throw std::invalid_argument("VulkanFusedDecoder::shade: sizes disagree (inputs " + std::to_string(inputs.size()) +
                                 ", light " + std::to_string(light.size()) + ", rgb " + std::to_string(rgb.size()) + ")");
   if (n == 0) return 0.0;
-  reserve(n);
+  reserve(n, false);
   inputs_.upload(inputs);
   light_.upload(light);
-  FusedPush push{static_cast<uint>(n), static_cast<uint>(layout_.inputs), static_cast<uint>(layout_.width),
-                 static_cast<uint>(layout_.hidden_layers), static_cast<uint>(layout_.outputs), 0, 0, 0};
-  const std::size_t per_group = tiled_ ? kFusedTiledPoints : kFusedGroupSize;
-  const auto groups = static_cast<std::uint32_t>((n + per_group - 1) / per_group);
-  const double ms = ctx_.submit_and_wait([&](VkCommandBuffer cmd) { pipeline_->record_dispatch(cmd, groups, 1, 1, &push); });
+  const double ms = dispatch(n, false);
   rgb_.download(rgb);
+  return ms;
+}
+
+shading::TransferBatchDecoder::Batch VulkanFusedDecoder::begin(std::size_t n, bool second) {
+  reserve(std::max<std::size_t>(n, 1), second);
+  batch_points_ = n;
+  batch_second_ = second;
+  return {inputs_.mapped_as<float>(n * static_cast<std::size_t>(layout_.inputs)), light_.mapped_as<float>(n * kTransferOutputs),
+          second ? light2_.mapped_as<float>(n * kTransferOutputs) : std::span<float>()};
+}
+
+double VulkanFusedDecoder::run(glm::vec3* out, glm::vec3* out2) {
+  const std::size_t n = batch_points_;
+  if (n == 0) return 0.0;
+  if (out2 && !batch_second_) throw std::invalid_argument("VulkanFusedDecoder::run: a second output, but begin() asked for no second light");
+  const double ms = dispatch(n, batch_second_);
+  static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
+  const auto rgb = rgb_.mapped_as<const float>(n * 3);
+  const auto rgb2 = batch_second_ ? rgb2_.mapped_as<const float>(n * 3) : std::span<const float>();
+  engine::jobs::parallel_for<std::size_t>(0, n, 8192, [&](std::size_t b, std::size_t e) {
+    std::copy(rgb.begin() + static_cast<std::ptrdiff_t>(3 * b), rgb.begin() + static_cast<std::ptrdiff_t>(3 * e), &out[b].x);
+    if (out2) std::copy(rgb2.begin() + static_cast<std::ptrdiff_t>(3 * b), rgb2.begin() + static_cast<std::ptrdiff_t>(3 * e), &out2[b].x);
+  });
   return ms;
 }
 

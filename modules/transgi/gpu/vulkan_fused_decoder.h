@@ -10,6 +10,7 @@
 #include "engine/gpu/gpu_buffer.h"
 #include "engine/gpu/vulkan_context.h"
 #include "model/mlp.h"
+#include "shading/transfer_batch_decoder.h"
 
 namespace transgi::gpu {
 
@@ -27,7 +28,7 @@ enum class FusedKernel {
   Tiled,     // fused_inference_tiled.comp: 64 points per workgroup in shared memory; fp32 weights
 };
 
-class VulkanFusedDecoder {
+class VulkanFusedDecoder : public shading::TransferBatchDecoder {
  public:
   // Throws std::invalid_argument for a layout the kernel cannot hold (wider
   // than kFusedMaxWidth, or not 75 outputs), GpuError for Vulkan failures.
@@ -42,16 +43,24 @@ class VulkanFusedDecoder {
   // light n x 75. Returns the kernel's GPU time in ms (-1 without timestamps).
   double shade(std::span<const float> inputs, std::span<const float> light, std::span<float> rgb);
 
+  // shading::TransferBatchDecoder: the frame's batch, written in place.
+  [[nodiscard]] int inputs() const override { return layout_.inputs; }
+  Batch begin(std::size_t n, bool second) override;
+  double run(glm::vec3* out, glm::vec3* out2) override;
+
  private:
-  void reserve(std::size_t n);
+  void reserve(std::size_t n, bool second);
+  double dispatch(std::size_t n, bool second);
 
   engine::gpu::VulkanContext& ctx_;
   model::MlpLayout layout_;
   bool fp16_ = false;
   bool tiled_ = false;
   engine::gpu::GpuBuffer params_;
-  engine::gpu::GpuBuffer inputs_, light_, rgb_;
+  engine::gpu::GpuBuffer inputs_, light_, rgb_, light2_, rgb2_;
   std::size_t capacity_ = 0;
+  std::size_t batch_points_ = 0;
+  bool batch_second_ = false;
   std::unique_ptr<engine::gpu::ComputePipeline> pipeline_;
 };
 

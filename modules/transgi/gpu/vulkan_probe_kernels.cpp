@@ -1,6 +1,7 @@
 #include "gpu/vulkan_probe_kernels.h"
 
 #include <exception>
+#include <stdexcept>
 
 namespace transgi::gpu {
 
@@ -24,6 +25,20 @@ void VulkanProbeKernels::project(const probes::MapProjector& projector, std::spa
   auto& p = projectors_[{l.width, l.height}];
   if (!p) p = std::make_unique<VulkanShProjector>(*ctx_, projector);
   project_ms_ += std::max(0.0, p->project(radiance, out));
+}
+
+shading::TransferBatchDecoder* VulkanProbeKernels::transfer_decoder(const std::shared_ptr<const model::TransferModel>& model) {
+  if (!model) return nullptr;
+  if (model != decoder_model_) {
+    decoder_model_ = model;
+    decoder_.reset();
+    try {
+      decoder_ = std::make_unique<VulkanFusedDecoder>(*ctx_, model->decoder);
+    } catch (const std::invalid_argument&) {
+      // A network wider than the kernels hold: the CPU decodes it.
+    }
+  }
+  return decoder_.get();
 }
 
 std::shared_ptr<VulkanProbeKernels> make_probe_kernels(const std::string& device, std::string* why) {

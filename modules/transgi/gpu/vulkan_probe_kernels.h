@@ -9,7 +9,9 @@
 
 #include "engine/gpu/gpu_ray_tracer.h"
 #include "engine/gpu/vulkan_context.h"
+#include "gpu/vulkan_fused_decoder.h"
 #include "gpu/vulkan_radiance_raster.h"
+#include "model/transfer_model.h"
 #include "gpu/vulkan_sh_projector.h"
 #include "probes/probe_kernels.h"
 
@@ -27,6 +29,10 @@ class VulkanProbeKernels : public probes::ProbeKernels {
                                  std::span<const std::uint8_t> targets) override;
   void project(const probes::MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out) override;
   engine::rt::RayBatchTracer* tracer() override { return &tracer_; }
+  // The real-time frame's transfer decoder on this device, made for
+  // `model`'s network when first asked (and again for another model); null
+  // where the kernel cannot hold that network, so the CPU decodes.
+  shading::TransferBatchDecoder* transfer_decoder(const std::shared_ptr<const model::TransferModel>& model);
   [[nodiscard]] const char* name() const override { return name_.c_str(); }
   // GPU milliseconds per stage since the last call (timestamps).
   struct StageMs {
@@ -44,6 +50,8 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   std::map<std::pair<int, int>, std::unique_ptr<VulkanRadianceRaster>> rasters_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanShProjector>> projectors_;
   engine::gpu::GpuRayTracer tracer_;
+  std::shared_ptr<const model::TransferModel> decoder_model_;  // kept alive: the cache's key
+  std::unique_ptr<VulkanFusedDecoder> decoder_;
   std::string name_;
   double raster_ms_ = 0.0, project_ms_ = 0.0;
 };

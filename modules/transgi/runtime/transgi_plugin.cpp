@@ -125,7 +125,7 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
                      const std::function<bool(Entity)>& has_transfer, std::span<const probes::ProbeField* const> fields,
                      const rt::RtScene& rt, const scene::SceneAssets& assets, const render::LightSet& lights,
                      const TransGISettings& settings, std::uint64_t seed, PackedDecoder& packed, GiFrame& frame,
-                     rt::RayBatchTracer* tracer) {
+                     rt::RayBatchTracer* tracer, shading::TransferBatchDecoder* batch_decoder) {
   if (model && packed.model != model) {
     packed.decoder = std::make_unique<shading::FusedDecoder>(model->decoder);
     packed.model = model;
@@ -155,7 +155,8 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   shading::RealtimeGiStats st;
   frame.gi = shading::shade_gi_realtime(g, rt, assets, model.get(), model ? packed.decoder.get() : nullptr, has_transfer, fields,
                                         settings.realtime, &st, deterministic ? &frame.direct : nullptr, &packed.scratch, &lights, settings.mirror,
-                                        settings.near_field);
+                                        settings.near_field, batch_decoder);
+  frame.gpu_inference_ms = st.inference_device_ms;
   GiStageTimes& t = frame.times;
   t.network_input = 0;  // inside the fused kernel, counted as inference
   t.inference = st.inference_ms;
@@ -207,10 +208,11 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
     const LatentMesh* l = latents.try_read<LatentMesh>(e);
     return l && model && l->model == model;
   };
-  frame->gpu_gbuffer_ms = 0.0;
+  frame->gpu_gbuffer_ms = frame->gpu_inference_ms = 0.0;
   if (settings->gi_path == GiPath::Realtime) {
     render_realtime(*rays, model, rs.has_transfer, fields, *rt, *assets, lights->set, *settings, rs.seed, *packed, *frame,
-                    backend->kernels ? backend->kernels->tracer() : nullptr);
+                    backend->kernels ? backend->kernels->tracer() : nullptr,
+                    backend->kernels ? backend->kernels->transfer_decoder(model) : nullptr);
     frame->times.collect_points = frame->probe_stats.scatter_ms;
     frame->times.probe_raster = frame->probe_stats.raster_ms;
     frame->times.probe_projection = frame->probe_stats.project_ms;

@@ -194,7 +194,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
                                           const RealtimeGiSettings& settings, RealtimeGiStats* stats_out,
                                           engine::image::ImageRGB* direct_out, RealtimeGiScratch* scratch,
                                           const engine::render::LightSet* mirror_lights, const MirrorRay& mirror,
-                                          const NearFieldRays& near_field) {
+                                          const NearFieldRays& near_field, TransferBatchDecoder* batch_decoder) {
   RealtimeGiStats stats;
   engine::image::ImageRGB image(g.width, g.height);
   // The probes' direct light is added to what direct_out holds (the rest of
@@ -327,8 +327,12 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
             light_direct ? light_direct + (k - b) * 75 : nullptr);
       }
     };
-    fill_seconds = shade_transfer_fused(*decoder, *model, assets, queries, fill, shaded.data(),
-                                        with_direct ? shaded_direct.data() : nullptr);
+    if (batch_decoder)
+      fill_seconds = shade_transfer_batched(*batch_decoder, *model, assets, queries, fill, shaded.data(),
+                                            with_direct ? shaded_direct.data() : nullptr, &stats.inference_device_ms);
+    else
+      fill_seconds = shade_transfer_fused(*decoder, *model, assets, queries, fill, shaded.data(),
+                                          with_direct ? shaded_direct.data() : nullptr);
     for (std::size_t k = 0; k < net.size(); ++k) value[net[k]] = shaded[k];
     if (with_direct)
       for (std::size_t k = 0; k < net.size(); ++k) value_direct[net[k]] = shaded_direct[k];

@@ -23,6 +23,7 @@
 #include "model/transfer_model.h"
 #include "probes/probe_field.h"
 #include "shading/fused_decoder.h"
+#include "shading/transfer_batch_decoder.h"
 #include "shading/gbuffer.h"
 #include "shading/near_field.h"
 #include "shading/transfer_renderer.h"
@@ -116,6 +117,7 @@ struct RealtimeGiStats {
   double rotate_ms = 0;     // probe SH into moved objects' frames
   double light_ms = 0;      // probe interpolation per decoded pixel
   double inference_ms = 0;  // latent gather, inputs, fused decoder + SH dot
+  double inference_device_ms = 0;  // the batch decoder's own time (a GPU's timestamps), when one decoded
   double upsample_ms = 0;   // choosing samples, joint bilateral upsampling
   double near_ms = 0;       // near-field rays on the decoded grid (off in the real-time preset)
   std::size_t grid_samples = 0, edge_samples = 0;  // decoded: on the grid, on their own
@@ -138,7 +140,9 @@ struct RealtimeGiStats {
 // realtime_direct.h). With
 // near_field.rays > 0, each decoded grid cell also gets the near field's
 // contact light (near_field.h; mirror_lights light its hits), filtered over
-// the grid; edge pixels decoded on their own do not.
+// the grid; edge pixels decoded on their own do not. With batch_decoder (a
+// GPU backend's kernel) the network samples are decoded by it in one batch
+// instead of by `decoder` tile by tile.
 engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
                                           const engine::scene::SceneAssets& assets, const model::TransferModel* model,
                                           const FusedDecoder* decoder,
@@ -148,6 +152,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
                                           engine::image::ImageRGB* direct_out = nullptr,
                                           RealtimeGiScratch* scratch = nullptr,
                                           const engine::render::LightSet* mirror_lights = nullptr, const MirrorRay& mirror = {},
-                                          const NearFieldRays& near_field = {});
+                                          const NearFieldRays& near_field = {},
+                                          TransferBatchDecoder* batch_decoder = nullptr);
 
 }  // namespace transgi::shading

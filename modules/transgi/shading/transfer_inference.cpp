@@ -77,6 +77,36 @@ double shade_transfer_fused(const FusedDecoder& decoder, const model::TransferMo
   return static_cast<double>(fill_ns.load()) * 1e-9;
 }
 
+double shade_transfer_batched(TransferBatchDecoder& decoder, const model::TransferModel& model,
+                              const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
+                              const TileLightFill& fill, glm::vec3* out, glm::vec3* out2, double* device_ms) {
+  if (device_ms) *device_ms = 0.0;
+  if (queries.empty()) return 0.0;
+  const auto in_size = static_cast<std::size_t>(decoder.inputs());
+  const TransferBatchDecoder::Batch batch = decoder.begin(queries.size(), out2 != nullptr);
+  const std::size_t tiles = (queries.size() + kFusedTile - 1) / kFusedTile;
+  std::atomic<std::int64_t> fill_ns{0};
+  engine::jobs::parallel_for<std::size_t>(0, tiles, 4, [&](std::size_t tb, std::size_t te) {
+    std::vector<float> z(static_cast<std::size_t>(model.latent_dim));
+    std::int64_t ns = 0;
+    for (std::size_t tile = tb; tile < te; ++tile) {
+      const std::size_t b = tile * kFusedTile, e = std::min(b + kFusedTile, queries.size());
+      const auto t0 = Clock::now();
+      fill(b, e, batch.light.data() + b * 75, out2 ? batch.light2.data() + b * 75 : nullptr);
+      ns += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0).count();
+      for (std::size_t i = b; i < e; ++i) {
+        const TransferQuery& q = queries[i];
+        model.meshes[q.mesh].latents.interpolate(*assets.meshes[q.mesh], q.triangle, q.barycentric, z.data());
+        model::assemble_input(z.data(), model.latent_dim, q.albedo, q.normal, q.wo, batch.inputs.data() + i * in_size);
+      }
+    }
+    fill_ns.fetch_add(ns, std::memory_order_relaxed);
+  });
+  const double ms = decoder.run(out, out2);
+  if (device_ms) *device_ms = ms;
+  return static_cast<double>(fill_ns.load()) * 1e-9;
+}
+
 void shade_transfer_fused(const FusedDecoder& decoder, const model::TransferModel& model,
                           const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
                           const float* light, glm::vec3* out, const float* light2, glm::vec3* out2) {

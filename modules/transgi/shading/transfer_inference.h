@@ -11,6 +11,7 @@
 
 #include "model/transfer_model.h"
 #include "shading/fused_decoder.h"
+#include "shading/transfer_batch_decoder.h"
 
 namespace transgi::shading {
 
@@ -53,5 +54,14 @@ double shade_transfer_fused(const FusedDecoder& decoder, const model::TransferMo
 // layer as scalar loops (no GEMM library, no threads).
 void infer_transfer_reference(const model::TransferModel& model, const engine::scene::SceneAssets& assets,
                               const TransferQuery& query, float* out75);
+
+// The same through a batch decoder (a GPU kernel): fill and the inputs are
+// written in parallel tiles straight into the decoder's batch, which is then
+// decoded at once. Returns the seconds spent in fill, summed over threads;
+// device_ms: the decoder's own time (-1 where unknown).
+double shade_transfer_batched(TransferBatchDecoder& decoder, const model::TransferModel& model,
+                              const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
+                              const TileLightFill& fill, glm::vec3* out, glm::vec3* out2 = nullptr,
+                              double* device_ms = nullptr);
 
 }  // namespace transgi::shading
