@@ -163,6 +163,7 @@ void EditorUi::gi_settings() {
   changed |= ImGui::Checkbox("edge-aware upsampling", &edit.realtime.edge_aware);
   changed |= ImGui::Checkbox("reuse last frame's GI (checkerboard)", &edit.realtime.reuse_history);
   changed |= ImGui::SliderInt("probe budget / frame", &edit.probes.update_budget, 0, 512);
+  changed |= ImGui::Checkbox("decode transfer on the GPU (vulkan backend)", &edit.device_inference);
   if (changed) *s = edit;
   // The backend at run time (issue 12): Vulkan, lavapipe where there is no GPU.
   int backend = s->backend == transgi::runtime::Backend::Vulkan ? 1 : 0;

@@ -37,10 +37,11 @@ enum class DirectLight {
 enum class Backend {
   Cpu,     // the oracle, and this machine's real-time path
   // Probe rays, the real-time G-buffer's camera rays and their shadow rays
-  // traced through a GPU BVH, the radiance raster and the SH projection as Vulkan compute
-  // kernels (shaders/); shading the hits and the accumulation stay on the
-  // CPU for now. Without a usable
-  // device the CPU runs them and GiFrame says why.
+  // traced through a GPU BVH; the radiance raster, the SH projection and the
+  // real-time transfer inference as Vulkan compute kernels (shaders/);
+  // shading the hits, the accumulation and the probe interpolation stay on
+  // the CPU for now. Without a usable device the CPU runs them and GiFrame
+  // says why.
   Vulkan,
 };
 
@@ -50,6 +51,12 @@ struct TransGISettings {
   // Vulkan device name (substring) for Backend::Vulkan; empty = the
   // ENGINE_GPU_DEVICE variable, then a discrete GPU first, lavapipe last.
   std::string gpu_device;
+  // Backend::Vulkan, real-time path: decode the transfer on the device.
+  // True frees the CPU of its largest data-parallel stage, at the cost of
+  // sending each network sample's inputs and lights over the bus (166 MB a
+  // 1080p frame): on an H100 beside 16 CPU cores the stage took 11.3 ms
+  // against the CPU's 7.5 (docs/gpu-h100.md); beside a few cores it wins.
+  bool device_inference = true;
   // Bumped to rebuild the GPU kernels from the shader folder as it is now
   // (hot reload; gpu::check_module_shaders first, so a broken edit keeps
   // the running kernels).

@@ -212,7 +212,7 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
   if (settings->gi_path == GiPath::Realtime) {
     render_realtime(*rays, model, rs.has_transfer, fields, *rt, *assets, lights->set, *settings, rs.seed, *packed, *frame,
                     backend->kernels ? backend->kernels->tracer() : nullptr,
-                    backend->kernels ? backend->kernels->transfer_decoder(model) : nullptr);
+                    backend->kernels && settings->device_inference ? backend->kernels->transfer_decoder(model) : nullptr);
     frame->times.collect_points = frame->probe_stats.scatter_ms;
     frame->times.probe_raster = frame->probe_stats.raster_ms;
     frame->times.probe_projection = frame->probe_stats.project_ms;
