@@ -3,6 +3,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "engine/jobs/parallel_for.h"
 #include "gpu/probe_grid_gpu.h"
 #include "gpu/shader_path.h"
 #include "transgi_shared.h"
@@ -26,25 +27,31 @@ GpuDdgiIrradiance VulkanDdgiIrradiance::irradiance(const ddgi::DdgiVolume& volum
   const probes::ProbeGrid& grid = volume.grid();
   const auto count = static_cast<std::size_t>(grid.count());
   const int isize = volume.irradiance_map(0).size(), dsize = volume.distance_map(0).size();
-  std::vector<float> irr(count * static_cast<std::size_t>(isize * isize) * 3), dist(count * static_cast<std::size_t>(dsize * dsize) * 2);
-  std::vector<glm::vec4> placed(count);
-  for (std::size_t q = 0; q < count; ++q) {
-    const auto& im = volume.irradiance_map(static_cast<int>(q));
-    const auto& dm = volume.distance_map(static_cast<int>(q));
-    for (std::size_t t = 0; t < im.texels.size(); ++t)
-      for (int c = 0; c < 3; ++c) irr[(q * im.texels.size() + t) * 3 + static_cast<std::size_t>(c)] = im.texels[t][c];
-    for (std::size_t t = 0; t < dm.texels.size(); ++t)
-      for (int c = 0; c < 2; ++c) dist[(q * dm.texels.size() + t) * 2 + static_cast<std::size_t>(c)] = dm.texels[t][c];
-    placed[q] = glm::vec4(volume.placed_grid().position(static_cast<int>(q)), volume.active(static_cast<int>(q)) ? 1.0f : 0.0f);
-  }
-  std::vector<DdgiPointGpu> pts(n);
-  for (std::size_t i = 0; i < n; ++i)
-    pts[i] = {positions[i].x, positions[i].y, positions[i].z, 0, normals[i].x, normals[i].y, normals[i].z, 0,
-              view_dirs[i].x, view_dirs[i].y, view_dirs[i].z, 0};
-  engine::gpu::bind_at_least(ctx_, *pipeline_, 0, points_, n * sizeof(DdgiPointGpu)).upload(std::span<const DdgiPointGpu>(pts));
-  engine::gpu::bind_at_least(ctx_, *pipeline_, 1, irradiance_, irr.size() * sizeof(float)).upload(std::span<const float>(irr));
-  engine::gpu::bind_at_least(ctx_, *pipeline_, 2, distance_, dist.size() * sizeof(float)).upload(std::span<const float>(dist));
-  engine::gpu::bind_at_least(ctx_, *pipeline_, 3, placed_, placed.size() * sizeof(glm::vec4)).upload(std::span<const glm::vec4>(placed));
+  // Straight into the mapped buffers and out of them, in parallel: at 1080p
+  // the 2 M points' serial copies took longer than the kernel (docs/gpu-h100.md).
+  const std::size_t itexels = static_cast<std::size_t>(isize * isize), dtexels = static_cast<std::size_t>(dsize * dsize);
+  const auto pts = engine::gpu::bind_at_least(ctx_, *pipeline_, 0, points_, n * sizeof(DdgiPointGpu)).mapped_as<DdgiPointGpu>(n);
+  const auto irr = engine::gpu::bind_at_least(ctx_, *pipeline_, 1, irradiance_, count * itexels * 3 * sizeof(float))
+                       .mapped_as<float>(count * itexels * 3);
+  const auto dist = engine::gpu::bind_at_least(ctx_, *pipeline_, 2, distance_, count * dtexels * 2 * sizeof(float))
+                        .mapped_as<float>(count * dtexels * 2);
+  const auto placed = engine::gpu::bind_at_least(ctx_, *pipeline_, 3, placed_, count * sizeof(glm::vec4)).mapped_as<glm::vec4>(count);
+  engine::jobs::parallel_for<std::size_t>(0, count, 8, [&](std::size_t q0, std::size_t q1) {
+    for (std::size_t q = q0; q < q1; ++q) {
+      const auto& im = volume.irradiance_map(static_cast<int>(q));
+      const auto& dm = volume.distance_map(static_cast<int>(q));
+      for (std::size_t t = 0; t < itexels; ++t)
+        for (int c = 0; c < 3; ++c) irr[(q * itexels + t) * 3 + static_cast<std::size_t>(c)] = im.texels[t][c];
+      for (std::size_t t = 0; t < dtexels; ++t)
+        for (int c = 0; c < 2; ++c) dist[(q * dtexels + t) * 2 + static_cast<std::size_t>(c)] = dm.texels[t][c];
+      placed[q] = glm::vec4(volume.placed_grid().position(static_cast<int>(q)), volume.active(static_cast<int>(q)) ? 1.0f : 0.0f);
+    }
+  });
+  engine::jobs::parallel_for<std::size_t>(0, n, 4096, [&](std::size_t b0, std::size_t b1) {
+    for (std::size_t i = b0; i < b1; ++i)
+      pts[i] = {positions[i].x, positions[i].y, positions[i].z, 0, normals[i].x, normals[i].y, normals[i].z, 0,
+                view_dirs[i].x, view_dirs[i].y, view_dirs[i].z, 0};
+  });
   engine::gpu::bind_at_least(ctx_, *pipeline_, 4, result_, n * sizeof(glm::vec4));
 
   const ddgi::DdgiSettings& s = volume.settings();
@@ -59,14 +66,15 @@ GpuDdgiIrradiance VulkanDdgiIrradiance::irradiance(const ddgi::DdgiVolume& volum
   push.distance_interior = static_cast<uint>(volume.distance_map(0).interior);
   const auto groups = static_cast<std::uint32_t>((n + kDdgiGroupSize - 1) / kDdgiGroupSize);
   out.gpu_ms = ctx_.submit_and_wait([&](VkCommandBuffer cmd) { pipeline_->record_dispatch(cmd, groups, 1, 1, &push); });
-  std::vector<glm::vec4> r(n);
-  result_.download(std::span<glm::vec4>(r));
+  const auto r = result_.mapped_as<const glm::vec4>(n);
   out.irradiance.resize(n);
   out.lit.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    out.irradiance[i] = glm::vec3(r[i]);
-    out.lit[i] = r[i].w != 0.0f ? 1 : 0;
-  }
+  engine::jobs::parallel_for<std::size_t>(0, n, 4096, [&](std::size_t b0, std::size_t b1) {
+    for (std::size_t i = b0; i < b1; ++i) {
+      out.irradiance[i] = glm::vec3(r[i]);
+      out.lit[i] = r[i].w != 0.0f ? 1 : 0;
+    }
+  });
   return out;
 }
 
