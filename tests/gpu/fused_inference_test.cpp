@@ -171,14 +171,7 @@ TEST(VulkanFusedInference, TheFramesBatchWithTwoLightsEqualsTheScalarReference) 
     std::vector<glm::vec3> out(queries.size(), glm::vec3(-7.0f)), out2(queries.size(), glm::vec3(-7.0f));
     std::vector<int> filled(queries.size(), 0);
     jobs.run([&] {
-      shading::shade_transfer_batched(
-          decoder, m, assets, queries,
-          [&](std::size_t b, std::size_t e, float* l, float* l2) {
-            for (std::size_t i = b; i < e; ++i) ++filled[i];
-            std::copy(light.begin() + static_cast<std::ptrdiff_t>(b * 75), light.begin() + static_cast<std::ptrdiff_t>(e * 75), l);
-            std::copy(light2.begin() + static_cast<std::ptrdiff_t>(b * 75), light2.begin() + static_cast<std::ptrdiff_t>(e * 75), l2);
-          },
-          out.data(), out2.data());
+      shading::shade_transfer_batched(decoder, m, assets, queries, copying_fill(light, light2, filled), out.data(), out2.data());
     });
     double worst = 0;
     for (std::size_t i = 0; i < queries.size(); ++i) {

@@ -155,21 +155,14 @@ TEST(TransferInference, FusedTilesWithFilledLightMatchTheScalarReference) {
   }
   const shading::FusedDecoder decoder(m.decoder, shading::best_fused_isa());
   std::vector<glm::vec3> out(queries.size()), out2(queries.size());
-  std::vector<std::size_t> filled(queries.size(), 0);
+  std::vector<int> filled(queries.size(), 0);
   jobs::JobSystem jobs({.threads = 2});
   jobs.run([&] {
-    shading::shade_transfer_fused(
-        decoder, m, assets, queries,
-        [&](std::size_t b, std::size_t e, float* l, float* l2) {
-          for (std::size_t i = b; i < e; ++i) ++filled[i];
-          std::copy(light.begin() + static_cast<std::ptrdiff_t>(b * 75), light.begin() + static_cast<std::ptrdiff_t>(e * 75), l);
-          std::copy(light2.begin() + static_cast<std::ptrdiff_t>(b * 75), light2.begin() + static_cast<std::ptrdiff_t>(e * 75), l2);
-        },
-        out.data(), out2.data());
+    shading::shade_transfer_fused(decoder, m, assets, queries, copying_fill(light, light2, filled), out.data(), out2.data());
   });
   double worst = 0, scale = 0;
   for (std::size_t i = 0; i < queries.size(); ++i) {
-    ASSERT_EQ(filled[i], 1u) << "query " << i << " was filled " << filled[i] << " times";
+    ASSERT_EQ(filled[i], 1) << "query " << i << " was filled " << filled[i] << " times";
     float t[75];
     shading::infer_transfer_reference(m, assets, queries[i], t);
     for (int c = 0; c < 3; ++c) {

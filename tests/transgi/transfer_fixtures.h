@@ -2,6 +2,8 @@
 // A small scene, random decoders and random shading points for the transfer
 // inference tests (tests/transgi/runtime_test.cpp on the CPU,
 // tests/gpu/fused_inference_test.cpp on Vulkan).
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -53,4 +55,16 @@ inline std::vector<transgi::shading::TransferQuery> random_queries(const engine:
     q.wo = engine::math::sample_uniform_sphere({rng.next_float(), rng.next_float()});
   }
   return queries;
+}
+
+// A tile fill (shade_transfer_fused, shade_transfer_batched) that copies
+// each query's two lights from whole-batch arrays (n x 75 each) and counts
+// how often each query was filled (each must be, once).
+inline transgi::shading::TileLightFill copying_fill(const std::vector<float>& light, const std::vector<float>& light2,
+                                                    std::vector<int>& filled) {
+  return [&light, &light2, &filled](std::size_t b, std::size_t e, float* l, float* l2) {
+    for (std::size_t i = b; i < e; ++i) ++filled[i];
+    std::copy(light.begin() + static_cast<std::ptrdiff_t>(b * 75), light.begin() + static_cast<std::ptrdiff_t>(e * 75), l);
+    if (l2) std::copy(light2.begin() + static_cast<std::ptrdiff_t>(b * 75), light2.begin() + static_cast<std::ptrdiff_t>(e * 75), l2);
+  };
 }
