@@ -34,8 +34,11 @@ shading::TransferBatchDecoder* VulkanProbeKernels::transfer_decoder(const std::s
     decoder_.reset();
     try {
       decoder_ = std::make_unique<VulkanFusedDecoder>(*ctx_, model->decoder);
-    } catch (const std::invalid_argument&) {
-      // A network wider than the kernels hold: the CPU decodes it.
+      decoder_why_.clear();
+    } catch (const std::exception& e) {
+      // A network wider than the kernels hold, or a kernel the device cannot
+      // build: the CPU decodes it, and the frame says why.
+      decoder_why_ = e.what();
     }
   }
   return decoder_.get();

@@ -33,6 +33,8 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   // `model`'s network when first asked (and again for another model); null
   // where the kernel cannot hold that network, so the CPU decodes.
   shading::TransferBatchDecoder* transfer_decoder(const std::shared_ptr<const model::TransferModel>& model);
+  // Why the last transfer_decoder() returned null (empty when it did not).
+  [[nodiscard]] const std::string& transfer_decoder_why() const { return decoder_why_; }
   [[nodiscard]] const char* name() const override { return name_.c_str(); }
   // GPU milliseconds per stage since the last call (timestamps).
   struct StageMs {
@@ -52,6 +54,7 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   engine::gpu::GpuRayTracer tracer_;
   std::shared_ptr<const model::TransferModel> decoder_model_;  // kept alive: the cache's key
   std::unique_ptr<VulkanFusedDecoder> decoder_;
+  std::string decoder_why_;
   std::string name_;
   double raster_ms_ = 0.0, project_ms_ = 0.0;
 };

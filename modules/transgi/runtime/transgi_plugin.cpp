@@ -210,9 +210,15 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
   };
   frame->gpu_gbuffer_ms = frame->gpu_inference_ms = 0.0;
   if (settings->gi_path == GiPath::Realtime) {
+    shading::TransferBatchDecoder* batch_decoder = nullptr;
+    if (backend->kernels && settings->device_inference && model) {
+      batch_decoder = backend->kernels->transfer_decoder(model);
+      if (!batch_decoder)
+        frame->backend_fallback += (frame->backend_fallback.empty() ? "" : "; ") +
+                                   std::string("transfer inference on the CPU: ") + backend->kernels->transfer_decoder_why();
+    }
     render_realtime(*rays, model, rs.has_transfer, fields, *rt, *assets, lights->set, *settings, rs.seed, *packed, *frame,
-                    backend->kernels ? backend->kernels->tracer() : nullptr,
-                    backend->kernels && settings->device_inference ? backend->kernels->transfer_decoder(model) : nullptr);
+                    backend->kernels ? backend->kernels->tracer() : nullptr, batch_decoder);
     frame->times.collect_points = frame->probe_stats.scatter_ms;
     frame->times.probe_raster = frame->probe_stats.raster_ms;
     frame->times.probe_projection = frame->probe_stats.project_ms;
