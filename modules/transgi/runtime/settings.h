@@ -54,9 +54,11 @@ struct TransGISettings {
   // Backend::Vulkan, real-time path: decode the transfer on the device.
   // True frees the CPU of its largest data-parallel stage, at the cost of
   // sending each network sample's inputs and lights over the bus (166 MB a
-  // 1080p frame): on an H100 beside 16 CPU cores the stage took 11.3 ms
-  // against the CPU's 7.5 (docs/gpu-h100.md); beside a few cores it wins.
-  bool device_inference = true;
+  // 1080p frame). Off by default because that cost is measured and the gain
+  // is not: on an H100 beside 16 CPU cores the stage took 12.9 ms against the
+  // CPU's 7.9, the frame 155-159 against 145-153 ms (docs/gpu-h100.md). It
+  // should pay beside fewer cores, and once the lights are made on the device.
+  bool device_inference = false;
   // Bumped to rebuild the GPU kernels from the shader folder as it is now
   // (hot reload; gpu::check_module_shaders first, so a broken edit keeps
   // the running kernels).
