@@ -222,9 +222,8 @@ std::string describe(const DeviceInfo& info) {
          bar + ")";
 }
 
-std::vector<std::uint32_t> VulkanContext::buffer_memory_types(std::uint32_t type_bits, bool mapped) const {
-  VkPhysicalDeviceMemoryProperties mem;
-  vkGetPhysicalDeviceMemoryProperties(physical_, &mem);
+std::vector<std::uint32_t> rank_buffer_memory_types(const VkPhysicalDeviceMemoryProperties& mem, std::uint32_t type_bits,
+                                                    bool mapped, BufferMemory preference) {
   constexpr VkMemoryPropertyFlags kMappable = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
   // Lower rank = better; -1 = unusable.
   auto rank = [&](VkMemoryPropertyFlags f) -> int {
@@ -233,7 +232,7 @@ std::vector<std::uint32_t> VulkanContext::buffer_memory_types(std::uint32_t type
     const bool cached = f & VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
     if (!mapped) return local ? (mappable ? 1 : 0) : 2;
     if (!mappable) return -1;
-    switch (info_.buffer_memory) {
+    switch (preference) {
       case BufferMemory::Cached: return (cached ? 0 : 2) + (local ? 1 : 0);
       case BufferMemory::WriteCombined: return (cached ? 2 : 0) + (local ? 1 : 0);
       case BufferMemory::Bar: return (local ? 0 : 2) + (cached ? 1 : 0);
@@ -244,10 +243,16 @@ std::vector<std::uint32_t> VulkanContext::buffer_memory_types(std::uint32_t type
   for (std::uint32_t i = 0; i < mem.memoryTypeCount; ++i)
     if (type_bits & (1u << i))
       if (const int r = rank(mem.memoryTypes[i].propertyFlags); r >= 0) ranked.emplace_back(r, i);
-  std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::stable_sort(ranked.begin(), ranked.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
   std::vector<std::uint32_t> out;
   for (const auto& [r, i] : ranked) out.push_back(i);
   return out;
+}
+
+std::vector<std::uint32_t> VulkanContext::buffer_memory_types(std::uint32_t type_bits, bool mapped) const {
+  VkPhysicalDeviceMemoryProperties mem;
+  vkGetPhysicalDeviceMemoryProperties(physical_, &mem);
+  return rank_buffer_memory_types(mem, type_bits, mapped, info_.buffer_memory);
 }
 
 double VulkanContext::submit_and_wait(const std::function<void(VkCommandBuffer)>& record) {

@@ -64,6 +64,13 @@ struct DeviceInfo {
   bool stage_device_only = false;  // GpuOptions::stage_device_only
 };
 
+// The memory types of `mem` among `type_bits` a storage buffer may take, best
+// first: mapped ones (host-visible and coherent) in `preference`'s order,
+// device-only ones device-local first (VulkanContext::buffer_memory_types on
+// its device's memory; here for tests with made-up devices).
+std::vector<std::uint32_t> rank_buffer_memory_types(const VkPhysicalDeviceMemoryProperties& mem, std::uint32_t type_bits,
+                                                    bool mapped, BufferMemory preference);
+
 // "vulkan (NAME; DRIVER; buffers: ...)" for logs and benchmark output.
 std::string describe(const DeviceInfo& info);
 

@@ -11,6 +11,7 @@
 #include "engine/gpu/gpu_buffer.h"
 #include "engine/gpu/gpu_error.h"
 #include "engine/gpu/shader_compiler.h"
+#include "engine/gpu/vulkan_context.h"
 #include "gpu_fixture.h"
 
 using namespace engine::gpu;
@@ -47,6 +48,33 @@ TEST(GpuDeviceChoice, ADeviceWithoutAComputeQueueIsPassedOver) {
   ASSERT_TRUE(c.index) << c.why;
   EXPECT_EQ(*c.index, 1u);
   EXPECT_FALSE(choose_device({}, "").index);
+}
+
+// A discrete GPU's memory as NVIDIA's driver lays it out: device-local;
+// host, uncached (write-combined); host, cached; device-local mapped through
+// the BAR. No driver needed.
+TEST(GpuBufferMemory, EachPreferenceRanksADiscreteGpusTypesAsItsCommentSays) {
+  VkPhysicalDeviceMemoryProperties mem{};
+  mem.memoryTypeCount = 4;
+  constexpr VkMemoryPropertyFlags kLocal = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+  constexpr VkMemoryPropertyFlags kMapped = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  mem.memoryTypes[0].propertyFlags = kLocal;
+  mem.memoryTypes[1].propertyFlags = kMapped;
+  mem.memoryTypes[2].propertyFlags = kMapped | VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
+  mem.memoryTypes[3].propertyFlags = kLocal | kMapped;
+  using V = std::vector<std::uint32_t>;
+  EXPECT_EQ(rank_buffer_memory_types(mem, 0xf, true, BufferMemory::Cached), (V{2, 1, 3}));
+  EXPECT_EQ(rank_buffer_memory_types(mem, 0xf, true, BufferMemory::WriteCombined), (V{1, 3, 2}));
+  EXPECT_EQ(rank_buffer_memory_types(mem, 0xf, true, BufferMemory::Bar), (V{3, 1, 2}));
+  EXPECT_EQ(rank_buffer_memory_types(mem, 0xf, false, BufferMemory::Cached), (V{0, 3, 1, 2}))
+      << "device-only buffers: unmappable device memory first, host memory last";
+  EXPECT_EQ(rank_buffer_memory_types(mem, 0x6, true, BufferMemory::Bar), (V{1, 2})) << "only the types the buffer allows";
+  // lavapipe and integrated GPUs: one type that is everything.
+  mem.memoryTypeCount = 1;
+  mem.memoryTypes[0].propertyFlags = kLocal | kMapped | VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
+  for (const BufferMemory m : {BufferMemory::Cached, BufferMemory::WriteCombined, BufferMemory::Bar})
+    EXPECT_EQ(rank_buffer_memory_types(mem, 0x1, true, m), (V{0}));
+  EXPECT_EQ(rank_buffer_memory_types(mem, 0x1, false, BufferMemory::Cached), (V{0}));
 }
 
 TEST(ShaderCompiler, AGlslErrorNamesTheFileAndLine) {
