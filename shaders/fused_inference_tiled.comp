@@ -5,12 +5,12 @@
 // slow per-thread memory (2.5 ms for 57,600 points on an H100). Here a
 // workgroup decodes 64 points at once: their activations sit in shared
 // memory as [row][point], and invocation (g, q) sums output rows 4g..4g+3
-// for points 16q..16q+15 in 64 registers. Per input row it loads 4 weights
-// (every invocation of a warp reads neighbouring ones) and 4 vec4s of
+// for points 16q..16q+15 in 64 registers. Per input row it loads its 4
+// weights as one vec4 (a warp's lanes read neighbouring ones) and 4 vec4s of
 // activations (the same for the whole warp: a broadcast) for 64 FMAs.
 // Weights are fp32, transposed by the host (in x out per layer) and padded,
-// so the 4 a lane needs are one vec4. The 75 outputs go to shared memory,
-// where they are dotted with the light SH.
+// so the 4 a lane needs are one vec4. The 75 outputs stay in shared memory,
+// where they are dotted with the light SH (and a second light, if asked).
 #extension GL_GOOGLE_include_directive : require
 #include "transgi_shared.h"
 
@@ -105,51 +105,41 @@ void main() {
     offset = bias_offset + out4;
   }
 
-  // Transfer coefficients are rows 0..74 of act. A second light first: half
-  // a tile's worth at a time is copied (coalesced) into the rows the
-  // transfer leaves free, then one lane per point dots it with the transfer.
-  if (p.second != 0u) {
-    const uint half_tile = TILE / 2u;
-    const uint scratch = kTransferOutputs * TILE;  // first free float of act
+  // Transfer coefficients are rows 0..74 of act; rows 75.. are free. Each
+  // light (the second with p.second) is dotted with them half a tile at a
+  // time: the lanes copy the half tile's light into the free rows, walking it
+  // in memory order (coalesced; light is the kernel's largest input), then
+  // one lane per point adds its 75 products.
+  const uint half_tile = TILE / 2u;
+  const uint scratch = kTransferOutputs * TILE;  // first free float of act
+  const uint lights = p.second != 0u ? 2u : 1u;
+  for (uint which = 0; which < lights; ++which)
     for (uint h = 0; h < 2u; ++h) {
       const uint first = base + h * half_tile;
       for (uint t = lane; t < half_tile * kTransferOutputs; t += kFusedTiledGroupSize) {
-        const uint pt = t / kTransferOutputs;
-        const uint a = scratch + t;
-        act[a / 4][a % 4] = first + pt < p.count ? light2[first * kTransferOutputs + t] : 0.0;
+        const uint a = scratch + t, at = first * kTransferOutputs + t;
+        const bool real = first + t / kTransferOutputs < p.count;
+        act[a / 4][a % 4] = real ? (which == 0u ? light[at] : light2[at]) : 0.0;
       }
       barrier();
       if (lane < half_tile && first + lane < p.count) {
         const uint pt = h * half_tile + lane;
-        vec3 gi2 = vec3(0.0);
+        vec3 gi = vec3(0.0);
         for (uint o = 0; o < kTransferOutputs; ++o) {
           const uint a = scratch + lane * kTransferOutputs + o;
-          gi2[o / kShCoefficients] += act[(o * TILE + pt) / 4][pt % 4] * act[a / 4][a % 4];
+          gi[o / kShCoefficients] += act[(o * TILE + pt) / 4][pt % 4] * act[a / 4][a % 4];
         }
         const uint i = first + lane;
-        rgb2[i * 3 + 0] = gi2.r;
-        rgb2[i * 3 + 1] = gi2.g;
-        rgb2[i * 3 + 2] = gi2.b;
+        if (which == 0u) {
+          rgb[i * 3 + 0] = gi.r;
+          rgb[i * 3 + 1] = gi.g;
+          rgb[i * 3 + 2] = gi.b;
+        } else {
+          rgb2[i * 3 + 0] = gi.r;
+          rgb2[i * 3 + 1] = gi.g;
+          rgb2[i * 3 + 2] = gi.b;
+        }
       }
-      barrier();
+      barrier();  // the free rows are read before the next copy
     }
-  }
-  // Each transfer coefficient is multiplied by its
-  // light coefficient in place, the lanes walking the tile's light in memory
-  // order (coalesced; light is the kernel's largest input), then one lane
-  // per point adds its 75 products.
-  for (uint t = lane; t < TILE * kTransferOutputs; t += kFusedTiledGroupSize) {
-    const uint pt = t / kTransferOutputs, o = t % kTransferOutputs;
-    const uint a = (o * TILE + pt) / 4;
-    act[a][pt % 4] *= base + pt < p.count ? light[base * kTransferOutputs + t] : 0.0;
-  }
-  barrier();
-  if (lane < TILE && base + lane < p.count) {
-    const uint i = base + lane;
-    vec3 gi = vec3(0.0);
-    for (uint o = 0; o < kTransferOutputs; ++o) gi[o / kShCoefficients] += act[(o * TILE + lane) / 4][lane % 4];
-    rgb[i * 3 + 0] = gi.r;
-    rgb[i * 3 + 1] = gi.g;
-    rgb[i * 3 + 2] = gi.b;
-  }
 }

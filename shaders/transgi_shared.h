@@ -183,7 +183,7 @@ static_assert(kFusedTiledGroupSize / 32 * kFusedTiledPointsPerLane == kFusedTile
                   32 * kFusedTiledRowsPerLane == kFusedMaxWidth,
               "the tiled kernel's lanes must cover its tile's points and the widest layer's rows");
 static_assert((kTransferOutputs + kTransferOutputs / 2) * kFusedTiledPoints <= kFusedMaxWidth * kFusedTiledPoints,
-              "the tiled kernel's shared activations must hold the transfer and half a tile of a second light");
+              "the tiled kernel's shared activations must hold the transfer and half a tile of light");
 }  // namespace transgi::gpu
 #endif
 

@@ -213,9 +213,13 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
     shading::TransferBatchDecoder* batch_decoder = nullptr;
     if (backend->kernels && settings->device_inference && model) {
       batch_decoder = backend->kernels->transfer_decoder(model);
-      if (!batch_decoder)
-        frame->backend_fallback += (frame->backend_fallback.empty() ? "" : "; ") +
-                                   std::string("transfer inference on the CPU: ") + backend->kernels->transfer_decoder_why();
+      // update_probes resets backend_fallback each frame, but not while the
+      // probes are frozen: say it once.
+      if (!batch_decoder) {
+        const std::string note = "transfer inference on the CPU: " + backend->kernels->transfer_decoder_why();
+        if (frame->backend_fallback.find(note) == std::string::npos)
+          frame->backend_fallback += (frame->backend_fallback.empty() ? "" : "; ") + note;
+      }
     }
     render_realtime(*rays, model, rs.has_transfer, fields, *rt, *assets, lights->set, *settings, rs.seed, *packed, *frame,
                     backend->kernels ? backend->kernels->tracer() : nullptr, batch_decoder);

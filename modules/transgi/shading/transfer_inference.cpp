@@ -17,6 +17,21 @@ double ms_since(Clock::time_point t) { return std::chrono::duration<double, std:
 // (width x chunk floats per layer) stay in the last-level cache.
 constexpr std::size_t kChunk = 8192;
 static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "shade_tile writes RGB triples into glm::vec3 arrays");
+
+// Query q's network input at `dst`: its latent interpolated over its
+// triangle (z: latent_dim floats of scratch), then albedo, normal, view.
+void network_input(const model::TransferModel& model, const engine::scene::SceneAssets& assets, const TransferQuery& q,
+                   float* z, float* dst) {
+  model.meshes[q.mesh].latents.interpolate(*assets.meshes[q.mesh], q.triangle, q.barycentric, z);
+  model::assemble_input(z, model.latent_dim, q.albedo, q.normal, q.wo, dst);
+}
+
+// fill(b, e, ...) with its time added to ns.
+void timed_fill(const TileLightFill& fill, std::size_t b, std::size_t e, float* light, float* light2, std::int64_t& ns) {
+  const auto t0 = Clock::now();
+  fill(b, e, light, light2);
+  ns += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0).count();
+}
 }  // namespace
 
 InferenceTimings infer_transfer(const model::TransferModel& model, const engine::scene::SceneAssets& assets,
@@ -28,12 +43,8 @@ InferenceTimings infer_transfer(const model::TransferModel& model, const engine:
   std::vector<float> inputs(queries.size() * static_cast<std::size_t>(in_size));
   engine::jobs::parallel_for<std::size_t>(0, queries.size(), 1024, [&](std::size_t b, std::size_t e) {
     std::vector<float> z(static_cast<std::size_t>(model.latent_dim));
-    for (std::size_t i = b; i < e; ++i) {
-      const TransferQuery& q = queries[i];
-      model.meshes[q.mesh].latents.interpolate(*assets.meshes[q.mesh], q.triangle, q.barycentric, z.data());
-      model::assemble_input(z.data(), model.latent_dim, q.albedo, q.normal, q.wo,
-                            inputs.data() + i * static_cast<std::size_t>(in_size));
-    }
+    for (std::size_t i = b; i < e; ++i)
+      network_input(model, assets, queries[i], z.data(), inputs.data() + i * static_cast<std::size_t>(in_size));
   });
   t.inputs_ms = ms_since(t0);
   t0 = Clock::now();
@@ -61,14 +72,9 @@ double shade_transfer_fused(const FusedDecoder& decoder, const model::TransferMo
     std::int64_t ns = 0;
     for (std::size_t tile = tb; tile < te; ++tile) {
       const std::size_t b = tile * kFusedTile, e = std::min(b + kFusedTile, queries.size());
-      const auto t0 = Clock::now();
-      fill(b, e, light.data(), out2 ? light2.data() : nullptr);
-      ns += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0).count();
-      for (std::size_t i = b; i < e; ++i) {
-        const TransferQuery& q = queries[i];
-        model.meshes[q.mesh].latents.interpolate(*assets.meshes[q.mesh], q.triangle, q.barycentric, z.data());
-        model::assemble_input(z.data(), model.latent_dim, q.albedo, q.normal, q.wo, inputs.data() + (i - b) * static_cast<std::size_t>(in_size));
-      }
+      timed_fill(fill, b, e, light.data(), out2 ? light2.data() : nullptr, ns);
+      for (std::size_t i = b; i < e; ++i)
+        network_input(model, assets, queries[i], z.data(), inputs.data() + (i - b) * static_cast<std::size_t>(in_size));
       decoder.shade_tile(inputs.data(), light.data(), static_cast<int>(e - b), &out[b].x, out2 ? light2.data() : nullptr,
                          out2 ? &out2[b].x : nullptr);
     }
@@ -91,14 +97,8 @@ double shade_transfer_batched(TransferBatchDecoder& decoder, const model::Transf
     std::int64_t ns = 0;
     for (std::size_t tile = tb; tile < te; ++tile) {
       const std::size_t b = tile * kFusedTile, e = std::min(b + kFusedTile, queries.size());
-      const auto t0 = Clock::now();
-      fill(b, e, batch.light.data() + b * 75, out2 ? batch.light2.data() + b * 75 : nullptr);
-      ns += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0).count();
-      for (std::size_t i = b; i < e; ++i) {
-        const TransferQuery& q = queries[i];
-        model.meshes[q.mesh].latents.interpolate(*assets.meshes[q.mesh], q.triangle, q.barycentric, z.data());
-        model::assemble_input(z.data(), model.latent_dim, q.albedo, q.normal, q.wo, batch.inputs.data() + i * in_size);
-      }
+      timed_fill(fill, b, e, batch.light.data() + b * 75, out2 ? batch.light2.data() + b * 75 : nullptr, ns);
+      for (std::size_t i = b; i < e; ++i) network_input(model, assets, queries[i], z.data(), batch.inputs.data() + i * in_size);
     }
     fill_ns.fetch_add(ns, std::memory_order_relaxed);
   });
