@@ -4,12 +4,14 @@
 # sudo where there is one. Debian 12 (bookworm).
 set -euo pipefail
 
+# glslang-tools: glslang-dev's CMake config names /usr/bin/glslangValidator, and
+# with --no-install-recommends nothing else brings it, so find_package fails.
 packages=(
   build-essential cmake ninja-build pkg-config git
   libtbb-dev libglm-dev libstb-dev libopenexr-dev libtinygltf-dev nlohmann-json3-dev libembree-dev libdnnl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   liblua5.4-dev libglfw3-dev libimgui-dev libgl-dev libgl1-mesa-dri
-  libvulkan-dev glslang-dev spirv-tools mesa-vulkan-drivers vulkan-validationlayers
+  libvulkan-dev glslang-dev glslang-tools spirv-tools mesa-vulkan-drivers vulkan-validationlayers
   xvfb xauth ffmpeg
 )
 # --fuzz: also the compiler of the `fuzz` preset (clang 14 with libFuzzer and
