@@ -83,7 +83,7 @@ PathRadiance PathTracer::trace(rt::Ray ray, math::Pcg32& rng) const {
     // Next-event estimation.
     LightSample ls;
     const float u_sel = rng.next_float();
-    const glm::vec2 u_light(rng.next_float(), rng.next_float());
+    const glm::vec2 u_light{rng.next_float(), rng.next_float()};
     if (lights_.sample(s.position, u_sel, u_light, ls) && glm::dot(ls.direction, s.geometric_normal) > 0) {
       const glm::vec3 wi = s.frame.to_local(ls.direction);
       const glm::vec3 f = wi.z > 0 ? material::brdf_eval(s.brdf, wo, wi) : glm::vec3(0.0f);
@@ -100,7 +100,7 @@ PathRadiance PathTracer::trace(rt::Ray ray, math::Pcg32& rng) const {
 
     // Continue the path by sampling the BRDF.
     material::BrdfSample bs;
-    const glm::vec2 u_brdf(rng.next_float(), rng.next_float());
+    const glm::vec2 u_brdf{rng.next_float(), rng.next_float()};
     const float u_lobe = rng.next_float();
     if (!material::brdf_sample(s.brdf, wo, u_brdf, u_lobe, bs)) break;
     const glm::vec3 dir = s.frame.to_world(bs.wi);
@@ -128,7 +128,7 @@ void PathTracer::add_samples(int n, const std::vector<std::uint8_t>& want) {
         const std::uint32_t first = count_[pixel];
         for (std::uint32_t s = first; s < first + static_cast<std::uint32_t>(n); ++s) {
           math::Pcg32 rng = math::make_rng(settings_.seed, pixel, static_cast<std::uint64_t>(s));
-          const glm::vec2 u(rng.next_float(), rng.next_float());
+          const glm::vec2 u{rng.next_float(), rng.next_float()};
           const rt::Ray ray = camera_.generate_filtered(x, y, u, settings_.filter_width);
           const PathRadiance L = trace(ray, rng);
           if (!finite(L.full) || !finite(L.direct) || !finite(L.gi)) {

@@ -40,7 +40,7 @@ bool render_batched(const engine::rt::RtScene& scene, const DdgiVolume& volume, 
     for (std::size_t pixel = b; pixel < e; ++pixel)
       for (std::size_t si = 0; si < spp; ++si) {
         math::Pcg32 rng = math::make_rng(s.seed, pixel, si);
-        const glm::vec2 u(rng.next_float(), rng.next_float());
+        const glm::vec2 u{rng.next_float(), rng.next_float()};
         rays[pixel * spp + si] = camera.generate_filtered(static_cast<int>(pixel % static_cast<std::size_t>(width)),
                                                           static_cast<int>(pixel / static_cast<std::size_t>(width)), u, s.filter_width);
       }
@@ -87,7 +87,7 @@ engine::image::ImageRGB render_ddgi_gi(const engine::rt::RtScene& scene, std::sp
         glm::vec3 sum(0.0f);
         for (int si = 0; si < s.spp; ++si) {
           math::Pcg32 rng = math::make_rng(s.seed, pixel, static_cast<std::uint64_t>(si));
-          const glm::vec2 u(rng.next_float(), rng.next_float());
+          const glm::vec2 u{rng.next_float(), rng.next_float()};
           const rt::Ray ray = camera.generate_filtered(x, y, u, s.filter_width);
           rt::Hit hit;
           if (!scene.intersect(ray, hit)) continue;

@@ -118,7 +118,7 @@ MachinePeak measure_machine_peak(const engine::rt::RtScene& scene, double second
     for (int i = b; i < e; ++i) {
       engine::math::Pcg32 rng = engine::math::make_rng(17, static_cast<std::uint64_t>(i), 0);
       engine::rt::Ray ray;
-      ray.origin = lo + (hi - lo) * glm::vec3(rng.next_float(), rng.next_float(), rng.next_float());
+      ray.origin = lo + (hi - lo) * glm::vec3{rng.next_float(), rng.next_float(), rng.next_float()};
       ray.direction = engine::math::sample_uniform_sphere({rng.next_float(), rng.next_float()});
       engine::rt::Hit hit;
       h += scene.intersect(ray, hit) ? 1 : 0;

@@ -83,7 +83,7 @@ PendingProbeRay begin_probe_ray(const engine::rt::RtScene& scene, const engine::
   p.to_probe = -dir;
   render::LightSample ls;
   const float u_sel = rng.next_float();
-  const glm::vec2 u(rng.next_float(), rng.next_float());
+  const glm::vec2 u{rng.next_float(), rng.next_float()};
   if (lights.sample(s.position, u_sel, u, ls) && glm::dot(ls.direction, s.geometric_normal) > 0) {
     const glm::vec3 wi = s.frame.to_local(ls.direction);
     const glm::vec3 f = wi.z > 0 ? material::brdf_eval(s.brdf, wo, wi) : glm::vec3(0.0f);

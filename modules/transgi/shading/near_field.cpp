@@ -32,7 +32,7 @@ glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::
   const int side = static_cast<int>(std::lround(std::sqrt(static_cast<float>(rays))));
   const bool stratified = side * side == rays;
   for (int k = 0; k < rays; ++k) {
-    glm::vec2 u(rng.next_float(), rng.next_float());
+    glm::vec2 u{rng.next_float(), rng.next_float()};
     if (stratified) u = (glm::vec2(static_cast<float>(k % side), static_cast<float>(k / side)) + u) / static_cast<float>(side);
     const glm::vec3 dir = frame.to_world(math::sample_cosine_hemisphere(u));
     if (glm::dot(dir, s.geometric_normal) <= 0) continue;

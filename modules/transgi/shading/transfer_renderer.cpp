@@ -56,7 +56,7 @@ glm::vec3 shade_mirror_gi(const engine::rt::RtScene& scene, const GSample& smp, 
     for (int k = 0; k < light_samples; ++k) {
       render::LightSample ls;
       const float u_sel = rng.next_float();
-      const glm::vec2 u(rng.next_float(), rng.next_float());
+      const glm::vec2 u{rng.next_float(), rng.next_float()};
       if (!lights->sample(s.position, u_sel, u, ls) || glm::dot(ls.direction, s.geometric_normal) <= 0) continue;
       const float cos_i = glm::dot(ls.direction, s.shading_normal);
       if (cos_i <= 0) continue;
@@ -89,7 +89,7 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
         for (int si = 0; si < s.spp; ++si) {
           const std::size_t pixel = static_cast<std::size_t>(y) * width + x;
           math::Pcg32 rng = math::make_rng(s.seed, pixel, static_cast<std::uint64_t>(si));
-          const glm::vec2 u(rng.next_float(), rng.next_float());
+          const glm::vec2 u{rng.next_float(), rng.next_float()};
           const rt::Ray ray = camera.generate_filtered(x, y, u, s.filter_width);
           Sample& out = samples[pixel * static_cast<std::size_t>(s.spp) + static_cast<std::size_t>(si)];
           out = trace_gsample(scene, assets, ray, background, spread);
