@@ -125,6 +125,7 @@ std::unique_ptr<VulkanContext> VulkanContext::create(const GpuOptions& options, 
   ctx->info_.kind = kind_of(props.deviceType);
   ctx->info_.driver = std::string(p12.driverName) + " " + p12.driverInfo;
   ctx->info_.shader_float16 = f12.shaderFloat16 == VK_TRUE;
+  ctx->info_.shader_int64 = f2.features.shaderInt64 == VK_TRUE;
   ctx->info_.max_shared_memory = props.limits.maxComputeSharedMemorySize;
   ctx->info_.buffer_memory = options.buffer_memory;
   ctx->info_.stage_device_only = options.stage_device_only;
@@ -149,13 +150,17 @@ std::unique_ptr<VulkanContext> VulkanContext::create(const GpuOptions& options, 
   // the fp32 variants.
   VkPhysicalDeviceVulkan12Features enable12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
   enable12.shaderFloat16 = f12.shaderFloat16;
+  // 64-bit integers: the shading kernels draw Pcg32's numbers bit for bit.
+  VkPhysicalDeviceFeatures2 enable2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  enable2.features.shaderInt64 = f2.features.shaderInt64;
+  enable2.pNext = &enable12;
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
   qci.queueFamilyIndex = ctx->queue_family_;
   qci.queueCount = 1;
   qci.pQueuePriorities = &priority;
   VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-  dci.pNext = &enable12;
+  dci.pNext = &enable2;
   dci.queueCreateInfoCount = 1;
   dci.pQueueCreateInfos = &qci;
   ENGINE_VK_CHECK(vkCreateDevice(ctx->physical_, &dci, nullptr, &ctx->device_));

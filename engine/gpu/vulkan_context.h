@@ -55,6 +55,7 @@ struct DeviceInfo {
   DeviceKind kind = DeviceKind::Other;
   std::string driver;       // "llvmpipe Mesa 22.3.6 (LLVM 15.0.6)"
   bool shader_float16 = false;
+  bool shader_int64 = false;  // the shading kernels need it (shaders/pcg32.glsl)
   std::uint32_t max_shared_memory = 0;
   double timestamp_period_ns = 0;  // 0: the queue has no timestamps
   BufferMemory buffer_memory = BufferMemory::Cached;

@@ -11,8 +11,8 @@ namespace engine::material {
 
 namespace {
 
-constexpr int kMuSize = 64;
-constexpr int kAlphaSize = 64;
+constexpr int kMuSize = kAlbedoTableMu;
+constexpr int kAlphaSize = kAlbedoTableAlpha;
 constexpr int kStrata = 40;  // kStrata^2 VNDF samples per table entry
 
 // Node grids in t = sqrt(mu) and r = sqrt(alpha): both change fastest near
@@ -116,5 +116,8 @@ SpecularAlbedo ggx_average_albedo(float alpha) {
   const SpecularAlbedo e0 = tb.average[static_cast<std::size_t>(j)], e1 = tb.average[static_cast<std::size_t>(j + 1)];
   return {(1 - ta) * e0.a + ta * e1.a, (1 - ta) * e0.b + ta * e1.b};
 }
+
+const SpecularAlbedo* ggx_albedo_directional_table() { return tables().directional.data(); }
+const SpecularAlbedo* ggx_albedo_average_table() { return tables().average.data(); }
 
 }  // namespace engine::material

@@ -18,4 +18,12 @@ SpecularAlbedo ggx_albedo(float mu, float alpha);
 // Cosine-weighted average over the hemisphere: 2 * integral E(mu) mu dmu.
 SpecularAlbedo ggx_average_albedo(float alpha);
 
+// The tables the two functions above interpolate, for kernels that read
+// them: directional[j * 64 + i] at sqrt(mu) = i / 63 and sqrt(alpha) at node
+// j of 64 from sqrt(kMinAlpha) to 1; average[j] likewise.
+inline constexpr int kAlbedoTableMu = 64;
+inline constexpr int kAlbedoTableAlpha = 64;
+const SpecularAlbedo* ggx_albedo_directional_table();  // kAlbedoTableMu x kAlbedoTableAlpha
+const SpecularAlbedo* ggx_albedo_average_table();      // kAlbedoTableAlpha
+
 }  // namespace engine::material

@@ -20,6 +20,10 @@ class Distribution1D {
   // Continuous sample in [0, 1); pdf is the density w.r.t. [0, 1).
   [[nodiscard]] float sample_continuous(float u, float* pdf, std::size_t* index) const;
   [[nodiscard]] float pdf(float x) const;
+  // The tables, for kernels that sample the same distribution (cdf has
+  // size() + 1 entries).
+  [[nodiscard]] const std::vector<float>& func() const { return func_; }
+  [[nodiscard]] const std::vector<double>& cdf() const { return cdf_; }
 
  private:
   std::vector<float> func_;
@@ -37,6 +41,8 @@ class Distribution2D {
   [[nodiscard]] glm::vec2 sample(glm::vec2 u, float* pdf) const;
   [[nodiscard]] float pdf(glm::vec2 uv) const;
   [[nodiscard]] bool empty() const { return rows_.empty(); }
+  [[nodiscard]] const std::vector<Distribution1D>& rows() const { return rows_; }
+  [[nodiscard]] const Distribution1D& marginal() const { return marginal_; }
 
  private:
   std::vector<Distribution1D> rows_;

@@ -77,6 +77,10 @@ class LightSet {
   [[nodiscard]] std::size_t punctual_count() const { return punctual_.size(); }
   [[nodiscard]] const std::vector<PunctualInstance>& punctual_lights() const { return punctual_; }
   [[nodiscard]] bool empty() const { return groups_ == 0; }
+  // What sample() draws from, for kernels that sample the same lights.
+  [[nodiscard]] const std::vector<EmissiveTriangle>& emissive_triangles() const { return triangles_; }
+  [[nodiscard]] const math::Distribution1D& triangle_distribution() const { return triangle_distribution_; }
+  [[nodiscard]] int groups() const { return groups_; }
 
  private:
   float group_probability() const { return groups_ > 0 ? 1.0f / static_cast<float>(groups_) : 0.0f; }

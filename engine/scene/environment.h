@@ -38,6 +38,10 @@ class Environment {
   [[nodiscard]] float yaw() const { return yaw_; }
   void set_strength(float strength) { strength_ = strength; }
   [[nodiscard]] bool valid() const { return !image_.empty(); }
+  // The map's frame and importance distribution, for kernels that sample it.
+  [[nodiscard]] const glm::mat3& to_world_matrix() const { return to_world_; }
+  [[nodiscard]] const glm::mat3& to_local_matrix() const { return to_local_; }
+  [[nodiscard]] const math::Distribution2D& distribution() const { return distribution_; }
 
   // Map-local direction <-> (u, v).
   static glm::vec2 direction_to_uv(const glm::vec3& local);

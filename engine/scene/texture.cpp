@@ -48,6 +48,8 @@ glm::vec4 bilinear(const std::uint8_t* rgba, int width, int height, Wrap wrap_s,
 
 }  // namespace
 
+const float* srgb_decode_table() { return srgb_lut().data(); }
+
 glm::vec4 Texture::sample(glm::vec2 uv, bool srgb) const {
   if (width <= 0 || height <= 0) return glm::vec4(1.0f);
   return bilinear(rgba.data(), width, height, wrap_s, wrap_t, uv, srgb);

@@ -13,6 +13,9 @@ namespace engine::scene {
 
 enum class Wrap : std::uint8_t { Repeat, ClampToEdge, MirroredRepeat };
 
+// The linear value of each sRGB-encoded byte, as sample() decodes texels.
+const float* srgb_decode_table();  // 256 entries
+
 struct MipLevel {
   int width = 0, height = 0;
   std::vector<std::uint8_t> rgba;

@@ -76,7 +76,7 @@ ecs::Entity pick_moving_object(ecs::World& world, const std::string& name) {
 int run_bench_frame(const std::vector<std::string>& argv) {
   const Args args("bench-frame", argv,
                   {"scene", "model", "width", "height", "frames", "warmup", "preset", "csv", "object", "threads", "camera",
-                   "direct-spp", "gi-scale", "gi-reuse", "probe-budget", "probe-settle", "backend", "device", "device-inference", "near-field-rays", "near-field-reach", "near-field-filter", "direct", "gi-out", "reference-out", "reference-spp", "map-width",
+                   "direct-spp", "gi-scale", "gi-reuse", "probe-budget", "probe-settle", "backend", "device", "device-inference", "device-shading", "near-field-rays", "near-field-reach", "near-field-filter", "direct", "gi-out", "reference-out", "reference-spp", "map-width",
                    "probe-volume", "probe-grid", "cascades", "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "cascade-map-width"},
                   {"allow-unbaked"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
@@ -121,7 +121,7 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   frame.height = height;
   std::ostringstream rows;
   rows << "frame,total_ms,gbuffer_ms,inference_ms,sh_light_ms,upsample_ms,probe_trace_ms,probe_raster_ms,probe_project_ms,"
-          "direct_ms,probes_traced,decoded_pixels,gpu_trace_ms,gpu_raster_ms,gpu_projection_ms,gpu_gbuffer_ms,gpu_inference_ms\n";
+          "direct_ms,probes_traced,decoded_pixels,gpu_trace_ms,gpu_raster_ms,gpu_projection_ms,gpu_gbuffer_ms,gpu_inference_ms,gpu_shading_ms\n";
   std::vector<double> totals;
   std::vector<std::vector<double>> stages;
   core::ProgressBar bar("bench-frame", static_cast<std::uint64_t>(warmup + frames), true);
@@ -144,7 +144,8 @@ int run_bench_frame(const std::vector<std::string>& argv) {
     rows << f - warmup << ',' << ms;
     for (double v : row) rows << ',' << v;
     rows << ',' << frame.probe_stats.traced << ',' << frame.shaded_samples << ',' << frame.gpu_trace_ms << ','
-         << frame.gpu_raster_ms << ',' << frame.gpu_projection_ms << ',' << frame.gpu_gbuffer_ms << ',' << frame.gpu_inference_ms << '\n';
+         << frame.gpu_raster_ms << ',' << frame.gpu_projection_ms << ',' << frame.gpu_gbuffer_ms << ',' << frame.gpu_inference_ms << ','
+         << frame.gpu_shading_ms << '\n';
   }
   bar.finish();
   if (!csv.empty()) eval::write_text(csv, rows.str());
@@ -179,9 +180,9 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   std::printf("\n");
   if (frame.gpu_ms() > 0)
     std::printf("GPU timestamps, last frame (ms): G-buffer rays %.2f (camera and shadow rays); probe rays %.2f (and their "
-                "shadow rays); radiance raster %.2f; SH projection %.2f; inference %.2f; total %.2f\n",
-                frame.gpu_gbuffer_ms, frame.gpu_trace_ms, frame.gpu_raster_ms, frame.gpu_projection_ms, frame.gpu_inference_ms,
-                frame.gpu_ms());
+                "shadow rays); probe-ray shading %.2f; radiance raster %.2f; SH projection %.2f; inference %.2f; total %.2f\n",
+                frame.gpu_gbuffer_ms, frame.gpu_trace_ms, frame.gpu_shading_ms, frame.gpu_raster_ms, frame.gpu_projection_ms,
+                frame.gpu_inference_ms, frame.gpu_ms());
   std::printf("direct light, last frame: %zu shadow rays to %zu punctual lights\n", frame.direct_stats.shadow_rays,
               frame.direct_stats.lights);
   // The NaN guards (docs/reliability.md): what each stage's boundary replaced in the last frame.

@@ -25,6 +25,7 @@ runtime::TransGISettings runtime_settings_from(const Args& args, const char* def
   s.backend = args.choice("backend", {"cpu", "vulkan"}, "cpu") == "vulkan" ? runtime::Backend::Vulkan : runtime::Backend::Cpu;
   s.gpu_device = args.str("device", std::string());
   if (args.has("device-inference")) s.device_inference = args.choice("device-inference", {"on", "off"}, "off") == "on";
+  if (args.has("device-shading")) s.device_shading = args.choice("device-shading", {"on", "off"}, "on") == "on";
   near_field_from(args, s.near_field);
   return s;
 }

@@ -27,6 +27,24 @@ void VulkanProbeKernels::project(const probes::MapProjector& projector, std::spa
   project_ms_ += std::max(0.0, p->project(radiance, out));
 }
 
+bool VulkanProbeKernels::shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                                          std::span<const engine::rt::Ray> rays, std::span<const std::uint64_t> items,
+                                          std::uint64_t seed, std::uint64_t sample, const probes::ProbeFeedbackSource* self,
+                                          const probes::ProbeFeedbackSource* outer,
+                                          std::vector<probes::ProbeRayHit>& out) {
+  if (!device_shading_) return false;
+  if (!shading_tried_) {
+    shading_tried_ = true;
+    try {
+      if (VulkanProbeShading::supported(*ctx_, &shading_why_)) shading_ = std::make_unique<VulkanProbeShading>(*ctx_);
+    } catch (const std::exception& e) {
+      // A kernel the device cannot build: the CPU shades, and says why.
+      shading_why_ = e.what();
+    }
+  }
+  return shading_ && shading_->shade(scene, lights, tracer_, rays, items, seed, sample, self, outer, out);
+}
+
 shading::TransferBatchDecoder* VulkanProbeKernels::transfer_decoder(const std::shared_ptr<const model::TransferModel>& model) {
   if (!model) return nullptr;
   if (model != decoder_model_) {

@@ -10,6 +10,7 @@
 #include "engine/gpu/gpu_ray_tracer.h"
 #include "engine/gpu/vulkan_context.h"
 #include "gpu/vulkan_fused_decoder.h"
+#include "gpu/vulkan_probe_shading.h"
 #include "gpu/vulkan_radiance_raster.h"
 #include "model/transfer_model.h"
 #include "gpu/vulkan_sh_projector.h"
@@ -28,6 +29,17 @@ class VulkanProbeKernels : public probes::ProbeKernels {
                                  const probes::SharingSettings& settings, std::vector<probes::FrameSamples>& out,
                                  std::span<const std::uint8_t> targets) override;
   void project(const probes::MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out) override;
+  // On the device unless switched off (set_device_shading) or the device
+  // cannot (VulkanProbeShading::supported; probe_shading_why() says why).
+  bool shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                        std::span<const engine::rt::Ray> rays, std::span<const std::uint64_t> items, std::uint64_t seed,
+                        std::uint64_t sample, const probes::ProbeFeedbackSource* self,
+                        const probes::ProbeFeedbackSource* outer, std::vector<probes::ProbeRayHit>& out) override;
+  // Whether probe rays are shaded on the device (on by default) or on the CPU.
+  void set_device_shading(bool on) { device_shading_ = on; }
+  [[nodiscard]] bool device_shading() const { return device_shading_; }
+  // Why the device does not shade probe rays (empty when it does).
+  [[nodiscard]] const std::string& probe_shading_why() const { return shading_why_; }
   engine::rt::RayBatchTracer* tracer() override { return &tracer_; }
   // The real-time frame's transfer decoder on this device, made for
   // `model`'s network when first asked (and again for another model); null
@@ -38,11 +50,11 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   [[nodiscard]] const char* name() const override { return name_.c_str(); }
   // GPU milliseconds per stage since the last call (timestamps).
   struct StageMs {
-    double trace = 0, raster = 0, projection = 0;
-    [[nodiscard]] double total() const { return trace + raster + projection; }
+    double trace = 0, raster = 0, projection = 0, shading = 0;
+    [[nodiscard]] double total() const { return trace + raster + projection + shading; }
   };
   StageMs take_stage_ms() {
-    StageMs s{tracer_.take_device_ms(), raster_ms_, project_ms_};
+    StageMs s{tracer_.take_device_ms(), raster_ms_, project_ms_, shading_ ? shading_->take_gpu_ms() : 0.0};
     raster_ms_ = project_ms_ = 0.0;
     return s;
   }
@@ -55,6 +67,9 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   std::shared_ptr<const model::TransferModel> decoder_model_;  // kept alive: the cache's key
   std::unique_ptr<VulkanFusedDecoder> decoder_;
   std::string decoder_why_;
+  std::unique_ptr<VulkanProbeShading> shading_;
+  bool device_shading_ = true, shading_tried_ = false;
+  std::string shading_why_;
   std::string name_;
   double raster_ms_ = 0.0, project_ms_ = 0.0;
 };

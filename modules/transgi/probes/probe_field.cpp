@@ -249,9 +249,8 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
       return outer->irradiance(p, n);
     return frame_ > 0 ? irradiance(p, n) : glm::vec3(0.0f);
   };
-  trace_probe_rays(
-      scene, lights, kernels_ ? kernels_->tracer() : nullptr, tracing, directions, [&](int q) { return grid.position(q); },
-      ray_rng, feedback, [&](int q, int i, const ProbeRayHit& h) {
+  // What each ray found, kept by the probe that shot it.
+  const auto consume = [&](int q, int i, const ProbeRayHit& h) {
         const glm::vec3& dir = directions[static_cast<std::size_t>(i)];
         if (h.emitted != glm::vec3(0.0f)) {
           // Monte Carlo projection over a near-uniform set: 4 pi / M per ray.
@@ -275,7 +274,41 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
         }
         if (h.saw_light) saw_light_[static_cast<std::size_t>(q)] = 1;
         points[static_cast<std::size_t>(q)].push_back(sp);
-      });
+      };
+  // The backend's device shades the rays where it can (the same random
+  // numbers and bounce light as the CPU path below).
+  const auto shade_on_device = [&] {
+    if (!kernels_ || tracing.empty()) return false;
+    std::vector<rt::Ray> rays;
+    std::vector<std::uint64_t> items;
+    rays.reserve(tracing.size() * static_cast<std::size_t>(M));
+    items.reserve(rays.capacity());
+    for (const int q : tracing)
+      for (int i = 0; i < M; ++i) {
+        rays.push_back(rt::Ray{grid.position(q), directions[static_cast<std::size_t>(i)]});
+        items.push_back(static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i));
+      }
+    const auto source = [](const ProbeField& f) {
+      return ProbeFeedbackSource{&f.grid_, f.settings_.map, &f.states_, f.sh_, f.usable_, f.settings_.interpolation};
+    };
+    const ProbeFeedbackSource self_source = source(*this);
+    const ProbeFeedbackSource outer_source = outer ? source(*outer) : ProbeFeedbackSource{};
+    std::vector<ProbeRayHit> shaded;
+    if (!kernels_->shade_probe_rays(scene, lights, rays, items, seed, frame_ + 1, frame_ > 0 ? &self_source : nullptr,
+                                    outer ? &outer_source : nullptr, shaded))
+      return false;
+    jobs::parallel_for(0, static_cast<int>(tracing.size()), 1, [&](int b, int e) {
+      for (int j = b; j < e; ++j)
+        for (int i = 0; i < M; ++i)
+          consume(tracing[static_cast<std::size_t>(j)], i,
+                  shaded[static_cast<std::size_t>(j) * static_cast<std::size_t>(M) + static_cast<std::size_t>(i)]);
+    });
+    return true;
+  };
+  if (!shade_on_device())
+    trace_probe_rays(
+        scene, lights, kernels_ ? kernels_->tracer() : nullptr, tracing, directions, [&](int q) { return grid.position(q); },
+        ray_rng, feedback, consume);
   for (std::uint8_t t : traced) stats.traced += t;
   stats.rays = static_cast<std::size_t>(stats.traced) * static_cast<std::size_t>(M);
   stats.hits = hits.load();

@@ -9,10 +9,25 @@
 #include <span>
 #include <vector>
 
+#include "engine/render/light_set.h"
 #include "engine/rt/ray_batch_tracer.h"
+#include "engine/rt/rt_scene.h"
+#include "probes/interpolation.h"
+#include "probes/probe_rays.h"
 #include "probes/radiance_sharing.h"
 
 namespace transgi::probes {
+
+// A probe field as the bounce light of probe rays reads it
+// (ProbeField::irradiance): its relocated grid, maps, SH and usable flags.
+struct ProbeFeedbackSource {
+  const ProbeGrid* grid = nullptr;
+  MapLayout layout;
+  const std::vector<ProbeMapState>* states = nullptr;
+  std::span<const float> sh;                // probes x 75
+  std::span<const std::uint8_t> usable;     // probes
+  InterpolationSettings interpolation;
+};
 
 class ProbeKernels {
  public:
@@ -25,6 +40,17 @@ class ProbeKernels {
   // As MapProjector::project for `maps` maps stored one after another:
   // radiance maps x texel_count(), out maps x 75.
   virtual void project(const MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out) = 0;
+  // Traces and shades probe rays (rays[k] with generator make_rng(seed,
+  // items[k], sample)) as trace_probe_rays does, the bounce light from
+  // `self` inside its grid's box and from `outer` outside it (null: none).
+  // Returns false, out untouched, where the backend does not shade (the
+  // caller then shades on the CPU).
+  virtual bool shade_probe_rays(const engine::rt::RtScene& /*scene*/, const engine::render::LightSet& /*lights*/,
+                                std::span<const engine::rt::Ray> /*rays*/, std::span<const std::uint64_t> /*items*/,
+                                std::uint64_t /*seed*/, std::uint64_t /*sample*/, const ProbeFeedbackSource* /*self*/,
+                                const ProbeFeedbackSource* /*outer*/, std::vector<ProbeRayHit>& /*out*/) {
+    return false;
+  }
   // The backend's ray tracer for the probe rays (and the G-buffer's camera
   // rays); null = Embree.
   virtual engine::rt::RayBatchTracer* tracer() = 0;

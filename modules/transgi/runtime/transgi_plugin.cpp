@@ -63,6 +63,7 @@ void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> casc
   }
   frame->backend = backend->kernels ? backend->kernels->name() : "cpu";
   frame->backend_fallback = backend->fallback;
+  if (backend->kernels) backend->kernels->set_device_shading(settings->device_shading);
   probes::ProbeFrameStats total;
   volumes.each([&](ProbeVolume& v) {
     if (!v.field) return;
@@ -87,6 +88,13 @@ void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> casc
   frame->gpu_trace_ms = gpu_ms.trace;
   frame->gpu_raster_ms = gpu_ms.raster;
   frame->gpu_projection_ms = gpu_ms.projection;
+  frame->gpu_shading_ms = gpu_ms.shading;
+  // The device could not shade the probe rays, so the CPU did.
+  if (backend->kernels && settings->device_shading && !backend->kernels->probe_shading_why().empty()) {
+    const std::string note = "probe rays shaded on the CPU: " + backend->kernels->probe_shading_why();
+    if (frame->backend_fallback.find(note) == std::string::npos)
+      frame->backend_fallback += (frame->backend_fallback.empty() ? "" : "; ") + note;
+  }
   ++frame->probe_frames;
 }
 

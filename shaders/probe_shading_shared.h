@@ -1,0 +1,83 @@
+// Structs of the probe-ray shading kernels (probe_hit_begin.comp,
+// probe_hit_finish.comp), shared with modules/transgi/gpu/vulkan_probe_shading:
+// probes::begin_probe_ray and finish_probe_ray on the device. Same rules as
+// transgi_shared.h.
+#ifndef PROBE_SHADING_SHARED_H
+#define PROBE_SHADING_SHARED_H
+
+#include "transgi_shared.h"
+
+#ifdef __cplusplus
+namespace transgi::gpu {
+#endif
+
+TRANSGI_CONST uint kProbeShadingGroupSize = 64u;
+
+// ProbeRayHit's flags and PendingProbeRay's.
+TRANSGI_CONST uint kProbeRayHit = 1u;
+TRANSGI_CONST uint kProbeRayBackFace = 2u;
+TRANSGI_CONST uint kProbeRaySawLight = 4u;
+TRANSGI_CONST uint kProbeRayReplacedNonFinite = 8u;
+TRANSGI_CONST uint kProbeRayNeedsShadow = 16u;
+TRANSGI_CONST uint kProbeRayTakesFeedback = 32u;
+
+struct ProbeHitPush {
+  uint count;
+  uint seed_lo, seed_hi;      // make_rng(seed, item, sample)
+  uint sample_lo, sample_hi;
+  float offset_scale;         // RtScene::offset_scale
+  uint pad0, pad1;
+};
+
+// probes::PendingProbeRay, between the two kernels (its radiance is zero).
+struct PendingProbeRayGpu {
+  float px, py, pz, distance;     // distance: +inf for an escaped ray
+  float nx, ny, nz;               // geometric normal, facing the probe
+  uint flags;
+  float er, eg, eb, pad0;         // emitted
+  float ur, ug, ub, pad1;         // unoccluded: what the light sample adds if its shadow ray is clear
+  float ar, ag, ab, pad2;         // diffuse albedo / pi
+  float sx, sy, sz, pad3;         // shading normal
+};
+
+// probes::ProbeRayHit.
+struct ProbeRayHitGpu {
+  float px, py, pz, distance;
+  float nx, ny, nz;
+  uint flags;
+  float rr, rg, rb, pad0;  // radiance leaving the hit towards the probe
+  float er, eg, eb, pad1;  // emitted
+};
+
+// Where a probe ray's bounce light comes from: a probe field's interpolation
+// (its probes, depth maps and SH at probe_base, depth_base in the shared
+// buffers), inside [box_min, box_max]; `outer` lights hits outside it.
+struct ProbeFeedbackFieldGpu {
+  InterpolatePush field;
+  uint probe_base, depth_base, enabled, pad0;
+  float box_min_x, box_min_y, box_min_z, pad1;
+  float box_max_x, box_max_y, box_max_z, pad2;
+};
+
+struct ProbeFeedbackGpu {
+  ProbeFeedbackFieldGpu self;
+  ProbeFeedbackFieldGpu outer;
+};
+
+struct ProbeFinishPush {
+  uint count, pad0, pad1, pad2;
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(ProbeHitPush) == 32 && offsetof(ProbeHitPush, offset_scale) == 20, "ProbeHitPush layout");
+static_assert(sizeof(PendingProbeRayGpu) == 96 && offsetof(PendingProbeRayGpu, flags) == 28 &&
+              offsetof(PendingProbeRayGpu, sx) == 80, "PendingProbeRayGpu layout");
+static_assert(sizeof(ProbeRayHitGpu) == 64 && offsetof(ProbeRayHitGpu, flags) == 28 && offsetof(ProbeRayHitGpu, er) == 48,
+              "ProbeRayHitGpu layout");
+static_assert(sizeof(ProbeFeedbackFieldGpu) == 144 && offsetof(ProbeFeedbackFieldGpu, probe_base) == 96 &&
+              offsetof(ProbeFeedbackFieldGpu, box_max_x) == 128, "ProbeFeedbackFieldGpu layout");
+static_assert(sizeof(ProbeFeedbackGpu) == 288, "ProbeFeedbackGpu layout");
+}  // namespace transgi::gpu
+#endif
+
+#endif  // PROBE_SHADING_SHARED_H

@@ -1,0 +1,226 @@
+// shaders/probe_hit_begin.comp and probe_hit_finish.comp against
+// probes::begin_probe_ray / finish_probe_ray (their CPU stages) on the same
+// hits and random numbers: the sample level (textures, its sun) with every
+// kind of light added (a point and a spot light, a sun with a disk, a
+// non-uniform environment map importance-sampled, emissive triangles), the
+// bounce light from a random probe field inside a box and an outer one
+// beyond it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "engine/gpu/gpu_ray_tracer.h"
+#include "engine/math/rng.h"
+#include "engine/render/light_set.h"
+#include "engine/rt/rt_scene.h"
+#include "engine/scene/environment.h"
+#include "engine/scene/scene_assets.h"
+#include "eval/method_runs.h"
+#include "gpu/vulkan_probe_shading.h"
+#include "gpu_fixture.h"
+#include "probes/interpolation.h"
+#include "shading/sh_light.h"
+
+using namespace transgi;
+using namespace engine;
+
+namespace {
+
+// A field of random probes (depth moments, SH, a few unusable) over [lo, hi].
+struct RandomField {
+  probes::ProbeGrid grid;
+  probes::MapLayout layout{16, 8};
+  std::vector<probes::ProbeMapState> states;
+  std::vector<std::uint8_t> usable;
+  std::vector<float> sh;
+  probes::InterpolationSettings interpolation;
+
+  RandomField(glm::vec3 lo, glm::vec3 hi, glm::ivec3 dims, std::uint64_t seed) {
+    grid = probes::ProbeGrid{lo, hi, dims};
+    math::Pcg32 rng(seed, 3);
+    const int count = grid.count();
+    const float unit = grid.min_spacing();
+    grid.offsets.resize(static_cast<std::size_t>(count));
+    for (auto& o : grid.offsets) o = 0.2f * unit * glm::vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f);
+    states.resize(static_cast<std::size_t>(count));
+    usable.resize(static_cast<std::size_t>(count));
+    sh.resize(static_cast<std::size_t>(count) * 75);
+    for (int q = 0; q < count; ++q) {
+      auto& st = states[static_cast<std::size_t>(q)];
+      st.depth.reset(layout.texel_count(), unit);
+      for (int t = 0; t < layout.texel_count(); ++t)
+        st.depth.set(static_cast<std::size_t>(t), unit * (0.3f + 2.0f * rng.next_float()), 0.02f * unit * unit * rng.next_float());
+      usable[static_cast<std::size_t>(q)] = rng.next_float() < 0.1f ? 0 : 1;
+      // A positive DC term and smaller higher bands, as light has.
+      for (int c = 0; c < 3; ++c)
+        for (int k = 0; k < 25; ++k)
+          sh[static_cast<std::size_t>(q) * 75 + c * 25 + k] = k == 0 ? 1.0f + rng.next_float() : 0.3f * (rng.next_float() - 0.5f);
+    }
+  }
+  [[nodiscard]] probes::ProbeFeedbackSource source() const {
+    return {&grid, layout, &states, sh, usable, interpolation};
+  }
+  // ProbeField::irradiance's arithmetic.
+  [[nodiscard]] glm::vec3 irradiance(const glm::vec3& p, const glm::vec3& n) const {
+    const probes::InterpolationResult r = probes::interpolate_probes(grid, layout, states, p, n, interpolation, usable);
+    float L[75] = {};
+    for (std::size_t i = 0; i < 8; ++i) {
+      if (r.weights[i] == 0.0f) continue;
+      for (int k = 0; k < 75; ++k) L[k] += r.weights[i] * sh[static_cast<std::size_t>(r.probes[i]) * 75 + k];
+    }
+    return shading::sh_irradiance(L, n);
+  }
+};
+
+// A sky brighter towards +Y with a hot spot, so importance sampling matters.
+scene::Environment test_sky() {
+  image::ImageRGB img(64, 32);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const float v = (static_cast<float>(y) + 0.5f) / static_cast<float>(img.height);
+      img.at(x, y) = glm::vec3(0.2f, 0.3f, 0.5f) * (1.5f - v) + ((x == 40 && y == 9) ? glm::vec3(200.0f, 180.0f, 150.0f) : glm::vec3(0.0f));
+    }
+  glm::mat4 m = glm::rotate(glm::mat4(1.0f), 0.7f, glm::vec3(0, 1, 0));
+  return scene::Environment(std::move(img), 1.3f, m);
+}
+
+std::vector<render::PunctualInstance> test_punctual() {
+  std::vector<render::PunctualInstance> out;
+  scene::PunctualLight point;
+  point.type = scene::PunctualLight::Type::Point;
+  point.color = {1.0f, 0.9f, 0.8f};
+  point.intensity = 20.0f;
+  point.range = 6.0f;
+  out.push_back({point, glm::vec3(0.5f, 1.8f, 0.2f), glm::vec3(0, 0, -1), 0.0f});
+  scene::PunctualLight spot;
+  spot.type = scene::PunctualLight::Type::Spot;
+  spot.intensity = 40.0f;
+  spot.inner_cone_angle = 0.3f;
+  spot.outer_cone_angle = 0.6f;
+  out.push_back({spot, glm::vec3(-1.0f, 2.2f, 0.5f), glm::normalize(glm::vec3(0.3f, -1.0f, 0.1f)), 0.0f});
+  scene::PunctualLight sun;
+  sun.type = scene::PunctualLight::Type::Directional;
+  sun.intensity = 3.0f;
+  out.push_back({sun, glm::vec3(0.0f), glm::normalize(glm::vec3(-0.4f, -1.0f, -0.3f)), 0.05f});
+  return out;
+}
+
+struct Compared {
+  int rays = 0, hits = 0, shadowed = 0, lit = 0, outside = 0;
+  int flag_mismatch = 0, value_mismatch = 0;
+  double mean_cpu = 0, mean_gpu = 0, worst = 0;
+};
+
+}  // namespace
+
+// Every ray's result to 1e-3 relative (+ 1e-5 absolute) in position,
+// normal, emission and radiance, and the same flags. A float CDF on the
+// device against the CPU's double one can pick a neighbouring bin for a
+// random number within rounding of a border, and a shadow ray that grazes
+// an edge can be blocked for one tracer and not the other: at most 0.5 % of
+// the rays may differ.
+TEST(VulkanProbeShading, EqualsTheCpuStagesOnTheSampleLevelWithEveryKindOfLight) {
+  GPU_TEST_CONTEXT_OR_SKIP(ctx);
+  std::string why;
+  if (!transgi::gpu::VulkanProbeShading::supported(*ctx, &why)) GTEST_SKIP() << why;
+  eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
+  const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
+  const scene::Environment sky = test_sky();
+  const render::LightSet lights(scene, test_punctual(), &sky);
+  ASSERT_EQ(lights.groups(), lights.emissive_triangle_count() > 0 ? 3 : 2);
+
+  const glm::vec3 lo = scene.bounds_min(), hi = scene.bounds_max();
+  const glm::vec3 mid = 0.5f * (lo + hi);
+  // The inner field holds the lower half of the scene (its floor and the
+  // walls' lower halves), the outer all of it.
+  const glm::vec3 margin(0.01f);
+  const RandomField inner(lo - margin, glm::vec3(hi.x, mid.y, hi.z) + margin, glm::ivec3(4, 3, 4), 5);
+  const RandomField outer(lo, hi, glm::ivec3(3, 3, 3), 6);
+  const probes::ProbeFeedbackSource self_source = inner.source(), outer_source = outer.source();
+
+  math::Pcg32 rng(21, 4);
+  const int n = 6000;
+  std::vector<rt::Ray> rays;
+  std::vector<std::uint64_t> items;
+  for (int i = 0; i < n; ++i) {
+    const glm::vec3 o = glm::mix(lo + 0.1f * (hi - lo), hi - 0.1f * (hi - lo), glm::vec3(rng.next_float(), rng.next_float(), rng.next_float()));
+    const glm::vec3 d = glm::normalize(glm::vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f) + 1e-4f);
+    rays.push_back(rt::Ray{o, d});
+    items.push_back(static_cast<std::uint64_t>(i) * 4096 + 7);
+  }
+  const std::uint64_t seed = 0x1234'5678'9abcULL, sample = 42;
+
+  transgi::gpu::VulkanProbeShading shading(*ctx);
+  engine::gpu::GpuRayTracer tracer(*ctx);
+  std::vector<probes::ProbeRayHit> got;
+  ASSERT_TRUE(shading.shade(scene, lights, tracer, rays, items, seed, sample, &self_source, &outer_source, got));
+  ASSERT_EQ(got.size(), rays.size());
+
+  // The CPU stages on the same hits.
+  std::vector<rt::Hit> hits(rays.size());
+  std::vector<std::uint8_t> found(rays.size());
+  ASSERT_TRUE(tracer.intersect(scene, rays, hits, found));
+  Compared c;
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    math::Pcg32 r = math::make_rng(seed, items[k], sample);
+    const probes::PendingProbeRay pending = probes::begin_probe_ray(scene, lights, rays[k].direction, found[k] ? &hits[k] : nullptr, r);
+    const bool blocked = pending.needs_shadow && scene.occluded(pending.shadow);
+    bool was_outside = false;
+    const probes::ProbeRayHit want = probes::finish_probe_ray(pending, blocked, [&](const glm::vec3& p, const glm::vec3& nrm, const glm::vec3&) {
+      was_outside = glm::any(glm::lessThan(p, inner.grid.min)) || glm::any(glm::greaterThan(p, inner.grid.max));
+      return was_outside ? outer.irradiance(p, nrm) : inner.irradiance(p, nrm);
+    });
+    const probes::ProbeRayHit& g = got[k];
+    ++c.rays;
+    c.hits += want.hit;
+    c.shadowed += pending.needs_shadow && blocked;
+    c.lit += pending.needs_shadow && !blocked;
+    c.outside += want.hit && pending.takes_feedback && was_outside;
+    if (g.hit != want.hit || g.back_face != want.back_face || g.saw_light != want.saw_light) {
+      if (c.flag_mismatch < 5)
+        std::printf("ray %d: hit, back face, saw light: cpu %d %d %d, gpu %d %d %d\n", i, want.hit, want.back_face,
+                    want.saw_light, g.hit, g.back_face, g.saw_light);
+      ++c.flag_mismatch;
+      continue;
+    }
+    double err = 0;
+    auto check = [&](const glm::vec3& a, const glm::vec3& b) {
+      for (int j = 0; j < 3; ++j) {
+        const double e = std::abs(double(a[j]) - b[j]) / (1e-3 * std::max(std::abs(double(b[j])), 1e-2));
+        if (std::isfinite(b[j]) || std::isfinite(a[j])) err = std::max(err, std::isfinite(e) ? e : 1e9);
+      }
+    };
+    if (want.hit) {
+      check(g.position, want.position);
+      check(g.normal, want.normal);
+      err = std::max(err, std::abs(double(g.distance) - want.distance) / (1e-3 * std::max(double(want.distance), 1e-2)));
+    }
+    check(g.emitted, want.emitted);
+    check(g.radiance, want.radiance);
+    c.worst = std::max(c.worst, err);
+    if (err > 1.0) {
+      if (c.value_mismatch < 5)
+        std::printf("ray %d: radiance cpu (%g %g %g) gpu (%g %g %g), emitted cpu (%g %g %g) gpu (%g %g %g)\n", i, want.radiance.r,
+                    want.radiance.g, want.radiance.b, g.radiance.r, g.radiance.g, g.radiance.b, want.emitted.r, want.emitted.g,
+                    want.emitted.b, g.emitted.r, g.emitted.g, g.emitted.b);
+      ++c.value_mismatch;
+    }
+    c.mean_cpu += (want.radiance.r + want.radiance.g + want.radiance.b + want.emitted.r + want.emitted.g + want.emitted.b) / n;
+    c.mean_gpu += (g.radiance.r + g.radiance.g + g.radiance.b + g.emitted.r + g.emitted.g + g.emitted.b) / n;
+  }
+  std::printf("probe shading: %d rays, %d hits, %d lit and %d shadowed light samples, %d lit by the outer field; "
+              "%d flag and %d value mismatches; largest error %.3g of the tolerance; mean radiance + emission cpu %.6g gpu %.6g\n",
+              c.rays, c.hits, c.lit, c.shadowed, c.outside, c.flag_mismatch, c.value_mismatch, c.worst, c.mean_cpu, c.mean_gpu);
+  EXPECT_GT(c.hits, n / 2) << "most rays should hit the level";
+  EXPECT_GT(c.lit, n / 20) << "the light samples should often be unoccluded";
+  EXPECT_GT(c.shadowed, n / 50);
+  EXPECT_GT(c.outside, n / 20) << "some hits should take the outer field's light";
+  EXPECT_LT(c.outside, c.hits - n / 20) << "some hits should take the inner field's light";
+  EXPECT_LE(c.flag_mismatch + c.value_mismatch, n / 200)
+      << "expected at most 0.5 % of rays to differ, got " << c.flag_mismatch << " flag and " << c.value_mismatch << " value mismatches";
+  EXPECT_NEAR(c.mean_gpu, c.mean_cpu, 2e-3 * c.mean_cpu) << "expected the mean radiance within 0.2 %";
+}
