@@ -3,6 +3,7 @@
 // probes::ProbeKernels: the probe rays' tracing and the per-probe blend. A
 // DdgiVolume without kernels runs the CPU functions (the oracle); the
 // Vulkan backend is gpu/vulkan_ddgi_kernels.h.
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -22,9 +23,10 @@ class DdgiKernels {
                      const std::vector<std::vector<RayRecord>>& records, const DdgiSettings& settings, float hysteresis,
                      bool clamp_brightness, float max_distance) = 0;
   // DdgiVolume::irradiance at each point (out[i]; 0 where no active probe
-  // weighs in). Returns false, out untouched, where the backend cannot.
+  // weighs in, and lit[i] = 0 then, else 1). Returns false, out and lit
+  // untouched, where the backend cannot.
   virtual bool irradiance(const DdgiVolume& volume, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
-                          std::span<const glm::vec3> view_dirs, std::span<glm::vec3> out) = 0;
+                          std::span<const glm::vec3> view_dirs, std::span<glm::vec3> out, std::span<std::uint8_t> lit) = 0;
   [[nodiscard]] virtual const char* name() const = 0;
 };
 

@@ -24,9 +24,10 @@ class VulkanDdgiKernels : public ddgi::DdgiKernels {
     blend_.blend(irradiance, distance, records, settings, hysteresis, clamp_brightness, max_distance);
   }
   bool irradiance(const ddgi::DdgiVolume& volume, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
-                  std::span<const glm::vec3> view_dirs, std::span<glm::vec3> out) override {
+                  std::span<const glm::vec3> view_dirs, std::span<glm::vec3> out, std::span<std::uint8_t> lit) override {
     const GpuDdgiIrradiance r = irradiance_.irradiance(volume, positions, normals, view_dirs);
     std::copy(r.irradiance.begin(), r.irradiance.end(), out.begin());
+    std::copy(r.lit.begin(), r.lit.end(), lit.begin());
     return true;
   }
   [[nodiscard]] const char* name() const override { return name_.c_str(); }
