@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <cstring>
+#include <string>
 #include <glm/gtc/quaternion.hpp>
 
 #include "engine/gpu/gpu_error.h"
@@ -14,10 +16,21 @@
 namespace engine::gpu {
 namespace {
 
+std::string mebibytes(std::uint64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.2f MiB", static_cast<double>(bytes) / (1024.0 * 1024.0));
+  return text;
+}
+
+// `what` names the data in the error where it is larger than a kernel can bind.
 template <class T>
-void upload_to(VulkanContext& ctx, GpuBuffer& b, std::vector<T> v, GpuBuffer::Placement placement) {
+void upload_to(VulkanContext& ctx, GpuBuffer& b, std::vector<T> v, GpuBuffer::Placement placement, const char* what) {
   if (v.empty()) v.push_back(T{});  // a binding needs a buffer
   const std::size_t bytes = v.size() * sizeof(T);
+  const std::uint64_t limit = ctx.info().max_storage_buffer_range;
+  if (limit > 0 && bytes > limit)
+    throw GpuError("GpuShadingScene: the scene's " + std::string(what) + " take " + mebibytes(bytes) +
+                   ", more than the device's largest storage buffer (" + mebibytes(limit) + ")");
   if (b.handle() == VK_NULL_HANDLE || b.size() < bytes) b = GpuBuffer(ctx, bytes, placement);
   b.upload(std::span<const T>(v));
 }
@@ -83,7 +96,7 @@ void GpuShadingScene::sync(const rt::RtScene& rt, const render::LightSet& lights
     g = {r0[0], r0[1], r0[2], r->to_world.translation.x, r1[0], r1[1], r1[2], r->to_world.translation.y,
          r2[0], r2[1], r2[2], r->to_world.translation.z, r->to_world.scale, r->mesh, 1u, 0u};
   }
-  upload_to(ctx_, instances_, std::move(instances), kPerFrame);
+  upload_to(ctx_, instances_, std::move(instances), kPerFrame, "instances");
   sync_lights(lights);
 }
 
@@ -137,12 +150,12 @@ void GpuShadingScene::sync_assets(const scene::SceneAssets& assets) {
     tables[kShadingAlbedoAverage + 2 * j] = avg[j].a;
     tables[kShadingAlbedoAverage + 2 * j + 1] = avg[j].b;
   }
-  upload_to(ctx_, mesh_first_, std::move(mesh_first), kStatic);
-  upload_to(ctx_, triangles_, std::move(tris), kStatic);
-  upload_to(ctx_, materials_, std::move(materials), kStatic);
-  upload_to(ctx_, textures_, std::move(textures), kStatic);
-  upload_to(ctx_, texels_, std::move(texels), kStatic);
-  upload_to(ctx_, tables_, std::move(tables), kStatic);
+  upload_to(ctx_, mesh_first_, std::move(mesh_first), kStatic, "meshes");
+  upload_to(ctx_, triangles_, std::move(tris), kStatic, "triangles");
+  upload_to(ctx_, materials_, std::move(materials), kStatic, "materials");
+  upload_to(ctx_, textures_, std::move(textures), kStatic, "textures");
+  upload_to(ctx_, texels_, std::move(texels), kStatic, "texels");
+  upload_to(ctx_, tables_, std::move(tables), kStatic, "shading tables");
 }
 
 void GpuShadingScene::sync_lights(const render::LightSet& lights) {
@@ -206,18 +219,18 @@ void GpuShadingScene::sync_lights(const render::LightSet& lights) {
       for (const auto& row : dist.rows())
         for (std::size_t x = 0; x < static_cast<std::size_t>(w); ++x) t.push_back(bin_pdf(row, x));
       if (t.size() != h.env_row_pdf + texels) throw GpuError("GpuShadingScene: environment tables of unexpected size");
-      upload_to(ctx_, light_tables_, std::move(t), kStatic);
+      upload_to(ctx_, light_tables_, std::move(t), kStatic, "environment map's tables");
       env_pixels_ = img.pixels.data();
       env_width_ = w;
       env_height_ = ht;
     }
   } else if (light_tables_.handle() == VK_NULL_HANDLE) {
-    upload_to(ctx_, light_tables_, std::vector<float>{}, kStatic);
+    upload_to(ctx_, light_tables_, std::vector<float>{}, kStatic, "environment map's tables");
   }
-  upload_to(ctx_, light_set_, std::vector<LightSetGpu>{h}, kPerFrame);
-  upload_to(ctx_, emissive_, std::move(emissive), kPerFrame);
-  upload_to(ctx_, triangle_cdf_, std::move(cdf), kPerFrame);
-  upload_to(ctx_, punctual_, std::move(punctual), kPerFrame);
+  upload_to(ctx_, light_set_, std::vector<LightSetGpu>{h}, kPerFrame, "light set");
+  upload_to(ctx_, emissive_, std::move(emissive), kPerFrame, "emissive triangles");
+  upload_to(ctx_, triangle_cdf_, std::move(cdf), kPerFrame, "emissive triangles' distribution");
+  upload_to(ctx_, punctual_, std::move(punctual), kPerFrame, "punctual lights");
 }
 
 void GpuShadingScene::bind(ComputePipeline& pipeline, std::uint32_t first) const {

@@ -127,6 +127,9 @@ std::unique_ptr<VulkanContext> VulkanContext::create(const GpuOptions& options, 
   ctx->info_.shader_float16 = f12.shaderFloat16 == VK_TRUE;
   ctx->info_.shader_int64 = f2.features.shaderInt64 == VK_TRUE;
   ctx->info_.max_shared_memory = props.limits.maxComputeSharedMemorySize;
+  ctx->info_.max_storage_buffer_range = props.limits.maxStorageBufferRange;
+  if (options.storage_buffer_range_cap > 0)
+    ctx->info_.max_storage_buffer_range = std::min(ctx->info_.max_storage_buffer_range, options.storage_buffer_range_cap);
   ctx->info_.buffer_memory = options.buffer_memory;
   ctx->info_.stage_device_only = options.stage_device_only;
   VkPhysicalDeviceMemoryProperties mem;

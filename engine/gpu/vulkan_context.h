@@ -48,6 +48,9 @@ struct GpuOptions {
   // True: always through staging copies, so tests on lavapipe take the path
   // a discrete GPU takes.
   bool stage_device_only = false;
+  // Caps DeviceInfo::max_storage_buffer_range below the device's (0 = no
+  // cap), so tests reach the path a device too small for a scene takes.
+  std::uint64_t storage_buffer_range_cap = 0;
 };
 
 struct DeviceInfo {
@@ -57,6 +60,7 @@ struct DeviceInfo {
   bool shader_float16 = false;
   bool shader_int64 = false;  // the shading kernels need it (shaders/pcg32.glsl)
   std::uint32_t max_shared_memory = 0;
+  std::uint64_t max_storage_buffer_range = 0;  // the largest buffer a kernel can bind
   double timestamp_period_ns = 0;  // 0: the queue has no timestamps
   BufferMemory buffer_memory = BufferMemory::Cached;
   // Largest heap of mappable device-local memory, 0 where there is none

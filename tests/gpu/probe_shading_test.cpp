@@ -19,6 +19,7 @@
 #include "engine/scene/environment.h"
 #include "engine/scene/scene_assets.h"
 #include "eval/method_runs.h"
+#include "gpu/vulkan_probe_kernels.h"
 #include "gpu/vulkan_probe_shading.h"
 #include "gpu_fixture.h"
 #include "probes/interpolation.h"
@@ -223,4 +224,30 @@ TEST(VulkanProbeShading, EqualsTheCpuStagesOnTheSampleLevelWithEveryKindOfLight)
   EXPECT_LE(c.flag_mismatch + c.value_mismatch, n / 200)
       << "expected at most 0.5 % of rays to differ, got " << c.flag_mismatch << " flag and " << c.value_mismatch << " value mismatches";
   EXPECT_NEAR(c.mean_gpu, c.mean_cpu, 2e-3 * c.mean_cpu) << "expected the mean radiance within 0.2 %";
+}
+
+// A device whose largest buffer cannot hold the level's shading data: the
+// kernels decline, the CPU shades, and the backend says why, naming what did
+// not fit.
+TEST(VulkanProbeShading, ASceneTooBigForTheDeviceIsShadedOnTheCpuAndSaysWhy) {
+  GPU_TEST_CONTEXT_OR_SKIP(unused);
+  engine::gpu::GpuOptions options;
+  options.storage_buffer_range_cap = 64 * 1024;  // the level's triangles and texels take more
+  std::string why;
+  std::shared_ptr<engine::gpu::VulkanContext> ctx(engine::gpu::VulkanContext::create(options, &why));
+  ASSERT_TRUE(ctx) << why;
+  if (!transgi::gpu::VulkanProbeShading::supported(*ctx, &why)) GTEST_SKIP() << why;
+  transgi::gpu::VulkanProbeKernels kernels(ctx);
+  eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
+  const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
+  const render::LightSet lights(scene, test_punctual(), nullptr);
+  const std::vector<rt::Ray> rays{rt::Ray{0.5f * (scene.bounds_min() + scene.bounds_max()), glm::vec3(0, -1, 0)}};
+  const std::vector<std::uint64_t> items{1};
+  std::vector<probes::ProbeRayHit> out;
+  EXPECT_FALSE(kernels.shade_probe_rays(scene, lights, rays, items, 1, 1, nullptr, nullptr, out));
+  EXPECT_TRUE(out.empty());
+  EXPECT_NE(kernels.probe_shading_why().find("largest storage buffer"), std::string::npos) << kernels.probe_shading_why();
+  std::printf("declined: %s\n", kernels.probe_shading_why().c_str());
+  // And stays declined, without trying again every frame.
+  EXPECT_FALSE(kernels.shade_probe_rays(scene, lights, rays, items, 1, 1, nullptr, nullptr, out));
 }

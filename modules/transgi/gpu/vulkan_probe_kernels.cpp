@@ -3,6 +3,8 @@
 #include <exception>
 #include <stdexcept>
 
+#include "engine/gpu/gpu_error.h"
+
 namespace transgi::gpu {
 
 probes::SharingStats VulkanProbeKernels::rasterize(const probes::ProbeGrid& grid, const probes::MapLayout& layout,
@@ -42,7 +44,16 @@ bool VulkanProbeKernels::shade_probe_rays(const engine::rt::RtScene& scene, cons
       shading_why_ = e.what();
     }
   }
-  return shading_ && shading_->shade(scene, lights, tracer_, rays, items, seed, sample, self, outer, out);
+  if (!shading_) return false;
+  try {
+    return shading_->shade(scene, lights, tracer_, rays, items, seed, sample, self, outer, out);
+  } catch (const engine::gpu::GpuError& e) {
+    // A scene the device cannot hold (textures past its largest buffer, out
+    // of memory): the CPU shades from now on, and the frame says why.
+    shading_.reset();
+    shading_why_ = e.what();
+    return false;
+  }
 }
 
 shading::TransferBatchDecoder* VulkanProbeKernels::transfer_decoder(const std::shared_ptr<const model::TransferModel>& model) {

@@ -86,12 +86,12 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
   if (self) check_source(*self);
   if (outer) check_source(*outer);
   if (!scene.assets()) return false;
+  scene_.sync(scene, lights);  // first: a scene the device cannot hold throws before out changes
   std::vector<engine::rt::Hit> hits(n);
   std::vector<std::uint8_t> found(n);
   if (!tracer.intersect(scene, rays, hits, found)) return false;
   out.resize(n);
   if (n == 0) return true;
-  scene_.sync(scene, lights);
 
   // 1. The surfaces and their light samples.
   const auto ray_in = bind_at_least(ctx_, *begin_, 0, rays_, n * sizeof(RayGpu)).mapped_as<RayGpu>(n);
