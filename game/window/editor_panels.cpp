@@ -165,6 +165,7 @@ void EditorUi::gi_settings() {
   changed |= ImGui::SliderInt("probe budget / frame", &edit.probes.update_budget, 0, 512);
   changed |= ImGui::Checkbox("decode transfer on the GPU (vulkan backend)", &edit.device_inference);
   changed |= ImGui::Checkbox("shade probe rays on the GPU (vulkan backend)", &edit.device_shading);
+  changed |= ImGui::Checkbox("make the decoded samples' light on the GPU", &edit.realtime.device_lights);
   if (changed) *s = edit;
   // The backend at run time (issue 12): Vulkan, lavapipe where there is no GPU.
   int backend = s->backend == transgi::runtime::Backend::Vulkan ? 1 : 0;

@@ -35,13 +35,14 @@ eval::MethodRun cornell(runtime::Backend backend) {
 // The real-time path with a network (random latents and weights: the test is
 // of equality, not of light), so the frame's transfer inference runs on the
 // device when the backend is Vulkan.
-eval::MethodRun cornell_realtime(runtime::Backend backend, int width, bool device_inference = true) {
+eval::MethodRun cornell_realtime(runtime::Backend backend, int width, bool device_inference = true, bool device_lights = true) {
   eval::TransgiRunOptions t;
   t.frames = 12;
   t.progress = false;
   t.settings.gi_path = runtime::GiPath::Realtime;
   t.settings.backend = backend;
   t.settings.device_inference = device_inference;
+  t.settings.realtime.device_lights = device_lights;
   t.settings.direct_spp = 0;
   t.settings.probes.map = probes::MapLayout{32, 16};
   t.settings.probes.fixed_pattern = true;
@@ -84,6 +85,25 @@ TEST(VulkanBackend, ARealtimeFrameDecodedOnTheDeviceEqualsTheCpuDecoding) {
   std::printf("Cornell box, real-time, 12 frames, 48x48, %zu samples decoded: GI RMSE between device and CPU decoding %.3g, "
               "mean |GI| %.4f\n", gpu.inferred_samples, rmse, mean);
   EXPECT_LT(rmse, 1e-4 * mean) << "expected the decodings within 1e-4 of the mean |GI|, got RMSE " << rmse;
+}
+
+// The device decodes both frames; in one it also makes the lights from the
+// probes (probe_lights.comp), in the other the CPU writes them: the same
+// interpolation, so within 1e-4 of the mean |GI| again.
+TEST(VulkanBackend, ARealtimeFrameWithLightsMadeOnTheDeviceEqualsOneWithTheCpusLights) {
+  GPU_TEST_CONTEXT_OR_SKIP(ctx);
+  const eval::MethodRun cpu_lights = cornell_realtime(runtime::Backend::Vulkan, 32, true, false);
+  const eval::MethodRun gpu_lights = cornell_realtime(runtime::Backend::Vulkan, 32, true, true);
+  ASSERT_EQ(gpu_lights.backend.rfind("vulkan", 0), 0u) << "the plugin fell back: " << gpu_lights.backend;
+  ASSERT_GT(gpu_lights.inferred_samples, 0u) << "the network decoded nothing";
+  double mean = 0;
+  for (const auto& p : cpu_lights.gi.pixels) mean += std::abs(p.r + p.g + p.b) / 3.0;
+  mean /= static_cast<double>(cpu_lights.gi.pixels.size());
+  ASSERT_GT(mean, 1e-4) << "a black frame would prove nothing";
+  const double rmse = engine::image::rmse_clamped(cpu_lights.gi, gpu_lights.gi);
+  std::printf("Cornell box, real-time, 12 frames, 48x48: GI RMSE between lights made on the device and by the CPU %.3g, "
+              "mean |GI| %.4f\n", rmse, mean);
+  EXPECT_LT(rmse, 1e-4 * mean) << "expected the two within 1e-4 of the mean |GI|, got RMSE " << rmse;
 }
 
 // A network wider than the kernels hold (256): the frame still renders, the

@@ -76,7 +76,7 @@ ecs::Entity pick_moving_object(ecs::World& world, const std::string& name) {
 int run_bench_frame(const std::vector<std::string>& argv) {
   const Args args("bench-frame", argv,
                   {"scene", "model", "width", "height", "frames", "warmup", "preset", "csv", "object", "threads", "camera",
-                   "direct-spp", "gi-scale", "gi-reuse", "probe-budget", "probe-settle", "backend", "device", "device-inference", "device-shading", "near-field-rays", "near-field-reach", "near-field-filter", "direct", "gi-out", "reference-out", "reference-spp", "map-width",
+                   "direct-spp", "gi-scale", "gi-reuse", "probe-budget", "probe-settle", "backend", "device", "device-inference", "device-shading", "device-lights", "near-field-rays", "near-field-reach", "near-field-filter", "direct", "gi-out", "reference-out", "reference-spp", "map-width",
                    "probe-volume", "probe-grid", "cascades", "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "cascade-map-width"},
                   {"allow-unbaked"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");

@@ -90,12 +90,39 @@ void VulkanFusedDecoder::reserve(std::size_t n, bool second) {
   }
 }
 
-double VulkanFusedDecoder::dispatch(std::size_t n, bool second) {
-  FusedPush push{static_cast<uint>(n), static_cast<uint>(layout_.inputs), static_cast<uint>(layout_.width),
-                 static_cast<uint>(layout_.hidden_layers), static_cast<uint>(layout_.outputs), second ? 1u : 0u, 0, 0};
+FusedPush VulkanFusedDecoder::push_for(std::size_t n, bool second) const {
+  return {static_cast<uint>(n), static_cast<uint>(layout_.inputs), static_cast<uint>(layout_.width),
+          static_cast<uint>(layout_.hidden_layers), static_cast<uint>(layout_.outputs), second ? 1u : 0u, 0, 0};
+}
+
+std::uint32_t VulkanFusedDecoder::groups_for(std::size_t n) const {
   const std::size_t per_group = tiled_ ? kFusedTiledPoints : kFusedGroupSize;
-  const auto groups = static_cast<std::uint32_t>((n + per_group - 1) / per_group);
-  return ctx_.submit_and_wait([&](VkCommandBuffer cmd) { pipeline_->record_dispatch(cmd, groups, 1, 1, &push); });
+  return static_cast<std::uint32_t>((n + per_group - 1) / per_group);
+}
+
+double VulkanFusedDecoder::dispatch(std::size_t n, bool second) {
+  const FusedPush push = push_for(n, second);
+  return ctx_.submit_and_wait([&](VkCommandBuffer cmd) { pipeline_->record_dispatch(cmd, groups_for(n), 1, 1, &push); });
+}
+
+bool VulkanFusedDecoder::set_probes(std::span<const probes::ProbeField* const> fields, int rotations, const ShOf& sh) {
+  if (lights_failed_) return false;
+  if (!lights_) {
+    try {
+      lights_ = std::make_unique<VulkanProbeLights>(ctx_);
+    } catch (const std::exception& e) {
+      lights_failed_ = true;
+      lights_why_ = e.what();
+      return false;
+    }
+  }
+  return lights_->set_probes(fields, rotations, sh, &lights_why_);
+}
+
+std::span<shading::ProbeLightMaker::Point> VulkanFusedDecoder::points(std::size_t n) {
+  if (!lights_) throw std::logic_error("VulkanFusedDecoder::points before a successful set_probes");
+  points_pending_ = true;
+  return lights_->points(n);
 }
 
 double VulkanFusedDecoder::shade(std::span<const float> inputs, std::span<const float> light, std::span<float> rgb) {
@@ -117,6 +144,7 @@ shading::TransferBatchDecoder::Batch VulkanFusedDecoder::begin(std::size_t n, bo
   reserve(std::max<std::size_t>(n, 1), second);
   batch_points_ = n;
   batch_second_ = second;
+  points_pending_ = false;
   return {inputs_.mapped_as<float>(n * static_cast<std::size_t>(layout_.inputs)), light_.mapped_as<float>(n * kTransferOutputs),
           second ? light2_.mapped_as<float>(n * kTransferOutputs) : std::span<float>()};
 }
@@ -125,7 +153,29 @@ double VulkanFusedDecoder::run(glm::vec3* out, glm::vec3* out2) {
   const std::size_t n = batch_points_;
   if (n == 0) return 0.0;
   if (out2 && !batch_second_) throw std::invalid_argument("VulkanFusedDecoder::run: a second output, but begin() asked for no second light");
-  const double ms = dispatch(n, batch_second_);
+  double ms = 0.0;
+  if (points_pending_) {
+    // The lights from the probes on the device, into device-local buffers
+    // the decoder reads, in the same submission.
+    points_pending_ = false;
+    const std::size_t bytes = n * kTransferOutputs * sizeof(float);
+    const auto device_only = engine::gpu::GpuBuffer::Placement::DeviceOnly;
+    if (device_light_.handle() == VK_NULL_HANDLE || device_light_.size() < bytes) device_light_ = engine::gpu::GpuBuffer(ctx_, bytes, device_only);
+    const std::size_t bytes2 = batch_second_ ? bytes : 4;
+    if (device_light2_.handle() == VK_NULL_HANDLE || device_light2_.size() < bytes2) device_light2_ = engine::gpu::GpuBuffer(ctx_, bytes2, device_only);
+    pipeline_->bind(2, device_light_);
+    pipeline_->bind(4, batch_second_ ? device_light2_ : light2_);
+    const FusedPush push = push_for(n, batch_second_);
+    ms = ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
+      lights_->record(cmd, n, batch_second_, device_light_, device_light2_);
+      engine::gpu::record_compute_barrier(cmd);
+      pipeline_->record_dispatch(cmd, groups_for(n), 1, 1, &push);
+    });
+    pipeline_->bind(2, light_);
+    pipeline_->bind(4, light2_);
+  } else {
+    ms = dispatch(n, batch_second_);
+  }
   static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
   const auto rgb = rgb_.mapped_as<const float>(n * 3);
   const auto rgb2 = batch_second_ ? rgb2_.mapped_as<const float>(n * 3) : std::span<const float>();

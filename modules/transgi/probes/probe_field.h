@@ -247,6 +247,8 @@ class ProbeField {
   [[nodiscard]] std::uint64_t frame() const { return frame_; }
   [[nodiscard]] const std::vector<ProbeMapState>& states() const { return states_; }
   [[nodiscard]] ProbeState state(int probe) const { return state_[static_cast<std::size_t>(probe)]; }
+  // Per probe, 1 unless buried or far: what interpolation weighs.
+  [[nodiscard]] const std::vector<std::uint8_t>& usable() const { return usable_; }
   // The frame probe last traced rays (budgeted fields; 0 before it ever did).
   [[nodiscard]] std::uint64_t last_traced(int probe) const {
     return static_cast<std::size_t>(probe) < last_traced_.size() ? last_traced_[static_cast<std::size_t>(probe)] : 0;

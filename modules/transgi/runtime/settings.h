@@ -53,11 +53,12 @@ struct TransGISettings {
   std::string gpu_device;
   // Backend::Vulkan, real-time path: decode the transfer on the device.
   // True frees the CPU of its largest data-parallel stage, at the cost of
-  // sending each network sample's inputs and lights over the bus (166 MB a
-  // 1080p frame). Off by default because that cost is measured and the gain
-  // is not: on an H100 beside 16 CPU cores the stage took 12.9 ms against the
-  // CPU's 7.9, the frame 155-159 against 145-153 ms (docs/gpu-h100.md). It
-  // should pay beside fewer cores, and once the lights are made on the device.
+  // sending each network sample's inputs over the bus. Off by default
+  // because that cost is measured and the gain is not: on an H100 beside 16
+  // CPU cores the stage took 12.9 ms against the CPU's 7.9, the frame
+  // 155-159 against 145-153 ms (docs/gpu-h100.md), when 150 floats of light
+  // a sample still crossed the bus; they are now made on the device
+  // (RealtimeGiSettings::device_lights), which no GPU has timed yet.
   bool device_inference = false;
   // Backend::Vulkan: shade the probe rays' hits on the device (materials,
   // textures, a light sample, the bounce from the probes), as the CPU would

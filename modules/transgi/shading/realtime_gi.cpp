@@ -327,7 +327,16 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
             light_direct ? light_direct + (k - b) * 75 : nullptr);
       }
     };
-    if (batch_decoder)
+    ProbeLightMaker* maker = batch_decoder && settings.device_lights ? batch_decoder->probe_lights() : nullptr;
+    if (maker && !maker->set_probes(fields, static_cast<int>(rotated.count()),
+                                    [&](int r, const probes::ProbeField* f, bool direct) { return rotated.sh(r, f, direct); }))
+      maker = nullptr;  // more fields than the device takes: the CPU makes the lights
+    if (maker)
+      shade_transfer_device_lights(
+          *batch_decoder, *maker, *model, assets, queries,
+          [&](std::size_t k) { return ProbeLightMaker::Point{sc.net_position[k], rotation_of[k], sc.net_normal[k], 0.0f}; },
+          shaded.data(), with_direct ? shaded_direct.data() : nullptr, &stats.inference_device_ms);
+    else if (batch_decoder)
       fill_seconds = shade_transfer_batched(*batch_decoder, *model, assets, queries, fill, shaded.data(),
                                             with_direct ? shaded_direct.data() : nullptr, &stats.inference_device_ms);
     else

@@ -13,6 +13,8 @@
 
 namespace transgi::shading {
 
+class ProbeLightMaker;
+
 class TransferBatchDecoder {
  public:
   struct Batch {
@@ -27,6 +29,9 @@ class TransferBatchDecoder {
   // Decodes the batch begin() handed out: out[n], and out2[n] when it asked
   // for a second light. Returns the device's milliseconds (-1 where unknown).
   virtual double run(glm::vec3* out, glm::vec3* out2) = 0;
+  // Where the decoder can also make the lights from the probes: its maker
+  // (probe_light_maker.h); null = the caller writes the lights.
+  virtual ProbeLightMaker* probe_lights() { return nullptr; }
 };
 
 }  // namespace transgi::shading

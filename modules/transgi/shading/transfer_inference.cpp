@@ -107,6 +107,30 @@ double shade_transfer_batched(TransferBatchDecoder& decoder, const model::Transf
   return static_cast<double>(fill_ns.load()) * 1e-9;
 }
 
+void shade_transfer_device_lights(TransferBatchDecoder& decoder, ProbeLightMaker& lights, const model::TransferModel& model,
+                                    const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
+                                    const std::function<ProbeLightMaker::Point(std::size_t)>& point_of, glm::vec3* out,
+                                    glm::vec3* out2, double* device_ms) {
+  if (device_ms) *device_ms = 0.0;
+  if (queries.empty()) return;
+  const auto in_size = static_cast<std::size_t>(decoder.inputs());
+  const TransferBatchDecoder::Batch batch = decoder.begin(queries.size(), out2 != nullptr);
+  const std::span<ProbeLightMaker::Point> points = lights.points(queries.size());
+  const std::size_t tiles = (queries.size() + kFusedTile - 1) / kFusedTile;
+  engine::jobs::parallel_for<std::size_t>(0, tiles, 4, [&](std::size_t tb, std::size_t te) {
+    std::vector<float> z(static_cast<std::size_t>(model.latent_dim));
+    for (std::size_t tile = tb; tile < te; ++tile) {
+      const std::size_t b = tile * kFusedTile, e = std::min(b + kFusedTile, queries.size());
+      for (std::size_t i = b; i < e; ++i) {
+        points[i] = point_of(i);
+        network_input(model, assets, queries[i], z.data(), batch.inputs.data() + i * in_size);
+      }
+    }
+  });
+  const double ms = decoder.run(out, out2);
+  if (device_ms) *device_ms = ms;
+}
+
 void shade_transfer_fused(const FusedDecoder& decoder, const model::TransferModel& model,
                           const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
                           const float* light, glm::vec3* out, const float* light2, glm::vec3* out2) {

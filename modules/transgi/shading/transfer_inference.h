@@ -11,6 +11,7 @@
 
 #include "model/transfer_model.h"
 #include "shading/fused_decoder.h"
+#include "shading/probe_light_maker.h"
 #include "shading/transfer_batch_decoder.h"
 
 namespace transgi::shading {
@@ -63,5 +64,13 @@ double shade_transfer_batched(TransferBatchDecoder& decoder, const model::Transf
                               const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
                               const TileLightFill& fill, glm::vec3* out, glm::vec3* out2 = nullptr,
                               double* device_ms = nullptr);
+
+// The same where the decoder makes the lights itself (probe_lights() after
+// set_probes): each query's network input and its point (where the probes
+// are interpolated) go into the batch instead of a light.
+void shade_transfer_device_lights(TransferBatchDecoder& decoder, ProbeLightMaker& lights, const model::TransferModel& model,
+                                    const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
+                                    const std::function<ProbeLightMaker::Point(std::size_t)>& point_of, glm::vec3* out,
+                                    glm::vec3* out2 = nullptr, double* device_ms = nullptr);
 
 }  // namespace transgi::shading

@@ -1,0 +1,178 @@
+// shaders/probe_lights.comp against probes::interpolate_fields_with (its CPU
+// stage): three cascades of probes updated in the sample level, each point
+// looked up with a rotated copy of the SH or the world's, points inside the
+// finest cascade, across the hand-over bands, in the coarsest alone and
+// outside them all.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "engine/math/rng.h"
+#include "engine/render/light_set.h"
+#include "engine/rt/rt_scene.h"
+#include "eval/method_runs.h"
+#include "gpu/vulkan_probe_lights.h"
+#include "gpu_fixture.h"
+#include "probes/cascades.h"
+
+using namespace transgi;
+using namespace engine;
+
+namespace {
+
+struct Cascades {
+  std::vector<std::unique_ptr<probes::ProbeField>> owned;
+  std::vector<const probes::ProbeField*> fields;
+};
+
+// Three 6^3 cascades (0.4, 0.8, 1.6 m cells) centred on a point of the
+// level, updated for 12 frames, the finer lit beyond their box by the
+// coarser, as the plugin runs them.
+Cascades level_cascades(const rt::RtScene& scene, const render::LightSet& lights, const glm::vec3& eye, int count = 3,
+                        float finest_cell = 0.4f) {
+  probes::CascadeSettings c;
+  c.count = count;
+  c.finest_cell = finest_cell;
+  c.dims = glm::ivec3(6);
+  Cascades out;
+  for (int k = 0; k < c.count; ++k) {
+    probes::ProbeFieldSettings s;
+    s.grid = probes::cascade_grid(c, k, probes::cascade_origin(c, k, eye));
+    s.map = probes::MapLayout{16, 8};
+    s.rays_per_probe = 32;
+    s.blend_cells = c.blend_cells;
+    out.owned.push_back(std::make_unique<probes::ProbeField>(s));
+  }
+  for (int frame = 0; frame < 12; ++frame)
+    for (int k = c.count - 1; k >= 0; --k)
+      out.owned[static_cast<std::size_t>(k)]->update(scene, lights, k + 1 < c.count ? out.owned[static_cast<std::size_t>(k) + 1].get() : nullptr);
+  for (const auto& f : out.owned) out.fields.push_back(f.get());
+  return out;
+}
+
+struct Compared {
+  int points = 0, differ = 0, blended = 0, outside = 0, mean_light = 0;
+};
+
+// The device's lights at `n` random points (half near the eye, half in and
+// around the coarsest cascade, a few far beyond) against
+// interpolate_fields_with, with two rotated SH copies besides the world's.
+Compared compare_lights(engine::gpu::VulkanContext& ctx, const Cascades& c, const glm::vec3& eye, int n, std::uint64_t seed) {
+  // Two rotated copies besides the world's: random SH, the kernel only reads them.
+  const int rotations = 2;
+  math::Pcg32 rng(seed, 11);
+  std::vector<std::vector<float>> copies;  // (r * fields + f) * 2 + direct
+  for (int r = 0; r < rotations; ++r)
+    for (const probes::ProbeField* f : c.fields)
+      for (int d = 0; d < 2; ++d) {
+        std::vector<float> v(f->light_sh_all().size());
+        for (float& x : v) x = rng.next_float() - 0.25f;
+        copies.push_back(std::move(v));
+      }
+  const auto index_of = [&](const probes::ProbeField* f) {
+    return static_cast<std::size_t>(std::find(c.fields.begin(), c.fields.end(), f) - c.fields.begin());
+  };
+  const shading::ProbeLightMaker::ShOf sh = [&](int r, const probes::ProbeField* f, bool direct) -> const float* {
+    if (r < 0) return (direct ? f->direct_sh_all() : f->light_sh_all()).data();
+    return copies[(static_cast<std::size_t>(r) * c.fields.size() + index_of(f)) * 2 + (direct ? 1 : 0)].data();
+  };
+
+  std::vector<shading::ProbeLightMaker::Point> pts(static_cast<std::size_t>(n));
+  const probes::ProbeGrid& coarse = c.fields.back()->placement();
+  for (auto& p : pts) {
+    // Half in the finest cascade's neighbourhood, half anywhere in and just
+    // outside the coarsest, a few far beyond it.
+    const float u = rng.next_float();
+    const bool near = u < 0.5f, far = u > 0.95f;
+    glm::vec3 a = near ? eye - 1.6f : coarse.min - 0.5f, b = near ? eye + 1.6f : coarse.max + 0.5f;
+    if (far) {
+      a = coarse.max + 20.0f;
+      b = coarse.max + 40.0f;
+    }
+    p.position = glm::mix(a, b, glm::vec3{rng.next_float(), rng.next_float(), rng.next_float()});
+    p.normal = glm::normalize(glm::vec3{rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f} + 1e-3f);
+    p.rotation = static_cast<int>(rng.next_float() * (rotations + 1)) - 1;
+  }
+
+  transgi::gpu::VulkanProbeLights device(ctx);
+  std::string why;
+  EXPECT_TRUE(device.set_probes(c.fields, rotations, sh, &why)) << why;
+  const auto mapped = device.points(n);
+  std::copy(pts.begin(), pts.end(), mapped.begin());
+  engine::gpu::GpuBuffer light(ctx, n * 75 * sizeof(float)), light2(ctx, n * 75 * sizeof(float));
+  ctx.submit_and_wait([&](VkCommandBuffer cmd) { device.record(cmd, n, true, light, light2); });
+  std::vector<float> got(static_cast<std::size_t>(n) * 75), got2(static_cast<std::size_t>(n) * 75);
+  light.download(std::span<float>(got));
+  light2.download(std::span<float>(got2));
+
+  int differ = 0, blended = 0, outside = 0, mean_light = 0;
+  float largest = 0;
+  for (float v : got) largest = std::max(largest, std::abs(v));
+  for (int i = 0; i < n; ++i) {
+    const auto& p = pts[static_cast<std::size_t>(i)];
+    float want[75], want2[75];
+    probes::interpolate_fields_with(
+        c.fields, p.position, p.normal, [&](const probes::ProbeField* f) { return sh(p.rotation, f, false); },
+        [&](const probes::ProbeField* f) { return sh(p.rotation, f, true); }, want, want2);
+    const probes::FieldMix m = probes::fields_at(c.fields, p.position);
+    blended += m.count == 2;
+    outside += !(glm::all(glm::greaterThanEqual(p.position, coarse.min)) && glm::all(glm::lessThanEqual(p.position, coarse.max)));
+    bool same_as_mean = p.rotation < 0;
+    for (int k = 0; k < 75 && same_as_mean; ++k) same_as_mean = want[k] == c.fields.back()->mean_light_sh()[k];
+    mean_light += same_as_mean;
+    float err = 0;
+    for (int k = 0; k < 75; ++k) {
+      err = std::max(err, std::abs(want[k] - got[static_cast<std::size_t>(i) * 75 + k]));
+      err = std::max(err, std::abs(want2[k] - got2[static_cast<std::size_t>(i) * 75 + k]));
+    }
+    if (err > 1e-4f * largest) {
+      if (differ < 5) std::printf("point %d: largest difference %g (rotation %d, %d fields mixed)\n", i, err, p.rotation, m.count);
+      ++differ;
+    }
+  }
+  std::printf("probe lights: %d points, %d across a hand-over band, %d outside every cascade, %d took the mean light; %d differ\n",
+              n, blended, outside, mean_light, differ);
+  return {n, differ, blended, outside, mean_light};
+}
+
+}  // namespace
+
+// Every point's 150 values (indirect and direct light) to 1e-4 of the
+// largest coefficient. The interpolation is the CPU's arithmetic, but the
+// device may fuse multiply-adds: a point within rounding of a texel border,
+// a visibility threshold or a box face may choose otherwise, so at most
+// 0.5 % of the points may differ (measured: see the printed line).
+TEST(VulkanProbeLights, EqualTheCpuFieldInterpolationAcrossCascadesAndRotations) {
+  GPU_TEST_CONTEXT_OR_SKIP(ctx);
+  eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
+  const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
+  const render::LightSet lights(scene, render::gather_punctual_lights(loaded.app->world()), nullptr);
+  const glm::vec3 lo = scene.bounds_min(), hi = scene.bounds_max(), eye = 0.5f * (lo + hi) + glm::vec3(0.7f, 0.1f, -0.4f);
+  Cascades c;
+  loaded.app->jobs().run([&] { c = level_cascades(scene, lights, eye); });
+
+  const Compared got = compare_lights(*ctx, c, eye, 4000, 5);
+  EXPECT_GT(got.blended, got.points / 50) << "some points should lie in the hand-over bands";
+  EXPECT_GT(got.outside, got.points / 50) << "some points should lie outside every cascade";
+  EXPECT_LE(got.differ, got.points / 200) << "expected at most 0.5 % of points to differ, got " << got.differ;
+}
+
+// Cascades over the level's roof and the empty sky above it: the probes up
+// there see no surface within a cell (far), so points among them find no lit
+// probe in any cascade and take the coarsest's mean light (world SH), or its
+// black fallback blend (a rotated copy).
+TEST(VulkanProbeLights, PointsWithNoLitProbeTakeTheCoarsestCascadesMeanLight) {
+  GPU_TEST_CONTEXT_OR_SKIP(ctx);
+  eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
+  const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
+  const render::LightSet lights(scene, render::gather_punctual_lights(loaded.app->world()), nullptr);
+  const glm::vec3 eye = 0.5f * (scene.bounds_min() + scene.bounds_max()) + glm::vec3(0.0f, 9.0f, 0.0f);
+  Cascades c;
+  loaded.app->jobs().run([&] { c = level_cascades(scene, lights, eye, 2, 2.0f); });
+  ASSERT_GT(std::abs(c.fields.back()->mean_light_sh()[0]), 0.0f) << "a black mean would not tell the branch from a black blend";
+  const Compared got = compare_lights(*ctx, c, eye, 2000, 9);
+  EXPECT_GT(got.mean_light, got.points / 50) << "some points should find no lit probe and take the mean light";
+  EXPECT_LE(got.differ, got.points / 200) << "expected at most 0.5 % of points to differ, got " << got.differ;
+}
