@@ -128,7 +128,8 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
   if (classify_now) {
     // Back faces (single-sided materials only) as RTXGI counts them, and the
     // winding-proof link to light for double-sided content (open_space.h).
-    const probes::OpenSpace open = probes::find_open_space(scene, grid_, saw_light, settings_.relocation);
+    const probes::OpenSpace open =
+        probes::find_open_space(scene, grid_, saw_light, settings_.relocation, kernels_ ? kernels_->tracer() : nullptr);
     placed_.offsets.assign(static_cast<std::size_t>(probes), glm::vec3(0.0f));
     for (int q = 0; q < probes; ++q) {
       const auto i = static_cast<std::size_t>(q);

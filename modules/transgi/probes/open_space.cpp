@@ -3,6 +3,8 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <span>
+#include <vector>
 
 #include "engine/jobs/parallel_for.h"
 
@@ -23,44 +25,88 @@ bool inside_grid(const ProbeGrid& grid, glm::ivec3 c) {
 // repeat, so a probe in a corner can follow one moved out of the wall beside
 // it; each pass only uses probes linked before it, so the order of the probes
 // does not matter.
-void relocate(const engine::rt::RtScene& scene, const ProbeGrid& grid, const RelocationSettings& s, OpenSpace& r) {
+// Each segment's closest hit distance (infinity: clear), through the
+// backend's tracer in one batch where it takes the scene, else Embree.
+std::vector<float> hit_distances(const engine::rt::RtScene& scene, engine::rt::RayBatchTracer* tracer,
+                                 std::span<const engine::rt::Ray> rays) {
+  using namespace engine;
+  std::vector<float> t(rays.size(), std::numeric_limits<float>::infinity());
+  std::vector<rt::Hit> hits(rays.size());
+  std::vector<std::uint8_t> found(rays.size());
+  if (tracer && tracer->intersect(scene, rays, hits, found)) {
+    for (std::size_t i = 0; i < rays.size(); ++i)
+      if (found[i]) t[i] = hits[i].t;
+    return t;
+  }
+  jobs::parallel_for<std::size_t>(0, rays.size(), 64, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      rt::Hit hit;
+      if (scene.intersect(rays[i], hit)) t[i] = hit.t;
+    }
+  });
+  return t;
+}
+
+// Moves unlinked probes towards linked neighbours (see the header). Passes
+// repeat, so a probe in a corner can follow one moved out of the wall beside
+// it; each pass only uses probes linked before it, so the order of the probes
+// does not matter, and a pass's segments are traced in one batch.
+void relocate(const engine::rt::RtScene& scene, engine::rt::RayBatchTracer* tracer, const ProbeGrid& grid,
+              const RelocationSettings& s, OpenSpace& r) {
   using namespace engine;
   const glm::vec3 limit = s.max_offset * grid.spacing();
   const float margin = s.margin * grid.min_spacing(), min_margin = s.min_margin * grid.min_spacing();
+  struct Candidate {
+    int q;
+    glm::vec3 from, d;
+    float len;
+  };
   for (int pass = 0; pass < 3; ++pass) {
     const std::vector<std::uint8_t> linked = r.open;
-    int moved = 0;
+    std::vector<Candidate> candidates;
+    std::vector<rt::Ray> rays;
     for (int q = 0; q < grid.count(); ++q) {
       if (linked[static_cast<std::size_t>(q)]) continue;
       const glm::vec3 target = grid.grid_point(q);
-      float best = std::numeric_limits<float>::infinity();
-      glm::vec3 best_offset(0.0f);
       grid.for_each_neighbour(q, [&](int n) {
         if (n == q || !linked[static_cast<std::size_t>(n)]) return;
         const glm::vec3 from = grid.grid_point(n) + r.offsets[static_cast<std::size_t>(n)];
         const glm::vec3 d = target - from;
         const float len = glm::length(d);
         if (!(len > 0)) return;
-        const glm::vec3 dir = d / len;
-        rt::Hit hit;
-        float t = len;
-        if (scene.intersect(rt::Ray{from, dir, 0.0f, len}, hit)) {
+        candidates.push_back({q, from, d, len});
+        rays.push_back(rt::Ray{from, d / len, 0.0f, len});
+      });
+    }
+    const std::vector<float> hit_t = hit_distances(scene, tracer, rays);
+    int moved = 0;
+    // Candidates come grouped by probe, in neighbour order.
+    for (std::size_t i = 0; i < candidates.size();) {
+      const int q = candidates[i].q;
+      const glm::vec3 target = grid.grid_point(q);
+      float best = std::numeric_limits<float>::infinity();
+      glm::vec3 best_offset(0.0f);
+      for (; i < candidates.size() && candidates[i].q == q; ++i) {
+        const Candidate& c = candidates[i];
+        const glm::vec3 dir = c.d / c.len;
+        float t = c.len;
+        if (std::isfinite(hit_t[i])) {
           // As far before the surface as `margin`, if the offset allows;
           // never closer than `min_margin`. The offset is (len - t) along dir.
           float reach = std::numeric_limits<float>::infinity();
           for (int a = 0; a < 3; ++a)
             if (std::abs(dir[a]) > 1e-6f) reach = std::min(reach, limit[a] / std::abs(dir[a]));
-          t = std::max(hit.t - margin, len - reach);
-          if (t > hit.t - std::min(min_margin, 0.5f * hit.t)) return;
+          t = std::max(hit_t[i] - margin, c.len - reach);
+          if (t > hit_t[i] - std::min(min_margin, 0.5f * hit_t[i])) continue;
         }
-        const glm::vec3 offset = from + d / len * t - target;
-        if (glm::any(glm::greaterThan(glm::abs(offset), limit * 1.001f))) return;
+        const glm::vec3 offset = c.from + c.d / c.len * t - target;
+        if (glm::any(glm::greaterThan(glm::abs(offset), limit * 1.001f))) continue;
         const float size = glm::length(offset);
         if (size < best) {
           best = size;
           best_offset = offset;
         }
-      });
+      }
       if (std::isfinite(best)) {
         r.offsets[static_cast<std::size_t>(q)] = best_offset;
         r.open[static_cast<std::size_t>(q)] = 1;
@@ -75,7 +121,7 @@ void relocate(const engine::rt::RtScene& scene, const ProbeGrid& grid, const Rel
 }  // namespace
 
 OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& grid, std::span<const std::uint8_t> saw_light,
-                          const RelocationSettings& relocation) {
+                          const RelocationSettings& relocation, engine::rt::RayBatchTracer* tracer) {
   using namespace engine;
   const int probes = grid.count();
   OpenSpace r;
@@ -95,21 +141,31 @@ OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& gri
   }
 
   // links[q] bit k: the segment from q to q + forward_offset(k) is clear.
+  // Segment s is (probe, k) = (segment_of[s] / kForward, % kForward).
   std::vector<std::uint16_t> links(static_cast<std::size_t>(probes), 0);
-  jobs::parallel_for(0, probes, 8, [&](int b, int e) {
-    for (int q = b; q < e; ++q) {
-      const glm::ivec3 c = grid.coords(q);
-      const glm::vec3 from = grid.grid_point(q);
-      for (int k = 0; k < kForward; ++k) {
-        const glm::ivec3 n = c + forward_offset(k);
-        if (!inside_grid(grid, n)) continue;
-        const glm::vec3 d = grid.grid_point(grid.index(n)) - from;
-        const float len = glm::length(d);
-        if (!(len > 0)) continue;
-        if (!scene.occluded(rt::Ray{from, d / len, 0.0f, len})) links[static_cast<std::size_t>(q)] |= std::uint16_t(1u << k);
-      }
+  std::vector<rt::Ray> segments;
+  std::vector<int> segment_of;
+  for (int q = 0; q < probes; ++q) {
+    const glm::ivec3 c = grid.coords(q);
+    const glm::vec3 from = grid.grid_point(q);
+    for (int k = 0; k < kForward; ++k) {
+      const glm::ivec3 n = c + forward_offset(k);
+      if (!inside_grid(grid, n)) continue;
+      const glm::vec3 d = grid.grid_point(grid.index(n)) - from;
+      const float len = glm::length(d);
+      if (!(len > 0)) continue;
+      segments.push_back(rt::Ray{from, d / len, 0.0f, len});
+      segment_of.push_back(q * kForward + k);
     }
-  });
+  }
+  std::vector<std::uint8_t> blocked(segments.size(), 0);
+  if (!tracer || !tracer->occluded(scene, segments, blocked))
+    jobs::parallel_for<std::size_t>(0, segments.size(), 64, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) blocked[i] = scene.occluded(segments[i]) ? 1 : 0;
+    });
+  for (std::size_t i = 0; i < segments.size(); ++i)
+    if (!blocked[i])
+      links[static_cast<std::size_t>(segment_of[i] / kForward)] |= std::uint16_t(1u << (segment_of[i] % kForward));
   auto visit = [&](int q) {
     if (r.open[static_cast<std::size_t>(q)]) return;
     r.open[static_cast<std::size_t>(q)] = 1;
@@ -131,7 +187,7 @@ OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& gri
       }
     }
   }
-  if (relocation.enabled) relocate(scene, grid, relocation, r);
+  if (relocation.enabled) relocate(scene, tracer, grid, relocation, r);
   for (std::uint8_t o : r.open) r.open_count += o;
   return r;
 }

@@ -23,6 +23,7 @@
 #include <span>
 #include <vector>
 
+#include "engine/rt/ray_batch_tracer.h"
 #include "engine/rt/rt_scene.h"
 #include "probes/probe_grid.h"
 
@@ -61,7 +62,9 @@ struct RelocationSettings {
 // stands off its grid point (grid.offsets) saw light from where it stands,
 // which says nothing of its grid point: it is no seed, or every other
 // classification would move it back into the wall and out again.
+// With `tracer` (a GPU backend's) the segments are traced by it, a batch per
+// step; without one, or where it declines the scene, by Embree.
 OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& grid, std::span<const std::uint8_t> saw_light,
-                          const RelocationSettings& relocation = {});
+                          const RelocationSettings& relocation = {}, engine::rt::RayBatchTracer* tracer = nullptr);
 
 }  // namespace transgi::probes

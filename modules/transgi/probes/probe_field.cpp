@@ -319,7 +319,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
     bool any_pending = classify;
     for (std::size_t q = 0; q < state_.size() && !any_pending; ++q) any_pending = traced[q] && needs_classify_[q];
     const OpenSpace open =
-        settings_.skip.open_space && any_pending ? find_open_space(scene, grid_, saw_light_, settings_.skip.relocation) : OpenSpace{};
+        settings_.skip.open_space && any_pending ? find_open_space(scene, grid_, saw_light_, settings_.skip.relocation, kernels_ ? kernels_->tracer() : nullptr) : OpenSpace{};
     if (!open.open.empty() && grid_.offsets.empty()) grid_.offsets.assign(state_.size(), glm::vec3(0.0f));
     for (std::size_t q = 0; q < state_.size(); ++q) {
       if (traced[q]) {
