@@ -19,18 +19,7 @@ layout(std430, set = RT_SET, binding = RT_BINDING + 5) readonly buffer RtAlphaMa
 layout(std430, set = RT_SET, binding = RT_BINDING + 6) readonly buffer RtAlphaBytes { uint rt_alpha_bytes[]; };
 layout(std430, set = RT_SET, binding = RT_BINDING + 7) readonly buffer RtAlphaTextures { RtAlphaTextureGpu rt_alpha_textures[]; };
 
-// scene::wrap_index.
-int rt_wrap(int i, int n, uint mode) {
-  if (mode == 1u) return clamp(i, 0, n - 1);
-  if (mode == 2u) {
-    const int period = 2 * n;
-    int m = i % period;
-    if (m < 0) m += period;
-    return m < n ? m : period - 1 - m;
-  }
-  int m = i % n;
-  return m < 0 ? m + n : m;
-}
+#include "texture_wrap.glsl"
 
 // RtScene's alpha_passes for triangle `index` (in leaf order) at (u, v).
 bool rt_alpha_passes(TriangleGpu tri, uint index, float u, float v) {
@@ -42,8 +31,8 @@ bool rt_alpha_passes(TriangleGpu tri, uint index, float u, float v) {
     const RtAlphaTextureGpu tex = rt_alpha_textures[m.texture];
     if (!isnan(uv.x) && !isinf(uv.x) && !isnan(uv.y) && !isinf(uv.y)) {
       const vec2 r = uv - 4096.0 * trunc(uv / 4096.0);  // std::fmod
-      const int x = rt_wrap(int(floor(r.x * float(tex.width))), tex.width, tex.wrap & 0xffu);
-      const int y = rt_wrap(int(floor(r.y * float(tex.height))), tex.height, tex.wrap >> 8);
+      const int x = texture_wrap(int(floor(r.x * float(tex.width))), tex.width, tex.wrap & 0xffu);
+      const int y = texture_wrap(int(floor(r.y * float(tex.height))), tex.height, tex.wrap >> 8);
       const uint byte_index = tex.offset + uint(y * tex.width + x);
       alpha *= float((rt_alpha_bytes[byte_index >> 2] >> ((byte_index & 3u) * 8u)) & 0xffu) / 255.0;
     }

@@ -55,21 +55,10 @@ vec3 offset_ray_origin(vec3 p, vec3 n, float scale) {
   return out_p;
 }
 
-// scene::wrap_index.
-int shading_wrap(int i, int n, uint mode) {
-  if (mode == 1u) return clamp(i, 0, n - 1);
-  if (mode == 2u) {
-    const int period = 2 * n;
-    int m = i % period;
-    if (m < 0) m += period;
-    return m < n ? m : period - 1 - m;
-  }
-  int m = i % n;
-  return m < 0 ? m + n : m;
-}
+#include "texture_wrap.glsl"
 
 vec4 texel_at(TextureGpu t, int x, int y, bool srgb) {
-  const int cx = shading_wrap(x, t.width, t.wrap & 0xffu), cy = shading_wrap(y, t.height, t.wrap >> 8);
+  const int cx = texture_wrap(x, t.width, t.wrap & 0xffu), cy = texture_wrap(y, t.height, t.wrap >> 8);
   const uint v = sh_texels[t.first + uint(cy * t.width + cx)];
   const uvec4 b = uvec4(v & 0xffu, (v >> 8) & 0xffu, (v >> 16) & 0xffu, v >> 24);
   if (srgb) return vec4(sh_tables[kShadingSrgbLut + b.r], sh_tables[kShadingSrgbLut + b.g], sh_tables[kShadingSrgbLut + b.b], float(b.a) / 255.0);

@@ -121,7 +121,7 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   frame.height = height;
   std::ostringstream rows;
   rows << "frame,total_ms,gbuffer_ms,inference_ms,sh_light_ms,upsample_ms,probe_trace_ms,probe_raster_ms,probe_project_ms,"
-          "direct_ms,probes_traced,decoded_pixels,gpu_trace_ms,gpu_raster_ms,gpu_projection_ms,gpu_gbuffer_ms,gpu_inference_ms,gpu_shading_ms\n";
+          "direct_ms,probes_traced,decoded_pixels,gpu_trace_ms,gpu_raster_ms,gpu_projection_ms,gpu_gbuffer_ms,gpu_inference_ms,gpu_shading_ms,gpu_accumulation_ms\n";
   std::vector<double> totals;
   std::vector<std::vector<double>> stages;
   core::ProgressBar bar("bench-frame", static_cast<std::uint64_t>(warmup + frames), true);
@@ -145,7 +145,7 @@ int run_bench_frame(const std::vector<std::string>& argv) {
     for (double v : row) rows << ',' << v;
     rows << ',' << frame.probe_stats.traced << ',' << frame.shaded_samples << ',' << frame.gpu_trace_ms << ','
          << frame.gpu_raster_ms << ',' << frame.gpu_projection_ms << ',' << frame.gpu_gbuffer_ms << ',' << frame.gpu_inference_ms << ','
-         << frame.gpu_shading_ms << '\n';
+         << frame.gpu_shading_ms << ',' << frame.gpu_accumulation_ms << '\n';
   }
   bar.finish();
   if (!csv.empty()) eval::write_text(csv, rows.str());
@@ -180,9 +180,10 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   std::printf("\n");
   if (frame.gpu_ms() > 0)
     std::printf("GPU timestamps, last frame (ms): G-buffer rays %.2f (camera and shadow rays); probe rays %.2f (and their "
-                "shadow rays); probe-ray shading %.2f; radiance raster %.2f; SH projection %.2f; inference %.2f; total %.2f\n",
-                frame.gpu_gbuffer_ms, frame.gpu_trace_ms, frame.gpu_shading_ms, frame.gpu_raster_ms, frame.gpu_projection_ms,
-                frame.gpu_inference_ms, frame.gpu_ms());
+                "shadow rays); probe-ray shading %.2f; radiance raster %.2f; accumulation %.2f; SH projection %.2f; inference %.2f; "
+                "total %.2f\n",
+                frame.gpu_gbuffer_ms, frame.gpu_trace_ms, frame.gpu_shading_ms, frame.gpu_raster_ms, frame.gpu_accumulation_ms,
+                frame.gpu_projection_ms, frame.gpu_inference_ms, frame.gpu_ms());
   std::printf("direct light, last frame: %zu shadow rays to %zu punctual lights\n", frame.direct_stats.shadow_rays,
               frame.direct_stats.lights);
   // The NaN guards (docs/reliability.md): what each stage's boundary replaced in the last frame.

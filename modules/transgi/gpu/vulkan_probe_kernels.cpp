@@ -29,6 +29,16 @@ void VulkanProbeKernels::project(const probes::MapProjector& projector, std::spa
   project_ms_ += std::max(0.0, p->project(radiance, out));
 }
 
+bool VulkanProbeKernels::accumulate(const probes::MapLayout& layout, std::span<probes::ProbeMapState* const> states,
+                                    std::span<const probes::FrameSamples* const> frames,
+                                    const probes::AccumulationSettings& settings, std::span<std::uint8_t> changed,
+                                    std::span<glm::vec3> filled) {
+  auto& a = accumulators_[{layout.width, layout.height}];
+  if (!a) a = std::make_unique<VulkanProbeAccumulator>(*ctx_, layout);
+  accumulate_ms_ += std::max(0.0, a->accumulate(states, frames, settings, changed, filled));
+  return true;
+}
+
 bool VulkanProbeKernels::shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
                                           std::span<const engine::rt::Ray> rays, std::span<const std::uint64_t> items,
                                           std::uint64_t seed, std::uint64_t sample, const probes::ProbeFeedbackSource* self,

@@ -10,6 +10,7 @@
 #include "engine/gpu/gpu_ray_tracer.h"
 #include "engine/gpu/vulkan_context.h"
 #include "gpu/vulkan_fused_decoder.h"
+#include "gpu/vulkan_probe_accumulator.h"
 #include "gpu/vulkan_probe_shading.h"
 #include "gpu/vulkan_radiance_raster.h"
 #include "model/transfer_model.h"
@@ -29,6 +30,9 @@ class VulkanProbeKernels : public probes::ProbeKernels {
                                  const probes::SharingSettings& settings, std::vector<probes::FrameSamples>& out,
                                  std::span<const std::uint8_t> targets) override;
   void project(const probes::MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out) override;
+  bool accumulate(const probes::MapLayout& layout, std::span<probes::ProbeMapState* const> states,
+                  std::span<const probes::FrameSamples* const> frames, const probes::AccumulationSettings& settings,
+                  std::span<std::uint8_t> changed, std::span<glm::vec3> filled) override;
   // On the device unless switched off (set_device_shading) or the device
   // cannot (VulkanProbeShading::supported; probe_shading_why() says why).
   bool shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
@@ -50,12 +54,12 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   [[nodiscard]] const char* name() const override { return name_.c_str(); }
   // GPU milliseconds per stage since the last call (timestamps).
   struct StageMs {
-    double trace = 0, raster = 0, projection = 0, shading = 0;
-    [[nodiscard]] double total() const { return trace + raster + projection + shading; }
+    double trace = 0, raster = 0, projection = 0, shading = 0, accumulation = 0;
+    [[nodiscard]] double total() const { return trace + raster + projection + shading + accumulation; }
   };
   StageMs take_stage_ms() {
-    StageMs s{tracer_.take_device_ms(), raster_ms_, project_ms_, shading_ ? shading_->take_gpu_ms() : 0.0};
-    raster_ms_ = project_ms_ = 0.0;
+    StageMs s{tracer_.take_device_ms(), raster_ms_, project_ms_, shading_ ? shading_->take_gpu_ms() : 0.0, accumulate_ms_};
+    raster_ms_ = project_ms_ = accumulate_ms_ = 0.0;
     return s;
   }
 
@@ -63,6 +67,7 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   std::shared_ptr<engine::gpu::VulkanContext> ctx_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanRadianceRaster>> rasters_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanShProjector>> projectors_;
+  std::map<std::pair<int, int>, std::unique_ptr<VulkanProbeAccumulator>> accumulators_;
   engine::gpu::GpuRayTracer tracer_;
   std::shared_ptr<const model::TransferModel> decoder_model_;  // kept alive: the cache's key
   std::unique_ptr<VulkanFusedDecoder> decoder_;
@@ -71,7 +76,7 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   bool device_shading_ = true, shading_tried_ = false;
   std::string shading_why_;
   std::string name_;
-  double raster_ms_ = 0.0, project_ms_ = 0.0;
+  double raster_ms_ = 0.0, project_ms_ = 0.0, accumulate_ms_ = 0.0;
 };
 
 // The Vulkan kernels on the chosen device (empty: ENGINE_GPU_DEVICE, then

@@ -383,11 +383,11 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   // 3. Accumulate, fill, project.
   t0 = Clock::now();
   std::atomic<int> bad_probes{0};
-  // Accumulates probe q's frame and updates its direct-light mean; returns
-  // the filled map to project.
-  auto accumulate_probe = [&](int q) {
-    ProbeMapState& st = states_[static_cast<std::size_t>(q)];
-    changed_[static_cast<std::size_t>(q)] = accumulate(st, frame[static_cast<std::size_t>(q)], settings_.accumulation) ? 1 : 0;
+  // After probe q's map took its frame (changed: it detected a change of
+  // light): its convergence and its direct-light mean.
+  auto after_accumulation = [&](int q, bool changed) {
+    const ProbeMapState& st = states_[static_cast<std::size_t>(q)];
+    changed_[static_cast<std::size_t>(q)] = changed ? 1 : 0;
     if (settings_.skip.skip_converged && st.stable_frames >= settings_.skip.settle_frames)
       state_[static_cast<std::size_t>(q)] = ProbeState::Converged;
     const std::size_t at = static_cast<std::size_t>(q) * 75;
@@ -397,6 +397,11 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
       direct_mean_[at + k] += (direct_frame[at + k] - direct_mean_[at + k]) / static_cast<float>(frames);
     std::copy_n(direct_mean_.data() + at, 75, direct_sh_.data() + at);
     if (settings_.direct_window) apply_hanning_window(direct_sh_.data() + at);
+  };
+  // Accumulates probe q's frame on the CPU; returns the filled map to project.
+  auto accumulate_probe = [&](int q) {
+    ProbeMapState& st = states_[static_cast<std::size_t>(q)];
+    after_accumulation(q, accumulate(st, frame[static_cast<std::size_t>(q)], settings_.accumulation));
     return filled_radiance(st, settings_.map, settings_.accumulation.fill_passes);
   };
   // After probe q's SH is projected into sh_.
@@ -431,12 +436,25 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
       if (updates(q)) batch.push_back(q);
     const auto texels = static_cast<std::size_t>(settings_.map.texel_count());
     std::vector<glm::vec3> maps(batch.size() * texels);
-    jobs::parallel_for(0, static_cast<int>(batch.size()), 1, [&](int b, int e) {
-      for (int i = b; i < e; ++i) {
-        const auto filled = accumulate_probe(batch[static_cast<std::size_t>(i)]);
-        std::copy(filled.begin(), filled.end(), maps.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(i) * texels));
-      }
-    });
+    std::vector<ProbeMapState*> batch_states;
+    std::vector<const FrameSamples*> batch_frames;
+    for (const int q : batch) {
+      batch_states.push_back(&states_[static_cast<std::size_t>(q)]);
+      batch_frames.push_back(&frame[static_cast<std::size_t>(q)]);
+    }
+    std::vector<std::uint8_t> batch_changed(batch.size());
+    if (kernels_->accumulate(settings_.map, batch_states, batch_frames, settings_.accumulation, batch_changed, maps)) {
+      jobs::parallel_for(0, static_cast<int>(batch.size()), 1, [&](int b, int e) {
+        for (int i = b; i < e; ++i) after_accumulation(batch[static_cast<std::size_t>(i)], batch_changed[static_cast<std::size_t>(i)] != 0);
+      });
+    } else {
+      jobs::parallel_for(0, static_cast<int>(batch.size()), 1, [&](int b, int e) {
+        for (int i = b; i < e; ++i) {
+          const auto filled = accumulate_probe(batch[static_cast<std::size_t>(i)]);
+          std::copy(filled.begin(), filled.end(), maps.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(i) * texels));
+        }
+      });
+    }
     std::vector<float> projected(batch.size() * 75);
     kernels_->project(projector_, maps, projected);
     for (std::size_t i = 0; i < batch.size(); ++i) {

@@ -13,6 +13,7 @@
 #include "engine/rt/ray_batch_tracer.h"
 #include "engine/rt/rt_scene.h"
 #include "probes/interpolation.h"
+#include "probes/probe_map.h"
 #include "probes/probe_rays.h"
 #include "probes/radiance_sharing.h"
 
@@ -37,6 +38,15 @@ class ProbeKernels {
                                  const std::vector<std::vector<ShadedPoint>>& points,
                                  const std::vector<const DepthMap*>& own_depth, const SharingSettings& settings,
                                  std::vector<FrameSamples>& out, std::span<const std::uint8_t> targets) = 0;
+  // For each i: accumulate(*states[i], *frames[i], settings) (changed[i] its
+  // result), then filled_radiance(*states[i], layout, settings.fill_passes)
+  // into filled (states.size() x texel_count()). Returns false, touching
+  // nothing, where the backend does not accumulate (the caller does).
+  virtual bool accumulate(const MapLayout& /*layout*/, std::span<ProbeMapState* const> /*states*/,
+                          std::span<const FrameSamples* const> /*frames*/, const AccumulationSettings& /*settings*/,
+                          std::span<std::uint8_t> /*changed*/, std::span<glm::vec3> /*filled*/) {
+    return false;
+  }
   // As MapProjector::project for `maps` maps stored one after another:
   // radiance maps x texel_count(), out maps x 75.
   virtual void project(const MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out) = 0;

@@ -54,11 +54,13 @@ struct GiFrame {
   // since (probe rays and their shadow rays, and any other batch traced
   // since the last G-buffer); the radiance raster; the SH projection; the
   // real-time path's transfer inference (fused decoder and SH dots); the
-  // probe rays' hit shading (TransGISettings::device_shading).
+  // probe rays' hit shading (TransGISettings::device_shading); the probes'
+  // accumulation.
   double gpu_gbuffer_ms = 0.0, gpu_trace_ms = 0.0, gpu_raster_ms = 0.0, gpu_projection_ms = 0.0, gpu_inference_ms = 0.0,
-         gpu_shading_ms = 0.0;
+         gpu_shading_ms = 0.0, gpu_accumulation_ms = 0.0;
   [[nodiscard]] double gpu_ms() const {
-    return gpu_gbuffer_ms + gpu_trace_ms + gpu_raster_ms + gpu_projection_ms + gpu_inference_ms + gpu_shading_ms;
+    return gpu_gbuffer_ms + gpu_trace_ms + gpu_raster_ms + gpu_projection_ms + gpu_inference_ms + gpu_shading_ms +
+           gpu_accumulation_ms;
   }
 };
 

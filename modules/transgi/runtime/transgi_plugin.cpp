@@ -89,6 +89,7 @@ void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> casc
   frame->gpu_raster_ms = gpu_ms.raster;
   frame->gpu_projection_ms = gpu_ms.projection;
   frame->gpu_shading_ms = gpu_ms.shading;
+  frame->gpu_accumulation_ms = gpu_ms.accumulation;
   // The device could not shade the probe rays, so the CPU did.
   if (backend->kernels && settings->device_shading && !backend->kernels->probe_shading_why().empty()) {
     const std::string note = "probe rays shaded on the CPU: " + backend->kernels->probe_shading_why();
