@@ -6,10 +6,11 @@
 // or the outer cascade's outside this field's box).
 #extension GL_GOOGLE_include_directive : require
 #include "probe_shading_shared.h"
+#include "rt_shared.h"
 
 layout(local_size_x = kProbeShadingGroupSize) in;
 layout(std430, set = 0, binding = 0) readonly buffer Pending { PendingProbeRayGpu pending[]; };
-layout(std430, set = 0, binding = 1) readonly buffer Blocked { uint blocked[]; };  // per ray, 1 = the shadow ray hit
+layout(std430, set = 0, binding = 1) readonly buffer ShadowHits { HitGpu shadow_hits[]; };  // per ray: its shadow ray's first hit
 layout(std430, set = 0, binding = 2) writeonly buffer Out { ProbeRayHitGpu out_hits[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Feedback { ProbeFeedbackGpu feedback; };
 layout(std430, set = 0, binding = 4) readonly buffer Depth { uint depth[]; };      // both fields' depth texels
@@ -60,7 +61,7 @@ void main() {
   o.pad0 = o.pad1 = 0.0;
   vec3 radiance = vec3(0.0);
   if ((q.flags & kProbeRayTakesFeedback) != 0u) {
-    if ((q.flags & kProbeRayNeedsShadow) != 0u && blocked[i] == 0u) {
+    if ((q.flags & kProbeRayNeedsShadow) != 0u && shadow_hits[i].instance == kRtNoHit) {
       radiance += vec3(q.ur, q.ug, q.ub);
       o.flags |= kProbeRaySawLight;
     }

@@ -21,6 +21,9 @@ class GpuRayTracer : public rt::RayBatchTracer {
   bool occluded(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<std::uint8_t> blocked) override;
   // GPU milliseconds of the traces since the last call (timestamps).
   double take_device_ms() override;
+  // The device's copy of `scene`, synced, for kernels that trace in their
+  // own submissions (GpuRtScene::bind); null where it declines the scene.
+  GpuRtScene* device_scene(const rt::RtScene& scene) { return follow(scene) ? rt_.get() : nullptr; }
 
  private:
   VulkanContext& ctx_;

@@ -126,6 +126,7 @@ TEST(VulkanBackend, ACornellBoxGiFrameEqualsTheCpuBackends) {
   const eval::MethodRun cpu = cornell(runtime::Backend::Cpu);
   const eval::MethodRun gpu = cornell(runtime::Backend::Vulkan);
   ASSERT_EQ(gpu.backend.rfind("vulkan", 0), 0u) << "the plugin fell back: " << gpu.backend;
+  EXPECT_EQ(gpu.backend.find("probe rays shaded on the CPU"), std::string::npos) << gpu.backend;
   double mean = 0;
   for (const auto& p : cpu.gi.pixels) mean += (p.r + p.g + p.b) / 3.0;
   mean /= static_cast<double>(cpu.gi.pixels.size());

@@ -1,6 +1,7 @@
-// shaders/probe_hit_begin.comp and probe_hit_finish.comp against
-// probes::begin_probe_ray / finish_probe_ray (their CPU stages) on the same
-// hits and random numbers: the sample level (textures, its sun) with every
+// The probe rays' chain on the device (probe_rays.comp, rt_query.comp,
+// probe_hit_begin.comp, rt_query.comp for the shadow rays,
+// probe_hit_finish.comp) against probes::begin_probe_ray / finish_probe_ray
+// (the CPU stages) on the same hits and random numbers: the sample level (textures, its sun) with every
 // kind of light added (a point and a spot light, a sun with a disk, a
 // non-uniform environment map importance-sampled, emissive triangles), the
 // bounce light from a random probe field inside a box and an outer one
@@ -142,25 +143,33 @@ TEST(VulkanProbeShading, EqualsTheCpuStagesOnTheSampleLevelWithEveryKindOfLight)
   const RandomField outer(lo, hi, glm::ivec3(3, 3, 3), 6);
   const probes::ProbeFeedbackSource self_source = inner.source(), outer_source = outer.source();
 
+  // 300 "probes" at random points, each shooting the same 20 random directions.
   math::Pcg32 rng(21, 4);
-  const int n = 6000;
-  std::vector<rt::Ray> rays;
-  std::vector<std::uint64_t> items;
-  for (int i = 0; i < n; ++i) {
-    const glm::vec3 o = glm::mix(lo + 0.1f * (hi - lo), hi - 0.1f * (hi - lo), glm::vec3(rng.next_float(), rng.next_float(), rng.next_float()));
-    const glm::vec3 d = glm::normalize(glm::vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f) + 1e-4f);
-    rays.push_back(rt::Ray{o, d});
-    items.push_back(static_cast<std::uint64_t>(i) * 4096 + 7);
+  const int probe_count = 300, m = 20, n = probe_count * m;
+  std::vector<glm::vec3> origins, directions;
+  std::vector<int> probe_ids;
+  for (int j = 0; j < probe_count; ++j) {
+    origins.push_back(glm::mix(lo + 0.1f * (hi - lo), hi - 0.1f * (hi - lo), glm::vec3{rng.next_float(), rng.next_float(), rng.next_float()}));
+    probe_ids.push_back(3 * j + 1);
   }
+  for (int i = 0; i < m; ++i)
+    directions.push_back(glm::normalize(glm::vec3{rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f} + 1e-4f));
   const std::uint64_t seed = 0x1234'5678'9abcULL, sample = 42;
 
   transgi::gpu::VulkanProbeShading shading(*ctx);
   engine::gpu::GpuRayTracer tracer(*ctx);
   std::vector<probes::ProbeRayHit> got;
-  ASSERT_TRUE(shading.shade(scene, lights, tracer, rays, items, seed, sample, &self_source, &outer_source, got));
-  ASSERT_EQ(got.size(), rays.size());
+  ASSERT_TRUE(shading.shade(scene, lights, tracer, origins, probe_ids, directions, seed, sample, &self_source, &outer_source, got));
+  ASSERT_EQ(got.size(), static_cast<std::size_t>(n));
 
-  // The CPU stages on the same hits.
+  // The CPU stages on the same rays, whose hits the same traversal finds.
+  std::vector<rt::Ray> rays;
+  std::vector<std::uint64_t> items;
+  for (int j = 0; j < probe_count; ++j)
+    for (int i = 0; i < m; ++i) {
+      rays.push_back(rt::Ray{origins[static_cast<std::size_t>(j)], directions[static_cast<std::size_t>(i)]});
+      items.push_back(static_cast<std::uint64_t>(probe_ids[static_cast<std::size_t>(j)]) * 4096 + static_cast<std::uint64_t>(i));
+    }
   std::vector<rt::Hit> hits(rays.size());
   std::vector<std::uint8_t> found(rays.size());
   ASSERT_TRUE(tracer.intersect(scene, rays, hits, found));
@@ -241,13 +250,13 @@ TEST(VulkanProbeShading, ASceneTooBigForTheDeviceIsShadedOnTheCpuAndSaysWhy) {
   eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
   const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
   const render::LightSet lights(scene, test_punctual(), nullptr);
-  const std::vector<rt::Ray> rays{rt::Ray{0.5f * (scene.bounds_min() + scene.bounds_max()), glm::vec3(0, -1, 0)}};
-  const std::vector<std::uint64_t> items{1};
+  const std::vector<glm::vec3> origins{0.5f * (scene.bounds_min() + scene.bounds_max())}, directions{glm::vec3(0, -1, 0)};
+  const std::vector<int> probe_ids{0};
   std::vector<probes::ProbeRayHit> out;
-  EXPECT_FALSE(kernels.shade_probe_rays(scene, lights, rays, items, 1, 1, nullptr, nullptr, out));
+  EXPECT_FALSE(kernels.shade_probe_rays(scene, lights, origins, probe_ids, directions, 1, 1, nullptr, nullptr, out));
   EXPECT_TRUE(out.empty());
   EXPECT_NE(kernels.probe_shading_why().find("largest storage buffer"), std::string::npos) << kernels.probe_shading_why();
   std::printf("declined: %s\n", kernels.probe_shading_why().c_str());
   // And stays declined, without trying again every frame.
-  EXPECT_FALSE(kernels.shade_probe_rays(scene, lights, rays, items, 1, 1, nullptr, nullptr, out));
+  EXPECT_FALSE(kernels.shade_probe_rays(scene, lights, origins, probe_ids, directions, 1, 1, nullptr, nullptr, out));
 }

@@ -40,9 +40,9 @@ bool VulkanProbeKernels::accumulate(const probes::MapLayout& layout, std::span<p
 }
 
 bool VulkanProbeKernels::shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
-                                          std::span<const engine::rt::Ray> rays, std::span<const std::uint64_t> items,
-                                          std::uint64_t seed, std::uint64_t sample, const probes::ProbeFeedbackSource* self,
-                                          const probes::ProbeFeedbackSource* outer,
+                                          std::span<const glm::vec3> origins, std::span<const int> probe_ids,
+                                          std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
+                                          const probes::ProbeFeedbackSource* self, const probes::ProbeFeedbackSource* outer,
                                           std::vector<probes::ProbeRayHit>& out) {
   if (!device_shading_) return false;
   if (!shading_tried_) {
@@ -56,7 +56,7 @@ bool VulkanProbeKernels::shade_probe_rays(const engine::rt::RtScene& scene, cons
   }
   if (!shading_) return false;
   try {
-    return shading_->shade(scene, lights, tracer_, rays, items, seed, sample, self, outer, out);
+    return shading_->shade(scene, lights, tracer_, origins, probe_ids, directions, seed, sample, self, outer, out);
   } catch (const engine::gpu::GpuError& e) {
     // A scene the device cannot hold (textures past its largest buffer, out
     // of memory): the CPU shades from now on, and the frame says why.

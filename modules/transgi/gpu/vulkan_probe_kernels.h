@@ -36,9 +36,10 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   // On the device unless switched off (set_device_shading) or the device
   // cannot (VulkanProbeShading::supported; probe_shading_why() says why).
   bool shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
-                        std::span<const engine::rt::Ray> rays, std::span<const std::uint64_t> items, std::uint64_t seed,
-                        std::uint64_t sample, const probes::ProbeFeedbackSource* self,
-                        const probes::ProbeFeedbackSource* outer, std::vector<probes::ProbeRayHit>& out) override;
+                        std::span<const glm::vec3> origins, std::span<const int> probe_ids,
+                        std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
+                        const probes::ProbeFeedbackSource* self, const probes::ProbeFeedbackSource* outer,
+                        std::vector<probes::ProbeRayHit>& out) override;
   // Whether probe rays are shaded on the device (on by default) or on the CPU.
   void set_device_shading(bool on) { device_shading_ = on; }
   [[nodiscard]] bool device_shading() const { return device_shading_; }

@@ -1,5 +1,7 @@
 #include "gpu/vulkan_probe_shading.h"
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -14,7 +16,6 @@
 namespace transgi::gpu {
 namespace {
 
-using engine::gpu::bind_at_least;
 using engine::gpu::GpuBuffer;
 
 constexpr std::size_t kRaysPerTask = 4096;
@@ -66,78 +67,61 @@ bool VulkanProbeShading::supported(const engine::gpu::VulkanContext& ctx, std::s
 VulkanProbeShading::VulkanProbeShading(engine::gpu::VulkanContext& ctx) : ctx_(ctx), scene_(ctx) {
   std::string why;
   if (!supported(ctx, &why)) throw engine::gpu::GpuError("VulkanProbeShading: " + why);
-  begin_ = std::make_unique<engine::gpu::ComputePipeline>(ctx, compile_module_shader("probe_hit_begin.comp"),
-                                                          5 + engine::gpu::GpuShadingScene::kBindings,
-                                                          static_cast<std::uint32_t>(sizeof(ProbeHitPush)));
-  finish_ = std::make_unique<engine::gpu::ComputePipeline>(ctx, compile_module_shader("probe_hit_finish.comp"), 7,
-                                                           static_cast<std::uint32_t>(sizeof(ProbeFinishPush)));
+  using engine::gpu::ComputePipeline;
+  const auto query = compile_module_shader("rt_query.comp");
+  const std::uint32_t query_bindings = 2 + engine::gpu::GpuRtScene::kBindings;
+  generate_ = std::make_unique<ComputePipeline>(ctx, compile_module_shader("probe_rays.comp"), 4, 2 * sizeof(std::uint32_t));
+  trace_ = std::make_unique<ComputePipeline>(ctx, query, query_bindings, 2 * sizeof(std::uint32_t));
+  begin_ = std::make_unique<ComputePipeline>(ctx, compile_module_shader("probe_hit_begin.comp"),
+                                             5 + engine::gpu::GpuShadingScene::kBindings, static_cast<std::uint32_t>(sizeof(ProbeHitPush)));
+  shadow_trace_ = std::make_unique<ComputePipeline>(ctx, query, query_bindings, 2 * sizeof(std::uint32_t));
+  finish_ = std::make_unique<ComputePipeline>(ctx, compile_module_shader("probe_hit_finish.comp"), 7,
+                                              static_cast<std::uint32_t>(sizeof(ProbeFinishPush)));
 }
 
+namespace {
+// `b` with room for `bytes` (grown, never shrunk).
+GpuBuffer& at_least(engine::gpu::VulkanContext& ctx, GpuBuffer& b, std::size_t bytes) {
+  if (b.handle() == VK_NULL_HANDLE || b.size() < bytes) b = GpuBuffer(ctx, std::max<std::size_t>(bytes, 4));
+  return b;
+}
+}  // namespace
+
 bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
-                               engine::rt::RayBatchTracer& tracer, std::span<const engine::rt::Ray> rays,
-                               std::span<const std::uint64_t> items, std::uint64_t seed, std::uint64_t sample,
-                               const probes::ProbeFeedbackSource* self, const probes::ProbeFeedbackSource* outer,
-                               std::vector<probes::ProbeRayHit>& out) {
+                               engine::gpu::GpuRayTracer& tracer, std::span<const glm::vec3> origins,
+                               std::span<const int> probe_ids, std::span<const glm::vec3> directions, std::uint64_t seed,
+                               std::uint64_t sample, const probes::ProbeFeedbackSource* self,
+                               const probes::ProbeFeedbackSource* outer, std::vector<probes::ProbeRayHit>& out) {
   using engine::gpu::HitGpu;
   using engine::gpu::RayGpu;
-  const std::size_t n = rays.size();
-  if (items.size() != n)
-    throw std::invalid_argument("VulkanProbeShading: " + std::to_string(n) + " rays but " + std::to_string(items.size()) + " items");
+  if (probe_ids.size() != origins.size())
+    throw std::invalid_argument("VulkanProbeShading: " + std::to_string(origins.size()) + " origins but " +
+                                std::to_string(probe_ids.size()) + " probe indices");
   if (self) check_source(*self);
   if (outer) check_source(*outer);
   if (!scene.assets()) return false;
   scene_.sync(scene, lights);  // first: a scene the device cannot hold throws before out changes
-  std::vector<engine::rt::Hit> hits(n);
-  std::vector<std::uint8_t> found(n);
-  if (!tracer.intersect(scene, rays, hits, found)) return false;
+  engine::gpu::GpuRtScene* rt = tracer.device_scene(scene);
+  if (!rt) return false;
+  const std::size_t m = directions.size(), n = origins.size() * m;
   out.resize(n);
   if (n == 0) return true;
 
-  // 1. The surfaces and their light samples.
-  const auto ray_in = bind_at_least(ctx_, *begin_, 0, rays_, n * sizeof(RayGpu)).mapped_as<RayGpu>(n);
-  const auto hit_in = bind_at_least(ctx_, *begin_, 1, hits_, n * sizeof(HitGpu)).mapped_as<HitGpu>(n);
-  const auto item_in = bind_at_least(ctx_, *begin_, 2, items_, n * 2 * sizeof(std::uint32_t)).mapped_as<std::uint32_t>(2 * n);
-  bind_at_least(ctx_, *begin_, 3, pending_, n * sizeof(PendingProbeRayGpu));
-  const auto shadow_out = bind_at_least(ctx_, *begin_, 4, shadows_, n * sizeof(RayGpu)).mapped_as<const RayGpu>(n);
-  engine::jobs::parallel_for<std::size_t>(0, n, kRaysPerTask, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) {
-      const engine::rt::Ray& r = rays[i];
-      ray_in[i] = {r.origin.x, r.origin.y, r.origin.z, r.tmin, r.direction.x, r.direction.y, r.direction.z, r.tmax};
-      const engine::rt::Hit& h = hits[i];
-      hit_in[i] = found[i] ? HitGpu{h.t, h.barycentric.x, h.barycentric.y, h.instance, h.primitive, h.mesh, 0, 0}
-                           : HitGpu{0, 0, 0, engine::gpu::kRtNoHit, 0, 0, 0, 0};
-      item_in[2 * i] = static_cast<std::uint32_t>(items[i]);
-      item_in[2 * i + 1] = static_cast<std::uint32_t>(items[i] >> 32);
-    }
-  });
-  scene_.bind(*begin_, 5);
-  ProbeHitPush push{};
-  push.count = static_cast<uint>(n);
-  push.seed_lo = static_cast<uint>(seed);
-  push.seed_hi = static_cast<uint>(seed >> 32);
-  push.sample_lo = static_cast<uint>(sample);
-  push.sample_hi = static_cast<uint>(sample >> 32);
-  push.offset_scale = scene.offset_scale();
-  const auto groups = static_cast<std::uint32_t>((n + kProbeShadingGroupSize - 1) / kProbeShadingGroupSize);
-  gpu_ms_ += ctx_.submit_and_wait([&](VkCommandBuffer cmd) { begin_->record_dispatch(cmd, groups, 1, 1, &push); });
+  // The probes and the frame's directions in; every per-ray buffer sized for n.
+  const auto origin_in = at_least(ctx_, origins_, origins.size() * sizeof(glm::vec4)).mapped_as<glm::vec4>(origins.size());
+  for (std::size_t j = 0; j < origins.size(); ++j)
+    origin_in[j] = glm::vec4(origins[j], std::bit_cast<float>(static_cast<std::uint32_t>(probe_ids[j])));
+  const auto direction_in = at_least(ctx_, directions_, m * sizeof(glm::vec4)).mapped_as<glm::vec4>(m);
+  for (std::size_t i = 0; i < m; ++i) direction_in[i] = glm::vec4(directions[i], 0.0f);
+  at_least(ctx_, rays_, n * sizeof(RayGpu));
+  at_least(ctx_, hits_, n * sizeof(HitGpu));
+  at_least(ctx_, items_, n * 2 * sizeof(std::uint32_t));
+  at_least(ctx_, pending_, n * sizeof(PendingProbeRayGpu));
+  at_least(ctx_, shadows_, n * sizeof(RayGpu));
+  at_least(ctx_, shadow_hits_, n * sizeof(HitGpu));
+  at_least(ctx_, out_, n * sizeof(ProbeRayHitGpu));
 
-  // 2. The shadow rays (those with tmin <= tmax), through the backend's tracer.
-  std::vector<engine::rt::Ray> shadows;
-  std::vector<std::uint32_t> shadow_of;
-  for (std::size_t i = 0; i < n; ++i) {
-    const RayGpu& s = shadow_out[i];
-    if (!(s.tmin <= s.tmax)) continue;
-    shadows.push_back(engine::rt::Ray{vec_of(s.origin_x, s.origin_y, s.origin_z), vec_of(s.dir_x, s.dir_y, s.dir_z), s.tmin, s.tmax});
-    shadow_of.push_back(static_cast<std::uint32_t>(i));
-  }
-  std::vector<std::uint8_t> blocked(shadows.size());
-  if (!tracer.occluded(scene, shadows, blocked))
-    for (std::size_t j = 0; j < shadows.size(); ++j) blocked[j] = scene.occluded(shadows[j]) ? 1 : 0;
-  const auto blocked_in = bind_at_least(ctx_, *finish_, 1, blocked_, n * sizeof(std::uint32_t)).mapped_as<std::uint32_t>(n);
-  std::fill(blocked_in.begin(), blocked_in.end(), 0u);
-  for (std::size_t j = 0; j < shadows.size(); ++j) blocked_in[shadow_of[j]] = blocked[j];
-
-  // 3. The bounce light from the fields' probes, both fields in one set of buffers.
+  // The bounce light from the fields' probes, both fields in one set of buffers.
   const probes::ProbeFeedbackSource* fields[2] = {self, outer};
   std::size_t probe_count = 0, texel_count = 0;
   for (const auto* f : fields)
@@ -146,9 +130,13 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
       texel_count += static_cast<std::size_t>(f->grid->count()) * static_cast<std::size_t>(f->layout.texel_count());
     }
   static_assert(sizeof(probes::DepthMap::Texel) == 4);
-  const auto depth = bind_at_least(ctx_, *finish_, 4, depth_, std::max<std::size_t>(1, texel_count) * 4).mapped_as<std::uint32_t>(std::max<std::size_t>(1, texel_count));
-  const auto probe_info = bind_at_least(ctx_, *finish_, 5, probes_, std::max<std::size_t>(1, probe_count) * sizeof(ProbeGpu)).mapped_as<ProbeGpu>(std::max<std::size_t>(1, probe_count));
-  const auto probe_sh = bind_at_least(ctx_, *finish_, 6, probe_sh_, std::max<std::size_t>(1, probe_count * kTransferOutputs) * sizeof(float)).mapped_as<float>(std::max<std::size_t>(1, probe_count * kTransferOutputs));
+  // At least one element each: a binding needs a buffer even without fields.
+  texel_count = std::max<std::size_t>(1, texel_count);
+  const std::size_t probe_slots = std::max<std::size_t>(1, probe_count);
+  const auto depth = at_least(ctx_, depth_, texel_count * 4).mapped_as<std::uint32_t>(texel_count);
+  const auto probe_info = at_least(ctx_, probes_, probe_slots * sizeof(ProbeGpu)).mapped_as<ProbeGpu>(probe_slots);
+  const auto probe_sh = at_least(ctx_, probe_sh_, probe_slots * kTransferOutputs * sizeof(float))
+                            .mapped_as<float>(probe_slots * kTransferOutputs);
   ProbeFeedbackGpu feedback{};
   std::size_t probe_base = 0, depth_base = 0;
   for (int which = 0; which < 2; ++which) {
@@ -173,12 +161,58 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
     probe_base += count;
     depth_base += count * texels;
   }
-  bind_at_least(ctx_, *finish_, 3, feedback_, sizeof(ProbeFeedbackGpu)).upload(std::span<const ProbeFeedbackGpu>(&feedback, 1));
-  finish_->bind(0, pending_);
-  const auto hits_out = bind_at_least(ctx_, *finish_, 2, out_, n * sizeof(ProbeRayHitGpu)).mapped_as<const ProbeRayHitGpu>(n);
-  const ProbeFinishPush finish_push{static_cast<uint>(n), 0, 0, 0};
-  gpu_ms_ += ctx_.submit_and_wait([&](VkCommandBuffer cmd) { finish_->record_dispatch(cmd, groups, 1, 1, &finish_push); });
+  at_least(ctx_, feedback_, sizeof(ProbeFeedbackGpu)).upload(std::span<const ProbeFeedbackGpu>(&feedback, 1));
 
+  // Every kernel's buffers, bound afresh: any may have grown.
+  generate_->bind(0, origins_);
+  generate_->bind(1, directions_);
+  generate_->bind(2, rays_);
+  generate_->bind(3, items_);
+  trace_->bind(0, rays_);
+  trace_->bind(1, hits_);
+  rt->bind(*trace_, 2);
+  begin_->bind(0, rays_);
+  begin_->bind(1, hits_);
+  begin_->bind(2, items_);
+  begin_->bind(3, pending_);
+  begin_->bind(4, shadows_);
+  scene_.bind(*begin_, 5);
+  shadow_trace_->bind(0, shadows_);
+  shadow_trace_->bind(1, shadow_hits_);
+  rt->bind(*shadow_trace_, 2);
+  finish_->bind(0, pending_);
+  finish_->bind(1, shadow_hits_);
+  finish_->bind(2, out_);
+  finish_->bind(3, feedback_);
+  finish_->bind(4, depth_);
+  finish_->bind(5, probes_);
+  finish_->bind(6, probe_sh_);
+
+  ProbeHitPush push{};
+  push.count = static_cast<uint>(n);
+  push.seed_lo = static_cast<uint>(seed);
+  push.seed_hi = static_cast<uint>(seed >> 32);
+  push.sample_lo = static_cast<uint>(sample);
+  push.sample_hi = static_cast<uint>(sample >> 32);
+  push.offset_scale = scene.offset_scale();
+  const std::uint32_t generate_push[2] = {static_cast<std::uint32_t>(n), static_cast<std::uint32_t>(m)};
+  const std::uint32_t closest[2] = {static_cast<std::uint32_t>(n), 0u}, any_hit[2] = {static_cast<std::uint32_t>(n), 1u};
+  const ProbeFinishPush finish_push{static_cast<uint>(n), 0, 0, 0};
+  const auto groups = static_cast<std::uint32_t>((n + kProbeShadingGroupSize - 1) / kProbeShadingGroupSize);
+  const auto rt_groups = static_cast<std::uint32_t>((n + engine::gpu::kRtGroupSize - 1) / engine::gpu::kRtGroupSize);
+  gpu_ms_ += std::max(0.0, ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
+    generate_->record_dispatch(cmd, groups, 1, 1, generate_push);
+    engine::gpu::record_compute_barrier(cmd);
+    trace_->record_dispatch(cmd, rt_groups, 1, 1, closest);
+    engine::gpu::record_compute_barrier(cmd);
+    begin_->record_dispatch(cmd, groups, 1, 1, &push);
+    engine::gpu::record_compute_barrier(cmd);
+    shadow_trace_->record_dispatch(cmd, rt_groups, 1, 1, any_hit);
+    engine::gpu::record_compute_barrier(cmd);
+    finish_->record_dispatch(cmd, groups, 1, 1, &finish_push);
+  }));
+
+  const auto hits_out = out_.mapped_as<const ProbeRayHitGpu>(n);
   engine::jobs::parallel_for<std::size_t>(0, n, kRaysPerTask, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       const ProbeRayHitGpu& g = hits_out[i];

@@ -1,10 +1,12 @@
 #pragma once
-// Probe-ray hit shading on a Vulkan device (shaders/probe_hit_begin.comp,
-// probe_hit_finish.comp): probes::begin_probe_ray, the shadow rays, and
-// probes::finish_probe_ray with the bounce light interpolated from the probe
-// fields, for a batch of rays the device has traced. The CPU functions are
-// the oracle (tests/gpu/probe_shading_test.cpp); the light sample draws the
-// same random numbers.
+// A frame's probe rays on a Vulkan device, in one submission: generated
+// (shaders/probe_rays.comp), traced (rt_query.comp), their hits shaded up to
+// the light sample's shadow ray (probe_hit_begin.comp: probes::begin_probe_ray),
+// the shadow rays traced, and the rest (probe_hit_finish.comp:
+// probes::finish_probe_ray, with the bounce light interpolated from the
+// probe fields). Only the probes' origins go in and the shaded hits come
+// out. The CPU functions are the oracle (tests/gpu/probe_shading_test.cpp);
+// the light sample draws the same random numbers.
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -13,6 +15,7 @@
 
 #include "engine/gpu/compute_pipeline.h"
 #include "engine/gpu/gpu_buffer.h"
+#include "engine/gpu/gpu_ray_tracer.h"
 #include "engine/gpu/gpu_shading_scene.h"
 #include "engine/gpu/vulkan_context.h"
 #include "engine/render/light_set.h"
@@ -31,16 +34,17 @@ class VulkanProbeShading {
   // random numbers); why not in *why.
   static bool supported(const engine::gpu::VulkanContext& ctx, std::string* why);
 
-  // Shades rays[k] (whose closest hits `tracer` finds) as
-  // shade_probe_ray(scene, lights, dir, hit, make_rng(seed, items[k], sample),
-  // feedback) does, feedback being `self`'s irradiance inside its box and
-  // `outer`'s outside it (either may be null: no light). Returns false, out
-  // untouched, where the tracer declines the scene.
-  bool shade(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
-             engine::rt::RayBatchTracer& tracer, std::span<const engine::rt::Ray> rays,
-             std::span<const std::uint64_t> items, std::uint64_t seed, std::uint64_t sample,
-             const probes::ProbeFeedbackSource* self, const probes::ProbeFeedbackSource* outer,
-             std::vector<probes::ProbeRayHit>& out);
+  // The rays of probes origins[j] (probe index probe_ids[j]) along each of
+  // `directions`, traced and shaded as trace_probe_rays does with
+  // generator make_rng(seed, probe_ids[j] * 4096 + i, sample) for ray i, the
+  // bounce light `self`'s irradiance inside its grid's box and `outer`'s
+  // beyond it (either null: none). out: origins.size() x directions.size(),
+  // probe-major. Returns false, out untouched, where the tracer declines the
+  // scene.
+  bool shade(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, engine::gpu::GpuRayTracer& tracer,
+             std::span<const glm::vec3> origins, std::span<const int> probe_ids, std::span<const glm::vec3> directions,
+             std::uint64_t seed, std::uint64_t sample, const probes::ProbeFeedbackSource* self,
+             const probes::ProbeFeedbackSource* outer, std::vector<probes::ProbeRayHit>& out);
 
   [[nodiscard]] double take_gpu_ms() {
     const double ms = gpu_ms_;
@@ -51,9 +55,9 @@ class VulkanProbeShading {
  private:
   engine::gpu::VulkanContext& ctx_;
   engine::gpu::GpuShadingScene scene_;
-  std::unique_ptr<engine::gpu::ComputePipeline> begin_, finish_;
-  engine::gpu::GpuBuffer rays_, hits_, items_, pending_, shadows_;
-  engine::gpu::GpuBuffer blocked_, out_, feedback_, depth_, probes_, probe_sh_;
+  std::unique_ptr<engine::gpu::ComputePipeline> generate_, trace_, begin_, shadow_trace_, finish_;
+  engine::gpu::GpuBuffer origins_, directions_, rays_, hits_, items_, pending_, shadows_, shadow_hits_;
+  engine::gpu::GpuBuffer out_, feedback_, depth_, probes_, probe_sh_;
   double gpu_ms_ = 0;
 };
 

@@ -279,23 +279,17 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   // numbers and bounce light as the CPU path below).
   const auto shade_on_device = [&] {
     if (!kernels_ || tracing.empty()) return false;
-    std::vector<rt::Ray> rays;
-    std::vector<std::uint64_t> items;
-    rays.reserve(tracing.size() * static_cast<std::size_t>(M));
-    items.reserve(rays.capacity());
-    for (const int q : tracing)
-      for (int i = 0; i < M; ++i) {
-        rays.push_back(rt::Ray{grid.position(q), directions[static_cast<std::size_t>(i)]});
-        items.push_back(static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i));
-      }
+    std::vector<glm::vec3> origins;
+    origins.reserve(tracing.size());
+    for (const int q : tracing) origins.push_back(grid.position(q));
     const auto source = [](const ProbeField& f) {
       return ProbeFeedbackSource{&f.grid_, f.settings_.map, &f.states_, f.sh_, f.usable_, f.settings_.interpolation};
     };
     const ProbeFeedbackSource self_source = source(*this);
     const ProbeFeedbackSource outer_source = outer ? source(*outer) : ProbeFeedbackSource{};
     std::vector<ProbeRayHit> shaded;
-    if (!kernels_->shade_probe_rays(scene, lights, rays, items, seed, frame_ + 1, frame_ > 0 ? &self_source : nullptr,
-                                    outer ? &outer_source : nullptr, shaded))
+    if (!kernels_->shade_probe_rays(scene, lights, origins, tracing, directions, seed, frame_ + 1,
+                                    frame_ > 0 ? &self_source : nullptr, outer ? &outer_source : nullptr, shaded))
       return false;
     jobs::parallel_for(0, static_cast<int>(tracing.size()), 1, [&](int b, int e) {
       for (int j = b; j < e; ++j)

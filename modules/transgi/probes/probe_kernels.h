@@ -50,15 +50,18 @@ class ProbeKernels {
   // As MapProjector::project for `maps` maps stored one after another:
   // radiance maps x texel_count(), out maps x 75.
   virtual void project(const MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out) = 0;
-  // Traces and shades probe rays (rays[k] with generator make_rng(seed,
-  // items[k], sample)) as trace_probe_rays does, the bounce light from
-  // `self` inside its grid's box and from `outer` outside it (null: none).
-  // Returns false, out untouched, where the backend does not shade (the
-  // caller then shades on the CPU).
+  // Traces and shades the rays of probes origins[j] (index probe_ids[j])
+  // along each of `directions` as trace_probe_rays does, ray i of probe q
+  // drawing from make_rng(seed, q * 4096 + i, sample), the bounce light from
+  // `self` inside its grid's box and from `outer` beyond it (null: none).
+  // out: origins.size() x directions.size(), probe-major. Returns false, out
+  // untouched, where the backend does not shade (the caller then shades on
+  // the CPU).
   virtual bool shade_probe_rays(const engine::rt::RtScene& /*scene*/, const engine::render::LightSet& /*lights*/,
-                                std::span<const engine::rt::Ray> /*rays*/, std::span<const std::uint64_t> /*items*/,
-                                std::uint64_t /*seed*/, std::uint64_t /*sample*/, const ProbeFeedbackSource* /*self*/,
-                                const ProbeFeedbackSource* /*outer*/, std::vector<ProbeRayHit>& /*out*/) {
+                                std::span<const glm::vec3> /*origins*/, std::span<const int> /*probe_ids*/,
+                                std::span<const glm::vec3> /*directions*/, std::uint64_t /*seed*/, std::uint64_t /*sample*/,
+                                const ProbeFeedbackSource* /*self*/, const ProbeFeedbackSource* /*outer*/,
+                                std::vector<ProbeRayHit>& /*out*/) {
     return false;
   }
   // The backend's ray tracer for the probe rays (and the G-buffer's camera
