@@ -23,7 +23,7 @@ layout(push_constant) uniform PushBlock { ProbeFinishPush p; };
 
 // ProbeField::irradiance: the pruned trilinear SH at (x, n), convolved with
 // the clamped cosine about n.
-vec3 field_irradiance(ProbeFeedbackFieldGpu f, vec3 x, vec3 n) {
+vec3 field_irradiance(ProbeFieldGpu f, vec3 x, vec3 n) {
   const InterpolationGpu r = interpolate_probes_at(f.field, f.probe_base, f.depth_base, x, n);
   float y[25];
   sh_eval(n, y);
@@ -66,7 +66,7 @@ void main() {
       o.flags |= kProbeRaySawLight;
     }
     const vec3 x = vec3(q.px, q.py, q.pz), n = vec3(q.sx, q.sy, q.sz);
-    const ProbeFeedbackFieldGpu self = feedback.self;
+    const ProbeFieldGpu self = feedback.self;
     const bool outside = any(lessThan(x, vec3(self.box_min_x, self.box_min_y, self.box_min_z))) ||
                          any(greaterThan(x, vec3(self.box_max_x, self.box_max_y, self.box_max_z)));
     vec3 bounce = vec3(0.0);

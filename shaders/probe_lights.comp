@@ -13,7 +13,7 @@
 
 layout(local_size_x = kProbeLightsGroupSize) in;
 layout(std430, set = 0, binding = 0) readonly buffer Points { ProbeLightPointGpu points[]; };
-layout(std430, set = 0, binding = 1) readonly buffer Fields { ProbeLightFieldGpu fields[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Fields { ProbeFieldGpu fields[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Depth { uint depth[]; };        // every field's depth texels
 layout(std430, set = 0, binding = 3) readonly buffer Probes { ProbeGpu probes[]; };  // every field's probes
 layout(std430, set = 0, binding = 4) readonly buffer Sh { float sh[]; };             // every copy of every field's SH
@@ -28,13 +28,13 @@ layout(push_constant) uniform PushBlock { ProbeLightsPush p; };
 
 // cascades.cpp's depth_inside: how far x lies inside field f's box.
 float depth_inside(uint f, vec3 x) {
-  const ProbeLightFieldGpu b = fields[f];
+  const ProbeFieldGpu b = fields[f];
   const vec3 d = min(x - vec3(b.box_min_x, b.box_min_y, b.box_min_z), vec3(b.box_max_x, b.box_max_y, b.box_max_z) - x);
   return min(d.x, min(d.y, d.z));
 }
 
 bool holds(uint f, vec3 x) {
-  const ProbeLightFieldGpu b = fields[f];
+  const ProbeFieldGpu b = fields[f];
   return all(greaterThanEqual(x, vec3(b.box_min_x, b.box_min_y, b.box_min_z))) &&
          all(lessThanEqual(x, vec3(b.box_max_x, b.box_max_y, b.box_max_z)));
 }
@@ -42,7 +42,7 @@ bool holds(uint f, vec3 x) {
 // ProbeField::interpolate: field f's weights at (x, n), and whether a lit
 // probe weighed in without the fallback.
 bool field_weights(uint f, vec3 x, vec3 n, out InterpolationGpu r) {
-  const ProbeLightFieldGpu b = fields[f];
+  const ProbeFieldGpu b = fields[f];
   r = interpolate_probes_at(b.field, b.probe_base, b.depth_base, x, n);
   if (r.fallback != 0u) return false;
   for (int c = 0; c < 8; ++c)

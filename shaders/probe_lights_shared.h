@@ -23,17 +23,6 @@ struct ProbeLightPointGpu {
   float nx, ny, nz, pad0;
 };
 
-// A field as the samples read it: its interpolation, where its probes and
-// depth texels start in the shared buffers, its box and hand-over band
-// (cascades.h's BlendBox), and where its mean light (75 indirect, 75 direct:
-// the ambient term when no field is lit) starts in the SH buffer.
-struct ProbeLightFieldGpu {
-  InterpolatePush field;
-  uint probe_base, depth_base, mean_at, pad0;
-  float box_min_x, box_min_y, box_min_z, band;
-  float box_max_x, box_max_y, box_max_z, pad1;
-};
-
 struct ProbeLightsPush {
   uint count;       // samples
   uint fields;
@@ -43,9 +32,6 @@ struct ProbeLightsPush {
 
 #ifdef __cplusplus
 static_assert(sizeof(ProbeLightPointGpu) == 32 && offsetof(ProbeLightPointGpu, rotation) == 12, "ProbeLightPointGpu layout");
-static_assert(sizeof(ProbeLightFieldGpu) == 144 && offsetof(ProbeLightFieldGpu, probe_base) == 96 &&
-              offsetof(ProbeLightFieldGpu, band) == 124 && offsetof(ProbeLightFieldGpu, box_max_x) == 128,
-              "ProbeLightFieldGpu layout");
 static_assert(sizeof(ProbeLightsPush) == 16, "ProbeLightsPush layout");
 }  // namespace transgi::gpu
 #endif

@@ -49,19 +49,11 @@ struct ProbeRayHitGpu {
   float er, eg, eb, pad1;  // emitted
 };
 
-// Where a probe ray's bounce light comes from: a probe field's interpolation
-// (its probes, depth maps and SH at probe_base, depth_base in the shared
-// buffers), inside [box_min, box_max]; `outer` lights hits outside it.
-struct ProbeFeedbackFieldGpu {
-  InterpolatePush field;
-  uint probe_base, depth_base, enabled, pad0;
-  float box_min_x, box_min_y, box_min_z, pad1;
-  float box_max_x, box_max_y, box_max_z, pad2;
-};
-
+// Where a probe ray's bounce light comes from: a field's interpolation
+// inside its box, the outer cascade's beyond it (`enabled` 0: no light).
 struct ProbeFeedbackGpu {
-  ProbeFeedbackFieldGpu self;
-  ProbeFeedbackFieldGpu outer;
+  ProbeFieldGpu self;
+  ProbeFieldGpu outer;
 };
 
 struct ProbeFinishPush {
@@ -74,8 +66,6 @@ static_assert(sizeof(PendingProbeRayGpu) == 96 && offsetof(PendingProbeRayGpu, f
               offsetof(PendingProbeRayGpu, sx) == 80, "PendingProbeRayGpu layout");
 static_assert(sizeof(ProbeRayHitGpu) == 64 && offsetof(ProbeRayHitGpu, flags) == 28 && offsetof(ProbeRayHitGpu, er) == 48,
               "ProbeRayHitGpu layout");
-static_assert(sizeof(ProbeFeedbackFieldGpu) == 144 && offsetof(ProbeFeedbackFieldGpu, probe_base) == 96 &&
-              offsetof(ProbeFeedbackFieldGpu, box_max_x) == 128, "ProbeFeedbackFieldGpu layout");
 static_assert(sizeof(ProbeFeedbackGpu) == 288, "ProbeFeedbackGpu layout");
 }  // namespace transgi::gpu
 #endif

@@ -57,6 +57,13 @@ eval::MethodRun cornell_realtime(runtime::Backend backend, int width, bool devic
   return eval::run_transgi(scene, std::make_shared<const model::TransferModel>(std::move(m)), 48, 48, t);
 }
 
+// The mean |GI| over pixels and channels (a random network's GI can be negative).
+double mean_abs(const engine::image::ImageRGB& img) {
+  double mean = 0;
+  for (const auto& p : img.pixels) mean += std::abs(p.r + p.g + p.b) / 3.0;
+  return mean / static_cast<double>(img.pixels.size());
+}
+
 }  // namespace
 
 // The real-time frame on the Vulkan backend with its transfer decoded by the
@@ -77,9 +84,7 @@ TEST(VulkanBackend, ARealtimeFrameDecodedOnTheDeviceEqualsTheCpuDecoding) {
   ASSERT_EQ(gpu.backend.rfind("vulkan", 0), 0u) << "the plugin fell back: " << gpu.backend;
   EXPECT_EQ(gpu.backend.find("transfer inference on the CPU"), std::string::npos) << gpu.backend;
   ASSERT_GT(gpu.inferred_samples, 0u) << "the network decoded nothing";
-  double mean = 0;
-  for (const auto& p : cpu.gi.pixels) mean += std::abs(p.r + p.g + p.b) / 3.0;
-  mean /= static_cast<double>(cpu.gi.pixels.size());
+  const double mean = mean_abs(cpu.gi);
   ASSERT_GT(mean, 1e-4) << "a black frame would prove nothing";
   const double rmse = engine::image::rmse_clamped(cpu.gi, gpu.gi);
   std::printf("Cornell box, real-time, 12 frames, 48x48, %zu samples decoded: GI RMSE between device and CPU decoding %.3g, "
@@ -96,9 +101,7 @@ TEST(VulkanBackend, ARealtimeFrameWithLightsMadeOnTheDeviceEqualsOneWithTheCpusL
   const eval::MethodRun gpu_lights = cornell_realtime(runtime::Backend::Vulkan, 32, true, true);
   ASSERT_EQ(gpu_lights.backend.rfind("vulkan", 0), 0u) << "the plugin fell back: " << gpu_lights.backend;
   ASSERT_GT(gpu_lights.inferred_samples, 0u) << "the network decoded nothing";
-  double mean = 0;
-  for (const auto& p : cpu_lights.gi.pixels) mean += std::abs(p.r + p.g + p.b) / 3.0;
-  mean /= static_cast<double>(cpu_lights.gi.pixels.size());
+  const double mean = mean_abs(cpu_lights.gi);
   ASSERT_GT(mean, 1e-4) << "a black frame would prove nothing";
   const double rmse = engine::image::rmse_clamped(cpu_lights.gi, gpu_lights.gi);
   std::printf("Cornell box, real-time, 12 frames, 48x48: GI RMSE between lights made on the device and by the CPU %.3g, "

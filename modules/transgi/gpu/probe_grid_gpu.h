@@ -1,5 +1,7 @@
 #pragma once
-// probes::ProbeGrid as the kernels read it (ProbeGridGpu, transgi_shared.h).
+// probes::ProbeGrid and a probe field as the kernels read them (ProbeGridGpu,
+// ProbeFieldGpu, transgi_shared.h).
+#include "probes/interpolation.h"
 #include "probes/probe_grid.h"
 #include "transgi_shared.h"
 
@@ -9,6 +11,35 @@ inline ProbeGridGpu probe_grid_gpu(const probes::ProbeGrid& grid) {
   const glm::vec3 s = grid.spacing();
   return {grid.min.x,       grid.min.y,  grid.min.z,  grid.count(),  s.x,          s.y,          s.z,          grid.min_spacing(),
           grid.dims.x,      grid.dims.y, grid.dims.z, 0,             grid.scroll.x, grid.scroll.y, grid.scroll.z, 0};
+}
+
+// A field whose probes start at probe_base and depth texels at depth_base
+// in a kernel's shared buffers: `grid` as relocated (interpolation reads
+// the probes where they stand), its box, and the hand-over band (in metres).
+inline ProbeFieldGpu probe_field_gpu(const probes::ProbeGrid& grid, const probes::MapLayout& layout,
+                                     const probes::InterpolationSettings& interpolation, float band, std::uint32_t probe_base,
+                                     std::uint32_t depth_base) {
+  ProbeFieldGpu r{};
+  r.field.grid = probe_grid_gpu(grid);
+  r.field.bias_length = interpolation.normal_bias * grid.min_spacing();
+  r.field.visibility_threshold = interpolation.visibility_threshold;
+  r.field.flags = (interpolation.prune_back_facing ? kInterpolatePruneBackFacing : 0u) |
+                  (interpolation.prune_occluded ? kInterpolatePruneOccluded : 0u) |
+                  (grid.offsets.empty() ? 0u : kInterpolateHasOffsets);
+  r.field.map_width = static_cast<uint>(layout.width);
+  r.field.map_height = static_cast<uint>(layout.height);
+  r.field.texels = static_cast<uint>(layout.texel_count());
+  r.probe_base = probe_base;
+  r.depth_base = depth_base;
+  r.enabled = 1u;
+  r.box_min_x = grid.min.x;
+  r.box_min_y = grid.min.y;
+  r.box_min_z = grid.min.z;
+  r.band = band;
+  r.box_max_x = grid.max.x;
+  r.box_max_y = grid.max.y;
+  r.box_max_z = grid.max.z;
+  return r;
 }
 
 }  // namespace transgi::gpu

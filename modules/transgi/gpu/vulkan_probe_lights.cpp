@@ -39,8 +39,8 @@ bool VulkanProbeLights::set_probes(std::span<const probes::ProbeField* const> fi
   const auto sh_out = engine::gpu::bind_at_least(ctx_, *pipeline_, 4, sh_, sh_floats * sizeof(float)).mapped_as<float>(sh_floats);
   const auto sh_at = engine::gpu::bind_at_least(ctx_, *pipeline_, 5, sh_at_, copies * 2 * f_count * sizeof(std::uint32_t))
                          .mapped_as<std::uint32_t>(copies * 2 * f_count);
-  const auto records = engine::gpu::bind_at_least(ctx_, *pipeline_, 1, fields_, f_count * sizeof(ProbeLightFieldGpu))
-                           .mapped_as<ProbeLightFieldGpu>(f_count);
+  const auto records = engine::gpu::bind_at_least(ctx_, *pipeline_, 1, fields_, f_count * sizeof(ProbeFieldGpu))
+                           .mapped_as<ProbeFieldGpu>(f_count);
   std::size_t probe_base = 0, depth_base = 0, sh_base = 0;
   const std::size_t mean_base = copies * 2 * probe_count * kTransferOutputs;
   for (std::size_t f = 0; f < f_count; ++f) {
@@ -48,28 +48,12 @@ bool VulkanProbeLights::set_probes(std::span<const probes::ProbeField* const> fi
     const probes::ProbeGrid& grid = field.grid();
     const auto count = static_cast<std::size_t>(grid.count());
     const auto texels = static_cast<std::size_t>(field.settings().map.texel_count());
-    const probes::InterpolationSettings& is = field.settings().interpolation;
-    ProbeLightFieldGpu r{};
-    r.field.grid = probe_grid_gpu(grid);
-    r.field.bias_length = is.normal_bias * grid.min_spacing();
-    r.field.visibility_threshold = is.visibility_threshold;
-    r.field.flags = (is.prune_back_facing ? kInterpolatePruneBackFacing : 0u) | (is.prune_occluded ? kInterpolatePruneOccluded : 0u) |
-                    (grid.offsets.empty() ? 0u : kInterpolateHasOffsets);
-    r.field.map_width = static_cast<uint>(field.settings().map.width);
-    r.field.map_height = static_cast<uint>(field.settings().map.height);
-    r.field.texels = static_cast<uint>(texels);
-    r.probe_base = static_cast<uint>(probe_base);
-    r.depth_base = static_cast<uint>(depth_base);
+    // Relocation moves probes, not the box, so the grid's box is the placed
+    // one that mix_at and next_holding hand points over by.
+    ProbeFieldGpu r = probe_field_gpu(grid, field.settings().map, field.settings().interpolation,
+                                      field.settings().blend_cells * grid.min_spacing(), static_cast<uint>(probe_base),
+                                      static_cast<uint>(depth_base));
     r.mean_at = static_cast<uint>(mean_base + f * 2 * kTransferOutputs);
-    // The hand-over boxes are the placed grid's (mix_at, next_holding).
-    const probes::ProbeGrid& placed = field.placement();
-    r.box_min_x = placed.min.x;
-    r.box_min_y = placed.min.y;
-    r.box_min_z = placed.min.z;
-    r.band = field.settings().blend_cells * placed.min_spacing();
-    r.box_max_x = placed.max.x;
-    r.box_max_y = placed.max.y;
-    r.box_max_z = placed.max.z;
     records[f] = r;
     engine::jobs::parallel_for<std::size_t>(0, count, 16, [&](std::size_t b, std::size_t e) {
       for (std::size_t q = b; q < e; ++q) {

@@ -22,32 +22,6 @@ constexpr std::size_t kRaysPerTask = 4096;
 
 glm::vec3 vec_of(float x, float y, float z) { return {x, y, z}; }
 
-// The feedback record of one field whose probes start at probe_base and
-// depth texels at depth_base in the shared buffers.
-ProbeFeedbackFieldGpu field_record(const probes::ProbeFeedbackSource& f, std::uint32_t probe_base, std::uint32_t depth_base) {
-  ProbeFeedbackFieldGpu r{};
-  const probes::ProbeGrid& grid = *f.grid;
-  r.field.grid = probe_grid_gpu(grid);
-  r.field.bias_length = f.interpolation.normal_bias * grid.min_spacing();
-  r.field.visibility_threshold = f.interpolation.visibility_threshold;
-  r.field.flags = (f.interpolation.prune_back_facing ? kInterpolatePruneBackFacing : 0u) |
-                  (f.interpolation.prune_occluded ? kInterpolatePruneOccluded : 0u) |
-                  (grid.offsets.empty() ? 0u : kInterpolateHasOffsets);
-  r.field.map_width = static_cast<uint>(f.layout.width);
-  r.field.map_height = static_cast<uint>(f.layout.height);
-  r.field.texels = static_cast<uint>(f.layout.texel_count());
-  r.probe_base = probe_base;
-  r.depth_base = depth_base;
-  r.enabled = 1u;
-  r.box_min_x = grid.min.x;
-  r.box_min_y = grid.min.y;
-  r.box_min_z = grid.min.z;
-  r.box_max_x = grid.max.x;
-  r.box_max_y = grid.max.y;
-  r.box_max_z = grid.max.z;
-  return r;
-}
-
 void check_source(const probes::ProbeFeedbackSource& f) {
   const auto count = static_cast<std::size_t>(f.grid->count());
   if (f.states->size() != count || f.sh.size() != count * kTransferOutputs || (!f.usable.empty() && f.usable.size() != count))
@@ -145,7 +119,8 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
     const auto count = static_cast<std::size_t>(f->grid->count());
     const auto texels = static_cast<std::size_t>(f->layout.texel_count());
     (which == 0 ? feedback.self : feedback.outer) =
-        field_record(*f, static_cast<std::uint32_t>(probe_base), static_cast<std::uint32_t>(depth_base));
+        probe_field_gpu(*f->grid, f->layout, f->interpolation, 0.0f, static_cast<std::uint32_t>(probe_base),
+                        static_cast<std::uint32_t>(depth_base));
     engine::jobs::parallel_for<std::size_t>(0, count, 16, [&](std::size_t b, std::size_t e) {
       for (std::size_t q = b; q < e; ++q) {
         const probes::DepthMap& d = (*f->states)[q].depth;
