@@ -179,8 +179,8 @@ int run_bench_frame(const std::vector<std::string>& argv) {
               frame.backend_fallback.c_str());
   std::printf("\n");
   if (frame.gpu_ms() > 0)
-    std::printf("GPU timestamps, last frame (ms): G-buffer rays %.2f (camera and shadow rays); probe rays %.2f (and their "
-                "shadow rays); probe-ray shading %.2f; radiance raster %.2f; accumulation %.2f; SH projection %.2f; inference %.2f; "
+    std::printf("GPU timestamps, last frame (ms): G-buffer rays %.2f (camera and shadow rays); other rays %.2f; probe rays "
+                "made, traced and shaded %.2f; radiance raster %.2f; accumulation %.2f; SH projection %.2f; inference %.2f; "
                 "total %.2f\n",
                 frame.gpu_gbuffer_ms, frame.gpu_trace_ms, frame.gpu_shading_ms, frame.gpu_raster_ms, frame.gpu_accumulation_ms,
                 frame.gpu_projection_ms, frame.gpu_inference_ms, frame.gpu_ms());
