@@ -1,8 +1,13 @@
 #pragma once
 // probes::ProbeGrid and a probe field as the kernels read them (ProbeGridGpu,
 // ProbeFieldGpu, transgi_shared.h).
+#include <cstdint>
+#include <span>
+#include <vector>
+
 #include "probes/interpolation.h"
 #include "probes/probe_grid.h"
+#include "probes/probe_map.h"
 #include "transgi_shared.h"
 
 namespace transgi::gpu {
@@ -41,5 +46,13 @@ inline ProbeFieldGpu probe_field_gpu(const probes::ProbeGrid& grid, const probes
   r.box_max_z = grid.max.z;
   return r;
 }
+
+// A field's probes (relocation offset, depth unit, whether it holds light)
+// into probes[probe_base ..] and their depth moments, `texels` a probe, into
+// depth[depth_base ..] (zeros for a probe that holds none), as the
+// interpolation kernels read them. usable empty: every probe.
+void write_probe_field(const probes::ProbeGrid& grid, const std::vector<probes::ProbeMapState>& states,
+                       std::span<const std::uint8_t> usable, std::size_t texels, std::size_t probe_base,
+                       std::size_t depth_base, std::span<std::uint32_t> depth, std::span<ProbeGpu> probes);
 
 }  // namespace transgi::gpu

@@ -39,19 +39,11 @@ GpuInterpolation VulkanProbeInterpolator::interpolate(const probes::ProbeGrid& g
     std::memcpy(&points[i * 6], &positions[i].x, 3 * sizeof(float));
     std::memcpy(&points[i * 6 + 3], &normals[i].x, 3 * sizeof(float));
   }
-  // Depth texels are two binary16 (mean, variance): exactly a GLSL half2.
-  static_assert(sizeof(probes::DepthMap::Texel) == 4);
-  std::vector<probes::DepthMap::Texel> depth(count * texels);
+  std::vector<std::uint32_t> depth(count * texels);
   std::vector<ProbeGpu> probe_info(count);
-  for (std::size_t q = 0; q < count; ++q) {
-    const auto& d = states[q].depth;
-    const bool usable_q = usable.empty() || usable[q] != 0;
-    if (usable_q && d.texels.size() == texels) std::memcpy(&depth[q * texels], d.texels.data(), texels * sizeof(depth[0]));
-    const glm::vec3 off = grid.offsets.empty() ? glm::vec3(0.0f) : grid.offsets[q];
-    probe_info[q] = {off.x, off.y, off.z, d.unit, usable_q ? 1u : 0u, 0, 0, 0};
-  }
+  write_probe_field(grid, states, usable, texels, 0, 0, depth, probe_info);
   engine::gpu::bind_at_least(ctx_, *pipeline_, 0, points_, points.size() * sizeof(float)).upload(std::span<const float>(points));
-  engine::gpu::bind_at_least(ctx_, *pipeline_, 1, depth_, depth.size() * sizeof(depth[0])).upload(std::span<const probes::DepthMap::Texel>(depth));
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 1, depth_, depth.size() * sizeof(depth[0])).upload(std::span<const std::uint32_t>(depth));
   engine::gpu::bind_at_least(ctx_, *pipeline_, 2, probes_, probe_info.size() * sizeof(ProbeGpu)).upload(std::span<const ProbeGpu>(probe_info));
   engine::gpu::bind_at_least(ctx_, *pipeline_, 3, probe_sh_, probe_sh.size() * sizeof(float)).upload(probe_sh);
   engine::gpu::bind_at_least(ctx_, *pipeline_, 4, results_, n * sizeof(InterpolationGpu));

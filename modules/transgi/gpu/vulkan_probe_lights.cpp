@@ -55,17 +55,7 @@ bool VulkanProbeLights::set_probes(std::span<const probes::ProbeField* const> fi
                                       static_cast<uint>(depth_base));
     r.mean_at = static_cast<uint>(mean_base + f * 2 * kTransferOutputs);
     records[f] = r;
-    engine::jobs::parallel_for<std::size_t>(0, count, 16, [&](std::size_t b, std::size_t e) {
-      for (std::size_t q = b; q < e; ++q) {
-        const probes::DepthMap& d = field.states()[q].depth;
-        const bool usable = field.usable()[q] != 0;
-        std::uint32_t* dst = depth.data() + depth_base + q * texels;
-        if (usable && d.texels.size() == texels) std::memcpy(dst, d.texels.data(), texels * 4);
-        else std::memset(dst, 0, texels * 4);
-        const glm::vec3 off = grid.offsets.empty() ? glm::vec3(0.0f) : grid.offsets[q];
-        probe_info[probe_base + q] = {off.x, off.y, off.z, d.unit, usable ? 1u : 0u, 0, 0, 0};
-      }
-    });
+    write_probe_field(grid, field.states(), field.usable(), texels, probe_base, depth_base, depth, probe_info);
     for (std::size_t c = 0; c < copies; ++c)
       for (int direct = 0; direct < 2; ++direct) {
         const float* src = sh(static_cast<int>(c) - 1, &field, direct != 0);

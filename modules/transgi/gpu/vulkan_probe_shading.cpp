@@ -103,7 +103,6 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
       probe_count += static_cast<std::size_t>(f->grid->count());
       texel_count += static_cast<std::size_t>(f->grid->count()) * static_cast<std::size_t>(f->layout.texel_count());
     }
-  static_assert(sizeof(probes::DepthMap::Texel) == 4);
   // At least one element each: a binding needs a buffer even without fields.
   texel_count = std::max<std::size_t>(1, texel_count);
   const std::size_t probe_slots = std::max<std::size_t>(1, probe_count);
@@ -121,17 +120,7 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
     (which == 0 ? feedback.self : feedback.outer) =
         probe_field_gpu(*f->grid, f->layout, f->interpolation, 0.0f, static_cast<std::uint32_t>(probe_base),
                         static_cast<std::uint32_t>(depth_base));
-    engine::jobs::parallel_for<std::size_t>(0, count, 16, [&](std::size_t b, std::size_t e) {
-      for (std::size_t q = b; q < e; ++q) {
-        const probes::DepthMap& d = (*f->states)[q].depth;
-        const bool usable = f->usable.empty() || f->usable[q] != 0;
-        std::uint32_t* dst = depth.data() + depth_base + q * texels;
-        if (usable && d.texels.size() == texels) std::memcpy(dst, d.texels.data(), texels * 4);
-        else std::memset(dst, 0, texels * 4);
-        const glm::vec3 off = f->grid->offsets.empty() ? glm::vec3(0.0f) : f->grid->offsets[q];
-        probe_info[probe_base + q] = {off.x, off.y, off.z, d.unit, usable ? 1u : 0u, 0, 0, 0};
-      }
-    });
+    write_probe_field(*f->grid, *f->states, f->usable, texels, probe_base, depth_base, depth, probe_info);
     std::memcpy(probe_sh.data() + probe_base * kTransferOutputs, f->sh.data(), f->sh.size() * sizeof(float));
     probe_base += count;
     depth_base += count * texels;
