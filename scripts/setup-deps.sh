@@ -6,12 +6,14 @@ set -euo pipefail
 
 # glslang-tools: glslang-dev's CMake config names /usr/bin/glslangValidator, and
 # with --no-install-recommends nothing else brings it, so find_package fails.
+# mesa-vulkan-drivers (lavapipe) comes from bookworm-backports (Mesa 25), below:
+# bookworm's own 22.3 has no VK_KHR_ray_query, whose path the GPU tests run.
 packages=(
   build-essential cmake ninja-build pkg-config git
   libtbb-dev libglm-dev libstb-dev libopenexr-dev libtinygltf-dev nlohmann-json3-dev libembree-dev libdnnl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   liblua5.4-dev libglfw3-dev libimgui-dev libgl-dev libgl1-mesa-dri
-  libvulkan-dev glslang-dev glslang-tools spirv-tools mesa-vulkan-drivers vulkan-validationlayers
+  libvulkan-dev glslang-dev glslang-tools spirv-tools vulkan-validationlayers
   xvfb xauth ffmpeg
 )
 # --fuzz: also the compiler of the `fuzz` preset (clang 14 with libFuzzer and
@@ -27,8 +29,19 @@ for p in "${packages[@]}"; do
   fi
 done
 
-if [ ${#missing[@]} -eq 0 ]; then
-  echo "setup-deps: all ${#packages[@]} packages already installed"
+# Debian 12 ships Mesa 22.3, whose lavapipe has no ray queries; its backports
+# carry Mesa 25 (VK_KHR_ray_query, VK_KHR_acceleration_structure). Later
+# Debian releases have a Mesa new enough in their own archive.
+mesa_minimum=25
+codename=$(. /etc/os-release 2>/dev/null && echo "${VERSION_CODENAME:-}")
+mesa_installed=$(dpkg-query -W -f='${Version}' mesa-vulkan-drivers 2>/dev/null || true)
+need_mesa=0
+if [ -z "$mesa_installed" ] || dpkg --compare-versions "$mesa_installed" lt "$mesa_minimum"; then
+  need_mesa=1
+fi
+
+if [ ${#missing[@]} -eq 0 ] && [ $need_mesa -eq 0 ]; then
+  echo "setup-deps: all ${#packages[@]} packages already installed, and mesa-vulkan-drivers $mesa_installed"
   exit 0
 fi
 
@@ -37,12 +50,27 @@ if [ "$(id -u)" -ne 0 ]; then
   if command -v sudo >/dev/null 2>&1; then
     as_root=(sudo)
   else
-    echo "setup-deps: need root or sudo to install: ${missing[*]}" >&2
+    echo "setup-deps: need root or sudo to install: ${missing[*]}$([ $need_mesa -eq 1 ] && echo " mesa-vulkan-drivers>=$mesa_minimum")" >&2
     exit 1
   fi
 fi
 
-echo "setup-deps: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
+mesa_release=()
+if [ $need_mesa -eq 1 ] && [ "$codename" = "bookworm" ]; then
+  if ! grep -rqs "bookworm-backports" /etc/apt/sources.list /etc/apt/sources.list.d/; then
+    echo "setup-deps: adding Debian's bookworm-backports (for mesa-vulkan-drivers >= $mesa_minimum)"
+    printf 'Types: deb\nURIs: http://deb.debian.org/debian\nSuites: bookworm-backports\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' |
+      "${as_root[@]}" tee /etc/apt/sources.list.d/bookworm-backports.sources >/dev/null
+  fi
+  mesa_release=(-t bookworm-backports)
+fi
 "${as_root[@]}" apt-get update -q
-"${as_root[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup-deps: installing ${missing[*]}"
+  "${as_root[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+if [ $need_mesa -eq 1 ]; then
+  echo "setup-deps: installing mesa-vulkan-drivers ${mesa_release[*]} (was: ${mesa_installed:-none})"
+  "${as_root[@]}" apt-get install -y -q --no-install-recommends "${mesa_release[@]}" mesa-vulkan-drivers
+fi
