@@ -1,6 +1,8 @@
 #include "engine/gpu/compute_pipeline.h"
 
+#include <algorithm>
 #include <string>
+#include <utility>
 
 #include "engine/gpu/gpu_buffer.h"
 #include "engine/gpu/gpu_error.h"
@@ -10,17 +12,22 @@ namespace engine::gpu {
 
 ComputePipeline::ComputePipeline(VulkanContext& ctx, std::span<const std::uint32_t> spirv,
                                  std::uint32_t storage_buffers, std::uint32_t push_constant_bytes)
-    : device_(ctx.device()), bindings_(storage_buffers), push_bytes_(push_constant_bytes) {
+    : ComputePipeline(ctx, spirv, std::vector<VkDescriptorType>(storage_buffers, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER),
+                      push_constant_bytes) {}
+
+ComputePipeline::ComputePipeline(VulkanContext& ctx, std::span<const std::uint32_t> spirv,
+                                 std::vector<VkDescriptorType> bindings, std::uint32_t push_constant_bytes)
+    : device_(ctx.device()), types_(std::move(bindings)), push_bytes_(push_constant_bytes) {
+  const auto count = static_cast<std::uint32_t>(types_.size());
   VkShaderModuleCreateInfo smi{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   smi.codeSize = spirv.size_bytes();
   smi.pCode = spirv.data();
   ENGINE_VK_CHECK(vkCreateShaderModule(device_, &smi, nullptr, &module_));
 
-  std::vector<VkDescriptorSetLayoutBinding> b(bindings_);
-  for (std::uint32_t i = 0; i < bindings_; ++i)
-    b[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+  std::vector<VkDescriptorSetLayoutBinding> b(count);
+  for (std::uint32_t i = 0; i < count; ++i) b[i] = {i, types_[i], 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
   VkDescriptorSetLayoutCreateInfo dli{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  dli.bindingCount = bindings_;
+  dli.bindingCount = count;
   dli.pBindings = b.data();
   ENGINE_VK_CHECK(vkCreateDescriptorSetLayout(device_, &dli, nullptr, &set_layout_));
 
@@ -40,11 +47,17 @@ ComputePipeline::ComputePipeline(VulkanContext& ctx, std::span<const std::uint32
   cpi.layout = layout_;
   ENGINE_VK_CHECK(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &cpi, nullptr, &pipeline_));
 
-  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, bindings_ ? bindings_ : 1};
+  std::vector<VkDescriptorPoolSize> sizes;
+  for (const VkDescriptorType t : types_) {
+    auto it = std::find_if(sizes.begin(), sizes.end(), [&](const VkDescriptorPoolSize& p) { return p.type == t; });
+    if (it == sizes.end()) sizes.push_back({t, 1});
+    else ++it->descriptorCount;
+  }
+  if (sizes.empty()) sizes.push_back({VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1});
   VkDescriptorPoolCreateInfo dpi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   dpi.maxSets = 1;
-  dpi.poolSizeCount = 1;
-  dpi.pPoolSizes = &size;
+  dpi.poolSizeCount = static_cast<std::uint32_t>(sizes.size());
+  dpi.pPoolSizes = sizes.data();
   ENGINE_VK_CHECK(vkCreateDescriptorPool(device_, &dpi, nullptr, &pool_));
   VkDescriptorSetAllocateInfo dai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
   dai.descriptorPool = pool_;
@@ -61,9 +74,30 @@ ComputePipeline::~ComputePipeline() {
   if (module_) vkDestroyShaderModule(device_, module_, nullptr);
 }
 
+void ComputePipeline::check_binding(std::uint32_t binding, VkDescriptorType type) const {
+  if (binding >= types_.size())
+    throw GpuError("ComputePipeline::bind: binding " + std::to_string(binding) + " of " + std::to_string(types_.size()));
+  if (types_[binding] != type)
+    throw GpuError("ComputePipeline::bind: binding " + std::to_string(binding) + " is of descriptor type " +
+                   std::to_string(types_[binding]) + ", not " + std::to_string(type));
+}
+
+void ComputePipeline::bind(std::uint32_t binding, VkAccelerationStructureKHR structure) {
+  check_binding(binding, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR);
+  VkWriteDescriptorSetAccelerationStructureKHR as{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET_ACCELERATION_STRUCTURE_KHR};
+  as.accelerationStructureCount = 1;
+  as.pAccelerationStructures = &structure;
+  VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  w.pNext = &as;
+  w.dstSet = set_;
+  w.dstBinding = binding;
+  w.descriptorCount = 1;
+  w.descriptorType = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR;
+  vkUpdateDescriptorSets(device_, 1, &w, 0, nullptr);
+}
+
 void ComputePipeline::bind(std::uint32_t binding, const GpuBuffer& buffer) {
-  if (binding >= bindings_)
-    throw GpuError("ComputePipeline::bind: binding " + std::to_string(binding) + " of " + std::to_string(bindings_));
+  check_binding(binding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
   VkDescriptorBufferInfo info{buffer.handle(), 0, VK_WHOLE_SIZE};
   VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
   w.dstSet = set_;

@@ -1,8 +1,9 @@
 #pragma once
-// One compute kernel: its SPIR-V, a descriptor set of storage buffers at
-// set 0, bindings 0..N-1 (the kernel's declared inputs and outputs, in
-// order), and a push-constant block. A pass binds buffers, then records a
-// dispatch into a command buffer.
+// One compute kernel: its SPIR-V, a descriptor set at set 0, bindings
+// 0..N-1 (the kernel's declared inputs and outputs, in order: storage
+// buffers, and where a kernel traces with ray queries, an acceleration
+// structure), and a push-constant block. A pass binds buffers, then records
+// a dispatch into a command buffer.
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -19,19 +20,27 @@ class ComputePipeline {
  public:
   ComputePipeline(VulkanContext& ctx, std::span<const std::uint32_t> spirv, std::uint32_t storage_buffers,
                   std::uint32_t push_constant_bytes);
+  // Bindings of the given types (VK_DESCRIPTOR_TYPE_STORAGE_BUFFER or
+  // VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR), in binding order.
+  ComputePipeline(VulkanContext& ctx, std::span<const std::uint32_t> spirv, std::vector<VkDescriptorType> bindings,
+                  std::uint32_t push_constant_bytes);
   ~ComputePipeline();
   ComputePipeline(const ComputePipeline&) = delete;
   ComputePipeline& operator=(const ComputePipeline&) = delete;
 
   // Throws GpuError for a binding out of range.
+  // Throws GpuError for a binding out of range or of another type.
   void bind(std::uint32_t binding, const GpuBuffer& buffer);
+  void bind(std::uint32_t binding, VkAccelerationStructureKHR structure);
   // push: exactly push_constant_bytes.
   void record_dispatch(VkCommandBuffer cmd, std::uint32_t groups_x, std::uint32_t groups_y, std::uint32_t groups_z,
                        const void* push) const;
 
  private:
   VkDevice device_ = VK_NULL_HANDLE;
-  std::uint32_t bindings_ = 0, push_bytes_ = 0;
+  std::vector<VkDescriptorType> types_;
+  std::uint32_t push_bytes_ = 0;
+  void check_binding(std::uint32_t binding, VkDescriptorType type) const;
   VkShaderModule module_ = VK_NULL_HANDLE;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;

@@ -19,11 +19,13 @@ void memory_barrier(VkCommandBuffer cmd, VkPipelineStageFlags src_stage, VkAcces
 
 }  // namespace
 
-GpuBuffer::GpuBuffer(VulkanContext& ctx, std::size_t bytes, Placement placement)
-    : ctx_(&ctx), device_(ctx.device()), bytes_(bytes < 4 ? 4 : bytes) {
+GpuBuffer::GpuBuffer(VulkanContext& ctx, std::size_t bytes, Placement placement, VkBufferUsageFlags extra_usage)
+    : ctx_(&ctx), device_(ctx.device()), bytes_(bytes < 4 ? 4 : bytes),
+      addressable_((extra_usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) != 0) {
   VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   bci.size = bytes_;
-  bci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  bci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+              extra_usage;
   bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   ENGINE_VK_CHECK(vkCreateBuffer(device_, &bci, nullptr, &buffer_));
   try {
@@ -31,6 +33,9 @@ GpuBuffer::GpuBuffer(VulkanContext& ctx, std::size_t bytes, Placement placement)
     vkGetBufferMemoryRequirements(device_, buffer_, &req);
     VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     mai.allocationSize = req.size;
+    VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
+    flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
+    if (addressable_) mai.pNext = &flags;
     const auto types = ctx.buffer_memory_types(req.memoryTypeBits, placement == Placement::Mapped);
     if (types.empty()) throw GpuError("no Vulkan memory type for a storage buffer on " + ctx.info().name);
     // A small BAR heap (256 MB without resizable BAR) fills up: the next
@@ -68,6 +73,7 @@ GpuBuffer& GpuBuffer::operator=(GpuBuffer&& o) noexcept {
     memory_ = std::exchange(o.memory_, VK_NULL_HANDLE);
     mapped_ = std::exchange(o.mapped_, nullptr);
     bytes_ = std::exchange(o.bytes_, 0);
+    addressable_ = std::exchange(o.addressable_, false);
   }
   return *this;
 }
@@ -81,6 +87,13 @@ void GpuBuffer::release() {
   buffer_ = VK_NULL_HANDLE;
   memory_ = VK_NULL_HANDLE;
   mapped_ = nullptr;
+}
+
+VkDeviceAddress GpuBuffer::device_address() const {
+  if (!addressable_) throw GpuError("GpuBuffer: device_address of a buffer made without VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT");
+  VkBufferDeviceAddressInfo info{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
+  info.buffer = buffer_;
+  return vkGetBufferDeviceAddress(device_, &info);
 }
 
 void GpuBuffer::check_mapped(std::size_t bytes) const {

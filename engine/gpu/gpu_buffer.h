@@ -22,8 +22,12 @@ class GpuBuffer {
   enum class Placement { Mapped, DeviceOnly };
 
   GpuBuffer() = default;
-  // bytes 0 is rounded up to 4.
-  GpuBuffer(VulkanContext& ctx, std::size_t bytes, Placement placement = Placement::Mapped);
+  // bytes 0 is rounded up to 4. extra_usage: beyond storage and transfer,
+  // e.g. what an acceleration structure's build reads; with
+  // VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT the buffer has a
+  // device_address().
+  GpuBuffer(VulkanContext& ctx, std::size_t bytes, Placement placement = Placement::Mapped,
+            VkBufferUsageFlags extra_usage = 0);
   ~GpuBuffer();
   GpuBuffer(GpuBuffer&& o) noexcept;
   GpuBuffer& operator=(GpuBuffer&& o) noexcept;
@@ -32,6 +36,8 @@ class GpuBuffer {
 
   [[nodiscard]] VkBuffer handle() const { return buffer_; }
   [[nodiscard]] std::size_t size() const { return bytes_; }
+  // Throws GpuError unless made with VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT.
+  [[nodiscard]] VkDeviceAddress device_address() const;
   // The mapped memory as `count` T's, for callers that fill or read it in
   // parallel without a copy. Throws GpuError on an unmapped buffer or one
   // too small.
@@ -61,6 +67,7 @@ class GpuBuffer {
   VkDeviceMemory memory_ = VK_NULL_HANDLE;
   void* mapped_ = nullptr;
   std::size_t bytes_ = 0;
+  bool addressable_ = false;
 };
 
 }  // namespace engine::gpu

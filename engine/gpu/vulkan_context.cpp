@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <initializer_list>
 #include <vector>
 
 #include "engine/gpu/gpu_error.h"
@@ -29,6 +30,17 @@ std::optional<std::uint32_t> compute_family(VkPhysicalDevice d) {
   for (std::uint32_t i = 0; i < n; ++i)
     if (families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) return i;
   return std::nullopt;
+}
+
+bool has_extensions(VkPhysicalDevice d, std::initializer_list<const char*> names) {
+  std::uint32_t n = 0;
+  if (vkEnumerateDeviceExtensionProperties(d, nullptr, &n, nullptr) != VK_SUCCESS) return false;
+  std::vector<VkExtensionProperties> all(n);
+  vkEnumerateDeviceExtensionProperties(d, nullptr, &n, all.data());
+  for (const char* name : names)
+    if (std::none_of(all.begin(), all.end(), [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; }))
+      return false;
+  return true;
 }
 
 bool layer_installed(const char* name) {
@@ -113,14 +125,33 @@ std::unique_ptr<VulkanContext> VulkanContext::create(const GpuOptions& options, 
 
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(ctx->physical_, &props);
+  // Ray queries need three extensions and three features; the feature
+  // structs are chained only where the extensions exist, as the spec asks.
+  const bool has_ray_query_extensions =
+      has_extensions(ctx->physical_, {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_QUERY_EXTENSION_NAME,
+                                      VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME});
+  VkPhysicalDeviceRayQueryFeaturesKHR frq{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR fas{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+  fas.pNext = &frq;
   VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  if (has_ray_query_extensions) f12.pNext = &fas;
   VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
   f2.pNext = &f12;
   vkGetPhysicalDeviceFeatures2(ctx->physical_, &f2);
+  VkPhysicalDeviceAccelerationStructurePropertiesKHR pas{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR};
   VkPhysicalDeviceVulkan12Properties p12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_PROPERTIES};
+  if (has_ray_query_extensions) p12.pNext = &pas;
   VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
   p2.pNext = &p12;
   vkGetPhysicalDeviceProperties2(ctx->physical_, &p2);
+  bool want_ray_query = options.ray_query;
+  if (const char* env = std::getenv("ENGINE_GPU_RAY_QUERY")) {
+    if (std::strcmp(env, "off") == 0) want_ray_query = false;
+    else if (std::strcmp(env, "on") != 0) return fail(std::string("ENGINE_GPU_RAY_QUERY=") + env + ": expected on or off");
+  }
+  ctx->info_.ray_query = want_ray_query && has_ray_query_extensions && frq.rayQuery && fas.accelerationStructure &&
+                         f12.bufferDeviceAddress;
+  ctx->info_.scratch_alignment = pas.minAccelerationStructureScratchOffsetAlignment;
   ctx->info_.name = props.deviceName;
   ctx->info_.kind = kind_of(props.deviceType);
   ctx->info_.driver = std::string(p12.driverName) + " " + p12.driverInfo;
@@ -157,6 +188,18 @@ std::unique_ptr<VulkanContext> VulkanContext::create(const GpuOptions& options, 
   VkPhysicalDeviceFeatures2 enable2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
   enable2.features.shaderInt64 = f2.features.shaderInt64;
   enable2.pNext = &enable12;
+  VkPhysicalDeviceRayQueryFeaturesKHR enable_rq{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR enable_as{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+  std::vector<const char*> device_extensions;
+  if (ctx->info_.ray_query) {
+    enable12.bufferDeviceAddress = VK_TRUE;
+    enable_as.accelerationStructure = VK_TRUE;
+    enable_rq.rayQuery = VK_TRUE;
+    enable_as.pNext = &enable_rq;
+    enable12.pNext = &enable_as;
+    device_extensions = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_QUERY_EXTENSION_NAME,
+                         VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME};
+  }
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
   qci.queueFamilyIndex = ctx->queue_family_;
@@ -166,7 +209,23 @@ std::unique_ptr<VulkanContext> VulkanContext::create(const GpuOptions& options, 
   dci.pNext = &enable2;
   dci.queueCreateInfoCount = 1;
   dci.pQueueCreateInfos = &qci;
+  dci.enabledExtensionCount = static_cast<std::uint32_t>(device_extensions.size());
+  dci.ppEnabledExtensionNames = device_extensions.data();
   ENGINE_VK_CHECK(vkCreateDevice(ctx->physical_, &dci, nullptr, &ctx->device_));
+  if (ctx->info_.ray_query) {
+    auto& api = ctx->as_api_;
+    const VkDevice dev = ctx->device_;
+    api.create = reinterpret_cast<PFN_vkCreateAccelerationStructureKHR>(vkGetDeviceProcAddr(dev, "vkCreateAccelerationStructureKHR"));
+    api.destroy = reinterpret_cast<PFN_vkDestroyAccelerationStructureKHR>(vkGetDeviceProcAddr(dev, "vkDestroyAccelerationStructureKHR"));
+    api.build_sizes = reinterpret_cast<PFN_vkGetAccelerationStructureBuildSizesKHR>(
+        vkGetDeviceProcAddr(dev, "vkGetAccelerationStructureBuildSizesKHR"));
+    api.cmd_build = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresKHR>(
+        vkGetDeviceProcAddr(dev, "vkCmdBuildAccelerationStructuresKHR"));
+    api.device_address = reinterpret_cast<PFN_vkGetAccelerationStructureDeviceAddressKHR>(
+        vkGetDeviceProcAddr(dev, "vkGetAccelerationStructureDeviceAddressKHR"));
+    if (!api.create || !api.destroy || !api.build_sizes || !api.cmd_build || !api.device_address)
+      return fail("the device lists VK_KHR_acceleration_structure but its entry points are missing");
+  }
   vkGetDeviceQueue(ctx->device_, ctx->queue_family_, 0, &ctx->queue_);
 
   VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
@@ -227,7 +286,7 @@ std::string describe(const DeviceInfo& info) {
   if (info.mappable_device_local_bytes > 0)
     std::snprintf(bar, sizeof bar, "%.1f GiB", static_cast<double>(info.mappable_device_local_bytes) / (1u << 30));
   return "vulkan (" + info.name + "; " + info.driver + "; mapped buffers: " + buffers + "; mappable device-local heap: " +
-         bar + ")";
+         bar + "; rays: " + (info.ray_query ? "VK_KHR_ray_query" : "compute BVH traversal") + ")";
 }
 
 std::vector<std::uint32_t> rank_buffer_memory_types(const VkPhysicalDeviceMemoryProperties& mem, std::uint32_t type_bits,

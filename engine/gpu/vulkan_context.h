@@ -51,6 +51,21 @@ struct GpuOptions {
   // Caps DeviceInfo::max_storage_buffer_range below the device's (0 = no
   // cap), so tests reach the path a device too small for a scene takes.
   std::uint64_t storage_buffer_range_cap = 0;
+  // Trace with VK_KHR_ray_query (acceleration structures the driver builds
+  // and traverses, on RT cores where the GPU has them) where the device has
+  // it; false: the compute-shader BVH traversal everywhere.
+  // ENGINE_GPU_RAY_QUERY=off turns it off for A/B runs (on: as asked here).
+  bool ray_query = true;
+};
+
+// The VK_KHR_acceleration_structure entry points, which the loader does not
+// export: looked up once per device (null where ray queries are off).
+struct AccelerationStructureApi {
+  PFN_vkCreateAccelerationStructureKHR create = nullptr;
+  PFN_vkDestroyAccelerationStructureKHR destroy = nullptr;
+  PFN_vkGetAccelerationStructureBuildSizesKHR build_sizes = nullptr;
+  PFN_vkCmdBuildAccelerationStructuresKHR cmd_build = nullptr;
+  PFN_vkGetAccelerationStructureDeviceAddressKHR device_address = nullptr;
 };
 
 struct DeviceInfo {
@@ -67,6 +82,11 @@ struct DeviceInfo {
   // (a discrete GPU without resizable BAR exposes 256 MB).
   std::uint64_t mappable_device_local_bytes = 0;
   bool stage_device_only = false;  // GpuOptions::stage_device_only
+  // Rays are traced with VK_KHR_ray_query: the device has it (with
+  // acceleration structures and buffer device addresses) and
+  // GpuOptions::ray_query asked for it.
+  bool ray_query = false;
+  std::uint32_t scratch_alignment = 0;  // minAccelerationStructureScratchOffsetAlignment
 };
 
 // The memory types of `mem` among `type_bits` a storage buffer may take, best
@@ -90,6 +110,8 @@ class VulkanContext {
   [[nodiscard]] VkDevice device() const { return device_; }
   [[nodiscard]] VkPhysicalDevice physical_device() const { return physical_; }
   [[nodiscard]] const DeviceInfo& info() const { return info_; }
+  // Valid where info().ray_query.
+  [[nodiscard]] const AccelerationStructureApi& acceleration_structures() const { return as_api_; }
   // Validation-layer errors seen so far (0 without the layer); tests assert 0.
   [[nodiscard]] int validation_errors() const { return validation_errors_; }
   [[nodiscard]] bool validation_enabled() const { return messenger_ != VK_NULL_HANDLE; }
@@ -124,6 +146,7 @@ class VulkanContext {
   VkFence fence_ = VK_NULL_HANDLE;
   VkQueryPool timestamps_ = VK_NULL_HANDLE;
   DeviceInfo info_;
+  AccelerationStructureApi as_api_;
   int validation_errors_ = 0;
 };
 
