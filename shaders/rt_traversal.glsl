@@ -1,8 +1,14 @@
-// Closest-hit queries against a two-level BVH (rt_shared.h), for devices
-// without VK_KHR_ray_query (lavapipe 22.3 has none). The includer defines
-// RT_SET and RT_BINDING (the first of eight consecutive bindings: TLAS nodes,
-// instances, BLAS nodes, triangles, then the alpha test's triangle UVs,
-// materials, texel bytes and textures) before including this file.
+// Closest-hit queries, rt_intersect(), in one of two ways, which give the
+// same hits (tests/gpu/rt_traversal_test.cpp runs both against Embree):
+// - with RT_RAY_QUERY defined (GpuRtScene::shader_defines, where the device
+//   has VK_KHR_ray_query): the driver's acceleration structure, traversed by
+//   rayQueryEXT, on RT cores where the GPU has them;
+// - otherwise (lavapipe 22.3, GPUs without ray queries): a two-level BVH
+//   (rt_shared.h) traversed here in a loop.
+// The includer defines RT_SET and RT_BINDING (the first of eight consecutive
+// bindings: the TLAS (nodes, or the acceleration structure), instances, BLAS
+// nodes (unused with ray queries), triangles, then the alpha test's triangle
+// UVs, materials, texel bytes and textures) before including this file.
 //
 // Arithmetic follows Embree's conventions, not its exact floating point:
 // t in (tmin, tmax], hits from both sides, barycentrics (u, v) such that the
@@ -10,9 +16,14 @@
 // where their texture says, as Embree's filter does.
 #include "rt_shared.h"
 
+#ifdef RT_RAY_QUERY
+#extension GL_EXT_ray_query : require
+layout(set = RT_SET, binding = RT_BINDING) uniform accelerationStructureEXT rt_tlas_structure;
+#else
 layout(std430, set = RT_SET, binding = RT_BINDING) readonly buffer RtTlas { BvhNodeGpu rt_tlas[]; };
-layout(std430, set = RT_SET, binding = RT_BINDING + 1) readonly buffer RtInstances { InstanceGpu rt_instances[]; };
 layout(std430, set = RT_SET, binding = RT_BINDING + 2) readonly buffer RtBlas { BvhNodeGpu rt_blas[]; };
+#endif
+layout(std430, set = RT_SET, binding = RT_BINDING + 1) readonly buffer RtInstances { InstanceGpu rt_instances[]; };
 layout(std430, set = RT_SET, binding = RT_BINDING + 3) readonly buffer RtTriangles { TriangleGpu rt_triangles[]; };
 layout(std430, set = RT_SET, binding = RT_BINDING + 4) readonly buffer RtTriangleUvs { RtTriangleUvGpu rt_triangle_uvs[]; };
 layout(std430, set = RT_SET, binding = RT_BINDING + 5) readonly buffer RtAlphaMaterials { RtAlphaMaterialGpu rt_alpha_materials[]; };
@@ -40,6 +51,7 @@ bool rt_alpha_passes(TriangleGpu tri, uint index, float u, float v) {
   return alpha >= m.cutoff;
 }
 
+#ifndef RT_RAY_QUERY
 // 1 / d without infinities that would make 0 * inf = NaN in the slab test.
 vec3 rt_safe_inverse(vec3 d) {
   const float tiny = 1e-30;
@@ -171,3 +183,55 @@ HitGpu rt_intersect(vec3 o, vec3 d, float tmin, float tmax, bool any_hit) {
   }
   return hit;
 }
+#else  // RT_RAY_QUERY
+
+HitGpu rt_no_hit(float tmax) {
+  HitGpu hit;
+  hit.t = tmax;
+  hit.u = 0.0;
+  hit.v = 0.0;
+  hit.instance = kRtNoHit;
+  hit.primitive = 0u;
+  hit.mesh = 0u;
+  hit.pad0 = 0u;
+  hit.pad1 = 0u;
+  return hit;
+}
+
+// The same contract through the driver's traversal. The BLAS keep each
+// mesh's triangles in its own order (GpuRtScene), so a primitive index
+// names the TriangleGpu at the instance's triangle_offset plus it, and the
+// instance's custom index names its InstanceGpu.
+HitGpu rt_intersect(vec3 o, vec3 d, float tmin, float tmax, bool any_hit) {
+  HitGpu hit = rt_no_hit(tmax);
+  // A ray query's origin, direction and interval must be finite and ordered
+  // (undefined otherwise); such a ray hits nothing in the loop above either.
+  if (any(isnan(o)) || any(isinf(o)) || any(isnan(d)) || any(isinf(d)) || isnan(tmin) || isnan(tmax) || !(tmin >= 0.0) ||
+      !(tmax >= tmin) || d == vec3(0.0))
+    return hit;
+  rayQueryEXT q;
+  rayQueryInitializeEXT(q, rt_tlas_structure, any_hit ? gl_RayFlagsTerminateOnFirstHitEXT : gl_RayFlagsNoneEXT, 0xffu, o, tmin,
+                        d, min(tmax, 3.0e38));
+  while (rayQueryProceedEXT(q)) {
+    // Only alpha-masked meshes are built non-opaque: their candidates pass
+    // the same cut-out test as in the loop above.
+    if (rayQueryGetIntersectionTypeEXT(q, false) != gl_RayQueryCandidateIntersectionTriangleEXT) continue;
+    const uint inst = rayQueryGetIntersectionInstanceCustomIndexEXT(q, false);
+    const uint index = rt_instances[inst].triangle_offset + uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, false));
+    const TriangleGpu tri = rt_triangles[index];
+    const vec2 uv = rayQueryGetIntersectionBarycentricsEXT(q, false);
+    if (tri.alpha_material == kRtOpaque || rt_alpha_passes(tri, index, uv.x, uv.y)) rayQueryConfirmIntersectionEXT(q);
+  }
+  if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) return hit;
+  const InstanceGpu I = rt_instances[rayQueryGetIntersectionInstanceCustomIndexEXT(q, true)];
+  const uint index = I.triangle_offset + uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, true));
+  const vec2 uv = rayQueryGetIntersectionBarycentricsEXT(q, true);
+  hit.t = rayQueryGetIntersectionTEXT(q, true);
+  hit.u = uv.x;
+  hit.v = uv.y;
+  hit.instance = I.id;
+  hit.primitive = rt_triangles[index].primitive;
+  hit.mesh = I.mesh;
+  return hit;
+}
+#endif  // RT_RAY_QUERY

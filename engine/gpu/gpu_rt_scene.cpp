@@ -1,6 +1,8 @@
 #include "engine/gpu/gpu_rt_scene.h"
 
+#include <cstddef>
 #include <cstdlib>
+#include <limits>
 
 #include "engine/gpu/gpu_error.h"
 #include "engine/gpu/shader_compiler.h"
@@ -22,9 +24,9 @@ std::filesystem::path engine_shader_dir() {
 
 template <class T>
 void upload_to(VulkanContext& ctx, GpuBuffer& b, const std::vector<T>& v,
-               GpuBuffer::Placement placement = GpuBuffer::Placement::Mapped) {
+               GpuBuffer::Placement placement = GpuBuffer::Placement::Mapped, VkBufferUsageFlags usage = 0) {
   const std::size_t bytes = v.size() * sizeof(T);
-  if (b.handle() == VK_NULL_HANDLE || b.size() < bytes) b = GpuBuffer(ctx, bytes, placement);
+  if (b.handle() == VK_NULL_HANDLE || b.size() < bytes) b = GpuBuffer(ctx, bytes, placement, usage);
   b.upload(std::span<const T>(v));
 }
 
@@ -33,14 +35,46 @@ void upload_to(VulkanContext& ctx, GpuBuffer& b, const std::vector<T>& v,
 constexpr GpuBuffer::Placement kStatic = GpuBuffer::Placement::DeviceOnly;
 constexpr std::size_t kRaysPerTask = 4096;
 
+// The triangle buffer is also the ray-query BLAS's vertex buffer: TriangleGpu
+// keeps its corners 16 bytes apart (p0 at 0, p1 at 16, p2 at 32).
+constexpr VkDeviceSize kCornerStride = 16;
+static_assert(offsetof(TriangleGpu, p1_x) == kCornerStride && offsetof(TriangleGpu, p2_x) == 2 * kCornerStride &&
+              sizeof(TriangleGpu) == 3 * kCornerStride);
+
+bool finite(glm::vec3 p) { return !glm::any(glm::isnan(p)) && !glm::any(glm::isinf(p)); }
+
+// A similarity's object-to-world 3 x 4 matrix, rows first (the TLAS's).
+void object_to_world(const transform::Similarity& s, float out[3][4]) {
+  const glm::mat3 r = glm::mat3_cast(s.rotation) * s.scale;
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 3; ++col) out[row][col] = r[col][row];
+    out[row][3] = s.translation[row];
+  }
+}
+
 }  // namespace
+
+std::vector<ShaderDefine> GpuRtScene::shader_defines(const VulkanContext& ctx) {
+  if (ctx.info().ray_query) return {{"RT_RAY_QUERY", "1"}};
+  return {};
+}
+
+std::vector<VkDescriptorType> GpuRtScene::binding_types(const VulkanContext& ctx, std::uint32_t first, std::uint32_t total) {
+  std::vector<VkDescriptorType> types(total, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+  if (ctx.info().ray_query && first < total) types[first] = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR;
+  return types;
+}
 
 GpuRtScene::GpuRtScene(VulkanContext& ctx) : ctx_(ctx) {
   const auto dir = engine_shader_dir();
   ShaderCompileOptions options;
   options.include_dirs.push_back(dir);
-  query_ = std::make_unique<ComputePipeline>(ctx, compile_compute_shader(dir / "rt_query.comp", options), 2 + kBindings,
+  options.defines = shader_defines(ctx);
+  query_ = std::make_unique<ComputePipeline>(ctx, compile_compute_shader(dir / "rt_query.comp", options),
+                                             binding_types(ctx, 2, 2 + kBindings),
                                              static_cast<std::uint32_t>(2 * sizeof(std::uint32_t)));
+  stats_.ray_query = ctx.info().ray_query;
+  if (stats_.ray_query) structures_ = std::make_unique<GpuAccelerationStructures>(ctx);
 }
 
 GpuRtScene::~GpuRtScene() = default;
@@ -83,17 +117,26 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
     }
     blas_root_.assign(assets->meshes.size(), 0);
     triangle_offset_.assign(assets->meshes.size(), 0);
+    std::vector<BlasInput> blas_inputs(assets->meshes.size());
     for (std::size_t m = 0; m < assets->meshes.size(); ++m) {
       const scene::MeshAsset& mesh = *assets->meshes[m];
-      std::vector<rt::BvhBox> boxes(mesh.triangles.size());
-      for (std::size_t t = 0; t < boxes.size(); ++t) {
-        const glm::uvec3 tri = mesh.triangles[t];
-        const glm::vec3 a = mesh.positions[tri.x], b = mesh.positions[tri.y], c = mesh.positions[tri.z];
-        boxes[t] = {glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
+      rt::Bvh bvh;
+      if (stats_.ray_query) {
+        // The driver builds the BLAS: triangles stay in the mesh's order.
+        bvh.order.resize(mesh.triangles.size());
+        for (std::uint32_t t = 0; t < bvh.order.size(); ++t) bvh.order[t] = t;
+      } else {
+        std::vector<rt::BvhBox> boxes(mesh.triangles.size());
+        for (std::size_t t = 0; t < boxes.size(); ++t) {
+          const glm::uvec3 tri = mesh.triangles[t];
+          const glm::vec3 a = mesh.positions[tri.x], b = mesh.positions[tri.y], c = mesh.positions[tri.z];
+          boxes[t] = {glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
+        }
+        bvh = rt::build_bvh(boxes);
       }
-      const rt::Bvh bvh = rt::build_bvh(boxes);
       blas_root_[m] = static_cast<std::uint32_t>(nodes.size());
       triangle_offset_[m] = static_cast<std::uint32_t>(tris.size());
+      blas_inputs[m].triangles = static_cast<std::uint32_t>(bvh.order.size());
       for (const auto& n : bvh.nodes) nodes.push_back(to_gpu(n));
       for (std::uint32_t item : bvh.order) {
         const glm::uvec3 tri = mesh.triangles[item];
@@ -101,6 +144,11 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
         const std::uint32_t mat = item < mesh.triangle_material.size() ? mesh.triangle_material[item] : 0;
         const std::uint32_t alpha = mat < alpha_of_material.size() ? alpha_of_material[mat] : kRtOpaque;
         tris.push_back({a.x, a.y, a.z, item, b.x, b.y, b.z, alpha, c.x, c.y, c.z, 0});
+        // A corner at infinity is undefined to a driver's builder; a NaN x
+        // makes the triangle inactive (the Vulkan spec), as Embree skips it.
+        if (stats_.ray_query && !(finite(a) && finite(b) && finite(c)))
+          tris.back().p0_x = tris.back().p1_x = tris.back().p2_x = std::numeric_limits<float>::quiet_NaN();
+        if (alpha != kRtOpaque) blas_inputs[m].opaque = false;
         RtTriangleUvGpu uv{};
         if (!mesh.uvs.empty()) {
           uv = {mesh.uvs[tri.x].x, mesh.uvs[tri.x].y, mesh.uvs[tri.y].x, mesh.uvs[tri.y].y,
@@ -121,9 +169,16 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
     if (nodes.empty()) nodes.push_back(to_gpu(rt::BvhNode{}));
     if (tris.empty()) tris.push_back({});
     upload_to(ctx_, blas_, nodes, kStatic);
-    upload_to(ctx_, triangles_, tris, kStatic);
-    stats_.blas_nodes = nodes.size();
+    const VkBufferUsageFlags build_input =
+        stats_.ray_query ? VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT : 0;
+    upload_to(ctx_, triangles_, tris, kStatic, build_input);
+    stats_.blas_nodes = stats_.ray_query ? 0 : nodes.size();
     stats_.triangles = tris.size();
+    if (structures_) {
+      for (std::size_t m = 0; m < blas_inputs.size(); ++m)
+        blas_inputs[m].vertices = triangles_.device_address() + triangle_offset_[m] * sizeof(TriangleGpu);
+      structures_->build_bottom(blas_inputs, kCornerStride);
+    }
   }
 
   std::vector<const rt::InstanceRecord*> live;
@@ -136,10 +191,18 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
     ids.push_back(id);
     boxes.push_back({r->bounds.min, r->bounds.max});
   }
-  const rt::Bvh tlas = rt::build_bvh(boxes, 1);
+  rt::Bvh tlas;
+  if (structures_) {
+    tlas.order.resize(live.size());
+    for (std::uint32_t i = 0; i < tlas.order.size(); ++i) tlas.order[i] = i;
+  } else {
+    tlas = rt::build_bvh(boxes, 1);
+  }
   std::vector<BvhNodeGpu> nodes;
   for (const auto& n : tlas.nodes) nodes.push_back(to_gpu(n));
+  if (nodes.empty()) nodes.push_back(to_gpu(rt::BvhNode{}));
   std::vector<InstanceGpu> instances;
+  std::vector<TlasInstance> tlas_instances;
   for (std::uint32_t item : tlas.order) {
     const rt::InstanceRecord& r = *live[item];
     // World to object: x_o = R^T (x_w - T) / s, as rows of a 3 x 4 matrix.
@@ -147,17 +210,26 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
     const glm::vec3 off = -(rt_ * r.to_world.translation);
     instances.push_back({rt_[0][0], rt_[1][0], rt_[2][0], off.x, rt_[0][1], rt_[1][1], rt_[2][1], off.y, rt_[0][2],
                          rt_[1][2], rt_[2][2], off.z, blas_root_[r.mesh], triangle_offset_[r.mesh], ids[item], r.mesh});
+    if (structures_) {
+      TlasInstance t;
+      object_to_world(r.to_world, t.object_to_world);
+      t.custom_index = static_cast<std::uint32_t>(instances.size() - 1);  // its InstanceGpu
+      t.blas = r.mesh;
+      tlas_instances.push_back(t);
+    }
   }
+  if (structures_) structures_->build_top(tlas_instances);
   if (instances.empty()) instances.push_back({});
   upload_to(ctx_, tlas_, nodes, kStatic);
   upload_to(ctx_, instances_, instances, kStatic);
-  stats_.tlas_nodes = nodes.size();
+  stats_.tlas_nodes = structures_ ? 0 : nodes.size();
   stats_.instances = live.size();
 }
 
 void GpuRtScene::bind(ComputePipeline& pipeline, std::uint32_t first) const {
   if (tlas_.handle() == VK_NULL_HANDLE) throw GpuError("GpuRtScene::bind before sync");
-  pipeline.bind(first, tlas_);
+  if (structures_) pipeline.bind(first, structures_->top());
+  else pipeline.bind(first, tlas_);
   pipeline.bind(first + 1, instances_);
   pipeline.bind(first + 2, blas_);
   pipeline.bind(first + 3, triangles_);

@@ -1,17 +1,28 @@
 #pragma once
 // The ray-tracing scene on the GPU, mirrored from an RtScene: one BLAS per
-// mesh asset, built once on the CPU (engine/rt/bvh_builder) and uploaded; a
-// TLAS over the live instances, rebuilt on the CPU at every sync (a few
-// thousand instances take well under a millisecond) and uploaded with the
-// instances' world-to-object transforms. Kernels include
-// shaders/rt_traversal.glsl and bind bindings() at four consecutive slots.
+// mesh asset and a TLAS over the live instances, rebuilt at every sync (a
+// move needs no BLAS rebuild). Two traversals, chosen by the device
+// (DeviceInfo::ray_query):
+// - VK_KHR_ray_query: the driver builds the BLAS (over the triangle buffer,
+//   whose corners are 16 bytes apart) and the TLAS on the device
+//   (GpuAccelerationStructures) and traverses them, on RT cores where the
+//   GPU has them;
+// - elsewhere (lavapipe 22.3, GPUs without ray queries): BLAS built once on
+//   the CPU (engine/rt/bvh_builder) and the TLAS at every sync (a few
+//   thousand instances take well under a millisecond), uploaded with the
+//   instances' world-to-object transforms and traversed in a compute shader.
+// Kernels include shaders/rt_traversal.glsl, compiled with shader_defines(),
+// make their pipelines with binding_types(), and bind() kBindings
+// consecutive slots; both traversals give the same hits.
 #include <cstdint>
 #include <memory>
 #include <span>
 #include <vector>
 
 #include "engine/gpu/compute_pipeline.h"
+#include "engine/gpu/gpu_acceleration_structures.h"
 #include "engine/gpu/gpu_buffer.h"
+#include "engine/gpu/shader_compiler.h"
 #include "engine/gpu/vulkan_context.h"
 #include "engine/rt/rt_scene.h"
 #include "rt_shared.h"
@@ -19,6 +30,7 @@
 namespace engine::gpu {
 
 struct GpuRtStats {
+  bool ray_query = false;  // traced with VK_KHR_ray_query (the node counts are then 0)
   std::size_t blas_builds = 0;
   std::size_t blas_nodes = 0, triangles = 0, tlas_nodes = 0, instances = 0;
 };
@@ -32,8 +44,16 @@ class GpuRtScene {
   void sync(const rt::RtScene& rt);
 
   // Binds the TLAS, instances, BLAS, triangles and the alpha test's four
-  // buffers at first .. first + 7 (rt_traversal.glsl's order).
+  // buffers at first .. first + 7 (rt_traversal.glsl's order); with ray
+  // queries the TLAS is the acceleration structure.
   void bind(ComputePipeline& pipeline, std::uint32_t first) const;
+
+  // What rt_traversal.glsl is compiled with on this device (RT_RAY_QUERY).
+  static std::vector<ShaderDefine> shader_defines(const VulkanContext& ctx);
+  // The descriptor types of a kernel with `total` bindings that binds the
+  // scene at `first`: storage buffers, and the TLAS where it is an
+  // acceleration structure.
+  static std::vector<VkDescriptorType> binding_types(const VulkanContext& ctx, std::uint32_t first, std::uint32_t total);
 
   // Closest hits of a batch of rays (shaders/rt_query.comp) in the scene as
   // of the last sync; found[i] says whether ray i hit. Hits carry the entity
@@ -65,6 +85,7 @@ class GpuRtScene {
   GpuBuffer triangle_uvs_, alpha_materials_, alpha_bytes_, alpha_textures_;
   GpuBuffer rays_, hits_;
   std::unique_ptr<ComputePipeline> query_;
+  std::unique_ptr<GpuAccelerationStructures> structures_;  // ray queries only
   GpuRtStats stats_;
 };
 

@@ -3,13 +3,17 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <vector>
 
+#include "engine/gpu/compute_pipeline.h"
 #include "engine/gpu/device_choice.h"
+#include "engine/gpu/gpu_acceleration_structures.h"
 #include "engine/gpu/gpu_buffer.h"
 #include "engine/gpu/gpu_error.h"
+#include "engine/gpu/gpu_rt_scene.h"
 #include "engine/gpu/shader_compiler.h"
 #include "engine/gpu/vulkan_context.h"
 #include "gpu_fixture.h"
@@ -162,4 +166,55 @@ TEST(VulkanContext, SaysWhichDeviceItRunsOnAndWhetherValidationIsOn) {
   EXPECT_FALSE(info.name.empty());
   // The kernels stage 16 KB of weights in shared memory; Vulkan guarantees 16 KB.
   EXPECT_GE(info.max_shared_memory, 16384u);
+}
+
+// GpuOptions::ray_query = false keeps a device with ray queries on the
+// compute traversal; the acceleration structures refuse such a context with
+// a reason instead of calling entry points that were never looked up.
+TEST(VulkanContext, RayQueriesAreUsedOnlyWhereAskedForAndAvailable) {
+  std::string why;
+  VulkanContext* compute = gpu_test::context_with(false, false, &why);
+  if (!compute) GTEST_SKIP() << "no Vulkan device: " << why;
+  EXPECT_FALSE(compute->info().ray_query);
+  EXPECT_EQ(compute->acceleration_structures().create, nullptr);
+  EXPECT_THROW(GpuAccelerationStructures structures(*compute), GpuError);
+  EXPECT_NE(describe(compute->info()).find("rays: compute BVH traversal"), std::string::npos) << describe(compute->info());
+  VulkanContext* preferred = gpu_test::context(&why);
+  ASSERT_NE(preferred, nullptr);
+  std::printf("ray queries: %s\n", preferred->info().ray_query ? "yes" : "no (the device has no VK_KHR_ray_query)");
+  if (preferred->info().ray_query) {
+    EXPECT_NE(preferred->acceleration_structures().cmd_build, nullptr);
+    EXPECT_NE(describe(preferred->info()).find("rays: VK_KHR_ray_query"), std::string::npos) << describe(preferred->info());
+  }
+}
+
+TEST(VulkanContext, AnUnknownRayQuerySettingIsAnErrorNamingTheVariable) {
+  ::setenv("ENGINE_GPU_RAY_QUERY", "maybe", 1);
+  std::string why;
+  const auto ctx = VulkanContext::create(GpuOptions{}, &why);
+  ::unsetenv("ENGINE_GPU_RAY_QUERY");
+  if (!ctx && why.find("ENGINE_GPU_RAY_QUERY") == std::string::npos) GTEST_SKIP() << "no Vulkan device: " << why;
+  EXPECT_EQ(ctx, nullptr);
+  EXPECT_EQ(why, "ENGINE_GPU_RAY_QUERY=maybe: expected on or off");
+}
+
+// A binding takes only the descriptor type its pipeline declared: a buffer
+// where the kernel expects its acceleration structure is refused by name.
+TEST(ComputePipeline, ABufferBoundWhereAnAccelerationStructureIsDeclaredIsRefused) {
+  GPU_TEST_CONTEXT_OR_SKIP(ctx);
+  if (!ctx->info().ray_query) GTEST_SKIP() << ctx->info().name << " has no VK_KHR_ray_query";
+  ShaderCompileOptions options;
+  options.include_dirs.push_back(ENGINE_TEST_SHADER_DIR);
+  options.defines = GpuRtScene::shader_defines(*ctx);
+  ComputePipeline pipeline(*ctx, compile_compute_shader(std::filesystem::path(ENGINE_TEST_SHADER_DIR) / "rt_query.comp", options),
+                           GpuRtScene::binding_types(*ctx, 2, 2 + GpuRtScene::kBindings), 8);
+  GpuBuffer b(*ctx, 64);
+  try {
+    pipeline.bind(2, b);
+    ADD_FAILURE() << "binding a buffer at the acceleration structure's slot must throw";
+  } catch (const GpuError& e) {
+    EXPECT_NE(std::string(e.what()).find("binding 2 is of descriptor type"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(pipeline.bind(3, b));
+  EXPECT_EQ(ctx->validation_errors(), 0);
 }

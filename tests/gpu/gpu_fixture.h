@@ -12,30 +12,37 @@
 
 namespace gpu_test {
 
-inline engine::gpu::VulkanContext* context(std::string* why) {
+// One context per combination of the options tests vary, made on first use.
+// Each is a static initialised by the creating call, so its destructor is
+// registered after the driver and layers it loaded, and runs before theirs
+// at exit (a static made before the create call is destroyed after the
+// validation layer's globals, and crashed in vkDeviceWaitIdle).
+template <bool StageDeviceOnly, bool RayQuery>
+engine::gpu::VulkanContext* context_slot(std::string* why) {
   static std::string why_not;
   static std::unique_ptr<engine::gpu::VulkanContext> ctx = [] {
     engine::gpu::GpuOptions options;
     options.validation = true;
+    options.stage_device_only = StageDeviceOnly;
+    options.ray_query = RayQuery;
     return engine::gpu::VulkanContext::create(options, &why_not);
   }();
   *why = why_not;
   return ctx.get();
 }
 
+// ray_query: trace with VK_KHR_ray_query where the device has it (the
+// default); false: the compute-shader BVH traversal, whatever the device.
+inline engine::gpu::VulkanContext* context_with(bool stage_device_only, bool ray_query, std::string* why) {
+  if (stage_device_only) return ray_query ? context_slot<true, true>(why) : context_slot<true, false>(why);
+  return ray_query ? context_slot<false, true>(why) : context_slot<false, false>(why);
+}
+
+inline engine::gpu::VulkanContext* context(std::string* why) { return context_with(false, true, why); }
+
 // A second context whose DeviceOnly buffers always go through staging
 // copies (GpuOptions::stage_device_only), as on a discrete GPU.
-inline engine::gpu::VulkanContext* staging_context(std::string* why) {
-  static std::string why_not;
-  static std::unique_ptr<engine::gpu::VulkanContext> ctx = [] {
-    engine::gpu::GpuOptions options;
-    options.validation = true;
-    options.stage_device_only = true;
-    return engine::gpu::VulkanContext::create(options, &why_not);
-  }();
-  *why = why_not;
-  return ctx.get();
-}
+inline engine::gpu::VulkanContext* staging_context(std::string* why) { return context_with(true, true, why); }
 
 }  // namespace gpu_test
 

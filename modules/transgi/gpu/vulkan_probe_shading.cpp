@@ -42,8 +42,9 @@ VulkanProbeShading::VulkanProbeShading(engine::gpu::VulkanContext& ctx) : ctx_(c
   std::string why;
   if (!supported(ctx, &why)) throw engine::gpu::GpuError("VulkanProbeShading: " + why);
   using engine::gpu::ComputePipeline;
-  const auto query = compile_module_shader("rt_query.comp");
-  const std::uint32_t query_bindings = 2 + engine::gpu::GpuRtScene::kBindings;
+  using engine::gpu::GpuRtScene;
+  const auto query = compile_module_shader("rt_query.comp", GpuRtScene::shader_defines(ctx));
+  const auto query_bindings = GpuRtScene::binding_types(ctx, 2, 2 + GpuRtScene::kBindings);
   generate_ = std::make_unique<ComputePipeline>(ctx, compile_module_shader("probe_rays.comp"), 4, 2 * sizeof(std::uint32_t));
   trace_ = std::make_unique<ComputePipeline>(ctx, query, query_bindings, 2 * sizeof(std::uint32_t));
   begin_ = std::make_unique<ComputePipeline>(ctx, compile_module_shader("probe_hit_begin.comp"),
