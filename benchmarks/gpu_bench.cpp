@@ -6,27 +6,50 @@
 // Vulkan device can be created.
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "engine/app/app.h"
+#include "engine/gpu/gpu_rt_scene.h"
 #include "engine/gpu/vulkan_context.h"
+#include "engine/rt/rt_scene.h"
 #include "engine/jobs/job_system.h"
+#include "engine/jobs/parallel_for.h"
 #include "engine/math/rng.h"
+#include "eval/method_runs.h"
 #include "gpu/vulkan_fused_decoder.h"
 #include "gpu/vulkan_sh_projector.h"
 #include "shading/fused_decoder.h"
 
 namespace {
 
+namespace eval_scene {
+// The sample level, loaded once (its Embree mirror synced).
+class Holder {
+ public:
+  Holder() : scene_(transgi::eval::load_scene(TRANSGI_LEVEL_SCENE, "", 2)) {}
+  engine::app::App& app() { return *scene_.app; }
+  const engine::rt::RtScene& rt() { return scene_.app->world().resource<engine::rt::RtScene>(); }
+
+ private:
+  transgi::eval::LoadedScene scene_;
+};
+}  // namespace eval_scene
+
+// RayQuery: true where the device has VK_KHR_ray_query (the default a
+// frame gets); false: the compute-shader BVH traversal.
+template <bool RayQuery = true>
 engine::gpu::VulkanContext* context(std::string* why_out) {
   static std::string why;
   static std::unique_ptr<engine::gpu::VulkanContext> ctx = [] {
     engine::gpu::GpuOptions o;
     o.validation = false;
+    o.ray_query = RayQuery;
     auto c = engine::gpu::VulkanContext::create(o, &why);
-    if (c) std::printf("Vulkan device: %s (%s)\n", c->info().name.c_str(), c->info().driver.c_str());
+    if (c) std::printf("Vulkan device: %s\n", engine::gpu::describe(c->info()).c_str());
     return c;
   }();
   *why_out = why;
@@ -105,8 +128,61 @@ void BM_ShProjection(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * probes);
 }
 
+// Incoherent rays (probe rays' kind) through the sample level: 65,536 rays
+// from random points in its bounds in random directions. Arg 0: Embree, one
+// ray at a time over the job system (the CPU backend); 1: the compute-shader
+// BVH traversal; 2: VK_KHR_ray_query (skipped where the device has none).
+// Counter hits: rays that hit, which must agree across the three.
+void BM_RayTraversal(benchmark::State& state) {
+  static eval_scene::Holder level;
+  const engine::rt::RtScene& rt = level.rt();
+  static const std::vector<engine::rt::Ray> rays = [&] {
+    engine::math::Pcg32 rng(9, 9);
+    std::vector<engine::rt::Ray> out(65536);
+    const glm::vec3 lo = rt.bounds_min(), hi = rt.bounds_max();
+    for (auto& r : out) {
+      r.origin = lo + (hi - lo) * glm::vec3(rng.next_float(), rng.next_float(), rng.next_float());
+      const float z = 2.0f * rng.next_float() - 1.0f, phi = 6.2831853f * rng.next_float();
+      const float sxy = std::sqrt(std::max(0.0f, 1.0f - z * z));
+      r.direction = {sxy * std::cos(phi), sxy * std::sin(phi), z};
+    }
+    return out;
+  }();
+  std::vector<engine::rt::Hit> hits(rays.size());
+  std::vector<std::uint8_t> found(rays.size());
+  if (state.range(0) == 0) {
+    state.SetLabel("embree");
+    for (auto _ : state)
+      level.app().jobs().run([&] {
+        engine::jobs::parallel_for<std::size_t>(0, rays.size(), 1024, [&](std::size_t b, std::size_t e) {
+          for (std::size_t i = b; i < e; ++i) found[i] = rt.intersect(rays[i], hits[i]) ? 1 : 0;
+        });
+      });
+  } else {
+    std::string why;
+    auto* ctx = state.range(0) == 2 ? context<true>(&why) : context<false>(&why);
+    if (!ctx) return state.SkipWithError(("no Vulkan device: " + why).c_str());
+    if (state.range(0) == 2 && !ctx->info().ray_query) return state.SkipWithError("the device has no VK_KHR_ray_query");
+    state.SetLabel(ctx->info().ray_query ? "ray query" : "compute BVH");
+    engine::gpu::GpuRtScene gpu(*ctx);
+    gpu.sync(rt);
+    double gpu_ms = 0;
+    for (auto _ : state) {
+      double ms = 0;
+      level.app().jobs().run([&] { gpu.intersect(rays, hits, found, &ms); });
+      gpu_ms += ms;
+    }
+    state.counters["gpu_ms"] = gpu_ms / static_cast<double>(state.iterations());
+  }
+  std::size_t n_hits = 0;
+  for (const std::uint8_t f : found) n_hits += f;
+  state.counters["hits"] = static_cast<double>(n_hits);
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(rays.size()));
+}
+
 }  // namespace
 
+BENCHMARK(BM_RayTraversal)->Arg(0)->Arg(1)->Arg(2)->Arg(0)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FusedInference)
     ->Args({0, kPoints})
     ->Args({1, kPoints})
