@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -27,10 +28,17 @@
 namespace {
 
 namespace eval_scene {
-// The sample level, loaded once (its Embree mirror synced).
+// The sample level, loaded once (its Embree mirror synced): from the
+// working directory's content/ where there is one (a packed run on another
+// machine), else from the source tree this was built from.
+std::string level_path() {
+  const std::string relative = "content/levels/living_room/scene.gltf";
+  return std::filesystem::exists(relative) ? relative : std::string(TRANSGI_LEVEL_SCENE);
+}
+
 class Holder {
  public:
-  Holder() : scene_(transgi::eval::load_scene(TRANSGI_LEVEL_SCENE, "", 2)) {}
+  Holder() : scene_(transgi::eval::load_scene(level_path(), "", 2)) {}
   engine::app::App& app() { return *scene_.app; }
   const engine::rt::RtScene& rt() { return scene_.app->world().resource<engine::rt::RtScene>(); }
 
