@@ -25,6 +25,14 @@ void barrier(VkCommandBuffer cmd, VkPipelineStageFlags src_stage, VkAccessFlags 
   vkCmdPipelineBarrier(cmd, src_stage, dst_stage, 0, 1, &b, 0, nullptr, 0, nullptr);
 }
 
+// The specification's alignment of an acceleration structure in its buffer.
+constexpr VkDeviceSize kStructureAlignment = 256;
+
+GpuBuffer storage_buffer(VulkanContext& ctx, VkDeviceSize bytes) {
+  return GpuBuffer(ctx, bytes, GpuBuffer::Placement::DeviceOnly,
+                   VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR | kAddressable);
+}
+
 constexpr VkPipelineStageFlags kBuildStage = VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR;
 
 void inputs_visible_to_build(VkCommandBuffer cmd) {
@@ -50,12 +58,13 @@ GpuAccelerationStructures::~GpuAccelerationStructures() {
   destroy(top_);
 }
 
-GpuAccelerationStructures::Structure GpuAccelerationStructures::make(VkAccelerationStructureTypeKHR type, VkDeviceSize bytes) {
+GpuAccelerationStructures::Structure GpuAccelerationStructures::make(VkAccelerationStructureTypeKHR type,
+                                                                     const GpuBuffer& storage, VkDeviceSize offset,
+                                                                     VkDeviceSize bytes) {
   Structure s;
-  s.storage = GpuBuffer(ctx_, bytes, GpuBuffer::Placement::DeviceOnly,
-                        VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR | kAddressable);
   VkAccelerationStructureCreateInfoKHR ci{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR};
-  ci.buffer = s.storage.handle();
+  ci.buffer = storage.handle();
+  ci.offset = offset;
   ci.size = bytes;
   ci.type = type;
   ENGINE_VK_CHECK(ctx_.acceleration_structures().create(ctx_.device(), &ci, nullptr, &s.handle));
@@ -67,9 +76,7 @@ GpuAccelerationStructures::Structure GpuAccelerationStructures::make(VkAccelerat
 
 void GpuAccelerationStructures::destroy(Structure& s) {
   if (s.handle) ctx_.acceleration_structures().destroy(ctx_.device(), s.handle, nullptr);
-  s.handle = VK_NULL_HANDLE;
-  s.storage = GpuBuffer();
-  s.address = 0;
+  s = Structure{};
 }
 
 VkDeviceAddress GpuAccelerationStructures::scratch(VkDeviceSize bytes) {
@@ -82,15 +89,15 @@ VkDeviceAddress GpuAccelerationStructures::scratch(VkDeviceSize bytes) {
 void GpuAccelerationStructures::build_bottom(std::span<const BlasInput> meshes, VkDeviceSize vertex_stride) {
   const AccelerationStructureApi& api = ctx_.acceleration_structures();
   for (auto& s : bottom_) destroy(s);
-  bottom_.clear();
-  bottom_.resize(meshes.size());
+  bottom_.assign(meshes.size(), Structure{});
+  bottom_storage_ = GpuBuffer();
   const std::size_t n = meshes.size();
   std::vector<VkAccelerationStructureGeometryKHR> geometry(n, {VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR});
   std::vector<VkAccelerationStructureBuildGeometryInfoKHR> info(n, {VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR});
   std::vector<VkAccelerationStructureBuildRangeInfoKHR> range(n);
-  std::vector<VkDeviceSize> scratch_offset(n, 0);
+  std::vector<VkDeviceSize> scratch_offset(n, 0), storage_offset(n, 0), storage_size(n, 0);
   const VkDeviceSize align = std::max<VkDeviceSize>(1, ctx_.info().scratch_alignment);
-  VkDeviceSize scratch_bytes = 0;
+  VkDeviceSize scratch_bytes = 0, storage_bytes = 0;
   std::vector<std::size_t> built;
   for (std::size_t m = 0; m < n; ++m) {
     if (meshes[m].triangles == 0) continue;
@@ -112,18 +119,22 @@ void GpuAccelerationStructures::build_bottom(std::span<const BlasInput> meshes, 
     b.pGeometries = &g;
     VkAccelerationStructureBuildSizesInfoKHR sizes{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
     api.build_sizes(ctx_.device(), VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &b, &meshes[m].triangles, &sizes);
-    bottom_[m] = make(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, sizes.accelerationStructureSize);
-    b.dstAccelerationStructure = bottom_[m].handle;
+    storage_offset[m] = storage_bytes;
+    storage_size[m] = sizes.accelerationStructureSize;
+    storage_bytes += round_up(sizes.accelerationStructureSize, kStructureAlignment);
     scratch_offset[m] = scratch_bytes;
     scratch_bytes += round_up(sizes.buildScratchSize, align);
     range[m] = {meshes[m].triangles, 0, 0, 0};
     built.push_back(m);
   }
   if (built.empty()) return;
+  bottom_storage_ = storage_buffer(ctx_, storage_bytes);
   const VkDeviceAddress base = scratch(scratch_bytes);
   std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos;
   std::vector<const VkAccelerationStructureBuildRangeInfoKHR*> ranges;
   for (const std::size_t m : built) {
+    bottom_[m] = make(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, bottom_storage_, storage_offset[m], storage_size[m]);
+    info[m].dstAccelerationStructure = bottom_[m].handle;
     info[m].scratchData.deviceAddress = base + scratch_offset[m];
     infos.push_back(info[m]);
     ranges.push_back(&range[m]);
@@ -154,7 +165,7 @@ void GpuAccelerationStructures::build_top(std::span<const TlasInstance> instance
     VkAccelerationStructureInstanceKHR& o = out[i];
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 4; ++c) o.transform.matrix[r][c] = in.object_to_world[r][c];
-    o.instanceCustomIndex = in.custom_index;
+    o.instanceCustomIndex = in.custom_index & 0xffffffu;  // checked above
     o.mask = 0xff;
     o.instanceShaderBindingTableRecordOffset = 0;
     // Hits from both sides, as Embree's and the compute traversal's.
@@ -178,7 +189,8 @@ void GpuAccelerationStructures::build_top(std::span<const TlasInstance> instance
   api.build_sizes(ctx_.device(), VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &b, &capacity, &sizes);
   if (!top_.handle || top_capacity_ < capacity) {
     destroy(top_);
-    top_ = make(VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR, sizes.accelerationStructureSize);
+    top_storage_ = storage_buffer(ctx_, sizes.accelerationStructureSize);
+    top_ = make(VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR, top_storage_, 0, sizes.accelerationStructureSize);
     top_capacity_ = capacity;
   }
   b.dstAccelerationStructure = top_.handle;

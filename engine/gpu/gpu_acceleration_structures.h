@@ -54,18 +54,22 @@ class GpuAccelerationStructures {
  private:
   struct Structure {
     VkAccelerationStructureKHR handle = VK_NULL_HANDLE;
-    GpuBuffer storage;
     VkDeviceAddress address = 0;
   };
-  Structure make(VkAccelerationStructureTypeKHR type, VkDeviceSize bytes);
+  // A structure of `bytes` at `offset` (a multiple of 256) in `storage`.
+  Structure make(VkAccelerationStructureTypeKHR type, const GpuBuffer& storage, VkDeviceSize offset, VkDeviceSize bytes);
   void destroy(Structure& s);
   // A scratch buffer of at least `bytes` at the device's scratch alignment;
   // returns its aligned address.
   VkDeviceAddress scratch(VkDeviceSize bytes);
 
   VulkanContext& ctx_;
+  // Every BLAS in one buffer: one memory allocation, however many meshes
+  // (drivers allow as few as 4,096 allocations).
   std::vector<Structure> bottom_;  // per mesh; handle null for an empty mesh
+  GpuBuffer bottom_storage_;
   Structure top_;
+  GpuBuffer top_storage_;
   std::uint32_t top_capacity_ = 0;
   GpuBuffer instances_, scratch_;
 };
