@@ -51,6 +51,20 @@ bool rt_alpha_passes(TriangleGpu tri, uint index, float u, float v) {
   return alpha >= m.cutoff;
 }
 
+// What rt_intersect returns for a ray that hits nothing up to tmax.
+HitGpu rt_no_hit(float tmax) {
+  HitGpu hit;
+  hit.t = tmax;
+  hit.u = 0.0;
+  hit.v = 0.0;
+  hit.instance = kRtNoHit;
+  hit.primitive = 0u;
+  hit.mesh = 0u;
+  hit.pad0 = 0u;
+  hit.pad1 = 0u;
+  return hit;
+}
+
 #ifndef RT_RAY_QUERY
 // 1 / d without infinities that would make 0 * inf = NaN in the slab test.
 vec3 rt_safe_inverse(vec3 d) {
@@ -149,15 +163,7 @@ void rt_traverse_blas(uint inst, vec3 wo, vec3 wd, float tmin, bool any_hit, ino
 // Closest hit of the ray in world space (any hit with any_hit: the answer to
 // "is anything there" at less traversal); hit.instance == kRtNoHit if none.
 HitGpu rt_intersect(vec3 o, vec3 d, float tmin, float tmax, bool any_hit) {
-  HitGpu hit;
-  hit.t = tmax;
-  hit.u = 0.0;
-  hit.v = 0.0;
-  hit.instance = kRtNoHit;
-  hit.primitive = 0u;
-  hit.mesh = 0u;
-  hit.pad0 = 0u;
-  hit.pad1 = 0u;
+  HitGpu hit = rt_no_hit(tmax);
   const vec3 inv_d = rt_safe_inverse(d);
   if (isinf(rt_enter(rt_tlas[0], o, inv_d, tmin, hit.t))) return hit;
   uint stack[kRtStackSize];
@@ -184,19 +190,6 @@ HitGpu rt_intersect(vec3 o, vec3 d, float tmin, float tmax, bool any_hit) {
   return hit;
 }
 #else  // RT_RAY_QUERY
-
-HitGpu rt_no_hit(float tmax) {
-  HitGpu hit;
-  hit.t = tmax;
-  hit.u = 0.0;
-  hit.v = 0.0;
-  hit.instance = kRtNoHit;
-  hit.primitive = 0u;
-  hit.mesh = 0u;
-  hit.pad0 = 0u;
-  hit.pad1 = 0u;
-  return hit;
-}
 
 // The same contract through the driver's traversal. The BLAS keep each
 // mesh's triangles in its own order (GpuRtScene), so a primitive index

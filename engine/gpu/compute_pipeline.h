@@ -57,4 +57,9 @@ GpuBuffer& bind_at_least(VulkanContext& ctx, ComputePipeline& pipeline, std::uin
 // Makes the writes of one dispatch visible to the reads of the next.
 void record_compute_barrier(VkCommandBuffer cmd);
 
+// One global memory barrier: `src` writes in `src_stage` become visible to
+// `dst` accesses in `dst_stage` (and in later submissions).
+void record_memory_barrier(VkCommandBuffer cmd, VkPipelineStageFlags src_stage, VkAccessFlags src,
+                           VkPipelineStageFlags dst_stage, VkAccessFlags dst);
+
 }  // namespace engine::gpu

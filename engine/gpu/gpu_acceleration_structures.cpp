@@ -4,6 +4,7 @@
 #include <string>
 #include <utility>
 
+#include "engine/gpu/compute_pipeline.h"
 #include "engine/gpu/gpu_error.h"
 #include "engine/gpu/vulkan_context.h"
 
@@ -14,16 +15,6 @@ constexpr VkBufferUsageFlags kAddressable = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRES
 
 VkDeviceSize round_up(VkDeviceSize x, VkDeviceSize a) { return a > 1 ? (x + a - 1) / a * a : x; }
 
-// Build inputs written by copies or the host become visible to the builder;
-// the builds' writes become visible to later builds and to the kernels'
-// ray queries (later submissions are in the barrier's second scope).
-void barrier(VkCommandBuffer cmd, VkPipelineStageFlags src_stage, VkAccessFlags src, VkPipelineStageFlags dst_stage,
-             VkAccessFlags dst) {
-  VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  b.srcAccessMask = src;
-  b.dstAccessMask = dst;
-  vkCmdPipelineBarrier(cmd, src_stage, dst_stage, 0, 1, &b, 0, nullptr, 0, nullptr);
-}
 
 // The specification's alignment of an acceleration structure in its buffer.
 constexpr VkDeviceSize kStructureAlignment = 256;
@@ -35,14 +26,17 @@ GpuBuffer storage_buffer(VulkanContext& ctx, VkDeviceSize bytes) {
 
 constexpr VkPipelineStageFlags kBuildStage = VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR;
 
+// Build inputs written by copies or the host become visible to the builder;
+// the builds' writes become visible to later builds and to the kernels'
+// ray queries (later submissions are in the barrier's second scope).
 void inputs_visible_to_build(VkCommandBuffer cmd) {
-  barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+  record_memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
           VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_HOST_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, kBuildStage,
           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR);
 }
 
 void build_visible_to_queries(VkCommandBuffer cmd) {
-  barrier(cmd, kBuildStage, VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR, kBuildStage | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+  record_memory_barrier(cmd, kBuildStage, VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR, kBuildStage | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
           VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_SHADER_READ_BIT);
 }
 

@@ -3,21 +3,11 @@
 #include <string>
 #include <utility>
 
+#include "engine/gpu/compute_pipeline.h"
 #include "engine/gpu/gpu_error.h"
 #include "engine/gpu/vulkan_context.h"
 
 namespace engine::gpu {
-namespace {
-
-void memory_barrier(VkCommandBuffer cmd, VkPipelineStageFlags src_stage, VkAccessFlags src, VkPipelineStageFlags dst_stage,
-                    VkAccessFlags dst) {
-  VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  b.srcAccessMask = src;
-  b.dstAccessMask = dst;
-  vkCmdPipelineBarrier(cmd, src_stage, dst_stage, 0, 1, &b, 0, nullptr, 0, nullptr);
-}
-
-}  // namespace
 
 GpuBuffer::GpuBuffer(VulkanContext& ctx, std::size_t bytes, Placement placement, VkBufferUsageFlags extra_usage)
     : ctx_(&ctx), device_(ctx.device()), bytes_(bytes < 4 ? 4 : bytes),
@@ -114,7 +104,7 @@ void GpuBuffer::write_bytes(const void* src, std::size_t n) {
   ctx_->submit_and_wait([&](VkCommandBuffer cmd) {
     vkCmdCopyBuffer(cmd, staging.buffer_, buffer_, 1, &region);
     // Later submissions' kernels and copies see the data.
-    memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+    record_memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                    VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                    VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT);
   });
@@ -130,7 +120,7 @@ void GpuBuffer::read_bytes(void* dst, std::size_t n) const {
   GpuBuffer staging(*ctx_, n);
   const VkBufferCopy region{0, 0, n};
   ctx_->submit_and_wait([&](VkCommandBuffer cmd) {
-    memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+    record_memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                    VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                    VK_ACCESS_TRANSFER_READ_BIT);
     vkCmdCopyBuffer(cmd, buffer_, staging.buffer_, 1, &region);  // submit_and_wait makes it visible to the host
