@@ -43,6 +43,18 @@ static_assert(offsetof(TriangleGpu, p1_x) == kCornerStride && offsetof(TriangleG
 
 bool finite(glm::vec3 p) { return !glm::any(glm::isnan(p)) && !glm::any(glm::isinf(p)); }
 
+// The world box around an object-space box under a similarity (its eight
+// corners carried over).
+rt::BvhBox world_box(const rt::BvhBox& b, const transform::Similarity& s) {
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  for (int k = 0; k < 8; ++k) {
+    const glm::vec3 p = s.apply_point({k & 1 ? b.max.x : b.min.x, k & 2 ? b.max.y : b.min.y, k & 4 ? b.max.z : b.min.z});
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  return {lo, hi};
+}
+
 // A similarity's object-to-world 3 x 4 matrix, rows first (the TLAS's).
 void object_to_world(const transform::Similarity& s, float out[3][4]) {
   const glm::mat3 r = glm::mat3_cast(s.rotation) * s.scale;
@@ -117,26 +129,39 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
     }
     blas_root_.assign(assets->meshes.size(), 0);
     triangle_offset_.assign(assets->meshes.size(), 0);
+    mesh_box_.assign(assets->meshes.size(), rt::BvhBox{});
     std::vector<BlasInput> blas_inputs(assets->meshes.size());
     for (std::size_t m = 0; m < assets->meshes.size(); ++m) {
       const scene::MeshAsset& mesh = *assets->meshes[m];
+      std::vector<rt::BvhBox> boxes(mesh.triangles.size());
+      std::vector<std::uint32_t> finite_triangles, broken_triangles;
+      glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+      for (std::uint32_t t = 0; t < boxes.size(); ++t) {
+        const glm::uvec3 tri = mesh.triangles[t];
+        const glm::vec3 a = mesh.positions[tri.x], b = mesh.positions[tri.y], c = mesh.positions[tri.z];
+        boxes[t] = {glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
+        // Embree skips a triangle with a non-finite corner; so do both traversals.
+        if (!(finite(a) && finite(b) && finite(c))) {
+          broken_triangles.push_back(t);
+          continue;
+        }
+        finite_triangles.push_back(t);
+        lo = glm::min(lo, boxes[t].min);
+        hi = glm::max(hi, boxes[t].max);
+      }
+      if (!finite_triangles.empty()) mesh_box_[m] = {lo, hi};
       rt::Bvh bvh;
       if (stats_.ray_query) {
-        // The driver builds the BLAS: triangles stay in the mesh's order.
-        bvh.order.resize(mesh.triangles.size());
-        for (std::uint32_t t = 0; t < bvh.order.size(); ++t) bvh.order[t] = t;
+        // The driver builds the BLAS over the finite triangles, in the mesh's
+        // order; the broken ones follow, outside it.
+        bvh.order = finite_triangles;
+        bvh.order.insert(bvh.order.end(), broken_triangles.begin(), broken_triangles.end());
       } else {
-        std::vector<rt::BvhBox> boxes(mesh.triangles.size());
-        for (std::size_t t = 0; t < boxes.size(); ++t) {
-          const glm::uvec3 tri = mesh.triangles[t];
-          const glm::vec3 a = mesh.positions[tri.x], b = mesh.positions[tri.y], c = mesh.positions[tri.z];
-          boxes[t] = {glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
-        }
-        bvh = rt::build_bvh(boxes);
+        bvh = rt::build_bvh(boxes);  // non-finite boxes are listed last, outside every leaf
       }
       blas_root_[m] = static_cast<std::uint32_t>(nodes.size());
       triangle_offset_[m] = static_cast<std::uint32_t>(tris.size());
-      blas_inputs[m].triangles = static_cast<std::uint32_t>(bvh.order.size());
+      blas_inputs[m].triangles = static_cast<std::uint32_t>(finite_triangles.size());
       for (const auto& n : bvh.nodes) nodes.push_back(to_gpu(n));
       for (std::uint32_t item : bvh.order) {
         const glm::uvec3 tri = mesh.triangles[item];
@@ -144,10 +169,6 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
         const std::uint32_t mat = item < mesh.triangle_material.size() ? mesh.triangle_material[item] : 0;
         const std::uint32_t alpha = mat < alpha_of_material.size() ? alpha_of_material[mat] : kRtOpaque;
         tris.push_back({a.x, a.y, a.z, item, b.x, b.y, b.z, alpha, c.x, c.y, c.z, 0});
-        // A corner at infinity is undefined to a driver's builder; a NaN x
-        // makes the triangle inactive (the Vulkan spec), as Embree skips it.
-        if (stats_.ray_query && !(finite(a) && finite(b) && finite(c)))
-          tris.back().p0_x = tris.back().p1_x = tris.back().p2_x = std::numeric_limits<float>::quiet_NaN();
         if (alpha != kRtOpaque) blas_inputs[m].opaque = false;
         RtTriangleUvGpu uv{};
         if (!mesh.uvs.empty()) {
@@ -189,7 +210,7 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
     if (!r || r->mesh >= blas_root_.size()) continue;
     live.push_back(r);
     ids.push_back(id);
-    boxes.push_back({r->bounds.min, r->bounds.max});
+    boxes.push_back(world_box(mesh_box_[r->mesh], r->to_world));
   }
   rt::Bvh tlas;
   if (structures_) {

@@ -24,6 +24,7 @@
 #include "engine/gpu/gpu_buffer.h"
 #include "engine/gpu/shader_compiler.h"
 #include "engine/gpu/vulkan_context.h"
+#include "engine/rt/bvh_builder.h"
 #include "engine/rt/rt_scene.h"
 #include "rt_shared.h"
 
@@ -81,6 +82,11 @@ class GpuRtScene {
   const rt::RtScene* synced_ = nullptr;
   std::uint64_t generation_ = 0;
   std::vector<std::uint32_t> blas_root_, triangle_offset_;  // per mesh
+  // Per mesh, the object-space box of its finite triangles: a mesh with a
+  // stray non-finite vertex has a non-finite MeshAsset box, which would drop
+  // every instance of it from the TLAS, while Embree skips only the
+  // triangles that use it.
+  std::vector<rt::BvhBox> mesh_box_;
   GpuBuffer tlas_, instances_, blas_, triangles_;
   GpuBuffer triangle_uvs_, alpha_materials_, alpha_bytes_, alpha_textures_;
   GpuBuffer rays_, hits_;

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <vector>
 
 #include <glm/gtc/quaternion.hpp>
@@ -390,6 +391,71 @@ TEST_P(GpuRtTraversal, AlphaMaskedTrianglesAreCutOutAsEmbreesFilterDoes) {
   EXPECT_LE(disagree, rays.size() / 500) << "rays at a texel's edge may round either way";
   EXPECT_GT(on_screens, 1000u);
   EXPECT_GT(through, 1000u);
+  EXPECT_EQ(ctx->validation_errors(), 0);
+}
+
+// Content no importer should let through, and a driver's builder would take
+// as undefined: a mesh without triangles (its instances are inactive), a
+// triangle with an infinite and one with a NaN corner (skipped, as Embree
+// skips them), and rays with a NaN origin, a zero direction or an empty
+// interval (no hit). Every other ray answers as Embree does.
+TEST_P(GpuRtTraversal, DegenerateMeshesAndRaysAreSkippedAsEmbreeSkipsThem) {
+  TRAVERSAL_CONTEXT_OR_SKIP(ctx, false);
+  scene::SceneAssets assets;
+  assets.generation = scene::next_scene_generation();
+  scene::MeshAsset empty;
+  empty.name = "empty";
+  scene::MeshAsset wall = scene::make_quad({4.0f, 4.0f}, 0);
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  // Two extra triangles in front of the wall, each with a corner off the map.
+  const auto base = static_cast<std::uint32_t>(wall.positions.size());
+  wall.positions.insert(wall.positions.end(), {glm::vec3(-1.0f, 1.0f, -1.0f), glm::vec3(1.0f, 1.0f, -1.0f), glm::vec3(0.0f, 1.0f, inf),
+                                               glm::vec3(-1.0f, 1.0f, 1.0f), glm::vec3(1.0f, 1.0f, 1.0f), glm::vec3(nan, 1.0f, 0.0f)});
+  wall.normals.resize(wall.positions.size(), glm::vec3(0.0f, 1.0f, 0.0f));
+  wall.uvs.resize(wall.positions.size(), glm::vec2(0.0f));
+  wall.triangles.push_back({base, base + 1, base + 2});
+  wall.triangles.push_back({base + 3, base + 4, base + 5});
+  wall.triangle_material.resize(wall.triangles.size(), 0);
+  wall.compute_bounds();
+  assets.meshes = {std::make_shared<scene::MeshAsset>(empty), std::make_shared<scene::MeshAsset>(wall)};
+  assets.materials.resize(1);
+  rt::RtScene rt;
+  rt.set_assets(&assets);
+  rt.upsert_instance(ecs::Entity{0, 0}, 0, transform::Similarity{});
+  rt.upsert_instance(ecs::Entity{1, 0}, 1, transform::Similarity{});
+  rt.commit();
+
+  math::Pcg32 rng(3, 3);
+  std::vector<rt::Ray> rays;
+  for (int i = 0; i < 2000; ++i) {
+    // Down onto the quad (make_quad lies in the XZ plane at y = 0), through
+    // where the two broken triangles would be.
+    rays.push_back(rt::Ray{glm::vec3(4.0f * rng.next_float() - 2.0f, 3.0f, 4.0f * rng.next_float() - 2.0f), glm::vec3(0.0f, -1.0f, 0.0f)});
+  }
+  rays.push_back(rt::Ray{glm::vec3(nan, 3.0f, 0.0f), glm::vec3(0.0f, -1.0f, 0.0f)});
+  rays.push_back(rt::Ray{glm::vec3(0.0f, 3.0f, 0.0f), glm::vec3(0.0f)});
+  rays.push_back(rt::Ray{glm::vec3(0.0f, 3.0f, 0.0f), glm::vec3(0.0f, -1.0f, 0.0f), 2.0f, 1.0f});
+  const std::size_t broken = 3;
+  gpu::GpuRtScene gpu_rt(*ctx);
+  gpu_rt.sync(rt);
+  std::vector<rt::Hit> got(rays.size());
+  std::vector<std::uint8_t> found(rays.size());
+  gpu_rt.intersect(rays, got, found);
+  std::size_t disagree = 0, on_wall = 0;
+  for (std::size_t i = 0; i + broken < rays.size(); ++i) {
+    rt::Hit want;
+    const bool hit = rt.intersect(rays[i], want);
+    on_wall += hit;
+    if (hit != (found[i] != 0) || (hit && (want.primitive != got[i].primitive || std::abs(want.t - got[i].t) > 1e-4f * want.t))) {
+      if (disagree++ < 5)
+        ADD_FAILURE() << "ray " << i << ": Embree " << (hit ? "hit primitive " + std::to_string(want.primitive) + " at t " + std::to_string(want.t) : std::string("missed"))
+                      << ", GPU " << (found[i] ? "hit primitive " + std::to_string(got[i].primitive) + " at t " + std::to_string(got[i].t) : std::string("missed"));
+    }
+    EXPECT_LT(got[i].primitive, 2u) << "ray " << i << " hit a triangle with a corner off the map";
+  }
+  for (std::size_t i = rays.size() - broken; i < rays.size(); ++i) EXPECT_EQ(found[i], 0) << "broken ray " << i << " hit";
+  EXPECT_GT(on_wall, 1000u);
+  EXPECT_EQ(disagree, 0u);
   EXPECT_EQ(ctx->validation_errors(), 0);
 }
 
