@@ -15,7 +15,6 @@ constexpr VkBufferUsageFlags kAddressable = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRES
 
 VkDeviceSize round_up(VkDeviceSize x, VkDeviceSize a) { return a > 1 ? (x + a - 1) / a * a : x; }
 
-
 // The specification's alignment of an acceleration structure in its buffer.
 constexpr VkDeviceSize kStructureAlignment = 256;
 
@@ -31,13 +30,14 @@ constexpr VkPipelineStageFlags kBuildStage = VK_PIPELINE_STAGE_ACCELERATION_STRU
 // ray queries (later submissions are in the barrier's second scope).
 void inputs_visible_to_build(VkCommandBuffer cmd) {
   record_memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-          VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_HOST_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, kBuildStage,
-          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR);
+                        VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_HOST_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, kBuildStage,
+                        VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR);
 }
 
 void build_visible_to_queries(VkCommandBuffer cmd) {
-  record_memory_barrier(cmd, kBuildStage, VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR, kBuildStage | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-          VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_SHADER_READ_BIT);
+  record_memory_barrier(cmd, kBuildStage, VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR,
+                        kBuildStage | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_SHADER_READ_BIT);
 }
 
 }  // namespace

@@ -210,8 +210,10 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
     if (!r || r->mesh >= blas_root_.size()) continue;
     live.push_back(r);
     ids.push_back(id);
-    boxes.push_back(world_box(mesh_box_[r->mesh], r->to_world));
+    if (!structures_) boxes.push_back(world_box(mesh_box_[r->mesh], r->to_world));
   }
+  // With ray queries the driver builds the TLAS (build_top below): the
+  // instances keep their id order, and no node buffer is made or uploaded.
   rt::Bvh tlas;
   if (structures_) {
     tlas.order.resize(live.size());
@@ -219,9 +221,6 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
   } else {
     tlas = rt::build_bvh(boxes, 1);
   }
-  std::vector<BvhNodeGpu> nodes;
-  for (const auto& n : tlas.nodes) nodes.push_back(to_gpu(n));
-  if (nodes.empty()) nodes.push_back(to_gpu(rt::BvhNode{}));
   std::vector<InstanceGpu> instances;
   std::vector<TlasInstance> tlas_instances;
   for (std::uint32_t item : tlas.order) {
@@ -239,16 +238,21 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
       tlas_instances.push_back(t);
     }
   }
-  if (structures_) structures_->build_top(tlas_instances);
   if (instances.empty()) instances.push_back({});
-  upload_to(ctx_, tlas_, nodes, kStatic);
   upload_to(ctx_, instances_, instances, kStatic);
-  stats_.tlas_nodes = structures_ ? 0 : nodes.size();
   stats_.instances = live.size();
+  if (structures_) {
+    structures_->build_top(tlas_instances);
+    return;
+  }
+  std::vector<BvhNodeGpu> nodes;
+  for (const auto& n : tlas.nodes) nodes.push_back(to_gpu(n));
+  upload_to(ctx_, tlas_, nodes, kStatic);
+  stats_.tlas_nodes = nodes.size();
 }
 
 void GpuRtScene::bind(ComputePipeline& pipeline, std::uint32_t first) const {
-  if (tlas_.handle() == VK_NULL_HANDLE) throw GpuError("GpuRtScene::bind before sync");
+  if (instances_.handle() == VK_NULL_HANDLE) throw GpuError("GpuRtScene::bind before sync");
   if (structures_) pipeline.bind(first, structures_->top());
   else pipeline.bind(first, tlas_);
   pipeline.bind(first + 1, instances_);
