@@ -1,21 +1,16 @@
 #include "engine/math/half.h"
 
-#include <cpuid.h>
 #include <immintrin.h>
+
+#include "engine/core/cpu_isa.h"
 
 namespace engine::math {
 
 namespace {
 
-bool has_f16c() {
-  // CPUID rather than __builtin_cpu_supports("f16c"), which clang 14 (the fuzz
-  // preset's compiler) does not know.
-  static const bool yes = [] {
-    unsigned a = 0, b = 0, c = 0, d = 0;
-    return __get_cpuid(1, &a, &b, &c, &d) && (c & bit_F16C) != 0 && __builtin_cpu_supports("avx");
-  }();
-  return yes;
-}
+// F16C is part of the AVX2 level (x86-64-v3), so the engine's ISA cap turns
+// it off with the rest.
+bool has_f16c() { return cpu::isa_enabled(cpu::Isa::Avx2); }
 
 __attribute__((target("avx,f16c"))) void to_halves_f16c(const float* in, std::uint16_t* out, std::size_t n) {
   std::size_t i = 0;

@@ -6,6 +6,9 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <string>
+
+#include "engine/core/cpu_isa.h"
 
 namespace engine::rt {
 
@@ -58,6 +61,18 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
 
 }  // namespace
 
+// Embree dispatches on the CPU by itself; max_isa holds it to the engine's
+// effective level, so a capped run traces rays as that machine would.
+namespace {
+std::string embree_config() {
+  switch (cpu::effective_isa()) {
+    case cpu::Isa::Scalar: return "verbose=0,max_isa=sse2";
+    case cpu::Isa::Avx2: return "verbose=0,max_isa=avx2";
+    default: return "verbose=0";
+  }
+}
+}  // namespace
+
 struct RtScene::Impl {
   RTCDevice device = nullptr;
   RTCScene top = nullptr;
@@ -66,7 +81,7 @@ struct RtScene::Impl {
   std::vector<std::uint32_t> free_ids;
 
   Impl() {
-    device = rtcNewDevice("verbose=0");
+    device = rtcNewDevice(embree_config().c_str());
     if (!device) throw RtError("cannot create Embree device (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
     rtcSetDeviceErrorFunction(device, embree_error, nullptr);
     top = rtcNewScene(device);

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "engine/core/cpu_isa.h"
 #include "engine/math/rng.h"
 #include "random_mlp.h"
 #include "model/model_file.h"
@@ -118,7 +119,7 @@ TEST(FusedDecoder, EveryBackendMatchesTheDoubleOracle) {
   int tested = 0;
   for (FusedIsa isa : {FusedIsa::Scalar, FusedIsa::Avx2, FusedIsa::Avx512Bf16, FusedIsa::Amx}) {
     if (!shading::cpu_supports(isa)) {
-      std::printf("[ skipped  ] %s: not supported by this CPU\n", shading::fused_isa_name(isa));
+      std::printf("[ skipped  ] %s: not enabled on %s\n", shading::fused_isa_name(isa), engine::cpu::isa_summary().c_str());
       continue;
     }
     for (const auto& layout : layouts) {

@@ -4,6 +4,7 @@
 
 #include <cstring>
 
+#include "engine/core/cpu_isa.h"
 #include "engine/math/sampling.h"
 #include "shading/realtime_gi.h"
 #include "shading/upsampling.h"
@@ -71,7 +72,7 @@ TEST(Upsampling, APixelNoCellResemblesIsDecodedOnItsOwn) {
 }
 
 TEST(Upsampling, VectorKernelEqualsTheReferenceBitForBit) {
-  if (best_upsampling_isa() == UpsamplingIsa::Scalar) GTEST_SKIP() << "this CPU has no AVX-512: only the reference runs";
+  if (best_upsampling_isa() == UpsamplingIsa::Scalar) GTEST_SKIP() << "no AVX-512 on " << engine::cpu::isa_summary() << ": only the reference runs";
   engine::math::Pcg32 rng(21, 5);
   // Sizes that are and are not multiples of 16, scales that are not halves,
   // normal powers from 0, and guides with misses, depth steps and NaN.

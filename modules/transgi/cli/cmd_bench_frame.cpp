@@ -13,6 +13,7 @@
 #include "cli/commands.h"
 #include "cli/reference_view.h"
 #include "cli/runtime_options.h"
+#include "engine/core/cpu_isa.h"
 #include "engine/core/progress.h"
 #include "engine/image/exr.h"
 #include "engine/render/camera_rays.h"
@@ -24,7 +25,10 @@
 #include "eval/machine_peak.h"
 #include "eval/method_runs.h"
 #include "eval/text_output.h"
+#include "model/gemm.h"
 #include "model/model_file.h"
+#include "shading/fused_decoder.h"
+#include "shading/upsampling.h"
 
 namespace transgi::cli {
 
@@ -112,6 +116,11 @@ int run_bench_frame(const std::vector<std::string>& argv) {
               "%.2f Mrays/s (%d threads); fused kernel: %s\n",
               peak.bf16_gflops, peak.amx_gflops, peak.fp32_gflops, peak.incoherent_mrays, scene.app->jobs().thread_count(),
               shading::fused_isa_name(shading::best_fused_isa()));
+  std::printf("instruction sets: %s; fused inference %s, upsampling %s, probe kernels %s, GEMM (oneDNN) %s\n",
+              engine::cpu::isa_summary().c_str(), shading::fused_isa_name(shading::best_fused_isa()),
+              shading::best_upsampling_isa() == shading::UpsamplingIsa::Avx512 ? "avx512" : "scalar",
+              engine::cpu::isa_name(std::min(engine::cpu::effective_isa(), engine::cpu::Isa::Avx512)),
+              model::onednn_isa_name().c_str());
   std::printf("moving '%s' on a %.3f m orbit, a full turn every 120 frames; preset %s, %dx%d\n",
               mover_name ? mover_name->value.c_str() : "?", static_cast<double>(radius), preset.c_str(), width, height);
 

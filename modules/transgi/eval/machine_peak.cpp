@@ -12,6 +12,7 @@
 
 #include <tbb/task_arena.h>
 
+#include "engine/core/cpu_isa.h"
 #include "engine/jobs/parallel_for.h"
 #include "engine/math/rng.h"
 #include "engine/math/sampling.h"
@@ -104,9 +105,9 @@ MachinePeak measure_machine_peak(const engine::rt::RtScene& scene, double second
     p.bf16_gflops = all_threads_gflops(bf16_loop, 24.0 * 64.0, seconds / 3);
   if (shading::cpu_supports(shading::FusedIsa::Amx))
     p.amx_gflops = all_threads_gflops(shading::detail::amx_peak_loop, 4.0 * 16384.0, seconds / 3);
-  if (__builtin_cpu_supports("avx512f"))
+  if (engine::cpu::isa_enabled(engine::cpu::Isa::Avx512))
     p.fp32_gflops = all_threads_gflops(fp32_loop_avx512, 24.0 * 32.0, seconds / 3);
-  else if (__builtin_cpu_supports("avx2"))
+  else if (engine::cpu::isa_enabled(engine::cpu::Isa::Avx2))
     p.fp32_gflops = all_threads_gflops(fp32_loop_avx2, 12.0 * 16.0, seconds / 3);
   // Incoherent rays: random origins inside the scene's bounds, random directions.
   constexpr int kRays = 1 << 17;

@@ -1,6 +1,9 @@
 #include "model/gemm.h"
 
 #include <oneapi/dnnl/dnnl.h>
+#include <oneapi/dnnl/dnnl_debug.h>
+
+#include "engine/core/cpu_isa.h"
 
 #include <cstdlib>
 #include <cstring>
@@ -13,6 +16,31 @@
 namespace transgi::model {
 
 namespace {
+
+dnnl_cpu_isa_t onednn_isa(engine::cpu::Isa isa) {
+  switch (isa) {
+    case engine::cpu::Isa::Scalar: return dnnl_cpu_isa_sse41;  // oneDNN's floor: it has no scalar code
+    case engine::cpu::Isa::Avx2: return dnnl_cpu_isa_avx2;
+    case engine::cpu::Isa::Avx512: return dnnl_cpu_isa_avx512_core_bf16;
+    case engine::cpu::Isa::Amx: return dnnl_cpu_isa_all;
+  }
+  return dnnl_cpu_isa_all;
+}
+
+// oneDNN fixes its ISA at its first JIT; this runs before any oneDNN call of
+// ours, so TRANSGI_MAX_ISA caps its kernels as it caps the engine's.
+void cap_onednn_isa() {
+  static const bool done = [] {
+    const engine::cpu::Isa isa = engine::cpu::effective_isa();
+    if (isa == engine::cpu::Isa::Amx) return true;
+    if (dnnl_set_max_cpu_isa(onednn_isa(isa)) != dnnl_success && isa < engine::cpu::detected_isa())
+      throw std::runtime_error(std::string("oneDNN refused the ISA cap ") + engine::cpu::isa_name(isa) + " (" +
+                               engine::cpu::max_isa_variable() + "): it had already chosen its kernels");
+    return true;
+  }();
+  (void)done;
+}
+
 void reference_gemm(bool ta, bool tb, std::int64_t m, std::int64_t n, std::int64_t k, float alpha, const float* a,
                     std::int64_t lda, const float* b, std::int64_t ldb, float beta, float* c, std::int64_t ldc) {
   for (std::int64_t i = 0; i < m; ++i)
@@ -90,6 +118,7 @@ class Bf16Matmul {
     dnnl_memory_t a = nullptr, b = nullptr, c = nullptr;
   };
   Bf16Matmul() {
+    cap_onednn_isa();
     check(dnnl_engine_create(&engine_, dnnl_cpu, 0), "engine_create");
     check(dnnl_stream_create(&stream_, engine_, dnnl_stream_default_flags), "stream_create");
   }
@@ -145,14 +174,37 @@ void gemm(GemmBackend backend, bool ta, bool tb, std::int64_t m, std::int64_t n,
     return;
   }
   if (backend == GemmBackend::OneDnnBf16) {
+    if (!bf16_gemm_available())
+      throw std::runtime_error(std::string("oneDNN has no bf16 matmul on ") + engine::cpu::isa_summary());
     Bf16Matmul::instance().run(ta, tb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc);
     return;
   }
+  cap_onednn_isa();
   const dnnl_status_t st = dnnl_sgemm(ta ? 'T' : 'N', tb ? 'T' : 'N', m, n, k, alpha, a, lda, b, ldb, beta, c, ldc);
   if (st != dnnl_success) throw std::runtime_error("oneDNN sgemm failed with status " + std::to_string(static_cast<int>(st)));
 }
 
-bool cpu_has_bf16() { return __builtin_cpu_supports("avx512bf16"); }
+bool bf16_gemm_available() {
+  // Whether oneDNN has a bf16 matmul at the effective ISA is oneDNN's to say
+  // (AVX-512 without BF16 emulates it; AVX2 has none in oneDNN 2.6), so ask it.
+  static const bool available = [] {
+    try {
+      float a = 1, b = 1, c = 0;
+      Bf16Matmul::instance().run(false, false, 1, 1, 1, 1.0f, &a, 1, &b, 1, 0.0f, &c, 1);
+      return c == 1.0f;
+    } catch (const std::runtime_error&) {
+      return false;
+    }
+  }();
+  return available;
+}
+
+std::string onednn_isa_name() {
+  cap_onednn_isa();
+  std::string name = dnnl_cpu_isa2str(dnnl_get_effective_cpu_isa());
+  const std::string prefix = "cpu_isa_";
+  return name.rfind(prefix, 0) == 0 ? name.substr(prefix.size()) : name;
+}
 
 GemmBackend default_gemm_backend() {
   if (const char* env = std::getenv("TRANSGI_GEMM")) {

@@ -7,6 +7,7 @@
 //    matmul primitive with f32 accumulation (AVX-512 BF16 instructions where
 //    the CPU has them). Half the bytes per operand, ~3 significant digits.
 #include <cstdint>
+#include <string>
 
 namespace transgi::model {
 
@@ -21,7 +22,11 @@ void gemm(GemmBackend backend, bool trans_a, bool trans_b, std::int64_t m, std::
 // the epilogue cost more than the bf16 instructions save. The environment
 // variable TRANSGI_GEMM=f32|bf16|reference overrides the choice.
 GemmBackend default_gemm_backend();
-bool cpu_has_bf16();
+// Whether oneDNN runs a bf16 matmul at the effective ISA (TRANSGI_MAX_ISA):
+// AVX-512 (with or without BF16) yes, AVX2 no. OneDnnBf16 throws where not.
+bool bf16_gemm_available();
 const char* gemm_backend_name(GemmBackend backend);
+// The instruction set oneDNN's kernels run with, after TRANSGI_MAX_ISA.
+std::string onednn_isa_name();
 
 }  // namespace transgi::model

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/core/cpu_isa.h"
+
 namespace transgi::probes {
 
 float chebyshev_visibility(float mean, float variance_in, float distance) {
@@ -41,7 +43,7 @@ Corners corners_reference(const ProbeGrid::Cage& cage, const MapLayout& layout, 
 // eight corners that the compiler turns into 8-lane vectors (this file is
 // built without FMA contraction, so every lane rounds as the reference does:
 // the results are bit-identical, tested).
-__attribute__((target_clones("default", "avx2", "arch=x86-64-v4"))) Corners corners(
+ENGINE_INLINE_BODY Corners corners_body(
     const ProbeGrid::Cage& cage, const MapLayout& layout, const glm::vec3& p, const glm::vec3& n, const glm::vec3& biased,
     bool occlusion) {
   Corners c;
@@ -71,6 +73,9 @@ __attribute__((target_clones("default", "avx2", "arch=x86-64-v4"))) Corners corn
   }
   return c;
 }
+ENGINE_ISA_DISPATCH(Corners, corners, (const ProbeGrid::Cage& cage, const MapLayout& layout, const glm::vec3& p, const glm::vec3& n,
+                   const glm::vec3& biased, bool occlusion),
+                   (cage, layout, p, n, biased, occlusion))
 
 InterpolationResult weigh(const ProbeGrid::Cage& cage, const Corners& c, const std::vector<ProbeMapState>& states,
                           const InterpolationSettings& s, std::span<const std::uint8_t> usable);

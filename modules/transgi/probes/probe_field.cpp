@@ -9,6 +9,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "engine/core/cpu_isa.h"
 #include "engine/jobs/parallel_for.h"
 #include "engine/math/rng.h"
 #include "engine/math/sampling.h"
@@ -55,7 +56,7 @@ bool ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float
 
 namespace {
 // out_a/out_b = sum of weights x the weighted probes' 75 values, vectorised per ISA.
-__attribute__((target_clones("default", "avx2", "arch=x86-64-v4"))) void blend_two(
+ENGINE_INLINE_BODY void blend_two_body(
     const InterpolationResult& r, const float* __restrict sh_a, float* __restrict out_a, const float* __restrict sh_b,
     float* __restrict out_b) {
   for (int k = 0; k < 75; ++k) out_a[k] = out_b[k] = 0.0f;
@@ -68,6 +69,9 @@ __attribute__((target_clones("default", "avx2", "arch=x86-64-v4"))) void blend_t
     for (int k = 0; k < 75; ++k) out_b[k] += w * b[k];
   }
 }
+ENGINE_ISA_DISPATCH(void, blend_two, (const InterpolationResult& r, const float* __restrict sh_a, float* __restrict out_a,
+                   const float* __restrict sh_b, float* __restrict out_b),
+                   (r, sh_a, out_a, sh_b, out_b))
 }  // namespace
 
 bool ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float* sh_a, float* out_a, const float* sh_b,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/core/cpu_isa.h"
 #include "engine/math/sampling.h"
 #include "engine/scene/environment.h"
 
@@ -51,7 +52,7 @@ MapProjector::MapProjector(MapLayout layout, int sub) : layout_(layout), basis_i
 namespace {
 // One row of texels into float partial sums (25 SH x 3 colours), which the
 // compiler vectorises for each ISA below; rows are summed in double.
-__attribute__((target_clones("default", "avx2", "arch=x86-64-v4"))) void project_row(
+ENGINE_INLINE_BODY void project_row_body(
     const glm::vec3* __restrict radiance, const std::array<float, kShCount>* __restrict basis, int n, float* __restrict row) {
   for (int i = 0; i < 3 * kShCount; ++i) row[i] = 0.0f;
   for (int x = 0; x < n; ++x) {
@@ -64,6 +65,9 @@ __attribute__((target_clones("default", "avx2", "arch=x86-64-v4"))) void project
     }
   }
 }
+ENGINE_ISA_DISPATCH(void, project_row, (const glm::vec3* __restrict radiance, const std::array<float, kShCount>* __restrict basis, int n,
+                   float* __restrict row),
+                   (radiance, basis, n, row))
 }  // namespace
 
 void MapProjector::project(const glm::vec3* radiance, float* out) const {

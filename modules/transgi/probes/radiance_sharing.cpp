@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 
+#include "engine/core/cpu_isa.h"
 #include "engine/jobs/parallel_for.h"
 
 namespace transgi::probes {
@@ -41,7 +42,7 @@ struct PointColumns {
 // direction from the target (> 0: the target sees the surface from behind).
 // The reference's arithmetic in the reference's order (this file is built
 // without FMA contraction), so the texels are the same bits.
-__attribute__((target_clones("default", "avx2", "arch=x86-64-v4"))) void point_geometry(
+ENGINE_INLINE_BODY void point_geometry_body(
     const PointColumns& c, const glm::vec3& origin, const MapLayout& layout, float* __restrict dist_out,
     int* __restrict texel_out, float* __restrict facing_out) {
   const float ox = origin.x, oy = origin.y, oz = origin.z;
@@ -68,6 +69,9 @@ __attribute__((target_clones("default", "avx2", "arch=x86-64-v4"))) void point_g
     facing_out[i] = nx[i] * ux + ny[i] * uy + nz[i] * uz;
   }
 }
+ENGINE_ISA_DISPATCH(void, point_geometry, (const PointColumns& c, const glm::vec3& origin, const MapLayout& layout, float* __restrict dist_out,
+                   int* __restrict texel_out, float* __restrict facing_out),
+                   (c, origin, layout, dist_out, texel_out, facing_out))
 
 // The reference's geometry: one point at a time through glm and
 // MapLayout::texel_of (points at the origin keep dist only; they are skipped).

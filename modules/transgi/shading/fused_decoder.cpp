@@ -7,10 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include <cpuid.h>
-#include <sys/syscall.h>
-#include <unistd.h>
-
+#include "engine/core/cpu_isa.h"
 #include "shading/fused_kernels.h"
 
 namespace transgi::shading {
@@ -24,36 +21,15 @@ std::uint16_t to_bf16(float x) {
 
 float from_bf16(std::uint16_t x) { return std::bit_cast<float>(static_cast<std::uint32_t>(x) << 16); }
 
-namespace {
-
-// AMX-TILE and AMX-BF16 in CPUID, and Linux's permission to use the tile
-// state: without ARCH_REQ_XCOMP_PERM the first tile instruction is SIGILL.
-bool amx_usable() {
-  static const bool usable = [] {
-    unsigned a = 0, b = 0, c = 0, d = 0;
-    if (!__get_cpuid_count(7, 0, &a, &b, &c, &d)) return false;
-    const bool tile = (d >> 24) & 1u, bf16 = (d >> 22) & 1u;
-    if (!tile || !bf16) return false;
-#ifdef SYS_arch_prctl
-    constexpr long kArchReqXcompPerm = 0x1023, kXfeatureXtiledata = 18;
-    return syscall(SYS_arch_prctl, kArchReqXcompPerm, kXfeatureXtiledata) == 0;
-#else
-    return false;
-#endif
-  }();
-  return usable;
-}
-
-}  // namespace
-
+// The engine's effective ISA (capped by TRANSGI_MAX_ISA) decides; the BF16
+// kernels also need AVX-512 BF16, which not every AVX-512 CPU has.
 bool cpu_supports(FusedIsa isa) {
+  using engine::cpu::Isa;
   switch (isa) {
     case FusedIsa::Scalar: return true;
-    case FusedIsa::Avx2: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-    case FusedIsa::Avx512Bf16:
-      return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
-             __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bf16");
-    case FusedIsa::Amx: return cpu_supports(FusedIsa::Avx512Bf16) && amx_usable();
+    case FusedIsa::Avx2: return engine::cpu::isa_enabled(Isa::Avx2);
+    case FusedIsa::Avx512Bf16: return engine::cpu::avx512_bf16();
+    case FusedIsa::Amx: return engine::cpu::isa_enabled(Isa::Amx);
   }
   return false;
 }
@@ -73,7 +49,7 @@ FusedIsa best_fused_isa() {
     for (FusedIsa isa : {FusedIsa::Scalar, FusedIsa::Avx2, FusedIsa::Avx512Bf16, FusedIsa::Amx})
       if (std::string(v) == fused_isa_name(isa)) {
         if (!cpu_supports(isa))
-          throw std::runtime_error(std::string("TRANSGI_FUSED_ISA=") + v + ": this CPU does not support it");
+          throw std::runtime_error(std::string("TRANSGI_FUSED_ISA=") + v + ": not available on " + engine::cpu::isa_summary());
         return isa;
       }
     throw std::runtime_error(std::string("TRANSGI_FUSED_ISA: expected scalar, avx2, avx512bf16 or amx, got '") + v + "'");

@@ -4,8 +4,9 @@
 // light run in one pass over a tile held in L1, so the 75 transfer
 // coefficients never reach memory and the weights stay in cache across tiles.
 //
-// Backends, chosen at run time (TRANSGI_FUSED_ISA=scalar|avx2|avx512bf16|amx
-// overrides):
+// Backends, chosen at run time: the best the engine's effective ISA allows
+// (engine/core/cpu_isa.h; TRANSGI_MAX_ISA caps it), or the one
+// TRANSGI_FUSED_ISA=scalar|avx2|avx512bf16|amx names, within that cap:
 //  - Amx: hidden and output layers as AMX bf16 tile products with fp32
 //    accumulation (Intel cores where vdpbf16ps runs at half the FMA rate);
 //    the first layer fp32 as below. Needs widths that are multiples of 32;

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "engine/core/cpu_isa.h"
 #include "engine/jobs/parallel_for.h"
 #include "shading/realtime_gi.h"
 
@@ -56,7 +57,7 @@ UpsamplingIsa best_upsampling_isa() {
   static const UpsamplingIsa isa = [] {
     const char* forced = std::getenv("TRANSGI_UPSAMPLING_ISA");
     if (forced && std::strcmp(forced, "scalar") == 0) return UpsamplingIsa::Scalar;
-    return __builtin_cpu_supports("avx512f") ? UpsamplingIsa::Avx512 : UpsamplingIsa::Scalar;
+    return engine::cpu::isa_enabled(engine::cpu::Isa::Avx512) ? UpsamplingIsa::Avx512 : UpsamplingIsa::Scalar;
   }();
   return isa;
 }

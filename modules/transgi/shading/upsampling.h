@@ -62,7 +62,8 @@ struct UpsamplingPlan {
 };
 
 enum class UpsamplingIsa { Scalar, Avx512 };
-// The fastest kernel this CPU runs (TRANSGI_UPSAMPLING_ISA=scalar forces the reference).
+// The fastest kernel the effective ISA allows (TRANSGI_MAX_ISA caps it;
+// TRANSGI_UPSAMPLING_ISA=scalar forces the reference).
 UpsamplingIsa best_upsampling_isa();
 
 // guide: per output pixel, world normal (xyz) and depth (w; 0 = miss), row-major.
