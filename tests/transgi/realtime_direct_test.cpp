@@ -1,4 +1,4 @@
-// The real-time direct light (issue 10, item 6): the sun split out of the
+// The real-time direct light (issue 10, item 6; soft shadows, issue 37): the sun split out of the
 // sky and shaded with one shadow ray per pixel, the residual sky through the
 // probes. Its reference is the path tracer's direct pass with the map as it
 // is (sun in the pixels); and it must not depend on any seed.
@@ -6,11 +6,16 @@
 
 #include "lambert.h"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
 
 #include "engine/app/app.h"
 #include "engine/render/light_plugin.h"
 #include "engine/render/path_tracer.h"
+#include "engine/rt/rt_plugin.h"
 #include "engine/scene/procedural.h"
 #include "runtime/transgi_plugin.h"
 #include "shading/realtime_direct.h"
@@ -152,7 +157,7 @@ TEST(RealtimeDirect, ShadedInsideTheGBufferLoopEqualsTheStandalonePass) {
     want = shading::shade_direct_realtime(separate, rt, lights.set, rays, &separate_stats);
     shading::DirectTileShader shader(rt, lights.set, rays, w, h);
     shading::trace_gbuffer(rt, assets, rays, w, h, fused, &shader);
-    got = shader.take(&fused_stats);
+    got = shader.take(fused, &fused_stats);
   });
   EXPECT_GT(separate_stats.shadow_rays, 0u);
   EXPECT_EQ(fused_stats.shadow_rays, separate_stats.shadow_rays);
@@ -160,4 +165,113 @@ TEST(RealtimeDirect, ShadedInsideTheGBufferLoopEqualsTheStandalonePass) {
   for (std::size_t i = 0; i < got.pixels.size(); ++i)
     ASSERT_EQ(got.pixels[i], want.pixels[i]) << "pixel " << i << ": inside the G-buffer loop " << got.pixels[i].r << ", standalone "
                                              << want.pixels[i].r;
+}
+
+namespace {
+
+// A floor under a plate at height 1 that covers x < 0, lit from straight
+// above by a directional light with a disk of half-angle `radius`, seen
+// from below the plate looking down. A floor point at x sees the part of
+// the disk beyond the plate's edge: with s = -x / tan(radius) (height 1),
+// the lit fraction is 1 - F(s), F(s) = (acos(-s) + s sqrt(1 - s^2)) / pi the
+// share of a unit disk left of the chord at s.
+struct PenumbraScene {
+  app::App app{app::AppOptions{.jobs = {.threads = 2}}};
+  ecs::Entity camera;
+  PenumbraScene() {
+    auto& w = app.world();
+    scene::SceneAssets a;
+    a.generation = scene::next_scene_generation();
+    a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({4, 4}, 0)),
+                std::make_shared<scene::MeshAsset>(scene::make_box({2.5f, 0.01f, 4.0f}, false, 0))};
+    a.materials = {lambert(glm::vec3(0.5f))};
+    w.insert_resource<scene::SceneAssets>(std::move(a));
+    app.add_plugin<rt::RtPlugin>();
+    const ecs::Entity floor = w.spawn();
+    w.emplace<transform::Transform>(floor);
+    w.emplace<scene::MeshInstance>(floor, scene::MeshInstance{0});
+    const ecs::Entity plate = w.spawn();
+    w.emplace<transform::Transform>(plate, transform::Transform::from_translation({-2.5f, 1.0f, 0.0f}));
+    w.emplace<scene::MeshInstance>(plate, scene::MeshInstance{1});
+    camera = w.spawn();
+    transform::Transform ct = transform::Transform::from_translation({0.0f, 0.9f, 0.0f});
+    ct.rotation = glm::quatLookAtRH(glm::vec3(0, -1, 0), glm::vec3(0, 0, -1));
+    w.emplace<transform::Transform>(camera, ct);
+    w.emplace<scene::Camera>(camera, scene::Camera{.yfov_radians = 1.0f});
+    app.update();
+  }
+  // The direct pass at size x size, and each pixel's floor position.
+  image::ImageRGB direct(float angular_radius, int size, shading::GBuffer& g) {
+    auto& w = app.world();
+    scene::PunctualLight sun;
+    sun.type = scene::PunctualLight::Type::Directional;
+    sun.color = glm::vec3(1.0f);
+    sun.intensity = 1.0f;
+    const render::LightSet lights(w.resource<rt::RtScene>(),
+                                  {render::PunctualInstance{sun, glm::vec3(0.0f), glm::vec3(0, -1, 0), angular_radius}}, nullptr);
+    const render::CameraRays rays(w.get<scene::Camera>(camera), w.get<transform::WorldTransform>(camera), size, size);
+    image::ImageRGB out;
+    app.jobs().run([&] {
+      shading::trace_gbuffer(w.resource<rt::RtScene>(), w.resource<scene::SceneAssets>(), rays, size, size, g);
+      out = shading::shade_direct_realtime(g, w.resource<rt::RtScene>(), lights, rays);
+    });
+    return out;
+  }
+};
+
+double disk_share_left_of(double s) {
+  s = std::clamp(s, -1.0, 1.0);
+  return (std::acos(-s) + s * std::sqrt(1.0 - s * s)) / 3.14159265358979;
+}
+
+}  // namespace
+
+TEST(RealtimeDirect, ASunsPenumbraIsSmoothAndAsWideAsItsDisk) {
+  // 0.1 rad: a 0.1 m half-width penumbra, 16 pixels either side of the edge.
+  const float radius = 0.1f;
+  PenumbraScene scene;
+  shading::GBuffer g;
+  const int size = 160;
+  const image::ImageRGB img = scene.direct(radius, size, g);
+  const float lit_value = 0.5f / 3.14159265f;  // albedo / pi x irradiance 1 (cos 1)
+  double abs_sum = 0, worst = 0;
+  int penumbra = 0, speckles = 0;
+  for (int y = 1; y + 1 < size; ++y)
+    for (int x = 1; x + 1 < size; ++x) {
+      const std::size_t p = static_cast<std::size_t>(y) * size + x;
+      ASSERT_TRUE(g.samples[p].hit);
+      const double fx = g.position[p].x;
+      const double want = 1.0 - disk_share_left_of(-fx / std::tan(radius));
+      const double got = img.pixels[p].g / lit_value;
+      if (want <= 0.02 || want >= 0.98) continue;
+      ++penumbra;
+      abs_sum += std::abs(got - want);
+      worst = std::max(worst, std::abs(got - want));
+      // A stipple: a pixel far from the median of its 3x3 neighbours.
+      std::vector<float> around;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) around.push_back(img.pixels[p + static_cast<std::size_t>(dy * size + dx)].g / lit_value);
+      std::nth_element(around.begin(), around.begin() + 4, around.end());
+      speckles += std::abs(got - around[4]) > 0.1;
+    }
+  std::printf("[ measured ] penumbra: %d pixels, mean |lit fraction - analytic| %.4f, worst %.3f, %d speckles\n", penumbra,
+              abs_sum / penumbra, worst, speckles);
+  ASSERT_GT(penumbra, 20 * size) << "the penumbra should be about 32 pixels wide";
+  EXPECT_LT(abs_sum / penumbra, 0.05) << "the penumbra's profile must follow the disk's";
+  EXPECT_LT(worst, 0.2);
+  EXPECT_LT(speckles, penumbra / 100) << "the penumbra must be smooth, not a dither";
+}
+
+TEST(RealtimeDirect, ADeltaLightsShadowStaysHard) {
+  PenumbraScene scene;
+  shading::GBuffer g;
+  const int size = 96;
+  const image::ImageRGB img = scene.direct(0.0f, size, g);
+  const float lit_value = 0.5f / 3.14159265f;
+  for (std::size_t p = 0; p < img.pixels.size(); ++p) {
+    const float got = img.pixels[p].g / lit_value;
+    const float want = g.position[p].x > 0 ? 1.0f : 0.0f;
+    if (std::abs(g.position[p].x) < 0.02f) continue;  // the pixels on the edge
+    ASSERT_NEAR(got, want, 1e-4f) << "pixel " << p << " at x = " << g.position[p].x;
+  }
 }

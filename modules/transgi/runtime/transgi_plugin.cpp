@@ -159,7 +159,7 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   // The direct light of punctual lights and the sun first: the probes' share
   // is added to it as the GI is upsampled.
   t0 = std::chrono::steady_clock::now();
-  if (deterministic) frame.direct = direct ? direct->take(&frame.direct_stats) : std::move(*batched_direct);
+  if (deterministic) frame.direct = direct ? direct->take(packed.gbuffer, &frame.direct_stats) : std::move(*batched_direct);
   const double take_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   shading::RealtimeGiStats st;
   frame.gi = shading::shade_gi_realtime(g, rt, assets, model.get(), model ? packed.decoder.get() : nullptr, has_transfer, fields,

@@ -3,13 +3,19 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
-#include <vector>
 #include <cmath>
+#include <limits>
+#include <vector>
 
 #include "engine/jobs/parallel_for.h"
 #include "engine/math/sampling.h"
 
 namespace transgi::shading {
+
+namespace {
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kNotReceiver = std::numeric_limits<float>::quiet_NaN();
+}  // namespace
 
 glm::vec2 disk_pattern(int x, int y) {
   // Index in the 8x8 block in bit-reversed order, so neighbouring pixels
@@ -30,17 +36,32 @@ DirectTileShader::DirectTileShader(const engine::rt::RtScene& scene, const engin
   // pattern directions are computed once per frame, not per pixel.
   directional_.resize(n_lights_);
   is_directional_.assign(n_lights_, 0);
+  soft_of_.assign(n_lights_, -1);
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   for (std::size_t l = 0; l < n_lights_; ++l) {
-    if (lights.punctual_lights()[l].light.type != scene::PunctualLight::Type::Directional) continue;
+    const render::PunctualInstance& light = lights.punctual_lights()[l];
+    if (light.light.type != scene::PunctualLight::Type::Directional) continue;
     is_directional_[l] = 1;
     for (int i = 0; i < 64; ++i) lights.sample_punctual(l, glm::vec3(0.0f), disk_pattern(i & 7, i >> 3), directional_[l][static_cast<std::size_t>(i)]);
+    if (!(light.angular_radius > 0.0f)) continue;
+    SoftLight soft;
+    soft.light = l;
+    soft.tan_radius = std::tan(std::min(light.angular_radius, 1.5f));
+    soft.centre = directional_[l][0];
+    soft.centre.direction = -light.direction;
+    soft.unshadowed.assign(pixels, glm::vec3(0.0f));
+    soft.blocker.assign(pixels, kNotReceiver);
+    soft_of_[l] = static_cast<int>(soft_.size());
+    soft_.push_back(std::move(soft));
   }
 }
 
 void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
   using namespace engine;
   rt::Ray rays[16];
-  bool blocked[16];
+  rt::Hit hits[16];
+  bool found[16];
+  float distance[16];
   std::size_t pixel[16];
   const GSample* samples[16];
   std::array<glm::vec3, 2> local[16];  // wo, wi in the shading frame
@@ -49,7 +70,7 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
   const scene::Environment* background = lights_.background();
   const std::size_t tile = static_cast<std::size_t>(ty / 4) * static_cast<std::size_t>((g.width + 3) / 4) + static_cast<std::size_t>(tx / 4);
   const bool collecting = batch_.collect != nullptr;
-  std::size_t answer = batch_.answers ? (*batch_.first)[tile] : 0;
+  std::size_t answer = batch_.distances ? (*batch_.first)[tile] : 0;
   // Emission and background first.
   for (int y = ty; y < std::min(ty + 4, g.height); ++y)
     for (int x = tx; x < std::min(tx + 4, g.width); ++x) {
@@ -62,6 +83,7 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
         out_.pixels[p] = background->radiance(camera_.generate({static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f}).direction);
     }
   for (std::size_t l = 0; l < n_lights_; ++l) {
+    SoftLight* soft = soft_of_[l] >= 0 ? &soft_[static_cast<std::size_t>(soft_of_[l])] : nullptr;
     int n = 0;
     for (int y = ty; y < std::min(ty + 4, g.height); ++y)
       for (int x = tx; x < std::min(tx + 4, g.width); ++x) {
@@ -73,16 +95,29 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
           ls = directional_[l][static_cast<std::size_t>((x & 7) | ((y & 7) << 3))];
         else if (!lights_.sample_punctual(l, s.position, disk_pattern(x, y), ls))
           continue;
-        if (glm::dot(ls.direction, s.geometric_normal) <= 0) continue;
         const math::Frame frame = math::Frame::from_normal(s.normal_world);
-        const glm::vec3 wo = frame.to_local(s.wo_world), wi = frame.to_local(ls.direction);
-        if (wo.z <= 0 || wi.z <= 0 || ls.radiance == glm::vec3(0.0f)) continue;
-        const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
+        const glm::vec3 wo = frame.to_local(s.wo_world);
+        if (soft) {
+          // The BRDF along the disk's centre; the pattern ray only says
+          // whether this part of the disk is seen.
+          const glm::vec3 wc = frame.to_local(soft->centre.direction);
+          if (glm::dot(soft->centre.direction, s.geometric_normal) <= 0 || wo.z <= 0 || wc.z <= 0) continue;
+          if (!collecting) {
+            soft->unshadowed[p] = material::brdf_eval(s.brdf, wo, wc) * wc.z * soft->centre.radiance;
+            soft->blocker[p] = 0.0f;  // blocked by the surface itself unless its ray says otherwise
+          }
+          if (glm::dot(ls.direction, s.geometric_normal) <= 0) continue;
+        } else {
+          if (glm::dot(ls.direction, s.geometric_normal) <= 0) continue;
+          const glm::vec3 wi = frame.to_local(ls.direction);
+          if (wo.z <= 0 || wi.z <= 0 || ls.radiance == glm::vec3(0.0f)) continue;
+          local[n] = {wo, wi};
+          light[n] = ls.radiance;
+        }
+        const float tmax = std::isinf(ls.distance) ? kInf : ls.distance * (1.0f - 1e-4f);
         rays[n] = rt::Ray{rt::offset_ray_origin(s.position, s.geometric_normal, scene_.offset_scale()), ls.direction, 0.0f, tmax};
         pixel[n] = p;
         samples[n] = &s;
-        local[n] = {wo, wi};
-        light[n] = ls.radiance;
         ++n;
       }
     if (n == 0) continue;
@@ -90,16 +125,25 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
       (*batch_.collect)[tile].insert((*batch_.collect)[tile].end(), rays, rays + n);
       continue;
     }
-    if (batch_.answers) {
-      for (int i = 0; i < n; ++i) blocked[i] = (*batch_.answers)[answer++] != 0;
+    if (batch_.distances) {
+      for (int i = 0; i < n; ++i) distance[i] = (*batch_.distances)[answer++];
+    } else if (soft) {
+      scene_.intersect16(rays, n, hits, found);
+      for (int i = 0; i < n; ++i) distance[i] = found[i] ? hits[i].t : kInf;
     } else {
+      bool blocked[16];
       scene_.occluded16(rays, n, blocked);
+      for (int i = 0; i < n; ++i) distance[i] = blocked[i] ? 0.0f : kInf;
     }
     traced += static_cast<std::size_t>(n);
+    if (soft) {
+      for (int i = 0; i < n; ++i) soft->blocker[pixel[i]] = distance[i];
+      continue;
+    }
     // The BRDF only where the light arrives: most of a room's pixels that face
     // the sun are in shadow.
     for (int i = 0; i < n; ++i) {
-      if (blocked[i]) continue;
+      if (distance[i] < kInf) continue;
       const glm::vec3 c = material::brdf_eval(samples[i]->brdf, local[i][0], local[i][1]) * local[i][1].z * light[i];
       if (c.r > 0 || c.g > 0 || c.b > 0) out_.pixels[pixel[i]] += c;
     }
@@ -118,7 +162,156 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
   rays_traced_.fetch_add(traced, std::memory_order_relaxed);
 }
 
-engine::image::ImageRGB DirectTileShader::take(RealtimeDirectStats* stats) {
+namespace {
+
+// Around each pixel: how many pattern rays are blocked, their blockers'
+// summed distance, and how many are lit, over the 3x3 blocks of 8x8 pixels
+// centred on the pixel's block (so at least 8 pixels either way): sums per
+// block, then per block of its neighbourhood.
+struct BlockerCounts {
+  int blocks_x = 0;
+  std::vector<glm::vec3> around;  // per block: blocked, distance sum, lit
+  [[nodiscard]] const glm::vec3& at(int x, int y) const {
+    return around[static_cast<std::size_t>(y / 8) * static_cast<std::size_t>(blocks_x) + static_cast<std::size_t>(x / 8)];
+  }
+};
+
+BlockerCounts count_blockers(const std::vector<float>& blocker, int width, int height) {
+  BlockerCounts c;
+  c.blocks_x = (width + 7) / 8;
+  const int blocks_y = (height + 7) / 8;
+  std::vector<glm::vec3> own(static_cast<std::size_t>(c.blocks_x) * blocks_y);
+  engine::jobs::parallel_for(0, blocks_y, 1, [&](int b0, int b1) {
+    for (int by = b0; by < b1; ++by)
+      for (int y = by * 8; y < std::min(height, by * 8 + 8); ++y)
+        for (int x = 0; x < width; ++x) {
+          const float d = blocker[static_cast<std::size_t>(y) * width + x];
+          glm::vec3& o = own[static_cast<std::size_t>(by) * c.blocks_x + static_cast<std::size_t>(x / 8)];
+          if (std::isfinite(d)) o += glm::vec3(1.0f, d, 0.0f);
+          else if (std::isinf(d)) o.z += 1.0f;
+        }
+  });
+  c.around.assign(own.size(), glm::vec3(0.0f));
+  for (int by = 0; by < blocks_y; ++by)
+    for (int bx = 0; bx < c.blocks_x; ++bx) {
+      glm::vec3& sum = c.around[static_cast<std::size_t>(by) * c.blocks_x + static_cast<std::size_t>(bx)];
+      for (int ny = std::max(0, by - 1); ny <= std::min(blocks_y - 1, by + 1); ++ny)
+        for (int nx = std::max(0, bx - 1); nx <= std::min(c.blocks_x - 1, bx + 1); ++nx)
+          sum += own[static_cast<std::size_t>(ny) * c.blocks_x + static_cast<std::size_t>(nx)];
+    }
+  return c;
+}
+
+// Whether pixel q lies on pixel p's surface: normals within ~25 degrees, q
+// within 2 % of p's depth of p's tangent plane.
+struct SurfaceTest {
+  const std::vector<glm::vec4>& guide;
+  const std::vector<glm::vec3>& position;
+  bool operator()(std::size_t p, std::size_t q) const {
+    const glm::vec3 np(guide[p]), nq(guide[q]);
+    return glm::dot(np, nq) > 0.9f && std::abs(glm::dot(np, position[q] - position[p])) <= 0.02f * guide[p].w;
+  }
+};
+
+}  // namespace
+
+std::vector<float> penumbra_filter(const GBuffer& g, const std::vector<float>& blocker, float tan_radius,
+                                   float pixel_spread) {
+  const int w = g.width, h = g.height;
+  const std::size_t n = blocker.size();
+  std::vector<float> lit(n);
+  engine::jobs::parallel_for<std::size_t>(0, n, 16384, [&](std::size_t b, std::size_t e) {
+    for (std::size_t p = b; p < e; ++p) lit[p] = std::isnan(blocker[p]) ? kNotReceiver : std::isinf(blocker[p]) ? 1.0f : 0.0f;
+  });
+  if (!(tan_radius > 0)) return lit;
+  // Where the pattern rays around a pixel are all lit or all blocked, the
+  // filter would change nothing; elsewhere their blockers' mean distance
+  // gives the penumbra's width.
+  const BlockerCounts counts = count_blockers(blocker, w, h);
+  std::vector<std::uint8_t> radius(n, 0);
+  engine::jobs::parallel_for(0, h, 8, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * w + x;
+        const float depth = g.guide[p].w;
+        const glm::vec3& c = counts.at(x, y);
+        if (std::isnan(lit[p]) || c.x < 0.5f || c.z < 0.5f || !(depth > 0)) continue;
+        // The penumbra's half-width in pixels, at most 8: a box 8 pixels
+        // wide or more covers the whole pattern.
+        const float r = std::ceil(c.y / c.x * tan_radius / (depth * pixel_spread));
+        radius[p] = static_cast<std::uint8_t>(std::clamp(r, 0.0f, 8.0f));
+      }
+  });
+  const SurfaceTest same{g.guide, g.position};
+  // A box of radius 4 or more is [-r, r - 1], an even width: 8 and 16
+  // pixels hold each of the pattern's 8 columns (rows) equally often, where
+  // 9 or 17 would count one more and leave its trace.
+  const auto last = [](int r) { return r >= 4 ? r - 1 : r; };
+  // Rows, then columns, each a box over the pixel's own radius on its own
+  // surface; the columns take the rows' means.
+  std::vector<float> rows(n), out(n);
+  engine::jobs::parallel_for(0, h, 4, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * w + x;
+        if (radius[p] == 0 || std::isnan(lit[p])) {
+          rows[p] = lit[p];
+          continue;
+        }
+        float sum = 0, count = 0;
+        for (int dx = -radius[p]; dx <= last(radius[p]); ++dx) {
+          const int qx = x + dx;
+          if (qx < 0 || qx >= w) continue;
+          const std::size_t q = p + static_cast<std::size_t>(static_cast<std::ptrdiff_t>(dx));
+          if (std::isnan(lit[q]) || !same(p, q)) continue;
+          sum += lit[q];
+          count += 1;
+        }
+        rows[p] = sum / count;
+      }
+  });
+  engine::jobs::parallel_for(0, h, 4, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * w + x;
+        if (radius[p] == 0 || std::isnan(lit[p])) {
+          out[p] = rows[p];
+          continue;
+        }
+        float sum = 0, count = 0;
+        for (int dy = -radius[p]; dy <= last(radius[p]); ++dy) {
+          const int qy = y + dy;
+          if (qy < 0 || qy >= h) continue;
+          const std::size_t q = static_cast<std::size_t>(qy) * w + x;
+          if (std::isnan(rows[q]) || !same(p, q)) continue;
+          sum += rows[q];
+          count += 1;
+        }
+        out[p] = sum / count;
+      }
+  });
+  return out;
+}
+
+engine::image::ImageRGB DirectTileShader::take(const GBuffer& g, RealtimeDirectStats* stats) {
+  for (const SoftLight& soft : soft_) {
+    const std::vector<float> lit = penumbra_filter(g, soft.blocker, soft.tan_radius, camera_.pixel_spread());
+    std::atomic<std::size_t> bad{0};
+    engine::jobs::parallel_for<std::size_t>(0, lit.size(), 16384, [&](std::size_t b, std::size_t e) {
+      std::size_t local_bad = 0;
+      for (std::size_t p = b; p < e; ++p) {
+        if (!(lit[p] > 0)) continue;
+        const glm::vec3 c = soft.unshadowed[p] * lit[p];
+        if (!(std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b))) {
+          ++local_bad;
+          continue;
+        }
+        out_.pixels[p] += c;
+      }
+      if (local_bad) bad.fetch_add(local_bad, std::memory_order_relaxed);
+    });
+    nonfinite_.fetch_add(bad.load(), std::memory_order_relaxed);
+  }
   if (stats) {
     stats->shadow_rays = rays_traced_.load();
     stats->lights = n_lights_;
@@ -138,11 +331,11 @@ engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt
       for (int t = t0; t < t1; ++t) shader.shade_tile(g, t % tiles_x * 4, t / tiles_x * 4);
     });
   };
-  // The shader reads `blocked` and `first` in the second pass: they live
+  // The shader reads `distances` and `first` in the second pass: they live
   // as long as the function.
   std::vector<engine::rt::Ray> rays;
   std::vector<std::size_t> first;
-  std::vector<std::uint8_t> blocked;
+  std::vector<float> distances;
   if (tracer) {
     std::vector<std::vector<engine::rt::Ray>> per_tile(static_cast<std::size_t>(tiles_x) * tiles_y);
     shader.set_batch({&per_tile, nullptr, nullptr});
@@ -157,15 +350,26 @@ engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt
     engine::jobs::parallel_for<std::size_t>(0, per_tile.size(), 256, [&](std::size_t b, std::size_t e) {
       for (std::size_t t = b; t < e; ++t) std::copy(per_tile[t].begin(), per_tile[t].end(), rays.begin() + static_cast<std::ptrdiff_t>(first[t]));
     });
-    blocked.resize(rays.size());
-    if (!tracer->occluded(scene, rays, blocked))
-      engine::jobs::parallel_for<std::size_t>(0, rays.size(), 256, [&](std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) blocked[i] = scene.occluded(rays[i]) ? 1 : 0;
+    // Closest hits, not any hit: a soft shadow's width needs the blocker's distance.
+    std::vector<engine::rt::Hit> hits(rays.size());
+    std::vector<std::uint8_t> found(rays.size());
+    distances.resize(rays.size());
+    if (tracer->intersect(scene, rays, hits, found)) {
+      engine::jobs::parallel_for<std::size_t>(0, rays.size(), 4096, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) distances[i] = found[i] ? hits[i].t : kInf;
       });
-    shader.set_batch({nullptr, &blocked, &first});
+    } else {
+      engine::jobs::parallel_for<std::size_t>(0, rays.size(), 256, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+          engine::rt::Hit hit;
+          distances[i] = scene.intersect(rays[i], hit) ? hit.t : kInf;
+        }
+      });
+    }
+    shader.set_batch({nullptr, &distances, &first});
   }
   each_tile();
-  return shader.take(stats);
+  return shader.take(g, stats);
 }
 
 void add_image(engine::image::ImageRGB& to, const engine::image::ImageRGB& from) {

@@ -4,9 +4,15 @@
 //    camera rays escape;
 //  - every punctual light, the sun split out of the environment included,
 //    with one shadow ray per light per pixel, traced as 4x4-pixel Embree
-//    packets. A sun with a disk takes its direction per pixel from a fixed
-//    8x8 pattern over the disk (no seed, no frame index), so its penumbra is
-//    a stable dither, not noise.
+//    packets. Delta lights keep that one ray: hard shadows.
+//  - a directional light with a disk (the sun) gets a soft shadow: each
+//    pixel's ray goes to one point of a fixed 8x8 pattern over the disk (no
+//    seed, no frame index), so 8x8 neighbouring pixels see the whole disk
+//    between them. A filter over the visibility of the pixels around each
+//    pixel on the same surface (penumbra_filter, after the last tile) turns
+//    that dither into the disk's average visibility: a smooth penumbra, as
+//    wide as the disk and the blocker's distance make it, and the same in
+//    every frame. The BRDF takes the disk's centre.
 // The rest of the direct light, the residual sky and emissive meshes, comes
 // from the probes' direct SH through the transfer (shade_gi_realtime's
 // direct_out), which the frame adds with add_image.
@@ -41,16 +47,18 @@ class DirectTileShader {
                    const engine::render::CameraRays& camera, int width, int height);
   // Pixels [tx, tx + 4) x [ty, ty + 4) of `g`, which must already hold them.
   void shade_tile(const GBuffer& g, int tx, int ty);
-  // The image, once every tile is shaded.
-  engine::image::ImageRGB take(RealtimeDirectStats* stats = nullptr);
+  // The image, once every tile of `g` is shaded: the soft lights'
+  // visibility filtered, then added.
+  engine::image::ImageRGB take(const GBuffer& g, RealtimeDirectStats* stats = nullptr);
 
   // Batched shadow rays (a GPU tracer): a first pass over the tiles with
   // `collect` set only gathers each tile's shadow rays into (*collect)[tile];
-  // a second pass with `answers` set shades, reading tile t's answers from
-  // answers[first[t]] on, in the order the first pass gathered them.
+  // a second pass with `distances` set shades, reading tile t's answers
+  // (the distance to the first hit, infinity for none) from
+  // distances[first[t]] on, in the order the first pass gathered them.
   struct Batch {
     std::vector<std::vector<engine::rt::Ray>>* collect = nullptr;
-    const std::vector<std::uint8_t>* answers = nullptr;
+    const std::vector<float>* distances = nullptr;
     const std::vector<std::size_t>* first = nullptr;
   };
   void set_batch(const Batch& batch) { batch_ = batch; }
@@ -63,6 +71,19 @@ class DirectTileShader {
   std::size_t n_lights_ = 0;
   std::vector<std::array<engine::render::LightSample, 64>> directional_;
   std::vector<std::uint8_t> is_directional_;
+  // A directional light with a disk: per pixel, what it would add unshadowed
+  // (BRDF x cosine x radiance along the disk's centre) and how far along the
+  // pixel's pattern direction the first blocker is (infinity: lit; NaN: the
+  // light does not reach this pixel at all).
+  struct SoftLight {
+    std::size_t light = 0;
+    float tan_radius = 0.0f;
+    engine::render::LightSample centre;
+    std::vector<glm::vec3> unshadowed;
+    std::vector<float> blocker;
+  };
+  std::vector<SoftLight> soft_;
+  std::vector<int> soft_of_;  // per punctual light: its index in soft_, or -1
   std::atomic<std::size_t> rays_traced_{0}, nonfinite_{0};
   Batch batch_;
 };
@@ -81,5 +102,16 @@ engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt
 // The fixed point on [0, 1)^2 that pixel (x, y) uses for disk lights: an
 // R2 low-discrepancy sequence over each 8x8 block.
 glm::vec2 disk_pattern(int x, int y);
+
+// The soft shadow's filter. blocker: per pixel of `g`, the distance to what
+// blocks its pattern ray (infinity: lit; NaN: not a receiver). Returns per
+// pixel the fraction of lit receivers around it on its own surface (a
+// normal within ~25 degrees, within 2 % of its depth of its plane) in a
+// square whose half-width is the penumbra's on screen (the mean blocker
+// distance nearby x tan_radius over the pixel's footprint): a box of 8 or
+// 16 pixels, which holds every point of the 8x8 pattern, where the
+// penumbra is 4 pixels wide or more, one no wider than it where narrower.
+std::vector<float> penumbra_filter(const GBuffer& g, const std::vector<float>& blocker, float tan_radius,
+                                   float pixel_spread);
 
 }  // namespace transgi::shading

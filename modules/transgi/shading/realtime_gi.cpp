@@ -116,6 +116,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
   g.camera = camera;
   g.samples.resize(static_cast<std::size_t>(width) * height);
   g.guide.resize(g.samples.size());
+  g.position.resize(g.samples.size());
   g.metal_roughness.resize(g.samples.size());
   g.entity.resize(g.samples.size());
   // 4x4 pixel tiles as one Embree packet: neighbouring camera rays share
@@ -178,6 +179,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
         GSample& s = g.samples[pixel[i]];
         make_gsample(scene, assets, rays[i], found[i] ? &hits[i] : nullptr, nullptr, spread, s);
         g.guide[pixel[i]] = s.hit ? glm::vec4(s.normal_world, std::max(s.depth, 1e-30f)) : glm::vec4(0.0f);
+        g.position[pixel[i]] = s.hit ? s.position : glm::vec3(0.0f);
         g.metal_roughness[pixel[i]] = s.hit && s.brdf.metallic >= 0.5f ? s.brdf.roughness : std::numeric_limits<float>::infinity();
         g.entity[pixel[i]] = s.entity;
       }

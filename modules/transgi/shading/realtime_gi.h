@@ -75,6 +75,9 @@ struct GBuffer {
   // upsampling compares; written by trace_gbuffer. 16 bytes a pixel instead
   // of a whole GSample keeps those passes in cache.
   std::vector<glm::vec4> guide;
+  // Per pixel: the world position hit (0 for a miss), for the soft
+  // shadows' same-surface test (realtime_direct.h); written by trace_gbuffer.
+  std::vector<glm::vec3> position;
   // Per pixel: the surface's roughness where it is metallic (>= 0.5), else
   // infinity (misses too), so the mirror pass finds its pixels in 4 bytes a
   // pixel rather than reading every GSample's material; written by trace_gbuffer.
