@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Packs what a GPU run through the `device` tool needs into .devpack/ (which
 # .git/info/exclude must ignore; the tool's `carry` takes it): the stripped
-# transgi binary and gpu_bench, every shared library they load except glibc's
+# transgi binary, gpu_bench and gpu_tests (the kernels against their CPU
+# oracles, on the real GPU), every shared library they load except glibc's
 # and the Vulkan loader (the loader comes from .gl, see
 # /work/.library/device/README.md), and Bitterli's Living Room with its model
 # when they are there. The device machine's image is not Debian, and nothing
@@ -13,7 +14,7 @@ cd "$root"
 stage=$(mktemp -d)
 trap 'rm -rf "$stage"' EXIT
 mkdir -p "$stage/lib" "$stage/bitterli" .devpack
-for bin in "$build/modules/transgi/transgi" "$build/benchmarks/gpu_bench"; do
+for bin in "$build/modules/transgi/transgi" "$build/benchmarks/gpu_bench" "$build/tests/gpu_tests"; do
   [ -x "$bin" ] || { echo "gpu_pack: $bin is missing; build first (cmake --build --preset release)" >&2; exit 1; }
   cp "$bin" "$stage/" && strip "$stage/$(basename "$bin")"
   for lib in $(ldd "$bin" | awk '$3 ~ /^\// {print $3}'); do
