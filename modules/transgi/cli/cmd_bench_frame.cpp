@@ -80,7 +80,7 @@ ecs::Entity pick_moving_object(ecs::World& world, const std::string& name) {
 int run_bench_frame(const std::vector<std::string>& argv) {
   const Args args("bench-frame", argv,
                   {"scene", "model", "width", "height", "frames", "warmup", "preset", "csv", "object", "threads", "camera",
-                   "direct-spp", "gi-scale", "gi-reuse", "probe-budget", "probe-settle", "backend", "device", "device-inference", "device-shading", "device-lights", "near-field-rays", "near-field-reach", "near-field-filter", "direct", "gi-out", "reference-out", "reference-spp", "map-width",
+                   "direct-spp", "gi-scale", "gi-reuse", "taa", "probe-budget", "probe-settle", "backend", "device", "device-inference", "device-shading", "device-lights", "near-field-rays", "near-field-reach", "near-field-filter", "direct", "gi-out", "reference-out", "reference-spp", "map-width",
                    "probe-volume", "probe-grid", "cascades", "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "cascade-map-width"},
                   {"allow-unbaked"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
@@ -130,7 +130,7 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   frame.height = height;
   std::ostringstream rows;
   rows << "frame,total_ms,gbuffer_ms,inference_ms,sh_light_ms,upsample_ms,probe_trace_ms,probe_raster_ms,probe_project_ms,"
-          "direct_ms,probes_traced,decoded_pixels,gpu_trace_ms,gpu_raster_ms,gpu_projection_ms,gpu_gbuffer_ms,gpu_inference_ms,gpu_shading_ms,gpu_accumulation_ms\n";
+          "direct_ms,antialiasing_ms,probes_traced,decoded_pixels,gpu_trace_ms,gpu_raster_ms,gpu_projection_ms,gpu_gbuffer_ms,gpu_inference_ms,gpu_shading_ms,gpu_accumulation_ms\n";
   std::vector<double> totals;
   std::vector<std::vector<double>> stages;
   core::ProgressBar bar("bench-frame", static_cast<std::uint64_t>(warmup + frames), true);
@@ -147,7 +147,7 @@ int run_bench_frame(const std::vector<std::string>& argv) {
     if (f < warmup) continue;
     const auto& s = frame.times;
     const std::vector<double> row{s.gbuffer + s.network_input, s.inference, s.sh_multiplication, s.upsample,
-                                  s.collect_points, s.probe_raster, s.probe_projection, s.direct};
+                                  s.collect_points, s.probe_raster, s.probe_projection, s.direct, s.antialiasing};
     totals.push_back(ms);
     stages.push_back(row);
     rows << f - warmup << ',' << ms;
@@ -160,7 +160,7 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   if (!csv.empty()) eval::write_text(csv, rows.str());
 
   const char* names[] = {"G-buffer", "inference (fused)", "SH light", "upsampling", "probe rays + shading", "probe raster",
-                         "probe accumulation + projection", "direct light"};
+                         "probe accumulation + projection", "direct light", "antialiasing"};
   std::printf("frame time over %d frames after %d warm-up: median %.2f ms, p95 %.2f, max %.2f\n", frames, warmup,
               percentile(totals, 0.5), percentile(totals, 0.95), percentile(totals, 1.0));
   std::printf("stage medians (ms):");

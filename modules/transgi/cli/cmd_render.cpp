@@ -204,7 +204,7 @@ int run_render(const std::vector<std::string>& argv) {
   const Args args("render", argv,
                   {"scene", "method", "pass", "spp", "width", "height", "out", "camera", "seed", "threads", "png", "exposure",
                    "model", "transfer", "gt-rays", "coefficient-maps", "lighting", "frames", "probe-grid", "probe-rays",
-                   "direct-spp", "probe-skip", "sharing", "no-latent", "timing-frames", "map-width", "hysteresis", "irradiance-gamma", "warmup-frames", "brightness-threshold", "preset", "gi-scale", "gi-reuse", "probe-budget", "probe-settle", "backend", "device", "device-inference", "device-shading", "device-lights", "direct", "near-field-rays", "near-field-reach", "near-field-filter",
+                   "direct-spp", "probe-skip", "sharing", "no-latent", "timing-frames", "map-width", "hysteresis", "irradiance-gamma", "warmup-frames", "brightness-threshold", "preset", "gi-scale", "gi-reuse", "taa", "probe-budget", "probe-settle", "backend", "device", "device-inference", "device-shading", "device-lights", "direct", "near-field-rays", "near-field-reach", "near-field-filter",
                    "probe-volume", "cascades", "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "cascade-map-width", "sun-elevation", "sun-azimuth"},
                   {"allow-unbaked"});
   const std::string scene_path = args.str("scene");

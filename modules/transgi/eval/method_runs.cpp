@@ -45,21 +45,24 @@ double median_total(const std::vector<std::vector<double>>& samples, std::size_t
 }
 
 // Runs `frames` App frames; the frame's image is requested (frame.width /
-// height set) on the last `timed` ones, after each of which `sample` collects
-// that frame's stage times. `after_frame` sees every frame.
+// height set) on the last `imaged` ones (at least `timed`), and after each of
+// the last `timed` `sample` collects that frame's stage times. `after_frame`
+// sees every frame.
 template <class Frame, class Sample, class AfterFrame>
 std::vector<std::vector<double>> run_frames(LoadedScene& scene, Frame& frame, int width, int height, int frames, int timed,
-                                            const std::string& label, bool progress, Sample&& sample, AfterFrame&& after_frame) {
+                                            int imaged, const std::string& label, bool progress, Sample&& sample,
+                                            AfterFrame&& after_frame) {
   timed = std::clamp(timed, 1, frames);
+  imaged = std::clamp(imaged, timed, frames);
   core::ProgressBar bar(label, static_cast<std::uint64_t>(frames), progress);
   std::vector<std::vector<double>> samples;
   for (int f = 0; f < frames; ++f) {
-    const bool render = f >= frames - timed;
+    const bool render = f >= frames - imaged;
     frame.width = render ? width : 0;
     frame.height = render ? height : 0;
     scene.app->jobs().run([&] { scene.app->update(); });
     after_frame();
-    if (render) samples.push_back(sample());
+    if (f >= frames - timed) samples.push_back(sample());
     bar.update(static_cast<std::uint64_t>(f + 1));
   }
   bar.finish();
@@ -113,7 +116,10 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
   frame.camera = scene.camera;
   int traced = 0;
   const auto samples = run_frames(
-      scene, frame, width, height, o.frames, o.timing_frames, "TransGI probe frames", o.progress,
+      // The temporal antialiasing's history builds over the frames that
+      // make an image, as in a game: every frame makes one then.
+      scene, frame, width, height, o.frames, o.timing_frames, o.settings.taa.enabled ? o.frames : o.timing_frames,
+      "TransGI probe frames", o.progress,
       [&] {
         const auto& t = frame.times;
         return std::vector<double>{t.gbuffer + t.network_input, t.inference, t.collect_points, t.probe_raster,
@@ -196,7 +202,7 @@ MethodRun run_ddgi(LoadedScene& scene, int width, int height, const DdgiRunOptio
   auto& frame = world.resource<ddgi::DdgiFrame>();
   frame.camera = scene.camera;
   const auto samples = run_frames(
-      scene, frame, width, height, o.frames, o.timing_frames, "DDGI probe updates", o.progress,
+      scene, frame, width, height, o.frames, o.timing_frames, o.timing_frames, "DDGI probe updates", o.progress,
       [&] { return std::vector<double>{frame.times.probe_trace, frame.times.probe_blend, frame.times.shading, frame.times.direct}; },
       [] {});
   MethodRun r;

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <string>
 
+#include "engine/render/temporal_aa.h"
 #include "probes/probe_field.h"
 #include "shading/realtime_gi.h"
 #include "shading/transfer_renderer.h"
@@ -72,6 +73,13 @@ struct TransGISettings {
   // the running kernels).
   std::uint32_t shader_generation = 0;
   shading::RealtimeGiSettings realtime;  // read when gi_path is Realtime
+  // Realtime path: temporal antialiasing of the full image, the one a
+  // player sees (engine/render/temporal_aa.h): jittered camera rays, each
+  // pixel blended with its reprojected, matched and clamped history; the gi
+  // and direct passes stay each frame's own. On in realtime_preset(). Off =
+  // one sample at each pixel's centre: aliased edges and the single
+  // G-buffer sample's error, at no cost.
+  engine::render::TemporalAaSettings taa;
   // Probe rays, map size, sharing, accumulation, interpolation and skips
   // (see ProbeFieldSettings and the structs it holds; its `grid` is ignored:
   // each ProbeVolume gives its own).

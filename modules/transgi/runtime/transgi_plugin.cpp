@@ -127,6 +127,9 @@ struct PackedDecoder {
   shading::GBuffer gbuffer;
   shading::RealtimeGiScratch scratch;
   render::TemporalAccumulation history;  // quality path, still views
+  render::TemporalAntialiasing taa;       // realtime path
+  // The light set's versions the last frame was rendered with.
+  std::uint64_t lights_version = 0, geometry_version = 0;
 };
 
 // Realtime path: fills the frame's gi, direct and full images and its stage times.
@@ -134,7 +137,7 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
                      const std::function<bool(Entity)>& has_transfer, std::span<const probes::ProbeField* const> fields,
                      const rt::RtScene& rt, const scene::SceneAssets& assets, const render::LightSet& lights,
                      const TransGISettings& settings, std::uint64_t seed, PackedDecoder& packed, GiFrame& frame,
-                     rt::RayBatchTracer* tracer, shading::TransferBatchDecoder* batch_decoder) {
+                     rt::RayBatchTracer* tracer, shading::TransferBatchDecoder* batch_decoder, bool light_changed) {
   if (model && packed.model != model) {
     packed.decoder = std::make_unique<shading::FusedDecoder>(model->decoder);
     packed.model = model;
@@ -147,7 +150,9 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   // With a backend's tracer the shadow rays go to it in one batch after the
   // G-buffer, not tile by tile inside it.
   if (deterministic && !tracer) direct.emplace(rt, lights, rays, frame.width, frame.height);
-  shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, packed.gbuffer, direct ? &*direct : nullptr, tracer);
+  const glm::vec2 jitter = settings.taa.enabled ? packed.taa.next_jitter(settings.taa) : glm::vec2(0.0f);
+  shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, packed.gbuffer, direct ? &*direct : nullptr, tracer,
+                         jitter);
   std::optional<engine::image::ImageRGB> batched_direct;
   if (deterministic && tracer)
     batched_direct = shading::shade_direct_realtime(packed.gbuffer, rt, lights, rays, &frame.direct_stats, tracer);
@@ -180,6 +185,18 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   else
     add_stochastic_direct(rt, lights, rays, settings.direct_spp, seed, frame);
   compose_full(frame);
+  // The image a player sees is antialiased; the gi and direct passes stay
+  // this frame's own (one resolve, not three).
+  if (settings.taa.enabled) {
+    t0 = std::chrono::steady_clock::now();
+    image::ImageRGB* layers[] = {&frame.full};
+    packed.taa.resolve(rays, render::TaaSurfaces{packed.gbuffer.position, packed.gbuffer.guide, packed.gbuffer.entity},
+                       render::objects_of(rt), layers, settings.taa,
+                       light_changed);
+    t.antialiasing = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  } else {
+    packed.taa.clear();
+  }
 }
 
 void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Get<const ProbeCascades>> cascades,
@@ -230,8 +247,13 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
           frame->backend_fallback += (frame->backend_fallback.empty() ? "" : "; ") + note;
       }
     }
+    // Lights or geometry that changed (a moving object's shadow) change
+    // pixels that did not move: the antialiasing clamps their history.
+    const bool light_changed = lights->version != packed->lights_version || lights->geometry_version != packed->geometry_version;
+    packed->lights_version = lights->version;
+    packed->geometry_version = lights->geometry_version;
     render_realtime(*rays, model, rs.has_transfer, fields, *rt, *assets, lights->set, *settings, rs.seed, *packed, *frame,
-                    backend->kernels ? backend->kernels->tracer() : nullptr, batch_decoder);
+                    backend->kernels ? backend->kernels->tracer() : nullptr, batch_decoder, light_changed);
     frame->times.collect_points = frame->probe_stats.scatter_ms;
     frame->times.probe_raster = frame->probe_stats.raster_ms;
     frame->times.probe_projection = frame->probe_stats.project_ms;
@@ -285,6 +307,7 @@ TransGISettings realtime_preset() {
   s.probes.update_budget = 128;
   s.probes.settle_frames = 24;
   s.realtime.reuse_history = true;
+  s.taa.enabled = true;
   s.direct_light = DirectLight::Deterministic;
   s.probes.fixed_pattern = true;  // with the deterministic direct light: no seed anywhere in the image
   s.near_field.rays = 0;          // off: at 640x360 it costs more than the frame's budget (docs/runtime.md)

@@ -118,7 +118,8 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
       // cells' 16-byte guides are in cache, their GSamples far apart.
       const glm::vec4& guide = up.cell_guide[c];
       const std::size_t pixel = up.cell_pixel[c];
-      const glm::vec3 dir(x0 + dx * (static_cast<float>(pixel % width) + 0.5f), y0 + dy * (static_cast<float>(pixel / width) + 0.5f), -1.0f);
+      const glm::vec3 dir(x0 + dx * (static_cast<float>(pixel % width) + 0.5f + g.jitter.x),
+                          y0 + dy * (static_cast<float>(pixel / width) + 0.5f + g.jitter.y), -1.0f);
       const float depth = guide.w;
       const glm::vec3 p_obj = m.c0 + (depth / std::sqrt(glm::dot(dir, dir))) * (m.a * dir);
       const glm::vec3 n_obj = m.normal * glm::vec3(guide);

@@ -49,7 +49,6 @@ DirectTileShader::DirectTileShader(const engine::rt::RtScene& scene, const engin
     soft.tan_radius = std::tan(std::min(light.angular_radius, 1.5f));
     soft.centre = directional_[l][0];
     soft.centre.direction = -light.direction;
-    soft.unshadowed.assign(pixels, glm::vec3(0.0f));
     soft.blocker.assign(pixels, kNotReceiver);
     soft_of_[l] = static_cast<int>(soft_.size());
     soft_.push_back(std::move(soft));
@@ -80,7 +79,7 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
       if (s.hit)
         out_.pixels[p] = s.emission;
       else if (background)
-        out_.pixels[p] = background->radiance(camera_.generate({static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f}).direction);
+        out_.pixels[p] = background->radiance(camera_.generate({static_cast<float>(x) + 0.5f + g.jitter.x, static_cast<float>(y) + 0.5f + g.jitter.y}).direction);
     }
   for (std::size_t l = 0; l < n_lights_; ++l) {
     SoftLight* soft = soft_of_[l] >= 0 ? &soft_[static_cast<std::size_t>(soft_of_[l])] : nullptr;
@@ -102,10 +101,7 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
           // whether this part of the disk is seen.
           const glm::vec3 wc = frame.to_local(soft->centre.direction);
           if (glm::dot(soft->centre.direction, s.geometric_normal) <= 0 || wo.z <= 0 || wc.z <= 0) continue;
-          if (!collecting) {
-            soft->unshadowed[p] = material::brdf_eval(s.brdf, wo, wc) * wc.z * soft->centre.radiance;
-            soft->blocker[p] = 0.0f;  // blocked by the surface itself unless its ray says otherwise
-          }
+          if (!collecting) soft->blocker[p] = 0.0f;  // blocked by the surface itself unless its ray says otherwise
           if (glm::dot(ls.direction, s.geometric_normal) <= 0) continue;
         } else {
           if (glm::dot(ls.direction, s.geometric_normal) <= 0) continue;
@@ -164,13 +160,14 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
 
 namespace {
 
-// Around each pixel: how many pattern rays are blocked, their blockers'
-// summed distance, and how many are lit, over the 3x3 blocks of 8x8 pixels
-// centred on the pixel's block (so at least 8 pixels either way): sums per
-// block, then per block of its neighbourhood.
+// Around each pixel, over the 3x3 blocks of 8x8 pixels centred on its own
+// (so at least 8 pixels either way): how many pattern rays are blocked, how
+// far the nearest blockers are (the least of the blocks' mean distances: a
+// table's shadow inside a window's keeps the table's narrow penumbra), and
+// how many rays are lit.
 struct BlockerCounts {
   int blocks_x = 0;
-  std::vector<glm::vec3> around;  // per block: blocked, distance sum, lit
+  std::vector<glm::vec3> around;  // per block: blocked, nearest mean blocker distance, lit
   [[nodiscard]] const glm::vec3& at(int x, int y) const {
     return around[static_cast<std::size_t>(y / 8) * static_cast<std::size_t>(blocks_x) + static_cast<std::size_t>(x / 8)];
   }
@@ -195,9 +192,15 @@ BlockerCounts count_blockers(const std::vector<float>& blocker, int width, int h
   for (int by = 0; by < blocks_y; ++by)
     for (int bx = 0; bx < c.blocks_x; ++bx) {
       glm::vec3& sum = c.around[static_cast<std::size_t>(by) * c.blocks_x + static_cast<std::size_t>(bx)];
+      float nearest = std::numeric_limits<float>::infinity();
       for (int ny = std::max(0, by - 1); ny <= std::min(blocks_y - 1, by + 1); ++ny)
-        for (int nx = std::max(0, bx - 1); nx <= std::min(c.blocks_x - 1, bx + 1); ++nx)
-          sum += own[static_cast<std::size_t>(ny) * c.blocks_x + static_cast<std::size_t>(nx)];
+        for (int nx = std::max(0, bx - 1); nx <= std::min(c.blocks_x - 1, bx + 1); ++nx) {
+          const glm::vec3& b = own[static_cast<std::size_t>(ny) * c.blocks_x + static_cast<std::size_t>(nx)];
+          sum.x += b.x;
+          sum.z += b.z;
+          if (b.x > 0.5f) nearest = std::min(nearest, b.y / b.x);
+        }
+      sum.y = nearest;
     }
   return c;
 }
@@ -238,7 +241,7 @@ std::vector<float> penumbra_filter(const GBuffer& g, const std::vector<float>& b
         if (std::isnan(lit[p]) || c.x < 0.5f || c.z < 0.5f || !(depth > 0)) continue;
         // The penumbra's half-width in pixels, at most 8: a box 8 pixels
         // wide or more covers the whole pattern.
-        const float r = std::ceil(c.y / c.x * tan_radius / (depth * pixel_spread));
+        const float r = std::ceil(c.y * tan_radius / (depth * pixel_spread));
         radius[p] = static_cast<std::uint8_t>(std::clamp(r, 0.0f, 8.0f));
       }
   });
@@ -300,8 +303,13 @@ engine::image::ImageRGB DirectTileShader::take(const GBuffer& g, RealtimeDirectS
     engine::jobs::parallel_for<std::size_t>(0, lit.size(), 16384, [&](std::size_t b, std::size_t e) {
       std::size_t local_bad = 0;
       for (std::size_t p = b; p < e; ++p) {
+        // The BRDF along the disk's centre, only where some of it arrives:
+        // most of a room's pixels that face the sun are in its shadow.
         if (!(lit[p] > 0)) continue;
-        const glm::vec3 c = soft.unshadowed[p] * lit[p];
+        const GSample& s = g.samples[p];
+        const engine::math::Frame frame = engine::math::Frame::from_normal(s.normal_world);
+        const glm::vec3 wo = frame.to_local(s.wo_world), wc = frame.to_local(soft.centre.direction);
+        const glm::vec3 c = engine::material::brdf_eval(s.brdf, wo, wc) * wc.z * soft.centre.radiance * lit[p];
         if (!(std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b))) {
           ++local_bad;
           continue;

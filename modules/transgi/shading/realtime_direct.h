@@ -71,15 +71,14 @@ class DirectTileShader {
   std::size_t n_lights_ = 0;
   std::vector<std::array<engine::render::LightSample, 64>> directional_;
   std::vector<std::uint8_t> is_directional_;
-  // A directional light with a disk: per pixel, what it would add unshadowed
-  // (BRDF x cosine x radiance along the disk's centre) and how far along the
-  // pixel's pattern direction the first blocker is (infinity: lit; NaN: the
-  // light does not reach this pixel at all).
+  // A directional light with a disk: per pixel, how far along the pixel's
+  // pattern direction the first blocker is (infinity: lit; NaN: the light
+  // does not reach this pixel at all). take() adds the BRDF along the
+  // disk's centre times the filtered visibility.
   struct SoftLight {
     std::size_t light = 0;
     float tan_radius = 0.0f;
     engine::render::LightSample centre;
-    std::vector<glm::vec3> unshadowed;
     std::vector<float> blocker;
   };
   std::vector<SoftLight> soft_;
@@ -107,8 +106,8 @@ glm::vec2 disk_pattern(int x, int y);
 // blocks its pattern ray (infinity: lit; NaN: not a receiver). Returns per
 // pixel the fraction of lit receivers around it on its own surface (a
 // normal within ~25 degrees, within 2 % of its depth of its plane) in a
-// square whose half-width is the penumbra's on screen (the mean blocker
-// distance nearby x tan_radius over the pixel's footprint): a box of 8 or
+// square whose half-width is the penumbra's on screen (the nearest blockers'
+// distance x tan_radius over the pixel's footprint): a box of 8 or
 // 16 pixels, which holds every point of the 8x8 pattern, where the
 // penumbra is 4 pixels wide or more, one no wider than it where narrower.
 std::vector<float> penumbra_filter(const GBuffer& g, const std::vector<float>& blocker, float tan_radius,

@@ -110,8 +110,9 @@ GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::Sce
 
 void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                    const engine::render::CameraRays& camera, int width, int height, GBuffer& g, DirectTileShader* direct,
-                   engine::rt::RayBatchTracer* tracer) {
+                   engine::rt::RayBatchTracer* tracer, glm::vec2 jitter) {
   g.width = width;
+  g.jitter = jitter;
   g.height = height;
   g.camera = camera;
   g.samples.resize(static_cast<std::size_t>(width) * height);
@@ -146,7 +147,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
         const int tx = t % tiles_x * 4, ty = t / tiles_x * 4;
         for (int y = ty; y < std::min(ty + 4, height); ++y)
           for (int x = tx; x < std::min(tx + 4, width); ++x)
-            batch_rays[i++] = camera.generate({static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f});
+            batch_rays[i++] = camera.generate({static_cast<float>(x) + 0.5f + jitter.x, static_cast<float>(y) + 0.5f + jitter.y});
       }
     });
     batch_hits.resize(batch_rays.size());
@@ -163,7 +164,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
       int n = 0;
       for (int y = ty; y < std::min(ty + 4, height); ++y)
         for (int x = tx; x < std::min(tx + 4, width); ++x, ++n) {
-          rays[n] = camera.generate({static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f});
+          rays[n] = camera.generate({static_cast<float>(x) + 0.5f + jitter.x, static_cast<float>(y) + 0.5f + jitter.y});
           pixel[n] = static_cast<std::size_t>(y) * width + x;
         }
       if (tile_first.empty()) {

@@ -85,6 +85,8 @@ struct GBuffer {
   // Per pixel: the entity hit (null for a miss), so routing samples by object
   // reads 8 bytes a pixel rather than a GSample; written by trace_gbuffer.
   std::vector<engine::ecs::Entity> entity;
+  // The sub-pixel offset its rays were traced with (film = pixel + 0.5 + jitter).
+  glm::vec2 jitter{0.0f};
   // The camera the G-buffer was traced from (trace_gbuffer), so the next
   // frame can find where a surface point was seen (gi_history.h).
   std::optional<engine::render::CameraRays> camera;
@@ -106,10 +108,12 @@ GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::Sce
 // `direct`, each 4x4 tile is also shaded by it as soon as it is traced, while
 // its samples are in cache (realtime_direct.h). With `tracer` (a GPU
 // backend), every camera ray is traced by it in one batch first; Embree's
-// packets trace them where it declines.
+// packets trace them where it declines. `jitter` moves every ray off the
+// pixel centre by that many pixels (temporal antialiasing, [-0.5, 0.5)).
 void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                    const engine::render::CameraRays& camera, int width, int height, GBuffer& g,
-                   DirectTileShader* direct = nullptr, engine::rt::RayBatchTracer* tracer = nullptr);
+                   DirectTileShader* direct = nullptr, engine::rt::RayBatchTracer* tracer = nullptr,
+                   glm::vec2 jitter = glm::vec2(0.0f));
 
 // Buffers the real-time path keeps from frame to frame: at 640x360 they are
 // tens of MB that would otherwise be faulted in and zeroed every frame.

@@ -1,0 +1,230 @@
+#include "engine/render/temporal_aa.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "engine/jobs/parallel_for.h"
+
+namespace engine::render {
+
+namespace {
+
+float radical_inverse(std::uint64_t i, std::uint64_t base) {
+  float inv = 1.0f / static_cast<float>(base), f = inv, r = 0.0f;
+  while (i > 0) {
+    r += f * static_cast<float>(i % base);
+    i /= base;
+    f *= inv;
+  }
+  return r;
+}
+
+}  // namespace
+
+glm::vec2 taa_jitter(std::uint64_t index, int phases) {
+  const std::uint64_t i = index % static_cast<std::uint64_t>(std::max(phases, 1)) + 1;
+  return {radical_inverse(i, 2) - 0.5f, radical_inverse(i, 3) - 0.5f};
+}
+
+std::vector<TaaObject> objects_of(const rt::RtScene& scene) {
+  std::vector<TaaObject> out;
+  scene.for_each_instance([&](const rt::InstanceRecord& inst) { out.push_back({inst.entity, inst.to_world}); });
+  return out;
+}
+
+glm::vec2 TemporalAntialiasing::next_jitter(const TemporalAaSettings& settings) const {
+  return settings.enabled ? taa_jitter(frame_, settings.jitter_phases) : glm::vec2(0.0f);
+}
+
+void TemporalAntialiasing::clear() {
+  prev_ = Previous{};
+  stats_ = Stats{};
+}
+
+void TemporalAntialiasing::plan_motion(std::span<const TaaObject> objects) {
+  std::uint32_t size = 0;
+  for (const TaaObject& o : objects) size = std::max(size, o.entity.index + 1);
+  placed_.assign(size, Placed{});
+  motion_.assign(size, Motion{});
+  any_moved_ = false;
+  for (const TaaObject& o : objects) {
+    placed_[o.entity.index] = Placed{o.entity.generation, true, o.to_world};
+    Motion& m = motion_[o.entity.index];
+    m.generation = o.entity.generation;
+    if (o.entity.index >= prev_.placed.size()) continue;
+    const Placed& then = prev_.placed[o.entity.index];
+    if (!then.present || then.generation != o.entity.generation || then.to_world == o.to_world) continue;
+    m.moved = true;
+    m.back = then.to_world * o.to_world.inverse();
+    any_moved_ = true;
+  }
+}
+
+void TemporalAntialiasing::keep_history(const CameraRays& camera, TaaSurfaces& surfaces,
+                                        std::span<image::ImageRGB* const> layers) {
+  const std::size_t n = surfaces.position.size();
+  prev_.camera = camera;
+  prev_.position.swap(surfaces.position);
+  prev_.guide.swap(surfaces.guide);
+  prev_.entity.swap(surfaces.entity);
+  // The caller gets storage of this frame's size back.
+  surfaces.position.resize(n);
+  surfaces.guide.resize(n);
+  surfaces.entity.resize(n);
+  prev_.layers.resize(layers.size());
+  for (std::size_t l = 0; l < layers.size(); ++l) {
+    prev_.layers[l].width = layers[l]->width;
+    prev_.layers[l].height = layers[l]->height;
+    prev_.layers[l].pixels.resize(n);
+  }
+  jobs::parallel_for<std::size_t>(0, n, 16384, [&](std::size_t b, std::size_t e) {
+    for (std::size_t l = 0; l < layers.size(); ++l)
+      std::copy(layers[l]->pixels.begin() + static_cast<std::ptrdiff_t>(b), layers[l]->pixels.begin() + static_cast<std::ptrdiff_t>(e),
+                prev_.layers[l].pixels.begin() + static_cast<std::ptrdiff_t>(b));
+  });
+  prev_.placed.swap(placed_);
+}
+
+void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surfaces, std::span<const TaaObject> objects,
+                                   std::span<image::ImageRGB* const> layers, const TemporalAaSettings& settings,
+                                   bool light_changed) {
+  if (layers.size() > kMaxLayers) throw std::invalid_argument("TemporalAntialiasing::resolve: at most 4 layers");
+  const int w = camera.width(), h = camera.height();
+  const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  const glm::vec2 jitter = next_jitter(settings);
+  ++frame_;
+  plan_motion(objects);
+  const bool have_history = prev_.camera && prev_.camera->width() == w && prev_.camera->height() == h &&
+                            prev_.layers.size() == layers.size() && prev_.position.size() == n;
+  if (!have_history) {
+    stats_ = Stats{};
+    keep_history(camera, surfaces, layers);
+    return;
+  }
+  out_.resize(layers.size());
+  for (std::size_t l = 0; l < layers.size(); ++l) out_[l].pixels.resize(n);
+  const CameraRays& before = *prev_.camera;
+  const float blend = std::clamp(settings.blend, 0.0f, 1.0f);
+  const bool camera_still = before.to_world() == camera.to_world();
+  std::atomic<std::size_t> reused{0}, rejected{0};
+  jobs::parallel_for(0, h, 4, [&](int y0, int y1) {
+    std::size_t local_reused = 0, local_rejected = 0;
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * w + x;
+        // Where this pixel's point was in the previous frame, carried by
+        // its object's motion. The point was traced through the jittered
+        // film position; the pixel's centre is `jitter` away from it in
+        // both frames, so a still view reads its history at the pixel
+        // itself (no resampling blur).
+        const ecs::Entity self = surfaces.entity[p];  // null for a miss
+        const bool hit = !self.is_null();
+        const bool self_moved = hit && moved(self);
+        glm::vec2 film(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
+        bool on_film = true;
+        // Position and normal are read only where the point moved on screen.
+        glm::vec3 position(0.0f), normal(0.0f);
+        if (!camera_still || self_moved) {
+          position = surfaces.position[p];
+          normal = glm::vec3(surfaces.guide[p]);
+          if (self_moved) {
+            const transform::Similarity& back = motion_[self.index].back;
+            position = back.apply_point(position);
+            normal = back.apply_direction(normal);
+          }
+          std::optional<glm::vec2> f;
+          if (hit) {
+            f = before.project(position);
+            if (f) *f -= jitter;
+          } else {
+            f = before.project(before.position() + camera.generate(film).direction);
+          }
+          on_film = f.has_value();
+          if (f) film = *f;
+        }
+        const glm::vec2 motion = film - glm::vec2(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
+        const bool still = !self_moved && glm::dot(motion, motion) < 0.05f * 0.05f;
+        // The previous frame's pixels around that point, bilinearly, each
+        // only where it showed this surface.
+        float weight = 0.0f;
+        glm::vec3 history[kMaxLayers] = {};
+        if (camera_still && !self_moved) {
+          // Most pixels of a still camera: the pixel itself, one tap.
+          const ecs::Entity was = prev_.entity[p];
+          if (was == self || !moved(was)) {
+            weight = 1.0f;
+            for (std::size_t l = 0; l < layers.size(); ++l) history[l] = prev_.layers[l].pixels[p];
+          }
+        } else if (on_film) {
+          const float fx = film.x - 0.5f, fy = film.y - 0.5f;
+          const int x0 = static_cast<int>(std::floor(fx)), y0t = static_cast<int>(std::floor(fy));
+          const float tx = fx - static_cast<float>(x0), ty = fy - static_cast<float>(y0t);
+          for (int k = 0; k < 4; ++k) {
+            const float wk = ((k & 1) ? tx : 1.0f - tx) * ((k >> 1) ? ty : 1.0f - ty);
+            const int qx = x0 + (k & 1), qy = y0t + (k >> 1);
+            if (wk <= 0.0f || qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
+            const std::size_t q = static_cast<std::size_t>(qy) * w + qx;
+            const ecs::Entity was = prev_.entity[q];
+            bool match;
+            if (was != self) {
+              // Another surface was seen there. Across a still silhouette
+              // that is the other side of the pixel's own edge (the jitter
+              // sees one or the other): keep it, that is the antialiasing.
+              // Where either object moved, it is a ghost.
+              match = !self_moved && !moved(was);
+            } else if (!hit || still) {
+              match = true;
+            } else {
+              // The same object, carried: the same tangent plane and normal.
+              const glm::vec4& g = prev_.guide[q];
+              const glm::vec3 nq(g);
+              match = glm::dot(nq, normal) > 0.9f && std::abs(glm::dot(nq, position - prev_.position[q])) <= 0.02f * g.w;
+            }
+            if (!match) continue;
+            weight += wk;
+            for (std::size_t l = 0; l < layers.size(); ++l) history[l] += wk * prev_.layers[l].pixels[q];
+          }
+        }
+        if (weight < 1e-3f) {
+          // Nothing there showed this surface: the pixel restarts.
+          if (hit) ++local_rejected;
+          for (std::size_t l = 0; l < layers.size(); ++l) out_[l].pixels[p] = layers[l]->pixels[p];
+          continue;
+        }
+        ++local_reused;
+        // Less of the history where only part of it matched; clamped in
+        // full once the point moves a quarter pixel or the light changed,
+        // not at all where neither.
+        const float alpha = blend + (1.0f - blend) * std::max(0.0f, 1.0f - weight);
+        const float clamp_amount = light_changed ? 1.0f : std::min(1.0f, 4.0f * glm::length(motion));
+        for (std::size_t l = 0; l < layers.size(); ++l) {
+          const image::ImageRGB& cur = *layers[l];
+          glm::vec3 kept = history[l] / weight;
+          if (clamp_amount > 0.0f) {
+            // The pixel and its four edge neighbours: the range that
+            // matters, at about half the reads of all eight.
+            const glm::vec3* c = cur.pixels.data();
+            const glm::vec3& m = c[p];
+            const glm::vec3& l_ = c[p - (x > 0 ? 1 : 0)];
+            const glm::vec3& r_ = c[p + (x + 1 < w ? 1 : 0)];
+            const glm::vec3& u_ = c[p - (y > 0 ? static_cast<std::size_t>(w) : 0)];
+            const glm::vec3& d_ = c[p + (y + 1 < h ? static_cast<std::size_t>(w) : 0)];
+            const glm::vec3 lo = glm::min(glm::min(glm::min(m, l_), glm::min(r_, u_)), d_);
+            const glm::vec3 hi = glm::max(glm::max(glm::max(m, l_), glm::max(r_, u_)), d_);
+            kept += clamp_amount * (glm::clamp(kept, lo, hi) - kept);
+          }
+          out_[l].pixels[p] = kept + alpha * (cur.pixels[p] - kept);
+        }
+      }
+    reused.fetch_add(local_reused, std::memory_order_relaxed);
+    rejected.fetch_add(local_rejected, std::memory_order_relaxed);
+  });
+  stats_ = Stats{reused.load(), rejected.load()};
+  for (std::size_t l = 0; l < layers.size(); ++l) layers[l]->pixels.swap(out_[l].pixels);
+  keep_history(camera, surfaces, layers);
+}
+
+}  // namespace engine::render

@@ -1,0 +1,121 @@
+#pragma once
+// Temporal antialiasing with reprojection (issue 37): each frame traces its
+// camera rays through a different sub-pixel point (a Halton (2, 3) cycle),
+// and the image a player sees is this frame's blended with the history of
+// earlier frames, found where each pixel's surface point was in the previous
+// frame: carried back through its object's motion (rigid objects move, the
+// point stays put in the object's frame) and the previous camera. A history
+// sample counts only where the previous frame saw the same object there,
+// on the same tangent plane, with a similar normal. Where the pixel moved on
+// screen, or the caller says the light changed, the history is clamped to
+// the range of the current frame's pixel and its four edge neighbours, so what changed does not
+// linger; where neither holds it is not, so a feature thinner than a pixel,
+// which only some jitter points hit, keeps its average instead of being
+// clamped away by the frames that miss it. Where nothing in the history
+// matches (an object moved away, a cut, a resize) the pixel restarts from
+// this frame: no ghost. A still view converges to the mean over the jitter
+// cycle: an antialiased image at one sample per pixel per frame.
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "engine/ecs/entity.h"
+#include "engine/image/image.h"
+#include "engine/render/camera_rays.h"
+#include "engine/rt/rt_scene.h"
+
+namespace engine::render {
+
+struct TemporalAaSettings {
+  bool enabled = false;
+  // The current frame's weight where the history matches. Higher = follows
+  // changing light sooner, at the cost of more aliasing and flicker left in.
+  float blend = 0.1f;
+  // Sub-pixel points in the jitter cycle. Higher = finer antialiasing of a
+  // still view, at the cost of a longer cycle to converge.
+  int jitter_phases = 16;
+};
+
+// What the resolve needs to know of each pixel's surface, this frame. The
+// resolve takes the vectors' contents into its history and gives back the
+// spent storage of the frame before (the same size), so no frame copies
+// them: fill them afresh before the next resolve.
+struct TaaSurfaces {
+  std::vector<glm::vec3>& position;  // world position (unused for a miss)
+  std::vector<glm::vec4>& guide;     // world normal (xyz), depth (w; 0 = the ray missed)
+  std::vector<ecs::Entity>& entity;  // what the ray hit (null for a miss)
+};
+
+struct TaaObject {
+  ecs::Entity entity;
+  transform::Similarity to_world;
+};
+// The ray-traced scene's instances as resolve() takes them.
+std::vector<TaaObject> objects_of(const rt::RtScene& scene);
+
+class TemporalAntialiasing {
+ public:
+  static constexpr std::size_t kMaxLayers = 4;
+  // The sub-pixel offset, in [-0.5, 0.5)^2 pixels, of the next frame's camera
+  // rays (film = pixel + 0.5 + jitter); 0 when disabled.
+  [[nodiscard]] glm::vec2 next_jitter(const TemporalAaSettings& settings) const;
+  // Blends each of `layers` (same size as the camera's image, traced with
+  // next_jitter()'s offset) with its history, in place, and keeps the
+  // result and the surfaces as the next frame's history. Every layer shares
+  // the reprojection; each is clamped by its own neighbours.
+  // light_changed: anything but the camera and the objects' motion changed
+  // what this frame shows (lights, materials, what the probes hold), so
+  // every pixel's history is clamped.
+  // objects: every object's object-to-world transform now (objects_of()).
+  void resolve(const CameraRays& camera, TaaSurfaces surfaces, std::span<const TaaObject> objects,
+               std::span<image::ImageRGB* const> layers, const TemporalAaSettings& settings, bool light_changed);
+  // Forgets the history: the next frame is its own.
+  void clear();
+
+  struct Stats {
+    std::size_t reused = 0;    // pixels blended with their history
+    std::size_t rejected = 0;  // hit pixels whose history did not match (restarted)
+  };
+  [[nodiscard]] const Stats& stats() const { return stats_; }
+
+ private:
+  // Per entity index: its transform in a frame (valid for `generation`).
+  struct Placed {
+    std::uint32_t generation = 0;
+    bool present = false;
+    transform::Similarity to_world;
+  };
+  // Per entity index, this frame: whether it moved since the previous one,
+  // and the transform that carries a point of it back there.
+  struct Motion {
+    std::uint32_t generation = 0;
+    bool moved = false;
+    transform::Similarity back;
+  };
+  void plan_motion(std::span<const TaaObject> objects);
+  [[nodiscard]] bool moved(ecs::Entity e) const {
+    return !e.is_null() && e.index < motion_.size() && motion_[e.index].moved && motion_[e.index].generation == e.generation;
+  }
+  void keep_history(const CameraRays& camera, TaaSurfaces& surfaces, std::span<image::ImageRGB* const> layers);
+
+  struct Previous {
+    std::optional<CameraRays> camera;
+    std::vector<glm::vec3> position;
+    std::vector<glm::vec4> guide;
+    std::vector<ecs::Entity> entity;
+    std::vector<image::ImageRGB> layers;
+    std::vector<Placed> placed;  // by entity index
+  } prev_;
+  std::vector<Motion> motion_;  // by entity index, this frame
+  std::vector<Placed> placed_;  // by entity index, this frame
+  bool any_moved_ = false;
+  std::vector<image::ImageRGB> out_;  // the resolve's output, kept to reuse its storage
+  std::uint64_t frame_ = 0;
+  Stats stats_;
+};
+
+// Halton (2, 3) point `index` of a cycle of `phases`, centred on 0.
+glm::vec2 taa_jitter(std::uint64_t index, int phases);
+
+}  // namespace engine::render
