@@ -86,6 +86,8 @@ void TemporalAntialiasing::keep_history(const CameraRays& camera, TaaSurfaces& s
                 prev_.layers[l].pixels.begin() + static_cast<std::ptrdiff_t>(b));
   });
   prev_.placed.swap(placed_);
+  prev_.frames.swap(frames_);
+  if (prev_.frames.size() != n) prev_.frames.assign(n, 1);
 }
 
 void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surfaces, std::span<const TaaObject> objects,
@@ -105,6 +107,7 @@ void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surface
     return;
   }
   out_.resize(layers.size());
+  frames_.resize(n);
   for (std::size_t l = 0; l < layers.size(); ++l) out_[l].pixels.resize(n);
   const CameraRays& before = *prev_.camera;
   const float blend = std::clamp(settings.blend, 0.0f, 1.0f);
@@ -149,13 +152,15 @@ void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surface
         const bool still = !self_moved && glm::dot(motion, motion) < 0.05f * 0.05f;
         // The previous frame's pixels around that point, bilinearly, each
         // only where it showed this surface.
-        float weight = 0.0f;
+        float weight = 0.0f, best = 0.0f;
+        std::uint8_t frames = 0;  // how many frames the history holds (its main tap's)
         glm::vec3 history[kMaxLayers] = {};
         if (camera_still && !self_moved) {
           // Most pixels of a still camera: the pixel itself, one tap.
           const ecs::Entity was = prev_.entity[p];
           if (was == self || !moved(was)) {
             weight = 1.0f;
+            frames = prev_.frames[p];
             for (std::size_t l = 0; l < layers.size(); ++l) history[l] = prev_.layers[l].pixels[p];
           }
         } else if (on_film) {
@@ -185,6 +190,10 @@ void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surface
             }
             if (!match) continue;
             weight += wk;
+            if (wk > best) {
+              best = wk;
+              frames = prev_.frames[q];
+            }
             for (std::size_t l = 0; l < layers.size(); ++l) history[l] += wk * prev_.layers[l].pixels[q];
           }
         }
@@ -192,28 +201,35 @@ void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surface
           // Nothing there showed this surface: the pixel restarts.
           if (hit) ++local_rejected;
           for (std::size_t l = 0; l < layers.size(); ++l) out_[l].pixels[p] = layers[l]->pixels[p];
+          frames_[p] = 1;
           continue;
         }
         ++local_reused;
         // Less of the history where only part of it matched; clamped in
         // full once the point moves a quarter pixel or the light changed,
         // not at all where neither.
-        const float alpha = blend + (1.0f - blend) * std::max(0.0f, 1.0f - weight);
+        // A young history is the plain mean of its frames (no first frame
+        // weighing on for long); a full one blends at `blend`.
+        frames_[p] = static_cast<std::uint8_t>(std::min(255, frames + 1));
+        const float alpha = std::max(blend + (1.0f - blend) * std::max(0.0f, 1.0f - weight), 1.0f / static_cast<float>(frames_[p]));
         const float clamp_amount = light_changed ? 1.0f : std::min(1.0f, 4.0f * glm::length(motion));
         for (std::size_t l = 0; l < layers.size(); ++l) {
           const image::ImageRGB& cur = *layers[l];
           glm::vec3 kept = history[l] / weight;
           if (clamp_amount > 0.0f) {
-            // The pixel and its four edge neighbours: the range that
-            // matters, at about half the reads of all eight.
-            const glm::vec3* c = cur.pixels.data();
-            const glm::vec3& m = c[p];
-            const glm::vec3& l_ = c[p - (x > 0 ? 1 : 0)];
-            const glm::vec3& r_ = c[p + (x + 1 < w ? 1 : 0)];
-            const glm::vec3& u_ = c[p - (y > 0 ? static_cast<std::size_t>(w) : 0)];
-            const glm::vec3& d_ = c[p + (y + 1 < h ? static_cast<std::size_t>(w) : 0)];
-            const glm::vec3 lo = glm::min(glm::min(glm::min(m, l_), glm::min(r_, u_)), d_);
-            const glm::vec3 hi = glm::max(glm::max(glm::max(m, l_), glm::max(r_, u_)), d_);
+            // The 3x3 neighbours' range: at a silhouette it spans both
+            // sides whichever way the edge runs, so the jitter's alternation
+            // there stays inside it.
+            glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+            for (int dy = -1; dy <= 1; ++dy) {
+              const glm::vec3* row = cur.pixels.data() + static_cast<std::size_t>(std::clamp(y + dy, 0, h - 1)) * w;
+              const glm::vec3 a = row[std::max(x - 1, 0)], b = row[x], c = row[std::min(x + 1, w - 1)];
+              lo = glm::min(lo, glm::min(glm::min(a, b), c));
+              hi = glm::max(hi, glm::max(glm::max(a, b), c));
+            }
+            const glm::vec3 margin = settings.clamp_margin * 0.5f * (glm::abs(lo) + glm::abs(hi));
+            lo -= margin;
+            hi += margin;
             kept += clamp_amount * (glm::clamp(kept, lo, hi) - kept);
           }
           out_[l].pixels[p] = kept + alpha * (cur.pixels[p] - kept);

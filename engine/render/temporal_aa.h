@@ -8,8 +8,9 @@
 // sample counts only where the previous frame saw the same object there,
 // on the same tangent plane, with a similar normal. Where the pixel moved on
 // screen, or the caller says the light changed, the history is clamped to
-// the range of the current frame's pixel and its four edge neighbours, so what changed does not
-// linger; where neither holds it is not, so a feature thinner than a pixel,
+// the range of the current frame's pixel and its four edge neighbours
+// (widened by a margin, so small changes of light blend instead of
+// flickering), so what changed does not linger; where neither holds it is not, so a feature thinner than a pixel,
 // which only some jitter points hit, keeps its average instead of being
 // clamped away by the frames that miss it. Where nothing in the history
 // matches (an object moved away, a cut, a resize) the pixel restarts from
@@ -29,9 +30,18 @@ namespace engine::render {
 
 struct TemporalAaSettings {
   bool enabled = false;
-  // The current frame's weight where the history matches. Higher = follows
-  // changing light sooner, at the cost of more aliasing and flicker left in.
+  // The current frame's weight where the history matches (a history of
+  // fewer than 1 / blend frames is their plain mean). Higher = follows
+  // changing light sooner, at the cost of more aliasing and of more of the
+  // jitter's alternation at edges left in (UE4's default is 0.04).
   float blend = 0.1f;
+  // Where the history is clamped, the range of the current neighbours is
+  // widened by this fraction of its middle: a change of light smaller than
+  // that (a probe's update, the sun a little further on) is blended over
+  // frames instead of passed through as flicker. Higher = steadier under
+  // slowly changing light, at the cost of a trail that long behind a
+  // change of that size (a moving shadow's soft edge).
+  float clamp_margin = 0.2f;
   // Sub-pixel points in the jitter cycle. Higher = finer antialiasing of a
   // still view, at the cost of a longer cycle to converge.
   int jitter_phases = 16;
@@ -104,6 +114,7 @@ class TemporalAntialiasing {
     std::vector<glm::vec3> position;
     std::vector<glm::vec4> guide;
     std::vector<ecs::Entity> entity;
+    std::vector<std::uint8_t> frames;  // per pixel: frames its history holds, up to 255
     std::vector<image::ImageRGB> layers;
     std::vector<Placed> placed;  // by entity index
   } prev_;
@@ -111,6 +122,7 @@ class TemporalAntialiasing {
   std::vector<Placed> placed_;  // by entity index, this frame
   bool any_moved_ = false;
   std::vector<image::ImageRGB> out_;  // the resolve's output, kept to reuse its storage
+  std::vector<std::uint8_t> frames_;  // this frame's per-pixel frame counts
   std::uint64_t frame_ = 0;
   Stats stats_;
 };

@@ -68,7 +68,8 @@ struct Synthetic {
   }
 };
 
-render::TemporalAaSettings on() { return render::TemporalAaSettings{.enabled = true}; }
+// A blend of 0.1, so the expectations below read simply.
+render::TemporalAaSettings on() { return render::TemporalAaSettings{.enabled = true, .blend = 0.1f}; }
 
 // The share of the jitter cycle's samples in pixel x that land left of film x `edge`.
 float covered(int x, float edge, int phases) {
@@ -177,4 +178,24 @@ TEST(TemporalAa, ChangedLightIsClampedOnlyWhenSaid) {
   const float clamped = v.frame(told, on(), true).at(kW / 2, kH / 2).r;
   EXPECT_NEAR(kept, 0.9f, 1e-5f) << "unclamped, the history fades at the blend rate";
   EXPECT_FLOAT_EQ(clamped, 0.0f) << "clamped to this frame's neighbours: out at once";
+}
+
+TEST(TemporalAa, ASmallChangeOfLightBlendsAndALargeOneIsClamped) {
+  // Under a slowly moving sun each frame's light differs a little from the
+  // last (and a probe's update jumps by a few per cent): within the clamp's
+  // margin that is blended over frames, not passed through as flicker.
+  Synthetic v;
+  render::TemporalAntialiasing taa;
+  v.shade = [](ecs::Entity, float) { return 1.0f; };
+  for (int f = 0; f < 16; ++f) v.frame(taa, on());
+  v.shade = [](ecs::Entity, float) { return 0.95f; };
+  const float small = v.frame(taa, on(), true).at(kW / 2, kH / 2).r;
+  const float margin = on().clamp_margin;
+  ASSERT_GT(margin, 0.05f);
+  EXPECT_NEAR(small, 1.0f - 0.1f * 0.05f, 1e-5f) << "a 5 % change is within the margin: blended at the blend rate";
+  v.shade = [](ecs::Entity, float) { return 0.5f; };
+  const float large = v.frame(taa, on(), true).at(kW / 2, kH / 2).r;
+  // Clamped to 0.5 x (1 + margin), then blended with 0.5.
+  const float clamped = 0.5f * (1.0f + margin);
+  EXPECT_NEAR(large, clamped + 0.1f * (0.5f - clamped), 1e-5f) << "a halving is clamped to the margin around this frame";
 }
