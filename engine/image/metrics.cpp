@@ -43,6 +43,60 @@ double rmse_clamped(const ImageRGB& a, const ImageRGB& b) {
   return std::sqrt(sum / (3.0 * static_cast<double>(a.size())));
 }
 
+std::vector<std::uint8_t> edge_band(const ImageRGB& guide, int radius, double contrast) {
+  const int w = guide.width, h = guide.height;
+  const auto at = [w](int x, int y) { return static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x); };
+  // The luminance of each pixel's 3x3 box mean, so a noisy reference's
+  // speckles are not edges.
+  std::vector<double> y(guide.size());
+  for (int py = 0; py < h; ++py)
+    for (int px = 0; px < w; ++px) {
+      double s = 0;
+      int n = 0;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int qx = px + dx, qy = py + dy;
+          if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
+          s += math::luminance(guide.pixels[at(qx, qy)]);
+          ++n;
+        }
+      y[at(px, py)] = s / n;
+    }
+  std::vector<std::uint8_t> edge(guide.size(), 0), band(guide.size(), 0);
+  for (int py = 0; py < h; ++py)
+    for (int px = 0; px < w; ++px) {
+      const double a = y[at(px, py)];
+      for (const auto& [qx, qy] : {std::pair{px + 1, py}, std::pair{px, py + 1}}) {
+        if (qx >= w || qy >= h) continue;
+        const double b = y[at(qx, qy)], d = std::abs(a - b);
+        if (d > 0.01 && d > contrast * std::max(a, b)) edge[at(px, py)] = edge[at(qx, qy)] = 1;
+      }
+    }
+  for (int py = 0; py < h; ++py)
+    for (int px = 0; px < w; ++px) {
+      if (!edge[at(px, py)]) continue;
+      for (int qy = std::max(0, py - radius); qy <= std::min(h - 1, py + radius); ++qy)
+        for (int qx = std::max(0, px - radius); qx <= std::min(w - 1, px + radius); ++qx) band[at(qx, qy)] = 1;
+    }
+  return band;
+}
+
+double rmse_clamped_in(const ImageRGB& a, const ImageRGB& b, const std::vector<std::uint8_t>& mask) {
+  check_sizes(a, b);
+  if (mask.size() != a.size()) throw ImageError("rmse_clamped_in: the mask is not the images' size");
+  double sum = 0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (!mask[i]) continue;
+    ++n;
+    for (int c = 0; c < 3; ++c) {
+      const double d = clamp01(a.pixels[i][c]) - clamp01(b.pixels[i][c]);
+      sum += d * d;
+    }
+  }
+  return n ? std::sqrt(sum / (3.0 * static_cast<double>(n))) : 0.0;
+}
+
 double top_error_share(const ImageRGB& a, const ImageRGB& b, double fraction) {
   check_sizes(a, b);
   std::vector<double> err(a.size());

@@ -2,6 +2,9 @@
 // Image error metrics, defined in docs/metrics.md. A is the test image, B the
 // reference. RMSE, L1 and SSIM use both images clamped to [0, 1] in linear
 // space (the paper's convention); relMSE uses the unclamped HDR values.
+#include <cstdint>
+#include <vector>
+
 #include "engine/image/image.h"
 #include "engine/image/png.h"
 
@@ -28,6 +31,14 @@ double l1_clamped(const ImageRGB& a, const ImageRGB& b);
 // L = 1, on Rec.709 luminance; mean over the 'valid' windows (no padding).
 double ssim_luminance(const ImageRGB& a, const ImageRGB& b);
 double relmse(const ImageRGB& a, const ImageRGB& b);
+
+// The pixels within `radius` of an edge of `guide`: where the luminance of
+// its 3x3 box mean changes between neighbours by more than `contrast` of
+// the brighter one and by more than 0.01 absolute. On a direct pass, the
+// band around its shadow edges (docs/metrics.md).
+std::vector<std::uint8_t> edge_band(const ImageRGB& guide, int radius = 3, double contrast = 0.25);
+// rmse_clamped over the pixels where mask is set; 0 where none is.
+double rmse_clamped_in(const ImageRGB& a, const ImageRGB& b, const std::vector<std::uint8_t>& mask);
 
 // Per-pixel mean absolute clamped error mapped through a perceptually
 // ordered colour map (black-red-yellow-white); `max_error` maps to white.

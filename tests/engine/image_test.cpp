@@ -6,6 +6,7 @@
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfTiledOutputFile.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -260,4 +261,25 @@ TEST(Metrics, TopErrorShareIsTheWorstPixelsShareOfTheSquaredError) {
   EXPECT_NEAR(engine::image::top_error_share(a, b, 0.01), 0.75 / 3.72, 1e-6);
   EXPECT_NEAR(engine::image::top_error_share(a, b, 1.0), 1.0, 1e-12);
   EXPECT_EQ(engine::image::top_error_share(a, a, 0.5), 0.0) << "no error, no share";
+}
+
+TEST(Metrics, EdgeBandHoldsThePixelsNearAStepAndItsRmseOnlyThose) {
+  // A step from 0.1 to 0.8 between columns 9 and 10 of a 24x8 image: the 3x3
+  // box mean blurs it over columns 9-10 and their neighbours, so with radius
+  // 2 the band is columns 6-13.
+  ImageRGB guide(24, 8);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 24; ++x) guide.at(x, y) = glm::vec3(x < 10 ? 0.1f : 0.8f);
+  const auto band = edge_band(guide, 2);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 24; ++x)
+      EXPECT_EQ(band[static_cast<std::size_t>(y) * 24 + x], x >= 6 && x <= 13 ? 1 : 0) << "pixel " << x << ", " << y;
+  ImageRGB a = guide, b = guide;
+  a.at(8, 3) += glm::vec3(0.3f);   // in the band
+  a.at(20, 3) += glm::vec3(0.9f);  // outside it
+  EXPECT_NEAR(rmse_clamped_in(a, b, band), std::sqrt(0.09 / (8.0 * 8.0)), 1e-6);
+  const ImageRGB flat(24, 8);
+  const auto none = edge_band(flat, 2);
+  EXPECT_EQ(std::count(none.begin(), none.end(), 1), 0);
+  EXPECT_EQ(rmse_clamped_in(a, b, none), 0.0);
 }

@@ -8,7 +8,7 @@
 namespace transgi::cli {
 
 int run_compare(const std::vector<std::string>& argv) {
-  const Args args("compare", argv, {"heatmap", "heatmap-max", "top-error"});
+  const Args args("compare", argv, {"heatmap", "heatmap-max", "top-error", "edge-band-of", "band"});
   if (args.positional().size() != 2) throw UsageError("compare: expected two EXR files: A.exr B.exr (B is the reference)");
   const auto a = engine::image::read_exr(args.positional()[0]);
   const auto b = engine::image::read_exr(args.positional()[1]);
@@ -22,6 +22,18 @@ int run_compare(const std::vector<std::string>& argv) {
     const auto heat = engine::image::error_heatmap(a, b, args.number("heatmap-max", 0, 1e9, 0.0), &used);
     engine::image::write_png(args.str("heatmap"), heat);
     std::fprintf(stderr, "heat map: black = 0, white = %.4g mean absolute error (clamped linear RGB)\n", used);
+  }
+  if (args.has("edge-band-of")) {
+    // The error near the edges of another image (a reference's direct pass:
+    // its shadow edges), printed on a line of its own.
+    const auto guide = engine::image::read_exr(args.str("edge-band-of"));
+    if (guide.width != a.width || guide.height != a.height)
+      throw std::runtime_error("--edge-band-of: " + args.str("edge-band-of") + " is not " + std::to_string(a.width) + "x" +
+                               std::to_string(a.height));
+    const auto band = engine::image::edge_band(guide, static_cast<int>(args.integer("band", 0, 64, 3)));
+    std::size_t n = 0;
+    for (auto v : band) n += v;
+    std::printf("{\"edge_band_rmse\": %.8g, \"edge_band_pixels\": %zu}\n", engine::image::rmse_clamped_in(a, b, band), n);
   }
   if (args.has("top-error")) {
     const double f = args.number("top-error", 0.0, 100.0) / 100.0;
