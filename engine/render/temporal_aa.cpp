@@ -63,6 +63,54 @@ void TemporalAntialiasing::plan_motion(std::span<const TaaObject> objects) {
   }
 }
 
+void TemporalAntialiasing::mark_near_moved() {
+  near_moved_.clear();
+  if (!any_moved_) return;
+  const int w = prev_.camera->width(), h = prev_.camera->height();
+  const std::size_t n = prev_.entity.size();
+  std::vector<std::uint8_t> own(n), row_has(static_cast<std::size_t>(h), 0);
+  near_moved_.assign(n, 0);
+  jobs::parallel_for(0, h, 16, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      std::uint8_t any = 0;
+      for (int x = 0; x < w; ++x) {
+        const std::size_t q = static_cast<std::size_t>(y) * w + x;
+        own[q] = moved(prev_.entity[q]) ? 1 : 0;
+        any |= own[q];
+      }
+      row_has[static_cast<std::size_t>(y)] = any;
+    }
+  });
+  // Dilated by one pixel, only on the rows around those that showed one.
+  jobs::parallel_for(0, h, 16, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      const int lo = std::max(0, y - 1), hi = std::min(h - 1, y + 1);
+      bool near = false;
+      for (int r = lo; r <= hi; ++r) near = near || row_has[static_cast<std::size_t>(r)];
+      if (!near) continue;
+      for (int x = 0; x < w; ++x) {
+        std::uint8_t any = 0;
+        for (int r = lo; r <= hi; ++r)
+          for (int dx = std::max(0, x - 1); dx <= std::min(w - 1, x + 1); ++dx) any |= own[static_cast<std::size_t>(r) * w + dx];
+        near_moved_[static_cast<std::size_t>(y) * w + x] = any;
+      }
+    }
+  });
+}
+
+bool TemporalAntialiasing::moved_beside(std::size_t q, ecs::Entity self) const {
+  const int w = prev_.camera->width(), h = prev_.camera->height();
+  const int x = static_cast<int>(q % static_cast<std::size_t>(w)), y = static_cast<int>(q / static_cast<std::size_t>(w));
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int qx = x + dx, qy = y + dy;
+      if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
+      const ecs::Entity e = prev_.entity[static_cast<std::size_t>(qy) * w + qx];
+      if (e != self && moved(e)) return true;
+    }
+  return false;
+}
+
 void TemporalAntialiasing::keep_history(const CameraRays& camera, TaaSurfaces& surfaces,
                                         std::span<image::ImageRGB* const> layers) {
   const std::size_t n = surfaces.position.size();
@@ -108,6 +156,7 @@ void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surface
   }
   out_.resize(layers.size());
   frames_.resize(n);
+  mark_near_moved();
   for (std::size_t l = 0; l < layers.size(); ++l) out_[l].pixels.resize(n);
   const CameraRays& before = *prev_.camera;
   const float blend = std::clamp(settings.blend, 0.0f, 1.0f);
@@ -158,7 +207,7 @@ void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surface
         if (camera_still && !self_moved) {
           // Most pixels of a still camera: the pixel itself, one tap.
           const ecs::Entity was = prev_.entity[p];
-          if (was == self || !moved(was)) {
+          if ((was == self || !moved(was)) && !(!near_moved_.empty() && near_moved_[p] && moved_beside(p, self))) {
             weight = 1.0f;
             frames = prev_.frames[p];
             for (std::size_t l = 0; l < layers.size(); ++l) history[l] = prev_.layers[l].pixels[p];
@@ -174,12 +223,15 @@ void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surface
             const std::size_t q = static_cast<std::size_t>(qy) * w + qx;
             const ecs::Entity was = prev_.entity[q];
             bool match;
-            if (was != self) {
+            const bool ghost_beside = !self_moved && !near_moved_.empty() && near_moved_[q] && moved_beside(q, self);
+            if (was != self || ghost_beside) {
               // Another surface was seen there. Across a still silhouette
               // that is the other side of the pixel's own edge (the jitter
               // sees one or the other): keep it, that is the antialiasing.
-              // Where either object moved, it is a ghost.
-              match = !self_moved && !moved(was);
+              // Where either object moved, it is a ghost; so is an edge
+              // pixel beside an object that moved, whose history averaged
+              // that object in.
+              match = !self_moved && !moved(was) && !ghost_beside;
             } else if (!hit || still) {
               match = true;
             } else {

@@ -107,6 +107,13 @@ class TemporalAntialiasing {
   [[nodiscard]] bool moved(ecs::Entity e) const {
     return !e.is_null() && e.index < motion_.size() && motion_[e.index].moved && motion_[e.index].generation == e.generation;
   }
+  // Whether the previous frame showed, at or beside its pixel q, an object
+  // other than `self` that has since moved: q's history holds some of it.
+  [[nodiscard]] bool moved_beside(std::size_t q, ecs::Entity self) const;
+  // Per previous pixel: whether it or a neighbour showed an object that has
+  // since moved (empty when none moved), so moved_beside runs only there.
+  void mark_near_moved();
+  std::vector<std::uint8_t> near_moved_;
   void keep_history(const CameraRays& camera, TaaSurfaces& surfaces, std::span<image::ImageRGB* const> layers);
 
   struct Previous {

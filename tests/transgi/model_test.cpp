@@ -77,15 +77,22 @@ TEST(Gemm, Bf16MatchesTheReferenceWithinBf16Rounding) {
     }
 }
 
-TEST(Mlp, ForwardMatchesBetweenBackends) {
+namespace {
+// The default decoder's outputs for 64 random inputs, through `backend`.
+std::vector<float> default_mlp_outputs(GemmBackend backend) {
   Mlp net(MlpLayout{});
   net.initialise(5);
   const int batch = 64;
   const auto x = random_vector(static_cast<std::size_t>(batch) * 16, 6);
-  std::vector<float> y_ref(static_cast<std::size_t>(batch) * 75), y_fast(y_ref.size());
+  std::vector<float> y(static_cast<std::size_t>(batch) * 75);
   MlpWorkspace ws;
-  net.forward(x.data(), batch, y_ref.data(), ws, GemmBackend::Reference);
-  net.forward(x.data(), batch, y_fast.data(), ws, GemmBackend::OneDnn);
+  net.forward(x.data(), batch, y.data(), ws, backend);
+  return y;
+}
+}  // namespace
+
+TEST(Mlp, ForwardMatchesBetweenBackends) {
+  const auto y_ref = default_mlp_outputs(GemmBackend::Reference), y_fast = default_mlp_outputs(GemmBackend::OneDnn);
   for (std::size_t i = 0; i < y_ref.size(); ++i) ASSERT_NEAR(y_fast[i], y_ref[i], 1e-4f) << i;
   EXPECT_EQ(MlpLayout{}.parameter_count(), 16u * 128 + 128 + 2 * (128 * 128 + 128) + 128 * 75 + 75);
   EXPECT_DOUBLE_EQ(MlpLayout{}.flops_per_sample(), 88832.0) << "the figure quoted in the developers' guide";
@@ -93,14 +100,7 @@ TEST(Mlp, ForwardMatchesBetweenBackends) {
 
 TEST(Mlp, Bf16ForwardAgreesToTwoSignificantDigits) {
   if (!bf16_gemm_available()) GTEST_SKIP() << "oneDNN has no bf16 matmul on " << engine::cpu::isa_summary();
-  Mlp net(MlpLayout{});
-  net.initialise(5);
-  const int batch = 64;
-  const auto x = random_vector(static_cast<std::size_t>(batch) * 16, 6);
-  std::vector<float> y_ref(static_cast<std::size_t>(batch) * 75), y_bf(y_ref.size());
-  MlpWorkspace ws;
-  net.forward(x.data(), batch, y_ref.data(), ws, GemmBackend::Reference);
-  net.forward(x.data(), batch, y_bf.data(), ws, GemmBackend::OneDnnBf16);
+  const auto y_ref = default_mlp_outputs(GemmBackend::Reference), y_bf = default_mlp_outputs(GemmBackend::OneDnnBf16);
   double err = 0, norm = 0;
   for (std::size_t i = 0; i < y_ref.size(); ++i) {
     err += (y_bf[i] - y_ref[i]) * (y_bf[i] - y_ref[i]);

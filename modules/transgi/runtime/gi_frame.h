@@ -31,6 +31,11 @@ struct GiFrame {
   // Output size; 0 = update the probes but render no image this frame.
   int width = 0, height = 0;
   engine::ecs::Entity camera;  // null = the first camera found
+  // Set for a frame that does not follow the one before (a camera cut, a
+  // teleport, a loaded save): the real-time path forgets its histories (the
+  // antialiasing's, the GI reuse's) for it instead of rejecting them pixel
+  // by pixel. Cleared once that frame is rendered.
+  bool camera_cut = false;
 
   // Results of the last rendered frame.
   engine::image::ImageRGB gi, direct, full;

@@ -142,6 +142,13 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
     packed.decoder = std::make_unique<shading::FusedDecoder>(model->decoder);
     packed.model = model;
   }
+  // A cut forgets the histories: every cell decoded, no antialiasing history.
+  shading::RealtimeGiSettings realtime = settings.realtime;
+  if (frame.camera_cut) {
+    realtime.reuse_history = false;
+    packed.taa.clear();
+    frame.camera_cut = false;
+  }
   auto t0 = std::chrono::steady_clock::now();
   const bool deterministic = deterministic_direct(settings);
   // The deterministic direct light is shaded tile by tile inside the
@@ -168,7 +175,7 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   const double take_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   shading::RealtimeGiStats st;
   frame.gi = shading::shade_gi_realtime(g, rt, assets, model.get(), model ? packed.decoder.get() : nullptr, has_transfer, fields,
-                                        settings.realtime, &st, deterministic ? &frame.direct : nullptr, &packed.scratch, &lights, settings.mirror,
+                                        realtime, &st, deterministic ? &frame.direct : nullptr, &packed.scratch, &lights, settings.mirror,
                                         settings.near_field, batch_decoder);
   frame.gpu_inference_ms = st.inference_device_ms;
   GiStageTimes& t = frame.times;

@@ -222,28 +222,39 @@ std::vector<float> penumbra_filter(const GBuffer& g, const std::vector<float>& b
                                    float pixel_spread) {
   const int w = g.width, h = g.height;
   const std::size_t n = blocker.size();
-  std::vector<float> lit(n);
+  std::vector<float> out(n);
   engine::jobs::parallel_for<std::size_t>(0, n, 16384, [&](std::size_t b, std::size_t e) {
-    for (std::size_t p = b; p < e; ++p) lit[p] = std::isnan(blocker[p]) ? kNotReceiver : std::isinf(blocker[p]) ? 1.0f : 0.0f;
+    for (std::size_t p = b; p < e; ++p) out[p] = std::isnan(blocker[p]) ? kNotReceiver : std::isinf(blocker[p]) ? 1.0f : 0.0f;
   });
-  if (!(tan_radius > 0)) return lit;
-  // Where the pattern rays around a pixel are all lit or all blocked, the
-  // filter would change nothing; elsewhere their blockers' mean distance
-  // gives the penumbra's width.
+  if (!(tan_radius > 0)) return out;
+  const std::vector<float> lit = out;
+  // Only the 8x8 blocks whose neighbourhood holds both lit and blocked
+  // pattern rays change; the rest keep their own visibility.
   const BlockerCounts counts = count_blockers(blocker, w, h);
+  const int blocks_x = counts.blocks_x;
+  std::vector<int> mixed;
+  for (std::size_t b = 0; b < counts.around.size(); ++b) {
+    const glm::vec3& c = counts.around[b];
+    if (c.x > 0.5f && c.z > 0.5f && std::isfinite(c.y)) mixed.push_back(static_cast<int>(b));
+  }
+  // Per pixel of those blocks: the penumbra's half-width in pixels from the
+  // nearest blockers' distance, at most 8 (a box 8 pixels wide or more covers
+  // the whole pattern).
   std::vector<std::uint8_t> radius(n, 0);
-  engine::jobs::parallel_for(0, h, 8, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < w; ++x) {
-        const std::size_t p = static_cast<std::size_t>(y) * w + x;
-        const float depth = g.guide[p].w;
-        const glm::vec3& c = counts.at(x, y);
-        if (std::isnan(lit[p]) || c.x < 0.5f || c.z < 0.5f || !(depth > 0)) continue;
-        // The penumbra's half-width in pixels, at most 8: a box 8 pixels
-        // wide or more covers the whole pattern.
-        const float r = std::ceil(c.y * tan_radius / (depth * pixel_spread));
-        radius[p] = static_cast<std::uint8_t>(std::clamp(r, 0.0f, 8.0f));
+  const auto each_mixed_pixel = [&](auto&& fn) {
+    engine::jobs::parallel_for(0, static_cast<int>(mixed.size()), 4, [&](int m0, int m1) {
+      for (int m = m0; m < m1; ++m) {
+        const int bx = mixed[static_cast<std::size_t>(m)] % blocks_x, by = mixed[static_cast<std::size_t>(m)] / blocks_x;
+        for (int y = by * 8; y < std::min(h, by * 8 + 8); ++y)
+          for (int x = bx * 8; x < std::min(w, bx * 8 + 8); ++x) fn(x, y, static_cast<std::size_t>(y) * w + x);
       }
+    });
+  };
+  each_mixed_pixel([&](int x, int y, std::size_t p) {
+    const float depth = g.guide[p].w;
+    if (std::isnan(lit[p]) || !(depth > 0)) return;
+    const float r = std::ceil(counts.at(x, y).y * tan_radius / (depth * pixel_spread));
+    radius[p] = static_cast<std::uint8_t>(std::clamp(r, 0.0f, 8.0f));
   });
   const SurfaceTest same{g.guide, g.position};
   // A box of radius 4 or more is [-r, r - 1], an even width: 8 and 16
@@ -251,47 +262,34 @@ std::vector<float> penumbra_filter(const GBuffer& g, const std::vector<float>& b
   // 9 or 17 would count one more and leave its trace.
   const auto last = [](int r) { return r >= 4 ? r - 1 : r; };
   // Rows, then columns, each a box over the pixel's own radius on its own
-  // surface; the columns take the rows' means.
-  std::vector<float> rows(n), out(n);
-  engine::jobs::parallel_for(0, h, 4, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < w; ++x) {
-        const std::size_t p = static_cast<std::size_t>(y) * w + x;
-        if (radius[p] == 0 || std::isnan(lit[p])) {
-          rows[p] = lit[p];
-          continue;
-        }
-        float sum = 0, count = 0;
-        for (int dx = -radius[p]; dx <= last(radius[p]); ++dx) {
-          const int qx = x + dx;
-          if (qx < 0 || qx >= w) continue;
-          const std::size_t q = p + static_cast<std::size_t>(static_cast<std::ptrdiff_t>(dx));
-          if (std::isnan(lit[q]) || !same(p, q)) continue;
-          sum += lit[q];
-          count += 1;
-        }
-        rows[p] = sum / count;
-      }
+  // surface; the columns take the rows' means (a pixel outside the blocks
+  // that change is its own mean).
+  std::vector<float> rows(lit);
+  each_mixed_pixel([&](int x, int, std::size_t p) {
+    if (radius[p] == 0) return;
+    float sum = 0, count = 0;
+    for (int dx = -radius[p]; dx <= last(radius[p]); ++dx) {
+      const int qx = x + dx;
+      if (qx < 0 || qx >= w) continue;
+      const std::size_t q = p + static_cast<std::size_t>(static_cast<std::ptrdiff_t>(dx));
+      if (std::isnan(lit[q]) || !same(p, q)) continue;
+      sum += lit[q];
+      count += 1;
+    }
+    rows[p] = sum / count;
   });
-  engine::jobs::parallel_for(0, h, 4, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < w; ++x) {
-        const std::size_t p = static_cast<std::size_t>(y) * w + x;
-        if (radius[p] == 0 || std::isnan(lit[p])) {
-          out[p] = rows[p];
-          continue;
-        }
-        float sum = 0, count = 0;
-        for (int dy = -radius[p]; dy <= last(radius[p]); ++dy) {
-          const int qy = y + dy;
-          if (qy < 0 || qy >= h) continue;
-          const std::size_t q = static_cast<std::size_t>(qy) * w + x;
-          if (std::isnan(rows[q]) || !same(p, q)) continue;
-          sum += rows[q];
-          count += 1;
-        }
-        out[p] = sum / count;
-      }
+  each_mixed_pixel([&](int x, int y, std::size_t p) {
+    if (radius[p] == 0) return;
+    float sum = 0, count = 0;
+    for (int dy = -radius[p]; dy <= last(radius[p]); ++dy) {
+      const int qy = y + dy;
+      if (qy < 0 || qy >= h) continue;
+      const std::size_t q = static_cast<std::size_t>(qy) * w + x;
+      if (std::isnan(rows[q]) || !same(p, q)) continue;
+      sum += rows[q];
+      count += 1;
+    }
+    out[p] = sum / count;
   });
   return out;
 }
