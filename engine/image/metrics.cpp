@@ -190,11 +190,16 @@ double ssim_luminance(const ImageRGB& a, const ImageRGB& b) {
 
 ErrorMetrics compare_images(const ImageRGB& a, const ImageRGB& b) {
   double la = 0, lb = 0;
+  glm::dvec3 ca(0.0), cb(0.0);
   for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) {
     la += math::luminance(a.pixels[i]);
     lb += math::luminance(b.pixels[i]);
+    ca += glm::dvec3(a.pixels[i]);
+    cb += glm::dvec3(b.pixels[i]);
   }
-  return {rmse_clamped(a, b), l1_clamped(a, b), ssim_luminance(a, b), relmse(a, b), lb > 0 ? la / lb : 0.0};
+  glm::dvec3 rgb(0.0);
+  for (int c = 0; c < 3; ++c) rgb[c] = cb[c] > 0 ? ca[c] / cb[c] : 0.0;
+  return {rmse_clamped(a, b), l1_clamped(a, b), ssim_luminance(a, b), relmse(a, b), lb > 0 ? la / lb : 0.0, rgb};
 }
 
 Rgb8Image error_heatmap(const ImageRGB& a, const ImageRGB& b, double max_error, double* used_max) {

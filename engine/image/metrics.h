@@ -16,6 +16,7 @@ struct ErrorMetrics {
   double ssim = 0;
   double relmse = 0;
   double mean_ratio = 0;  // mean luminance of a over b's (1 = the same overall light; 0 if b is black)
+  glm::dvec3 mean_ratio_rgb{0.0};  // the same per channel: a shift of hue shows as channels apart
 };
 
 inline constexpr double kRelMseEpsilon = 1e-2;

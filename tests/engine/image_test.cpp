@@ -196,6 +196,19 @@ TEST(Metrics, RmseL1AndRelMseHandComputed) {
   EXPECT_NEAR(relmse(a, b), expected, 1e-9);
 }
 
+TEST(Metrics, MeanRatioPerChannelIsEachChannelsSumOverTheReferences) {
+  // Unclamped: a's (1.5, -0.25, 0.25) and b's (0.75, 0.25, 0) on every pixel -> 2, -1, and 0 where b has none.
+  ImageRGB a(11, 11), b(11, 11);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    a.pixels[i] = {1.5f, -0.25f, 0.25f};
+    b.pixels[i] = {0.75f, 0.25f, 0.0f};
+  }
+  const ErrorMetrics m = compare_images(a, b);
+  EXPECT_NEAR(m.mean_ratio_rgb.r, 2.0, 1e-9);
+  EXPECT_NEAR(m.mean_ratio_rgb.g, -1.0, 1e-9);
+  EXPECT_EQ(m.mean_ratio_rgb.b, 0.0);
+}
+
 TEST(Metrics, SsimOfIdenticalImagesIsOne) {
   ImageRGB a(16, 13);
   for (std::size_t i = 0; i < a.size(); ++i) a.pixels[i] = glm::vec3(static_cast<float>(i % 7) / 7.0f);

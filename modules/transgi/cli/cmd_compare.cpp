@@ -40,8 +40,8 @@ int run_compare(const std::vector<std::string>& argv) {
     std::printf("{\"rmse\": %.8g, \"l1\": %.8g, \"ssim\": %.8g, \"relmse\": %.8g, \"mean_ratio\": %.6g, \"top_error_share\": %.6g}\n",
                 m.rmse, m.l1, m.ssim, m.relmse, m.mean_ratio, engine::image::top_error_share(a, b, f));
   } else {
-    std::printf("{\"rmse\": %.8g, \"l1\": %.8g, \"ssim\": %.8g, \"relmse\": %.8g, \"mean_ratio\": %.6g}\n", m.rmse, m.l1, m.ssim, m.relmse,
-                m.mean_ratio);
+    std::printf("{\"rmse\": %.8g, \"l1\": %.8g, \"ssim\": %.8g, \"relmse\": %.8g, \"mean_ratio\": %.6g, \"mean_ratio_rgb\": [%.4f, %.4f, %.4f]}\n",
+                m.rmse, m.l1, m.ssim, m.relmse, m.mean_ratio, m.mean_ratio_rgb.r, m.mean_ratio_rgb.g, m.mean_ratio_rgb.b);
   }
   return 0;
 }
