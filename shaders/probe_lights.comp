@@ -71,26 +71,34 @@ void main() {
   const vec3 x = vec3(q.px, q.py, q.pz), n = vec3(q.nx, q.ny, q.nz);
   const uint last = p.fields - 1u;
 
-  // blend_boxes: the first field whose box holds x, and across its band the next.
+  // blend_boxes: the first field whose box holds x, and across its band the
+  // next; the fallbacks (the far field, last) only where no other box holds x.
+  uint blended_fields = p.fields;
+  while (blended_fields > 0u && fields[blended_fields - 1u].fallback != 0u) --blended_fields;
+  const uint blended_last = blended_fields > 0u ? blended_fields - 1u : last;
   uint first = last, second = 0u;
   float w0 = 1.0, w1 = 0.0;
   bool two = false;
   uint f = 0u;
-  while (f < p.fields && depth_inside(f, x) < 0.0) ++f;
-  if (f < p.fields) {
+  while (f < blended_fields && depth_inside(f, x) < 0.0) ++f;
+  if (f < blended_fields) {
     first = f;
     const float band = fields[f].band;
     const float w = band > 0.0 ? clamp(depth_inside(f, x) / band, 0.0, 1.0) : 1.0;
     if (w < 1.0) {
       uint g = f + 1u;
-      while (g < p.fields && depth_inside(g, x) < 0.0) ++g;
-      if (g < p.fields || f != last) {
-        second = g < p.fields ? g : last;
+      while (g < blended_fields && depth_inside(g, x) < 0.0) ++g;
+      if (g < blended_fields || f != blended_last) {
+        second = g < blended_fields ? g : blended_last;
         w0 = w;
         w1 = 1.0 - w;
         two = true;
       }
     }
+  } else {
+    uint h = blended_fields;
+    while (h < p.fields && depth_inside(h, x) < 0.0) ++h;
+    first = h < p.fields ? h : last;
   }
 
   // An unlit field hands the point on to the next that holds it.

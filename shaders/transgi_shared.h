@@ -84,12 +84,14 @@ struct InterpolatePush {
 // probe rays' bounce light, the frame's lights): its interpolation, where its
 // probes and depth texels start, where its mean light starts in an SH buffer
 // (probe_lights.comp), whether it is there at all (probe_hit_finish.comp),
-// and its placed grid's box with the hand-over band (cascades.h's BlendBox).
+// and its placed grid's box with the hand-over band and whether it is a
+// fallback, lighting only what no other box holds (cascades.h's BlendBox).
 struct ProbeFieldGpu {
   InterpolatePush field;
   uint probe_base, depth_base, mean_at, enabled;
   float box_min_x, box_min_y, box_min_z, band;
-  float box_max_x, box_max_y, box_max_z, pad0;
+  float box_max_x, box_max_y, box_max_z;
+  uint fallback;
 };
 
 // Per probe: its relocation offset, its depth unit, whether it holds light.
@@ -183,7 +185,8 @@ static_assert(sizeof(InterpolatePush) == 96 && offsetof(InterpolatePush, bias_le
               "InterpolatePush layout");
 static_assert(sizeof(ProbeGpu) == 32 && offsetof(ProbeGpu, usable) == 16, "ProbeGpu layout");
 static_assert(sizeof(ProbeFieldGpu) == 144 && offsetof(ProbeFieldGpu, probe_base) == 96 && offsetof(ProbeFieldGpu, enabled) == 108 &&
-              offsetof(ProbeFieldGpu, band) == 124 && offsetof(ProbeFieldGpu, box_max_x) == 128,
+              offsetof(ProbeFieldGpu, band) == 124 && offsetof(ProbeFieldGpu, box_max_x) == 128 &&
+              offsetof(ProbeFieldGpu, fallback) == 140,
               "ProbeFieldGpu layout");
 static_assert(sizeof(InterpolationGpu) == 80 && offsetof(InterpolationGpu, weights) == 32 &&
               offsetof(InterpolationGpu, pruned) == 64, "InterpolationGpu layout");

@@ -31,7 +31,7 @@ struct Cascades {
 // level, updated for 12 frames, the finer lit beyond their box by the
 // coarser, as the plugin runs them.
 Cascades level_cascades(const rt::RtScene& scene, const render::LightSet& lights, const glm::vec3& eye, int count = 3,
-                        float finest_cell = 0.4f) {
+                        float finest_cell = 0.4f, bool far_field = false) {
   probes::CascadeSettings c;
   c.count = count;
   c.finest_cell = finest_cell;
@@ -45,9 +45,19 @@ Cascades level_cascades(const rt::RtScene& scene, const render::LightSet& lights
     s.blend_cells = c.blend_cells;
     out.owned.push_back(std::make_unique<probes::ProbeField>(s));
   }
+  if (far_field) {
+    // A far field over the level's bounds, as follow_camera adds past the coarsest cascade.
+    probes::ProbeFieldSettings s;
+    s.grid = probes::ProbeGrid::centred_in(scene.bounds_min(), scene.bounds_max(), c.dims);
+    s.map = probes::MapLayout{16, 8};
+    s.rays_per_probe = 32;
+    s.blend_cells = probes::kFallbackBlendCells;
+    out.owned.push_back(std::make_unique<probes::ProbeField>(s));
+  }
+  const int fields = static_cast<int>(out.owned.size());
   for (int frame = 0; frame < 12; ++frame)
-    for (int k = c.count - 1; k >= 0; --k)
-      out.owned[static_cast<std::size_t>(k)]->update(scene, lights, k + 1 < c.count ? out.owned[static_cast<std::size_t>(k) + 1].get() : nullptr);
+    for (int k = fields - 1; k >= 0; --k)
+      out.owned[static_cast<std::size_t>(k)]->update(scene, lights, k + 1 < fields ? out.owned[static_cast<std::size_t>(k) + 1].get() : nullptr);
   for (const auto& f : out.owned) out.fields.push_back(f.get());
   return out;
 }
@@ -80,7 +90,10 @@ Compared compare_lights(engine::gpu::VulkanContext& ctx, const Cascades& c, cons
   };
 
   std::vector<shading::ProbeLightMaker::Point> pts(static_cast<std::size_t>(n));
-  const probes::ProbeGrid& coarse = c.fields.back()->placement();
+  // The coarsest cascade: the last field that is not a fallback (a far field).
+  std::size_t last_cascade = c.fields.size() - 1;
+  while (last_cascade > 0 && c.fields[last_cascade]->settings().blend_cells == probes::kFallbackBlendCells) --last_cascade;
+  const probes::ProbeGrid& coarse = c.fields[last_cascade]->placement();
   for (auto& p : pts) {
     // Half in the finest cascade's neighbourhood, half anywhere in and just
     // outside the coarsest, a few far beyond it.
@@ -156,6 +169,24 @@ TEST(VulkanProbeLights, EqualTheCpuFieldInterpolationAcrossCascadesAndRotations)
   const Compared got = compare_lights(*ctx, c, eye, 4000, 5);
   EXPECT_GT(got.blended, got.points / 50) << "some points should lie in the hand-over bands";
   EXPECT_GT(got.outside, got.points / 50) << "some points should lie outside every cascade";
+  EXPECT_LE(got.differ, got.points / 200) << "expected at most 0.5 % of points to differ, got " << got.differ;
+}
+
+// Two small cascades (0.4 and 0.8 m cells, 4.8 m across) and a far field
+// over the level: points past the cascades take the far field's light, and
+// points in the coarsest cascade's band keep the cascades' (cascades.h's
+// fallback box), on the device as on the CPU.
+TEST(VulkanProbeLights, EqualTheCpuAcrossCascadesAndAFarField) {
+  GPU_TEST_CONTEXT_OR_SKIP(ctx);
+  eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
+  const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
+  const render::LightSet lights(scene, render::gather_punctual_lights(loaded.app->world()), nullptr);
+  const glm::vec3 eye = 0.5f * (scene.bounds_min() + scene.bounds_max()) + glm::vec3(0.7f, 0.1f, -0.4f);
+  Cascades c;
+  loaded.app->jobs().run([&] { c = level_cascades(scene, lights, eye, 2, 0.4f, true); });
+  const Compared got = compare_lights(*ctx, c, eye, 4000, 13);
+  EXPECT_GT(got.blended, got.points / 50) << "some points should lie in the hand-over band";
+  EXPECT_GT(got.outside, got.points / 50) << "some points should lie past the cascades, in the far field";
   EXPECT_LE(got.differ, got.points / 200) << "expected at most 0.5 % of points to differ, got " << got.differ;
 }
 

@@ -19,6 +19,7 @@
 #include "engine/app/app.h"
 #include "engine/scene/components.h"
 #include "engine/scene/procedural.h"
+#include "runtime/probe_placement.h"
 #include "runtime/transgi_plugin.h"
 
 using namespace transgi;
@@ -32,6 +33,7 @@ struct RoomCase {
   float point_light = 0.0f;  // the point light's intensity at scale 1 (candela; scaled by scale^2)
   glm::ivec3 dims{4, 3, 4};  // probe grid
   bool keep_updating = false;  // on = converged probes keep tracing (no convergence skip)
+  bool default_probes = false; // on = the default placement (cascades, fitted grid, far field) instead of a scaled volume
 };
 
 class Room {
@@ -69,6 +71,10 @@ class Room {
     transform::Transform ct = transform::Transform::from_translation(s * glm::vec3(0.0f, 0.0f, 1.9f));
     w.emplace<transform::Transform>(camera, ct);
     w.emplace<scene::Camera>(camera, scene::Camera{.yfov_radians = 1.2f, .znear = 0.01f * s});
+    if (c.default_probes) {
+      runtime::spawn_probes(w, runtime::ProbePlacement{});
+      return;
+    }
     const ecs::Entity volume = w.spawn();
     w.emplace<runtime::ProbeVolume>(volume, runtime::ProbeVolume{.min = s * glm::vec3(-1.8f, -1.3f, -1.8f),
                                                                  .max = s * glm::vec3(1.8f, 1.3f, 1.8f), .dims = c.dims});
@@ -134,8 +140,8 @@ Measured measure(const RoomCase& c, int frames = kFrames) {
   return m;
 }
 
-void expect_scale_invariant(float scale) {
-  const RoomCase base{.point_light = 3.0f};
+void expect_scale_invariant(float scale, bool default_probes = false) {
+  const RoomCase base{.point_light = 3.0f, .default_probes = default_probes};
   const Measured one = measure(base);
   RoomCase scaled = base;
   scaled.scale = scale;
@@ -162,6 +168,16 @@ void expect_linear_in_emission(float emission) {
 TEST(Stress, MillimetreAndTenKilometreRoomsLightAsAMetreRoom) {
   expect_scale_invariant(1e-3f);
   expect_scale_invariant(1e4f);
+}
+
+// Issue 37's far field: at the default placement a 40 km room is past every
+// camera-centred cascade (32 m across), whose probes are far from every
+// surface there and hold nothing; the far field over the scene's bounds
+// lights it as a 4 m room (before it: 23 % of the full image lost). A 4 mm
+// room gets one fitted grid.
+TEST(Stress, AtTheDefaultPlacementMillimetreAndTenKilometreRoomsLightAsAMetreRoom) {
+  expect_scale_invariant(1e-3f, true);
+  expect_scale_invariant(1e4f, true);
 }
 
 TEST(Stress, LightIsLinearInEmitterStrengthFromOneMillionthToAMillion) {

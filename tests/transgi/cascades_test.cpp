@@ -164,6 +164,26 @@ TEST(CascadeBlend, WeightsSumToOneAndTheFinestHoldsItsInterior) {
   EXPECT_EQ(far.box[0], s.count - 1);
 }
 
+TEST(CascadeBlend, AFallbackBoxLightsOnlyWhatNoOtherBoxHolds) {
+  // One cascade [0, 10]^3 with a 2 m band, then a far field [-100, 100]^3:
+  // inside the cascade, the blend is what it was without the far field (the
+  // band keeps its light whole); beyond it, the far field takes all.
+  const std::vector<BlendBox> alone = {{glm::vec3(0.0f), glm::vec3(10.0f), 2.0f}};
+  std::vector<BlendBox> with = alone;
+  with.push_back({glm::vec3(-100.0f), glm::vec3(100.0f), 0.0f, true});
+  for (const glm::vec3 p : {glm::vec3(5.0f), glm::vec3(9.5f, 5.0f, 5.0f), glm::vec3(0.2f, 0.1f, 9.9f)}) {
+    const BoxMix a = blend_boxes(alone, p), b = blend_boxes(with, p);
+    EXPECT_EQ(b.count, a.count);
+    EXPECT_EQ(b.box[0], 0);
+    EXPECT_EQ(b.weight[0], a.weight[0]) << "at (" << p.x << ", " << p.y << ", " << p.z << ")";
+  }
+  const BoxMix beyond = blend_boxes(with, glm::vec3(50.0f, 5.0f, 5.0f));
+  EXPECT_EQ(beyond.count, 1);
+  EXPECT_EQ(beyond.box[0], 1);
+  EXPECT_EQ(beyond.weight[0], 1.0f);
+  EXPECT_EQ(blend_boxes(with, glm::vec3(500.0f)).box[0], 1) << "outside every box: the fallback, clamped";
+}
+
 TEST(CascadeBlend, AnAuthoredVolumeOverridesTheCascadesInsideIt) {
   CascadeSettings s;
   const glm::vec3 eye{0.0f, 1.5f, 0.0f};
@@ -330,6 +350,34 @@ TEST(CascadeFit, ASmallSceneGetsOneGridOverItsBoundsAndABigOneGetsCascades) {
   }
 }
 
+TEST(CascadeFit, PastTheCoarsestCascadeAFarFieldCoversTheScene) {
+  // The room is 12 m; cascades of 0.25 m cells reach 6 x 0.25 x 2^(count-1):
+  // 12 m with four of them (no far field), 3 m with two (a far field last,
+  // one grid over the scene's bounds; none when switched off).
+  for (const int count : {4, 2})
+    for (const bool far : {true, false}) {
+      CascadeSettings cs;
+      cs.count = count;
+      cs.dims = glm::ivec3(6);
+      cs.finest_cell = 0.25f;
+      cs.fit_scene_cell = 0.0f;
+      cs.far_field = far;
+      Room room(cs);
+      room.app.jobs().run([&] { room.app.update(); });
+      const runtime::ProbeCascades* set = nullptr;
+      room.app.world().view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& c) { set = &c; });
+      ASSERT_NE(set, nullptr);
+      const auto& rt = room.app.world().resource<rt::RtScene>();
+      const bool want = far && count == 2;
+      ASSERT_EQ(needs_far_field(cs, rt.bounds_min(), rt.bounds_max()), count == 2);
+      EXPECT_EQ(set->state.far_field, want) << count << " cascades, far field " << far;
+      ASSERT_EQ(set->state.fields.size(), static_cast<std::size_t>(count + (want ? 1 : 0)));
+      if (want) {
+        EXPECT_EQ(set->state.fields.back()->settings().grid, ProbeGrid::centred_in(rt.bounds_min(), rt.bounds_max(), cs.dims));
+      }
+    }
+}
+
 TEST(AuthoredVolumes, AMarkedNodeGetsAVolumeOverItsRotatedBoxAndAFlatOneIsRefusedByName) {
   ecs::World w;
   const ecs::Entity e = w.spawn();
@@ -371,6 +419,7 @@ TEST(DdgiCascades, TheSameScrollKeepsMapsSeedsTheEnteredAndNeverGivesABlackPixel
   cs.count = 2;
   cs.dims = glm::ivec3(6);
   cs.fit_scene_cell = 0.0f;
+  cs.far_field = false;  // the two cascades alone: what scrolls
   Room room(cs, /*ddgi=*/true);
   auto& frame = room.app.world().resource<ddgi::DdgiFrame>();
   frame.width = 48;

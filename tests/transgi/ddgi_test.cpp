@@ -120,3 +120,18 @@ TEST(Ddgi, ClassificationDisablesAProbeInsideGeometry) {
   app.jobs().run([&] { unclassified.update(app.world().resource<rt::RtScene>(), no_lights); });
   EXPECT_TRUE(unclassified.active(0)) << "classification off";
 }
+
+TEST(Ddgi, BiasesAreRtxgisCappedAtAFractionOfTheProbeSpacing) {
+  // RTXGI's 0.1 world units on metre cells; a millimetre room gets 0.4 of its
+  // own cells instead of a bias a hundred rooms long (issue 37: its mean
+  // image was 0.88x of the metre room's).
+  const DdgiSettings s;
+  ASSERT_FLOAT_EQ(s.normal_bias, 0.1f);
+  const DdgiVolume metre(transgi::probes::ProbeGrid::centred_in(glm::vec3(-2.0f), glm::vec3(2.0f), glm::ivec3(4)), s);
+  EXPECT_FLOAT_EQ(metre.biases().x, 0.1f);
+  EXPECT_FLOAT_EQ(metre.biases().y, 0.1f);
+  const DdgiVolume millimetre(transgi::probes::ProbeGrid::centred_in(glm::vec3(-2e-3f), glm::vec3(2e-3f), glm::ivec3(4)), s);
+  const float spacing = millimetre.grid().min_spacing();
+  EXPECT_NEAR(millimetre.biases().x, 0.4f * spacing, 1e-9f);
+  EXPECT_NEAR(millimetre.biases().y, 0.4f * spacing, 1e-9f);
+}

@@ -33,12 +33,16 @@ void sync_volumes(View<Get<DdgiProbeVolume>> volumes, View<Get<DdgiCascades>> ca
   });
   const probes::CascadeViewer viewer = probes::viewer_of(cameras, frame->camera, rt->bounds_min(), rt->bounds_max());
   cascades.each([&](DdgiCascades& set) {
-    DdgiSettings s = *settings;
-    s.blend_cells = set.cascades.blend_cells;
+    // The far field (k = count) lights only what no cascade holds.
+    const auto settings_for = [&](int k) {
+      DdgiSettings s = *settings;
+      s.blend_cells = k >= std::max(1, set.cascades.count) ? probes::kFallbackBlendCells : set.cascades.blend_cells;
+      return s;
+    };
     probes::follow_camera(
         set.state, set.cascades, viewer, rt->bounds_min(), rt->bounds_max(),
-        [&](const probes::ProbeGrid& grid, int) { return std::make_shared<DdgiVolume>(grid, s); },
-        [&](const DdgiVolume& v, const probes::ProbeGrid&, int) { return v.settings() == s; },
+        [&](const probes::ProbeGrid& grid, int k) { return std::make_shared<DdgiVolume>(grid, settings_for(k)); },
+        [&](const DdgiVolume& v, const probes::ProbeGrid&, int k) { return v.settings() == settings_for(k); },
         [&](DdgiVolume& v, glm::ivec3 cells, const DdgiVolume* coarser) { return v.scroll(cells, coarser); },
         [&](DdgiVolume&, bool) {});
   });

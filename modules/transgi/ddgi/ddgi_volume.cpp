@@ -168,9 +168,15 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
   return stats;
 }
 
+glm::vec2 DdgiVolume::biases() const {
+  const float cap = 0.4f * grid_.min_spacing();
+  return {std::min(settings_.normal_bias, cap), std::min(settings_.view_bias, cap)};
+}
+
 glm::vec3 DdgiVolume::irradiance(const glm::vec3& position, const glm::vec3& n, const glm::vec3& view_dir, bool* lit) const {
   if (lit) *lit = false;
-  const glm::vec3 bias = n * settings_.normal_bias - view_dir * settings_.view_bias;
+  const glm::vec2 b = biases();
+  const glm::vec3 bias = n * b.x - view_dir * b.y;
   const glm::vec3 biased = position + bias;
   const glm::vec3 spacing = grid_.spacing();
   glm::ivec3 base(0);

@@ -48,8 +48,12 @@ struct DdgiSettings {
   // Sharpness of the distance filter (cosine power). Higher = crisper
   // visibility edges, at the cost of banding.
   float distance_exponent = 50.0f;
-  // Shading-point offsets before the visibility test (world units). Higher =
-  // fewer self-shadowing artefacts, at the cost of light leaking through thin walls.
+  // Shading-point offsets before the visibility test (world units, RTXGI's
+  // 0.1), each at most 0.4 of the volume's smallest probe spacing
+  // (DdgiVolume::biases): RTXGI's value assumes metre-sized cells, and a
+  // scene a thousand times smaller would be offset a hundred of its own
+  // widths. Higher = fewer self-shadowing artefacts, at the cost of light
+  // leaking through thin walls.
   float normal_bias = 0.1f;
   float view_bias = 0.1f;
   // A probe whose rays hit back faces more often than this skips irradiance blending.
@@ -120,6 +124,9 @@ class DdgiVolume {
   [[nodiscard]] const probes::ProbeGrid& placement() const { return grid_; }
 
   [[nodiscard]] const probes::ProbeGrid& grid() const { return grid_; }
+  // The normal and view biases this volume shades with: the settings',
+  // capped at 0.4 of its smallest probe spacing.
+  [[nodiscard]] glm::vec2 biases() const;
   // grid() with each probe where relocation moved it.
   [[nodiscard]] const probes::ProbeGrid& placed_grid() const { return placed_; }
   [[nodiscard]] const DdgiSettings& settings() const { return settings_; }

@@ -57,8 +57,8 @@ GpuDdgiIrradiance VulkanDdgiIrradiance::irradiance(const ddgi::DdgiVolume& volum
   const ddgi::DdgiSettings& s = volume.settings();
   DdgiPush push{};
   push.grid = probe_grid_gpu(grid);
-  push.normal_bias = s.normal_bias;
-  push.view_bias = s.view_bias;
+  push.normal_bias = volume.biases().x;
+  push.view_bias = volume.biases().y;
   push.irradiance_gamma = s.irradiance_gamma;
   push.points = static_cast<int>(n);
   push.irradiance_size = static_cast<uint>(isize), push.distance_size = static_cast<uint>(dsize);

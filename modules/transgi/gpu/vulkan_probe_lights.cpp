@@ -5,6 +5,7 @@
 #include "engine/jobs/parallel_for.h"
 #include "gpu/probe_grid_gpu.h"
 #include "gpu/shader_path.h"
+#include "probes/cascades.h"
 
 namespace transgi::gpu {
 
@@ -50,9 +51,11 @@ bool VulkanProbeLights::set_probes(std::span<const probes::ProbeField* const> fi
     const auto texels = static_cast<std::size_t>(field.settings().map.texel_count());
     // Relocation moves probes, not the box, so the grid's box is the placed
     // one that mix_at and next_holding hand points over by.
+    const bool fallback = field.settings().blend_cells == probes::kFallbackBlendCells;
     ProbeFieldGpu r = probe_field_gpu(grid, field.settings().map, field.settings().interpolation,
-                                      field.settings().blend_cells * grid.min_spacing(), static_cast<uint>(probe_base),
+                                      fallback ? 0.0f : field.settings().blend_cells * grid.min_spacing(), static_cast<uint>(probe_base),
                                       static_cast<uint>(depth_base));
+    r.fallback = fallback ? 1u : 0u;
     r.mean_at = static_cast<uint>(mean_base + f * 2 * kTransferOutputs);
     records[f] = r;
     write_probe_field(grid, field.states(), field.usable(), texels, probe_base, depth_base, depth, probe_info);

@@ -17,11 +17,14 @@ namespace transgi::probes {
 
 template <class Field>
 struct CascadeState {
-  std::vector<std::shared_ptr<Field>> fields{};  // finest first
+  std::vector<std::shared_ptr<Field>> fields{};  // finest first, then the far field if there is one
   std::vector<glm::ivec3> origins{};             // each field's cascade_origin
   // The scene was small enough (CascadeSettings::fit_scene_cell) that
   // `fields` is one grid fitted to its bounds, decided and fitted once.
   bool fitted_to_scene = false;
+  // The last of `fields` is the far field (CascadeSettings::far_field): a
+  // grid over the scene's bounds, fitted once, beyond every cascade.
+  bool far_field = false;
 };
 
 // The viewer: eye position and unit forward (zero when unknown); a non-finite
@@ -51,9 +54,10 @@ CascadeViewer viewer_of(const CameraView& cameras, Entity requested, const glm::
 // Whether a scene with these bounds gets one fitted grid (fit_scene_cell).
 [[nodiscard]] bool fits_one_grid(const CascadeSettings& c, const glm::vec3& lo, const glm::vec3& hi);
 
-// After it, `state` holds one field per cascade placed on the viewer, or the
+// After it, `state` holds one field per cascade placed on the viewer (and the
+// far field after them where the scene reaches beyond the coarsest), or the
 // one fitted grid. Fields are made by make(grid, k) (k = -1 for the fitted
-// grid); a field for which same_but_place(field, grid, k) is false is made
+// grid, k = count for the far field); a field for which same_but_place(field, grid, k) is false is made
 // anew; one whose origin moved is scrolled by scroll(field, cells, coarser),
 // coarsest first, so a finer cascade's entered probes are seeded from a
 // coarser one that has already moved; scroll returns how many probes
@@ -80,6 +84,9 @@ int follow_camera(CascadeState<Field>& state, const CascadeSettings& c, const Ca
   }
   const CascadeViewer v = viewer.sanitised();
   const int n = std::max(1, c.count);
+  // The far field, if any, stays last; set aside while the cascades follow.
+  std::shared_ptr<Field> far;
+  if (state.far_field && !state.fields.empty()) far = state.fields.back();
   state.fields.resize(static_cast<std::size_t>(n));
   state.origins.resize(static_cast<std::size_t>(n));
   int entered = 0;
@@ -102,6 +109,15 @@ int follow_camera(CascadeState<Field>& state, const CascadeSettings& c, const Ca
       origin = wanted_origin;
       kept(*field, true);
     }
+  }
+  state.far_field = c.far_field && needs_far_field(c, scene_lo, scene_hi);
+  if (state.far_field) {
+    if (!far || !same_but_place(*far, far->placement(), n))
+      far = make(ProbeGrid::centred_in(scene_lo, scene_hi, c.dims), n);
+    else
+      kept(*far, false);
+    state.fields.push_back(std::move(far));
+    state.origins.push_back(glm::ivec3(0));
   }
   return entered;
 }

@@ -44,6 +44,12 @@ bool fits_one_grid(const CascadeSettings& c, const glm::vec3& lo, const glm::vec
   return c.fit_scene_cell > 0 && std::isfinite(cell) && cell <= c.fit_scene_cell;
 }
 
+bool needs_far_field(const CascadeSettings& s, const glm::vec3& lo, const glm::vec3& hi) {
+  const glm::vec3 extent = hi - lo;
+  const float reach = cascade_cell(s, std::max(1, s.count) - 1) * static_cast<float>(std::min({s.dims.x, s.dims.y, s.dims.z}));
+  return std::isfinite(extent.x + extent.y + extent.z) && std::max({extent.x, extent.y, extent.z}) > reach;
+}
+
 namespace {
 // How far p lies inside [lo, hi] (its nearest face), negative outside.
 float depth_inside(const BlendBox& b, const glm::vec3& p) {
@@ -52,7 +58,23 @@ float depth_inside(const BlendBox& b, const glm::vec3& p) {
 }
 }  // namespace
 
-BoxMix blend_boxes(std::span<const BlendBox> boxes, const glm::vec3& p) {
+BoxMix blend_boxes(std::span<const BlendBox> all, const glm::vec3& p) {
+  // The fallbacks come last; the blend runs over the boxes before them.
+  std::size_t end = all.size();
+  while (end > 0 && all[end - 1].fallback) --end;
+  if (end < all.size()) {
+    BoxMix m;
+    for (std::size_t i = 0; i < end; ++i)
+      if (depth_inside(all[i], p) >= 0) return blend_boxes(all.first(end), p);
+    m.box = {static_cast<int>(all.size()) - 1, 0};  // held by none: the fallback holding p, else the last, clamped
+    for (std::size_t i = end; i < all.size(); ++i)
+      if (depth_inside(all[i], p) >= 0) {
+        m.box[0] = static_cast<int>(i);
+        break;
+      }
+    return m;
+  }
+  const std::span<const BlendBox> boxes = all;
   BoxMix m;
   m.box = {static_cast<int>(boxes.size()) - 1, 0};
   std::size_t i = 0;

@@ -54,6 +54,14 @@ struct CascadeSettings {
   // cascades, docs/results.md). Higher = more scenes lit by one fitted grid,
   // at the cost of coarser probes in big ones; 0 = always cascades.
   float fit_scene_cell = 2.0f;
+  // Where the scene reaches beyond the coarsest cascade, one more grid of
+  // `dims` probes over the scene's bounds (the far field, fitted once) lights
+  // what no cascade holds, as Lumen's far field does: a room 5 km across is
+  // lit as one 5 m across. Off = beyond the coarsest cascade only its clamped
+  // light, whose probes are far from every surface there (inactive): dark.
+  // Costs one grid of probes, refreshed at the budget one cascade coarser
+  // than the last would get.
+  bool far_field = true;
   // Radiance map width of the cascades' probes on the real-time path
   // (height half of it; 0 = the run-time settings' map). Higher = finer
   // angular detail before the SH-4 projection, at the cost of 11 bytes per
@@ -68,6 +76,9 @@ struct CascadeSettings {
   bool operator==(const CascadeSettings&) const = default;
 };
 
+// Whether the scene's bounds reach beyond the coarsest cascade's extent on
+// some axis (then a far field is added, if asked).
+[[nodiscard]] bool needs_far_field(const CascadeSettings& s, const glm::vec3& lo, const glm::vec3& hi);
 // Cell size of cascade k.
 [[nodiscard]] float cascade_cell(const CascadeSettings& s, int k);
 // Grid coordinates (in cascade k's cells, world-anchored) of probe (0,0,0)
@@ -90,7 +101,13 @@ struct CascadeSettings {
 struct BlendBox {
   glm::vec3 lo{0.0f}, hi{0.0f};
   float band = 0.0f;
+  // A fallback (the far field; boxes after every other): it lights only what
+  // no other box holds, and no other box fades into it, so the cascades'
+  // light is the same with it as without wherever they reach.
+  bool fallback = false;
 };
+// A field whose settings' blend_cells is this is a fallback box (the far field).
+inline constexpr float kFallbackBlendCells = -1.0f;
 struct BoxMix {
   std::array<int, 2> box{0, 0};
   std::array<float, 2> weight{1.0f, 0.0f};
@@ -123,7 +140,8 @@ template <class Field>
   }
   for (std::size_t i = 0; i < fields.size(); ++i) {
     const ProbeGrid& g = fields[i]->placement();
-    boxes[i] = {g.min, g.max, fields[i]->settings().blend_cells * g.min_spacing()};
+    const float cells = fields[i]->settings().blend_cells;
+    boxes[i] = {g.min, g.max, cells == kFallbackBlendCells ? 0.0f : cells * g.min_spacing(), cells == kFallbackBlendCells};
   }
   const BoxMix b = blend_boxes(std::span<const BlendBox>(boxes, fields.size()), p);
   m.count = b.count;

@@ -75,7 +75,8 @@ void sync_probe_cascades(View<Get<const scene::Camera, const transform::WorldTra
     const auto wanted = [&](const probes::ProbeGrid& grid, int k) {
       probes::ProbeFieldSettings s = k >= 0 ? cascade_field_settings(settings->probes, c, k, glm::ivec3(0), settings->gi_path) : settings->probes;
       s.grid = grid;
-      s.blend_cells = c.blend_cells;
+      // The far field (k = count) lights only what no cascade holds.
+      s.blend_cells = k >= std::max(1, c.count) ? probes::kFallbackBlendCells : c.blend_cells;
       return s;
     };
     entered += probes::follow_camera(
