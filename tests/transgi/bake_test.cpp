@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "bake/trainer.h"
+#include "engine/core/fnv1a.h"
 #include "engine/scene/procedural.h"
 #include "model/model_file.h"
 
@@ -105,7 +106,11 @@ TEST(Dataset, IsDeterministicForASeed) {
 
 TEST(Trainer, LowersValidationErrorWellBelowAConstantPredictor) {
   const auto assets = tiny_scene();
-  const auto data = bake::generate_dataset(assets, tiny_data());
+  // The paper's targets, albedo included: a constant cannot follow their
+  // albedo's variation (demodulated, this scene's band 0 is nearly constant).
+  auto settings = tiny_data();
+  settings.demodulate = false;
+  const auto data = bake::generate_dataset(assets, settings);
   auto m = bake::make_untrained_model(assets, 7, model::MlpLayout{.width = 64, .hidden_layers = 3}, 3);
   bake::TrainSettings ts;
   ts.iterations = 1500;
@@ -151,8 +156,10 @@ TEST(ModelFile, RoundTripsExactly) {
   auto m = bake::make_untrained_model(assets, 7, model::MlpLayout{.width = 16, .hidden_layers = 1}, 9);
   m.bake_settings_json = R"({"points": 600})";
   m.metrics_json = R"({"rmse": 0.1})";
+  m.demodulated = true;
   model::save_model(d.path / "m.tgm", m);
   const auto back = model::load_model(d.path / "m.tgm");
+  EXPECT_TRUE(back.demodulated);
   EXPECT_EQ(back.decoder.layout(), m.decoder.layout());
   EXPECT_EQ(back.decoder.params(), m.decoder.params());
   ASSERT_EQ(back.meshes.size(), 2u);
@@ -160,6 +167,32 @@ TEST(ModelFile, RoundTripsExactly) {
   EXPECT_EQ(back.meshes[1].latents.vertex_to_latent, m.meshes[1].latents.vertex_to_latent);
   EXPECT_EQ(back.metrics_json, m.metrics_json);
   EXPECT_NO_THROW(model::validate_model(back, assets, d.path / "m.tgm"));
+}
+
+TEST(ModelFile, AFormatOneFileLoadsAsNotDemodulated) {
+  // Format 1 (before issue 37) ends at the metrics, with no flags word: its
+  // decoder predicts the transfer with the albedo in it.
+  TempDir d;
+  const auto assets = tiny_scene();
+  auto m = bake::make_untrained_model(assets, 7, model::MlpLayout{.width = 16, .hidden_layers = 1}, 9);
+  m.demodulated = true;
+  model::save_model(d.path / "v2.tgm", m);
+  std::ifstream in(d.path / "v2.tgm", std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string payload = bytes.substr(24, bytes.size() - 24 - 4);  // without the flags
+  engine::core::Fnv1a f;
+  f.bytes(payload.data(), payload.size());
+  const std::uint32_t version = 1;
+  const std::uint64_t size = payload.size(), checksum = f.h;
+  std::string v1 = bytes.substr(0, 4);
+  v1.append(reinterpret_cast<const char*>(&version), 4);
+  v1.append(reinterpret_cast<const char*>(&size), 8);
+  v1.append(reinterpret_cast<const char*>(&checksum), 8);
+  v1 += payload;
+  std::ofstream(d.path / "v1.tgm", std::ios::binary) << v1;
+  const auto back = model::load_model(d.path / "v1.tgm");
+  EXPECT_FALSE(back.demodulated);
+  EXPECT_EQ(back.decoder.params(), m.decoder.params());
 }
 
 TEST(ModelFile, RejectsTruncatedCorruptNewerAndStaleFiles) {
@@ -180,7 +213,7 @@ TEST(ModelFile, RejectsTruncatedCorruptNewerAndStaleFiles) {
   flipped[bytes.size() / 2] ^= 0x40;
   expect_load_error(write("flip.tgm", flipped), "checksum");
   std::string newer = bytes;
-  newer[4] = 2;
+  newer[4] = static_cast<char>(model::kModelFormatVersion + 1);
   expect_load_error(write("newer.tgm", newer), "newer TransGI");
   expect_load_error(write("junk.tgm", std::string(64, 'x')), "bad magic");
   expect_load_error(d.path / "absent.tgm", "not found");

@@ -33,7 +33,7 @@ std::uint64_t dataset_key(const engine::scene::SceneAssets& assets, const Datase
   }
   const double fields[] = {double(s.points), double(s.min_points_per_mesh), double(s.outgoing_per_point), double(s.rays),
                            double(s.visibility_fraction), double(s.validation_fraction), double(s.seed),
-                           double(s.max_points_per_vertex)};
+                           double(s.max_points_per_vertex), double(s.demodulate ? 1 : 0)};
   return fnv(fields, sizeof(fields), h);
 }
 
@@ -141,6 +141,7 @@ BakeReport run_bake(const engine::scene::SceneAssets& assets, const fs::path& ou
   const auto t0 = std::chrono::steady_clock::now();
   if (s.resume && load_dataset(dataset_cache_path(out), key, data)) {
     report.dataset_from_cache = true;
+    data.demodulated = s.data.demodulate;  // part of the cache's key
   } else {
     data = generate_dataset(assets, s.data, cb.sampling);
     save_dataset(dataset_cache_path(out), key, data);
@@ -191,7 +192,8 @@ BakeReport run_bake(const engine::scene::SceneAssets& assets, const fs::path& ou
                 << ", \"rays\": " << s.data.rays << ", \"visibility_fraction\": " << s.data.visibility_fraction
                 << ", \"iterations\": " << s.train.iterations << ", \"batch\": " << s.train.batch
                 << ", \"learning_rate\": " << s.train.learning_rate << ", \"latent_dim\": " << s.latent_dim
-                << ", \"width\": " << l.width << ", \"hidden_layers\": " << l.hidden_layers << ", \"seed\": " << s.data.seed << "}";
+                << ", \"width\": " << l.width << ", \"hidden_layers\": " << l.hidden_layers << ", \"seed\": " << s.data.seed
+                << ", \"demodulated\": " << (s.data.demodulate ? "true" : "false") << "}";
   metrics_json << "{\"data_seconds\": " << report.data_seconds << ", \"train_seconds\": " << report.train_seconds
                << ", \"samples\": " << report.samples << ", \"rollbacks\": " << report.rollbacks
                << ", \"validation_rmse\": " << report.validation.total << ", \"validation_rmse_per_band\": " << json_bands(report.validation)

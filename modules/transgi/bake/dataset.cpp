@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "engine/jobs/parallel_for.h"
+#include "model/transfer_model.h"
 
 namespace transgi::bake {
 
@@ -82,6 +83,12 @@ TransferDataset generate_dataset(const engine::scene::SceneAssets& assets, const
         PointResult& r = results[global];
         r.targets.resize(static_cast<std::size_t>(K) * kTransferValues);
         transfer.estimate(sp, wo, s.rays, rng, r.targets);
+        if (s.demodulate)
+          for (std::size_t j = 0; j < wo.size(); ++j) {
+            const glm::vec3 d = model::demodulation(sp.brdf, glm::dot(sp.shading_normal, wo[j]));
+            for (int c = 0; c < 3; ++c)
+              for (int k = 0; k < engine::math::kShCount; ++k) r.targets[j * kTransferValues + static_cast<std::size_t>(c * engine::math::kShCount + k)] /= d[c];
+          }
         for (const glm::vec3& w : wo)
           r.samples.push_back({static_cast<std::uint32_t>(m), sp.triangle, sp.barycentric, sp.shading_normal, w, sp.brdf.base_color});
         const std::size_t n = done.fetch_add(1) + 1;
@@ -94,6 +101,7 @@ TransferDataset generate_dataset(const engine::scene::SceneAssets& assets, const
 
   // Split by point: every (1 / fraction)-th point, deterministic, goes to validation.
   TransferDataset d;
+  d.demodulated = s.demodulate;
   std::vector<std::size_t> train, valid;
   const std::size_t stride = s.validation_fraction > 0 ? std::max<std::size_t>(2, static_cast<std::size_t>(std::lround(1.0 / s.validation_fraction))) : 0;
   for (std::size_t p = 0; p < total_points; ++p) (stride && p % stride == stride - 1 ? valid : train).push_back(p);

@@ -36,6 +36,11 @@ struct DatasetSettings {
   float visibility_fraction = 0.5f;
   float validation_fraction = 0.05f;
   std::uint64_t seed = 1;
+  // Targets divided by each point's directional albedo towards each wo
+  // (model::demodulation): the network learns light, and shading multiplies
+  // the pixel's own albedo back, so textures and hues are exact in the GI
+  // (issue 37). Off = the paper's transfer, albedo included.
+  bool demodulate = true;
 };
 
 struct TransferSample {
@@ -48,6 +53,9 @@ struct TransferSample {
 };
 
 struct TransferDataset {
+  // Whether the targets are demodulated (DatasetSettings::demodulate); a
+  // model trained on them is (Trainer sets TransferModel::demodulated).
+  bool demodulated = false;
   std::vector<TransferSample> samples;  // training samples first, then validation
   std::vector<float> targets;           // kTransferValues per sample
   std::size_t training_count = 0;

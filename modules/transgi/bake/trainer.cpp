@@ -64,6 +64,8 @@ Trainer::Trainer(const TransferDataset& data, const engine::scene::SceneAssets& 
     : data_(data), assets_(assets), model_(model), settings_(std::move(settings)), rng_(settings_.seed, 0x7a41) {
   if (data.training_count == 0) throw std::invalid_argument("the dataset has no training samples");
   if (model.meshes.size() != assets.meshes.size()) throw std::invalid_argument("model and scene have different mesh counts");
+  // The model predicts what its targets are: transfer over albedo or not.
+  model_.demodulated = data.demodulated;
   for (const auto& m : model_.meshes) {
     latent_offset_.push_back(latent_count_);
     latent_count_ += m.latents.values.size();

@@ -101,6 +101,7 @@ void save_model(const std::filesystem::path& path, const TransferModel& model) {
   }
   w.string(model.bake_settings_json);
   w.string(model.metrics_json);
+  w.value<std::uint32_t>(model.demodulated ? 1u : 0u);
 
   std::vector<std::byte> file(kHeaderBytes);
   std::memcpy(file.data(), kMagic, 4);
@@ -177,6 +178,11 @@ TransferModel load_model(const std::filesystem::path& path) {
   }
   model.bake_settings_json = r.string("bake settings");
   model.metrics_json = r.string("metrics");
+  if (version >= 2) {
+    const auto flags = r.value<std::uint32_t>("flags");
+    if (flags & ~1u) r.fail("unknown flags " + std::to_string(flags));
+    model.demodulated = (flags & 1u) != 0;
+  }
   if (r.at != r.in.size()) r.fail("trailing bytes");
   return model;
 }

@@ -18,7 +18,8 @@
 
 namespace transgi::model {
 
-inline constexpr std::uint32_t kModelFormatVersion = 1;
+// 2: a flags word after the metrics (bit 0: TransferModel::demodulated).
+inline constexpr std::uint32_t kModelFormatVersion = 2;
 
 class ModelFileError : public std::runtime_error {
  public:

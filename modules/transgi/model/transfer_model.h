@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/material/brdf.h"
 #include "engine/scene/scene_assets.h"
 #include "model/latent_mesh.h"
 #include "model/mlp.h"
@@ -21,12 +22,26 @@ struct TransferModel {
   Mlp decoder;
   int latent_dim = 7;
   std::vector<MeshLatents> meshes;  // by SceneAssets::meshes index
+  // The decoder predicts the transfer divided by the surface's directional
+  // albedo (demodulation()): shading multiplies the pixel's own albedo back,
+  // so a texture's detail and hue in the GI are exact whatever the network
+  // smooths (issue 37). False for models baked before format 2.
+  bool demodulated = false;
   std::string bake_settings_json;   // what produced it (free-form JSON)
   std::string metrics_json;         // training and validation results (free-form JSON)
 
   [[nodiscard]] std::size_t decoder_bytes() const { return decoder.params().size() * sizeof(float); }
   [[nodiscard]] std::size_t latent_bytes() const;
 };
+
+// Reflectances are floored here before transfer or light is divided by
+// them: a black channel would otherwise carry its rounding into the rest.
+inline constexpr float kMinReflectance = 0.01f;
+// What a demodulated model's transfer is divided by at a surface point seen
+// from cos_o: its directional albedo, floored at kMinReflectance (the bake
+// and every shading path use this one function).
+glm::vec3 demodulation(const engine::material::BrdfParams& brdf, float cos_o);
+inline glm::vec3 demodulation(const glm::vec3& reflectance) { return glm::max(reflectance, glm::vec3(kMinReflectance)); }
 
 // Inputs after the latent: albedo (3), normal (3), wo (3).
 inline constexpr int kTransferInputExtra = 9;

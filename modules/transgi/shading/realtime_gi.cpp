@@ -23,6 +23,7 @@
 
 namespace transgi::shading {
 
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -345,9 +346,14 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     else
       fill_seconds = shade_transfer_fused(*decoder, *model, assets, queries, fill, shaded.data(),
                                           with_direct ? shaded_direct.data() : nullptr);
-    for (std::size_t k = 0; k < net.size(); ++k) value[net[k]] = shaded[k];
-    if (with_direct)
-      for (std::size_t k = 0; k < net.size(); ++k) value_direct[net[k]] = shaded_direct[k];
+    // A demodulated model's light is over albedo already; the step below
+    // divides every sample by its albedo, so give these theirs first.
+    const bool demodulated = model->demodulated;
+    for (std::size_t k = 0; k < net.size(); ++k) {
+      const glm::vec3 d = demodulated ? model::demodulation(g.samples[decode[net[k]]].reflectance) : glm::vec3(1.0f);
+      value[net[k]] = d * shaded[k];
+      if (with_direct) value_direct[net[k]] = d * shaded_direct[k];
+    }
   }
   // The fused call's wall time, split by the share its threads spent
   // interpolating light (reported as SH light) and decoding (inference).
@@ -367,6 +373,16 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     if (with_direct) value_direct[i] = glm::vec3(0.0f);
     ++stats.nonfinite_samples;
   }
+  // Divided by each sample's reflectance: what is upsampled (and kept for
+  // the next frame's reuse) is light, smooth where a texture is not; the
+  // composite multiplies each pixel's own reflectance back (issue 37).
+  engine::jobs::parallel_for<std::size_t>(0, decode.size(), 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const glm::vec3 inv = 1.0f / model::demodulation(g.samples[decode[i]].reflectance);
+      value[i] *= inv;
+      if (with_direct) value_direct[i] *= inv;
+    }
+  });
 
   if (reuse) {
     // The reused cells' values after the decoded ones, a reused cell's slot
@@ -426,7 +442,9 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     for (std::size_t c = 0; c < filtered.size(); ++c) {
       const std::size_t p = up.cell_pixel[c], slot = slot_of_pixel[p];
       if (slot == kNone) continue;
-      value[slot] = glm::max(value[slot] + g.samples[p].diffuse * engine::math::kInvPi * filtered[c], glm::vec3(0.0f));
+      const GSample& s = g.samples[p];
+      value[slot] = glm::max(value[slot] + s.diffuse / model::demodulation(s.reflectance) * engine::math::kInvPi * filtered[c],
+                             glm::vec3(0.0f));
     }
     stats.near_ms = ms_since(t0);
   }
@@ -442,9 +460,10 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
       for (int x = 0; x < g.width; ++x) {
         const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
         if (up.kind[p] == UpsamplingPlan::kMiss) continue;
+        const glm::vec3 reflectance = model::demodulation(g.samples[p].reflectance);
         if (up.kind[p] == UpsamplingPlan::kOwn) {
-          image.pixels[p] = value[slot_of_pixel[p]];
-          if (with_direct) direct_out->pixels[p] += value_direct[slot_of_pixel[p]];
+          image.pixels[p] = reflectance * value[slot_of_pixel[p]];
+          if (with_direct) direct_out->pixels[p] += reflectance * value_direct[slot_of_pixel[p]];
           continue;
         }
         glm::vec3 sum(0.0f), sum_direct(0.0f);
@@ -455,8 +474,8 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
           sum += w * value[slot];
           if (with_direct) sum_direct += w * value_direct[slot];
         }
-        image.pixels[p] = sum;
-        if (with_direct) direct_out->pixels[p] += sum_direct;
+        image.pixels[p] = reflectance * sum;
+        if (with_direct) direct_out->pixels[p] += reflectance * sum_direct;
       }
   });
   stats.upsample_ms = plan_ms + ms_since(t0);

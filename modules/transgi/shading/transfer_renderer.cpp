@@ -124,6 +124,16 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
       queries[i] = {smp.mesh, smp.triangle, smp.bary, smp.albedo, smp.normal_obj, smp.wo_obj};
     }
     const InferenceTimings it = infer_transfer(model, assets, queries, transfer.data());
+    // A demodulated model predicts transfer over albedo: each sample's own
+    // albedo, at full resolution, multiplies it back.
+    if (model.demodulated)
+      jobs::parallel_for<std::size_t>(0, hits.size(), 1024, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+          const glm::vec3 d = model::demodulation(samples[hits[i]].reflectance);
+          for (int c = 0; c < 3; ++c)
+            for (int k = 0; k < 25; ++k) transfer[i * bake::kTransferValues + static_cast<std::size_t>(c * 25 + k)] *= d[c];
+        }
+      });
     result.timings.inputs_ms = it.inputs_ms;
     result.timings.inference_ms = it.inference_ms;
   } else {
