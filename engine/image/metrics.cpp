@@ -97,6 +97,46 @@ double rmse_clamped_in(const ImageRGB& a, const ImageRGB& b, const std::vector<s
   return n ? std::sqrt(sum / (3.0 * static_cast<double>(n))) : 0.0;
 }
 
+ColourMetrics compare_colour(const ImageRGB& a, const ImageRGB& b) {
+  check_sizes(a, b);
+  const int w = a.width, h = a.height;
+  const auto at = [w](int x, int y) { return static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x); };
+  double mean_b = 0;
+  for (const glm::vec3& p : b.pixels) mean_b += math::luminance(p);
+  mean_b /= static_cast<double>(std::max<std::size_t>(1, b.size()));
+  const auto detail = [&](const ImageRGB& img, int x, int y) {
+    double s = 0;
+    int n = 0;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int qx = x + dx, qy = y + dy;
+        if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
+        s += math::luminance(img.pixels[at(qx, qy)]);
+        ++n;
+      }
+    const double local = s / n;
+    return local > 0 ? std::abs(math::luminance(img.pixels[at(x, y)]) - local) / local : 0.0;
+  };
+  ColourMetrics m;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const glm::vec3 pa = glm::max(a.pixels[at(x, y)], glm::vec3(0.0f)), pb = glm::max(b.pixels[at(x, y)], glm::vec3(0.0f));
+      if (!(math::luminance(pb) > 0.05 * mean_b)) continue;
+      const float sa = pa.r + pa.g + pa.b, sb = pb.r + pb.g + pb.b;
+      const glm::vec3 ca = sa > 0 ? pa / sa : glm::vec3(1.0f / 3), cb = pb / sb;
+      m.chroma_error += std::abs(ca.r - cb.r) + std::abs(ca.g - cb.g) + std::abs(ca.b - cb.b);
+      m.detail_a += detail(a, x, y);
+      m.detail_b += detail(b, x, y);
+      ++m.pixels;
+    }
+  if (m.pixels) {
+    m.chroma_error /= static_cast<double>(m.pixels);
+    m.detail_a /= static_cast<double>(m.pixels);
+    m.detail_b /= static_cast<double>(m.pixels);
+  }
+  return m;
+}
+
 double top_error_share(const ImageRGB& a, const ImageRGB& b, double fraction) {
   check_sizes(a, b);
   std::vector<double> err(a.size());

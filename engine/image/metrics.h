@@ -41,6 +41,20 @@ std::vector<std::uint8_t> edge_band(const ImageRGB& guide, int radius = 3, doubl
 // rmse_clamped over the pixels where mask is set; 0 where none is.
 double rmse_clamped_in(const ImageRGB& a, const ImageRGB& b, const std::vector<std::uint8_t>& mask);
 
+// Colour and texture of a test image against its reference (issue 37),
+// over the pixels where the reference is lit (luminance above 5 % of its
+// mean): chroma_error, the mean over them of |c(A) - c(B)|_1, c = rgb /
+// (r + g + b) (a shift of hue, whatever the brightness); detail, the mean
+// of |Y - (3x3 box mean of Y)| / (3x3 box mean of Y), how much the image
+// varies from pixel to pixel relative to its local level (a texture's
+// contrast; a reference's noise adds to it).
+struct ColourMetrics {
+  double chroma_error = 0;
+  double detail_a = 0, detail_b = 0;
+  std::size_t pixels = 0;
+};
+ColourMetrics compare_colour(const ImageRGB& a, const ImageRGB& b);
+
 // Per-pixel mean absolute clamped error mapped through a perceptually
 // ordered colour map (black-red-yellow-white); `max_error` maps to white.
 // max_error <= 0 picks the 99th percentile of the errors.

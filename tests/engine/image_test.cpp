@@ -296,3 +296,23 @@ TEST(Metrics, EdgeBandHoldsThePixelsNearAStepAndItsRmseOnlyThose) {
   EXPECT_EQ(std::count(none.begin(), none.end(), 1), 0);
   EXPECT_EQ(rmse_clamped_in(a, b, none), 0.0);
 }
+
+TEST(Metrics, ColourMetricsMeasureHueShiftAndDetail) {
+  // B: an orange/blue checker; A: the same light in grey (luminance kept
+  // per pixel does not matter to chroma: c = rgb / sum).
+  ImageRGB a(8, 8), b(8, 8);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) {
+      b.at(x, y) = ((x + y) & 1) ? glm::vec3(0.6f, 0.3f, 0.1f) : glm::vec3(0.1f, 0.2f, 0.7f);
+      a.at(x, y) = glm::vec3(0.3f);
+    }
+  const ColourMetrics same = compare_colour(b, b);
+  EXPECT_EQ(same.pixels, 64u);
+  EXPECT_DOUBLE_EQ(same.chroma_error, 0.0);
+  EXPECT_DOUBLE_EQ(same.detail_a, same.detail_b);
+  EXPECT_GT(same.detail_b, 0.1) << "a checker varies from pixel to pixel";
+  const ColourMetrics grey = compare_colour(a, b);
+  // Orange c = (0.6, 0.3, 0.1), blue c = (0.1, 0.2, 0.7): |c - 1/3| sums 0.533 and 0.733.
+  EXPECT_NEAR(grey.chroma_error, 0.5 * (0.5333333 + 0.7333333), 1e-5);
+  EXPECT_DOUBLE_EQ(grey.detail_a, 0.0) << "flat grey has no detail";
+}

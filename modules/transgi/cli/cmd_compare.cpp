@@ -8,7 +8,7 @@
 namespace transgi::cli {
 
 int run_compare(const std::vector<std::string>& argv) {
-  const Args args("compare", argv, {"heatmap", "heatmap-max", "top-error", "edge-band-of", "band"});
+  const Args args("compare", argv, {"heatmap", "heatmap-max", "top-error", "edge-band-of", "band"}, {"colour"});
   if (args.positional().size() != 2) throw UsageError("compare: expected two EXR files: A.exr B.exr (B is the reference)");
   const auto a = engine::image::read_exr(args.positional()[0]);
   const auto b = engine::image::read_exr(args.positional()[1]);
@@ -34,6 +34,12 @@ int run_compare(const std::vector<std::string>& argv) {
     std::size_t n = 0;
     for (auto v : band) n += v;
     std::printf("{\"edge_band_rmse\": %.8g, \"edge_band_pixels\": %zu}\n", engine::image::rmse_clamped_in(a, b, band), n);
+  }
+  if (args.has("colour")) {
+    // Hue and texture against the reference (engine/image/metrics.h), a line of their own.
+    const auto c = engine::image::compare_colour(a, b);
+    std::printf("{\"chroma_error\": %.6g, \"detail\": %.6g, \"detail_reference\": %.6g, \"detail_ratio\": %.4f, \"colour_pixels\": %zu}\n",
+                c.chroma_error, c.detail_a, c.detail_b, c.detail_b > 0 ? c.detail_a / c.detail_b : 0.0, c.pixels);
   }
   if (args.has("top-error")) {
     const double f = args.number("top-error", 0.0, 100.0) / 100.0;
