@@ -11,6 +11,22 @@
 namespace engine::image {
 
 namespace {
+// The mean luminance of the 3x3 pixels around (x, y) that lie in the image.
+double box3_luminance(const ImageRGB& img, int x, int y) {
+  double s = 0;
+  int n = 0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int qx = x + dx, qy = y + dy;
+      if (qx < 0 || qy < 0 || qx >= img.width || qy >= img.height) continue;
+      s += math::luminance(img.pixels[static_cast<std::size_t>(qy) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(qx)]);
+      ++n;
+    }
+  return s / n;
+}
+}  // namespace
+
+namespace {
 
 void check_sizes(const ImageRGB& a, const ImageRGB& b) {
   if (a.width != b.width || a.height != b.height)
@@ -50,18 +66,7 @@ std::vector<std::uint8_t> edge_band(const ImageRGB& guide, int radius, double co
   // speckles are not edges.
   std::vector<double> y(guide.size());
   for (int py = 0; py < h; ++py)
-    for (int px = 0; px < w; ++px) {
-      double s = 0;
-      int n = 0;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int qx = px + dx, qy = py + dy;
-          if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
-          s += math::luminance(guide.pixels[at(qx, qy)]);
-          ++n;
-        }
-      y[at(px, py)] = s / n;
-    }
+    for (int px = 0; px < w; ++px) y[at(px, py)] = box3_luminance(guide, px, py);
   std::vector<std::uint8_t> edge(guide.size(), 0), band(guide.size(), 0);
   for (int py = 0; py < h; ++py)
     for (int px = 0; px < w; ++px) {
@@ -105,16 +110,7 @@ ColourMetrics compare_colour(const ImageRGB& a, const ImageRGB& b) {
   for (const glm::vec3& p : b.pixels) mean_b += math::luminance(p);
   mean_b /= static_cast<double>(std::max<std::size_t>(1, b.size()));
   const auto detail = [&](const ImageRGB& img, int x, int y) {
-    double s = 0;
-    int n = 0;
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int qx = x + dx, qy = y + dy;
-        if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
-        s += math::luminance(img.pixels[at(qx, qy)]);
-        ++n;
-      }
-    const double local = s / n;
+    const double local = box3_luminance(img, x, y);
     return local > 0 ? std::abs(math::luminance(img.pixels[at(x, y)]) - local) / local : 0.0;
   };
   ColourMetrics m;

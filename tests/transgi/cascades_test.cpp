@@ -327,15 +327,23 @@ TEST(CascadeScroll, ProbesThatStayKeepTheirLightAndEnteredOnesAreSeededFromTheCo
   EXPECT_GT(seeded, 0) << "no entered probe got light from the coarser cascade";
 }
 
+namespace {
+// One frame of the room; its cascade set as the plugin left it.
+const runtime::ProbeCascades* first_frames_cascades(Room& room) {
+  room.app.jobs().run([&] { room.app.update(); });
+  const runtime::ProbeCascades* set = nullptr;
+  room.app.world().view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& c) { set = &c; });
+  return set;
+}
+}  // namespace
+
 TEST(CascadeFit, ASmallSceneGetsOneGridOverItsBoundsAndABigOneGetsCascades) {
   for (const float fit : {2.5f, 1.0f}) {
     CascadeSettings cs;
     cs.dims = glm::ivec3(6);
     cs.fit_scene_cell = fit;  // the room is 12 m: 2 m cells over its bounds
     Room room(cs);
-    room.app.jobs().run([&] { room.app.update(); });
-    const runtime::ProbeCascades* set = nullptr;
-    room.app.world().view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& c) { set = &c; });
+    const runtime::ProbeCascades* set = first_frames_cascades(room);
     ASSERT_NE(set, nullptr);
     const auto& rt = room.app.world().resource<rt::RtScene>();
     if (fit >= 2.0f) {
@@ -363,9 +371,7 @@ TEST(CascadeFit, PastTheCoarsestCascadeAFarFieldCoversTheScene) {
       cs.fit_scene_cell = 0.0f;
       cs.far_field = far;
       Room room(cs);
-      room.app.jobs().run([&] { room.app.update(); });
-      const runtime::ProbeCascades* set = nullptr;
-      room.app.world().view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& c) { set = &c; });
+      const runtime::ProbeCascades* set = first_frames_cascades(room);
       ASSERT_NE(set, nullptr);
       const auto& rt = room.app.world().resource<rt::RtScene>();
       const bool want = far && count == 2;
