@@ -90,19 +90,6 @@ float spec_probability(const BrdfParams& p, float cos_o) {
   return std::clamp(spec / (spec + diffuse), 0.1f, 0.9f);
 }
 
-glm::vec3 directional_albedo(const BrdfParams& p, float cos_o) {
-  if (!(cos_o > 0)) return glm::vec3(0.0f);
-  const SpecularAlbedo e = ggx_albedo(cos_o, alpha_of(p));
-  glm::vec3 dielectric(0.0f), metal(0.0f);
-  for (int k = 0; k < 3; ++k) {
-    const float f0 = std::min(kDielectricF0 * p.specular_color[k], 1.0f);
-    const float spec = std::min(1.0f, p.specular * e.with_f0(f0));
-    dielectric[k] = p.base_color[k] * (1.0f - spec) + spec;
-    metal[k] = e.with_f0(p.base_color[k]);
-  }
-  return (1.0f - p.metallic) * dielectric + p.metallic * metal;
-}
-
 glm::vec3 brdf_eval(const BrdfParams& p, const glm::vec3& wo, const glm::vec3& wi) {
   const float cos_o = wo.z, cos_i = wi.z;
   if (cos_o <= 0 || cos_i <= 0) return glm::vec3(0.0f);

@@ -49,13 +49,6 @@ struct BrdfSample {
 // TransGI's fallback for objects without latents.
 inline glm::vec3 diffuse_albedo(const BrdfParams& p) { return p.base_color * (1.0f - p.metallic); }
 
-// The directional albedo at cos_o = wo.z: the integral of f(wo, wi) cos_i
-// over wi, per channel (the dielectric's s E(wo) + base (1 - s E(wo)), the
-// metal's Schlick albedo with F0 = base). How much of uniform light the
-// surface reflects towards wo: what TransGI's transfer is divided by, so
-// the network learns light, not albedo (issue 37). 0 for cos_o <= 0.
-glm::vec3 directional_albedo(const BrdfParams& p, float cos_o);
-
 // f(wo, wi). Zero when either direction is below the surface.
 glm::vec3 brdf_eval(const BrdfParams& p, const glm::vec3& wo, const glm::vec3& wi);
 // Density with which brdf_sample() produces wi.

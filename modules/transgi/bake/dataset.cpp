@@ -83,12 +83,12 @@ TransferDataset generate_dataset(const engine::scene::SceneAssets& assets, const
         PointResult& r = results[global];
         r.targets.resize(static_cast<std::size_t>(K) * kTransferValues);
         transfer.estimate(sp, wo, s.rays, rng, r.targets);
-        if (s.demodulate)
-          for (std::size_t j = 0; j < wo.size(); ++j) {
-            const glm::vec3 d = model::demodulation(sp.brdf, glm::dot(sp.shading_normal, wo[j]));
+        if (s.demodulate) {
+          const glm::vec3 d = model::demodulation(sp.brdf.base_color);
+          for (std::size_t j = 0; j < wo.size(); ++j)
             for (int c = 0; c < 3; ++c)
               for (int k = 0; k < engine::math::kShCount; ++k) r.targets[j * kTransferValues + static_cast<std::size_t>(c * engine::math::kShCount + k)] /= d[c];
-          }
+        }
         for (const glm::vec3& w : wo)
           r.samples.push_back({static_cast<std::uint32_t>(m), sp.triangle, sp.barycentric, sp.shading_normal, w, sp.brdf.base_color});
         const std::size_t n = done.fetch_add(1) + 1;

@@ -36,10 +36,10 @@ struct DatasetSettings {
   float visibility_fraction = 0.5f;
   float validation_fraction = 0.05f;
   std::uint64_t seed = 1;
-  // Targets divided by each point's directional albedo towards each wo
-  // (model::demodulation): the network learns light, and shading multiplies
-  // the pixel's own albedo back, so textures and hues are exact in the GI
-  // (issue 37). Off = the paper's transfer, albedo included.
+  // Targets divided by each point's base colour (model::demodulation): the
+  // network learns light, and shading multiplies the pixel's own base colour
+  // back, so textures and hues are exact in the GI (issue 37). Off = the
+  // paper's transfer, albedo included.
   bool demodulate = true;
 };
 

@@ -6,9 +6,6 @@
 
 namespace transgi::model {
 
-glm::vec3 demodulation(const engine::material::BrdfParams& brdf, float cos_o) {
-  return demodulation(engine::material::directional_albedo(brdf, cos_o));
-}
 
 std::size_t TransferModel::latent_bytes() const {
   std::size_t n = 0;

@@ -5,7 +5,6 @@
 #include <string>
 #include <vector>
 
-#include "engine/material/brdf.h"
 #include "engine/scene/scene_assets.h"
 #include "model/latent_mesh.h"
 #include "model/mlp.h"
@@ -22,8 +21,8 @@ struct TransferModel {
   Mlp decoder;
   int latent_dim = 7;
   std::vector<MeshLatents> meshes;  // by SceneAssets::meshes index
-  // The decoder predicts the transfer divided by the surface's directional
-  // albedo (demodulation()): shading multiplies the pixel's own albedo back,
+  // The decoder predicts the transfer divided by the surface's base colour
+  // (demodulation()): shading multiplies the pixel's own base colour back,
   // so a texture's detail and hue in the GI are exact whatever the network
   // smooths (issue 37). False for models baked before format 2.
   bool demodulated = false;
@@ -34,14 +33,16 @@ struct TransferModel {
   [[nodiscard]] std::size_t latent_bytes() const;
 };
 
-// Reflectances are floored here before transfer or light is divided by
+// Base colours are floored here before transfer or light is divided by
 // them: a black channel would otherwise carry its rounding into the rest.
-inline constexpr float kMinReflectance = 0.01f;
-// What a demodulated model's transfer is divided by at a surface point seen
-// from cos_o: its directional albedo, floored at kMinReflectance (the bake
-// and every shading path use this one function).
-glm::vec3 demodulation(const engine::material::BrdfParams& brdf, float cos_o);
-inline glm::vec3 demodulation(const glm::vec3& reflectance) { return glm::max(reflectance, glm::vec3(kMinReflectance)); }
+inline constexpr float kMinAlbedo = 0.01f;
+// What a demodulated model's transfer is divided by at a surface point: its
+// base colour (the texture's, per pixel), floored at kMinAlbedo. The bake
+// and every shading path use this one function. The base colour scales the
+// diffuse lobe and a metal's Fresnel; what does not follow it (a
+// dielectric's faint specular) the network learns from its albedo input.
+// And it is what the real-time path has per pixel at no cost.
+inline glm::vec3 demodulation(const glm::vec3& base_color) { return glm::max(base_color, glm::vec3(kMinAlbedo)); }
 
 // Inputs after the latent: albedo (3), normal (3), wo (3).
 inline constexpr int kTransferInputExtra = 9;

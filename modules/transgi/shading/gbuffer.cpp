@@ -64,7 +64,6 @@ void make_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAs
   out.brdf = render::evaluate_material(assets, material, uv, footprint);
   out.albedo = out.brdf.base_color;  // the network's input
   out.diffuse = material::diffuse_albedo(out.brdf);
-  out.reflectance = material::directional_albedo(out.brdf, glm::dot(nobj, wo));
   out.emission = render::evaluate_emission(assets, material, uv, footprint);
   out.geometric_normal = glm::dot(ng, out.wo_world) < 0 ? -ng : ng;
   out.depth = hit.t;

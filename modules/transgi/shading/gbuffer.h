@@ -15,10 +15,6 @@ struct GSample {
   std::uint32_t mesh = 0, triangle = 0;
   glm::vec2 bary{0.0f};
   glm::vec3 normal_obj{0.0f}, wo_obj{0.0f}, albedo{0.0f}, diffuse{0.0f}, background{0.0f};
-  // The BRDF's directional albedo towards the camera (material::
-  // directional_albedo): the real-time GI is upsampled divided by it and
-  // multiplied back per pixel, so a texture keeps its detail.
-  glm::vec3 reflectance{0.0f};
   glm::vec3 position{0.0f}, normal_world{0.0f};
   // For direct light: the full material, what the surface emits, the world
   // geometric normal facing the viewer (shadow-ray offsets) and the unit

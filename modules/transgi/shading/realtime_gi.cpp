@@ -119,6 +119,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
   g.samples.resize(static_cast<std::size_t>(width) * height);
   g.guide.resize(g.samples.size());
   g.position.resize(g.samples.size());
+  g.albedo.resize(g.samples.size());
   g.metal_roughness.resize(g.samples.size());
   g.entity.resize(g.samples.size());
   // 4x4 pixel tiles as one Embree packet: neighbouring camera rays share
@@ -182,6 +183,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
         make_gsample(scene, assets, rays[i], found[i] ? &hits[i] : nullptr, nullptr, spread, s);
         g.guide[pixel[i]] = s.hit ? glm::vec4(s.normal_world, std::max(s.depth, 1e-30f)) : glm::vec4(0.0f);
         g.position[pixel[i]] = s.hit ? s.position : glm::vec3(0.0f);
+        g.albedo[pixel[i]] = s.hit ? s.albedo : glm::vec3(0.0f);
         g.metal_roughness[pixel[i]] = s.hit && s.brdf.metallic >= 0.5f ? s.brdf.roughness : std::numeric_limits<float>::infinity();
         g.entity[pixel[i]] = s.entity;
       }
@@ -307,8 +309,10 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
       probes::interpolate_fields_with(
           fields, s.position, s.normal_world, [](const probes::ProbeField* f) { return f->light_sh_all().data(); },
           [](const probes::ProbeField* f) { return f->direct_sh_all().data(); }, world, with_direct ? world_direct : nullptr);
-      value[diffuse[k]] = s.diffuse * engine::math::kInvPi * sh_irradiance(world, s.normal_world);
-      if (with_direct) value_direct[diffuse[k]] = s.diffuse * engine::math::kInvPi * sh_irradiance(world_direct, s.normal_world);
+      // Over the base colour, as every sample is upsampled (below).
+      const glm::vec3 over = s.diffuse / model::demodulation(s.albedo) * engine::math::kInvPi;
+      value[diffuse[k]] = over * sh_irradiance(world, s.normal_world);
+      if (with_direct) value_direct[diffuse[k]] = over * sh_irradiance(world_direct, s.normal_world);
     }
   });
   const double diffuse_light_ms = ms_since(t0);
@@ -346,14 +350,16 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     else
       fill_seconds = shade_transfer_fused(*decoder, *model, assets, queries, fill, shaded.data(),
                                           with_direct ? shaded_direct.data() : nullptr);
-    // A demodulated model's light is over albedo already; the step below
-    // divides every sample by its albedo, so give these theirs first.
+    // Every sample's light is upsampled over its base colour (issue 37): a
+    // demodulated model's already is; a format-1 model's is divided here.
     const bool demodulated = model->demodulated;
-    for (std::size_t k = 0; k < net.size(); ++k) {
-      const glm::vec3 d = demodulated ? model::demodulation(g.samples[decode[net[k]]].reflectance) : glm::vec3(1.0f);
-      value[net[k]] = d * shaded[k];
-      if (with_direct) value_direct[net[k]] = d * shaded_direct[k];
-    }
+    engine::jobs::parallel_for<std::size_t>(0, net.size(), 1024, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        const glm::vec3 inv = demodulated ? glm::vec3(1.0f) : 1.0f / model::demodulation(g.albedo[decode[net[k]]]);
+        value[net[k]] = inv * shaded[k];
+        if (with_direct) value_direct[net[k]] = inv * shaded_direct[k];
+      }
+    });
   }
   // The fused call's wall time, split by the share its threads spent
   // interpolating light (reported as SH light) and decoding (inference).
@@ -373,16 +379,6 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     if (with_direct) value_direct[i] = glm::vec3(0.0f);
     ++stats.nonfinite_samples;
   }
-  // Divided by each sample's reflectance: what is upsampled (and kept for
-  // the next frame's reuse) is light, smooth where a texture is not; the
-  // composite multiplies each pixel's own reflectance back (issue 37).
-  engine::jobs::parallel_for<std::size_t>(0, decode.size(), 4096, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) {
-      const glm::vec3 inv = 1.0f / model::demodulation(g.samples[decode[i]].reflectance);
-      value[i] *= inv;
-      if (with_direct) value_direct[i] *= inv;
-    }
-  });
 
   if (reuse) {
     // The reused cells' values after the decoded ones, a reused cell's slot
@@ -443,7 +439,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
       const std::size_t p = up.cell_pixel[c], slot = slot_of_pixel[p];
       if (slot == kNone) continue;
       const GSample& s = g.samples[p];
-      value[slot] = glm::max(value[slot] + s.diffuse / model::demodulation(s.reflectance) * engine::math::kInvPi * filtered[c],
+      value[slot] = glm::max(value[slot] + s.diffuse / model::demodulation(g.albedo[p]) * engine::math::kInvPi * filtered[c],
                              glm::vec3(0.0f));
     }
     stats.near_ms = ms_since(t0);
@@ -460,10 +456,10 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
       for (int x = 0; x < g.width; ++x) {
         const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
         if (up.kind[p] == UpsamplingPlan::kMiss) continue;
-        const glm::vec3 reflectance = model::demodulation(g.samples[p].reflectance);
+        const glm::vec3 albedo = model::demodulation(g.albedo[p]);
         if (up.kind[p] == UpsamplingPlan::kOwn) {
-          image.pixels[p] = reflectance * value[slot_of_pixel[p]];
-          if (with_direct) direct_out->pixels[p] += reflectance * value_direct[slot_of_pixel[p]];
+          image.pixels[p] = albedo * value[slot_of_pixel[p]];
+          if (with_direct) direct_out->pixels[p] += albedo * value_direct[slot_of_pixel[p]];
           continue;
         }
         glm::vec3 sum(0.0f), sum_direct(0.0f);
@@ -474,8 +470,8 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
           sum += w * value[slot];
           if (with_direct) sum_direct += w * value_direct[slot];
         }
-        image.pixels[p] = reflectance * sum;
-        if (with_direct) direct_out->pixels[p] += reflectance * sum_direct;
+        image.pixels[p] = albedo * sum;
+        if (with_direct) direct_out->pixels[p] += albedo * sum_direct;
       }
   });
   stats.upsample_ms = plan_ms + ms_since(t0);

@@ -75,6 +75,10 @@ struct GBuffer {
   // upsampling compares; written by trace_gbuffer. 16 bytes a pixel instead
   // of a whole GSample keeps those passes in cache.
   std::vector<glm::vec4> guide;
+  // Per pixel: the base colour hit (0 for a miss): the real-time GI is
+  // upsampled divided by it and multiplied back per pixel, so a texture
+  // keeps its full-resolution detail; written by trace_gbuffer.
+  std::vector<glm::vec3> albedo;
   // Per pixel: the world position hit (0 for a miss), for the soft
   // shadows' same-surface test (realtime_direct.h); written by trace_gbuffer.
   std::vector<glm::vec3> position;

@@ -129,7 +129,7 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
     if (model.demodulated)
       jobs::parallel_for<std::size_t>(0, hits.size(), 1024, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
-          const glm::vec3 d = model::demodulation(samples[hits[i]].reflectance);
+          const glm::vec3 d = model::demodulation(samples[hits[i]].albedo);
           for (int c = 0; c < 3; ++c)
             for (int k = 0; k < 25; ++k) transfer[i * bake::kTransferValues + static_cast<std::size_t>(c * 25 + k)] *= d[c];
         }
