@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/image/tonemap.h"
 #include "engine/math/sampling.h"
 
 namespace engine::image {
@@ -131,6 +132,30 @@ ColourMetrics compare_colour(const ImageRGB& a, const ImageRGB& b) {
     m.detail_b /= static_cast<double>(m.pixels);
   }
   return m;
+}
+
+double speckle_fraction(const ImageRGB& img, int threshold) {
+  const Rgb8Image shown = to_srgb8(img);
+  const int w = img.width, h = img.height;
+  if (w <= 0 || h <= 0) return 0.0;
+  std::size_t speckles = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      bool speckle = false;
+      for (int c = 0; c < 3 && !speckle; ++c) {
+        int v[9], k = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int qx = std::clamp(x + dx, 0, w - 1), qy = std::clamp(y + dy, 0, h - 1);
+            v[k++] = shown.pixels[(static_cast<std::size_t>(qy) * w + qx) * 3 + c];
+          }
+        std::nth_element(v, v + 4, v + 9);
+        const int own = shown.pixels[(static_cast<std::size_t>(y) * w + x) * 3 + c];
+        speckle = std::abs(own - v[4]) > threshold;
+      }
+      speckles += speckle ? 1 : 0;
+    }
+  return static_cast<double>(speckles) / (static_cast<double>(w) * h);
 }
 
 double top_error_share(const ImageRGB& a, const ImageRGB& b, double fraction) {

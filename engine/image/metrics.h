@@ -55,6 +55,14 @@ struct ColourMetrics {
 };
 ColourMetrics compare_colour(const ImageRGB& a, const ImageRGB& b);
 
+// The fraction of pixels, as displayed (to_srgb8 at exposure 0), that lie
+// more than `threshold` (8-bit levels) from the median of their 3x3
+// neighbourhood in some channel: isolated bright or dark pixels, speckles
+// (issue 37). A smooth image, an edge or a texture's pattern scores about 0;
+// a path tracer's converged frame a few tenths of a percent. The border's
+// neighbourhoods are clamped to the image.
+double speckle_fraction(const ImageRGB& img, int threshold = 60);
+
 // Per-pixel mean absolute clamped error mapped through a perceptually
 // ordered colour map (black-red-yellow-white); `max_error` maps to white.
 // max_error <= 0 picks the 99th percentile of the errors.

@@ -316,3 +316,21 @@ TEST(Metrics, ColourMetricsMeasureHueShiftAndDetail) {
   EXPECT_NEAR(grey.chroma_error, 0.5 * (0.5333333 + 0.7333333), 1e-5);
   EXPECT_DOUBLE_EQ(grey.detail_a, 0.0) << "flat grey has no detail";
 }
+
+TEST(Metrics, SpeckleFractionCountsIsolatedPixelsNotEdgesOrGradients) {
+  using namespace engine::image;
+  ImageRGB img(20, 10);
+  for (int y = 0; y < 10; ++y)
+    for (int x = 0; x < 20; ++x) img.at(x, y) = glm::vec3(x < 10 ? 0.05f : 0.8f) * (1.0f + 0.01f * static_cast<float>(y));
+  EXPECT_DOUBLE_EQ(speckle_fraction(img), 0.0) << "a hard edge is not a speckle";
+  img.at(3, 4) = glm::vec3(1.0f);     // white on the dark side
+  img.at(15, 5) = glm::vec3(0.0f);    // black on the bright side
+  img.at(0, 0) = glm::vec3(0.0f, 0.0f, 1.0f);  // a blue corner pixel: one channel is enough
+  EXPECT_DOUBLE_EQ(speckle_fraction(img), 3.0 / 200.0);
+  // 60 levels is the threshold: a step of 50/255 (displayed) is not one.
+  ImageRGB soft(5, 5, glm::vec3(srgb_to_linear(0.5f)));
+  soft.at(2, 2) = glm::vec3(srgb_to_linear(0.5f + 50.0f / 255.0f));
+  EXPECT_DOUBLE_EQ(speckle_fraction(soft), 0.0);
+  soft.at(2, 2) = glm::vec3(srgb_to_linear(0.5f + 70.0f / 255.0f));
+  EXPECT_DOUBLE_EQ(speckle_fraction(soft), 1.0 / 25.0);
+}

@@ -38,8 +38,10 @@ int run_compare(const std::vector<std::string>& argv) {
   if (args.has("colour")) {
     // Hue and texture against the reference (engine/image/metrics.h), a line of their own.
     const auto c = engine::image::compare_colour(a, b);
-    std::printf("{\"chroma_error\": %.6g, \"detail\": %.6g, \"detail_reference\": %.6g, \"detail_ratio\": %.4f, \"colour_pixels\": %zu}\n",
-                c.chroma_error, c.detail_a, c.detail_b, c.detail_b > 0 ? c.detail_a / c.detail_b : 0.0, c.pixels);
+    std::printf("{\"chroma_error\": %.6g, \"detail\": %.6g, \"detail_reference\": %.6g, \"detail_ratio\": %.4f, \"colour_pixels\": %zu, "
+                "\"speckles\": %.6g, \"speckles_reference\": %.6g}\n",
+                c.chroma_error, c.detail_a, c.detail_b, c.detail_b > 0 ? c.detail_a / c.detail_b : 0.0, c.pixels,
+                engine::image::speckle_fraction(a), engine::image::speckle_fraction(b));
   }
   if (args.has("top-error")) {
     const double f = args.number("top-error", 0.0, 100.0) / 100.0;
