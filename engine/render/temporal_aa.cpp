@@ -22,6 +22,13 @@ float radical_inverse(std::uint64_t i, std::uint64_t base) {
   return r;
 }
 
+// The range of the 3x3 neighbours of each pixel of one row, per layer: at a
+// silhouette it spans both sides whichever way the edge runs, so the
+// jitter's alternation there stays inside it. Rows beyond the image repeat
+// its edge. Separable: each of the three rows' horizontal ranges, then
+// their vertical one, over flat float rows (a pixel's neighbours are 3
+// floats away) so that the loops vectorise.
+
 }  // namespace
 
 glm::vec2 taa_jitter(std::uint64_t index, int phases) {
@@ -34,6 +41,75 @@ std::vector<TaaObject> objects_of(const rt::RtScene& scene) {
   scene.for_each_instance([&](const rt::InstanceRecord& inst) { out.push_back({inst.entity, inst.to_world}); });
   return out;
 }
+
+static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "a row of pixels is read as a row of floats");
+class TemporalAntialiasing::NeighbourRange {
+ public:
+  // The horizontal ranges of rows [y0 - 1, y1], edges repeated, for row().
+  void rows(std::span<image::ImageRGB* const> layers, int w, int h, int y0, int y1) {
+    n_ = 3 * static_cast<std::size_t>(w);
+    y0_ = y0;
+    count_ = static_cast<std::size_t>(y1 - y0 + 2);
+    layers_ = layers.size();
+    h_lo_.resize(layers_ * count_ * n_);
+    h_hi_.resize(layers_ * count_ * n_);
+    lo_.resize(layers_ * n_);
+    hi_.resize(layers_ * n_);
+    for (std::size_t l = 0; l < layers_; ++l)
+      for (std::size_t r = 0; r < count_; ++r) {
+        const int y = std::clamp(y0 - 1 + static_cast<int>(r), 0, h - 1);
+        horizontal(&layers[l]->pixels[static_cast<std::size_t>(y) * w].x, n_, &h_lo_[(l * count_ + r) * n_],
+                   &h_hi_[(l * count_ + r) * n_]);
+      }
+    h_ = h;
+  }
+  // Row y's 3x3 ranges (y0 <= y < y1 of the last rows() call).
+  void row(int y) {
+    const std::size_t r = static_cast<std::size_t>(y - y0_);  // the row above y
+    // Beyond the image the edge row repeats: the row itself stands in.
+    const std::size_t above = y == 0 ? r + 1 : r, below = y == h_ - 1 ? r + 1 : r + 2;
+    for (std::size_t l = 0; l < layers_; ++l) {
+      const float* base_lo = &h_lo_[l * count_ * n_];
+      const float* base_hi = &h_hi_[l * count_ * n_];
+      const float *a = base_lo + above * n_, *b = base_lo + (r + 1) * n_, *c = base_lo + below * n_;
+      float* lo = &lo_[l * n_];
+      for (std::size_t i = 0; i < n_; ++i) lo[i] = std::min(std::min(a[i], b[i]), c[i]);
+      a = base_hi + above * n_, b = base_hi + (r + 1) * n_, c = base_hi + below * n_;
+      float* hi = &hi_[l * n_];
+      for (std::size_t i = 0; i < n_; ++i) hi[i] = std::max(std::max(a[i], b[i]), c[i]);
+    }
+  }
+  [[nodiscard]] glm::vec3 lo(std::size_t layer, int x) const { return at(lo_, layer, x); }
+  [[nodiscard]] const float* lo_row(std::size_t layer) const { return &lo_[layer * n_]; }
+  [[nodiscard]] const float* hi_row(std::size_t layer) const { return &hi_[layer * n_]; }
+  [[nodiscard]] glm::vec3 hi(std::size_t layer, int x) const { return at(hi_, layer, x); }
+
+ private:
+  static void horizontal(const float* src, std::size_t n, float* lo, float* hi) {
+    if (n == 3) {
+      std::copy(src, src + 3, lo);
+      std::copy(src, src + 3, hi);
+      return;
+    }
+    for (std::size_t c = 0; c < 3; ++c) {
+      lo[c] = std::min(src[c], src[c + 3]);
+      hi[c] = std::max(src[c], src[c + 3]);
+      lo[n - 3 + c] = std::min(src[n - 6 + c], src[n - 3 + c]);
+      hi[n - 3 + c] = std::max(src[n - 6 + c], src[n - 3 + c]);
+    }
+    for (std::size_t i = 3; i + 3 < n; ++i) {
+      lo[i] = std::min(std::min(src[i - 3], src[i]), src[i + 3]);
+      hi[i] = std::max(std::max(src[i - 3], src[i]), src[i + 3]);
+    }
+  }
+  [[nodiscard]] glm::vec3 at(const std::vector<float>& v, std::size_t layer, int x) const {
+    const float* f = &v[layer * n_ + 3 * static_cast<std::size_t>(x)];
+    return {f[0], f[1], f[2]};
+  }
+  std::vector<float> lo_, hi_, h_lo_, h_hi_;
+  std::size_t n_ = 0, count_ = 0, layers_ = 0;
+  int y0_ = 0, h_ = 0;
+};
 
 glm::vec2 TemporalAntialiasing::next_jitter(const TemporalAaSettings& settings) const {
   return settings.enabled ? taa_jitter(frame_, settings.jitter_phases) : glm::vec2(0.0f);
@@ -138,6 +214,52 @@ void TemporalAntialiasing::keep_history(const CameraRays& camera, TaaSurfaces& s
   if (prev_.frames.size() != n) prev_.frames.assign(n, 1);
 }
 
+std::size_t TemporalAntialiasing::blend_still_row(std::size_t row, int w, const std::vector<ecs::Entity>& entity,
+                                                  std::span<image::ImageRGB* const> layers,
+                                                  const NeighbourRange& range, float clamp_amount, float blend,
+                                                  const TemporalAaSettings& settings, std::vector<std::uint8_t>& plain,
+                                                  std::vector<float>& alpha3) {
+  // Which pixels are plain: their surface did not move, and their history,
+  // at the pixel itself, shows no object that did.
+  std::size_t count = 0;
+  for (int x = 0; x < w; ++x) {
+    const std::size_t p = row + static_cast<std::size_t>(x);
+    const ecs::Entity self = entity[p], was = prev_.entity[p];
+    const bool is_plain = !moved(self) && (was == self || !moved(was)) && !(!near_moved_.empty() && near_moved_[p] && moved_beside(p, self));
+    plain[static_cast<std::size_t>(x)] = is_plain ? 1 : 0;
+    float alpha = 1.0f;
+    if (is_plain) {
+      frames_[p] = static_cast<std::uint8_t>(std::min(255, prev_.frames[p] + 1));
+      alpha = std::max(blend, 1.0f / static_cast<float>(frames_[p]));
+      ++count;
+    }
+    alpha3[3 * static_cast<std::size_t>(x)] = alpha3[3 * static_cast<std::size_t>(x) + 1] = alpha3[3 * static_cast<std::size_t>(x) + 2] = alpha;
+  }
+  if (count == 0) return 0;
+  // Every pixel of the row as if plain, in flat float rows (vectorised);
+  // resolve() overwrites the others.
+  const std::size_t n = 3 * static_cast<std::size_t>(w);
+  const float margin_scale = settings.clamp_margin * 0.5f;
+  for (std::size_t l = 0; l < layers.size(); ++l) {
+    const float* history = &prev_.layers[l].pixels[row].x;
+    const float* cur = &layers[l]->pixels[row].x;
+    float* out = &out_[l].pixels[row].x;
+    const float* a = alpha3.data();
+    if (clamp_amount > 0.0f) {
+      const float *lo = range.lo_row(l), *hi = range.hi_row(l);
+      for (std::size_t i = 0; i < n; ++i) {
+        const float margin = margin_scale * (std::abs(lo[i]) + std::abs(hi[i]));
+        float kept = history[i];
+        kept += clamp_amount * (std::min(std::max(kept, lo[i] - margin), hi[i] + margin) - kept);
+        out[i] = kept + a[i] * (cur[i] - kept);
+      }
+    } else {
+      for (std::size_t i = 0; i < n; ++i) out[i] = history[i] + a[i] * (cur[i] - history[i]);
+    }
+  }
+  return count;
+}
+
 void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surfaces, std::span<const TaaObject> objects,
                                    std::span<image::ImageRGB* const> layers, const TemporalAaSettings& settings,
                                    bool light_changed) {
@@ -162,11 +284,23 @@ void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surface
   const float blend = std::clamp(settings.blend, 0.0f, 1.0f);
   const bool camera_still = before.to_world() == camera.to_world();
   std::atomic<std::size_t> reused{0}, rejected{0};
-  jobs::parallel_for(0, h, 4, [&](int y0, int y1) {
+  // Where some pixel's history may be clamped, each row's 3x3 range per
+  // layer is found first, as flat float rows the compiler vectorises.
+  const bool may_clamp = light_changed || !camera_still || any_moved_;
+  jobs::parallel_for(0, h, 16, [&](int y0, int y1) {
     std::size_t local_reused = 0, local_rejected = 0;
-    for (int y = y0; y < y1; ++y)
+    NeighbourRange range;
+    std::vector<std::uint8_t> plain(static_cast<std::size_t>(w));
+    std::vector<float> alpha3(3 * static_cast<std::size_t>(w));
+    if (may_clamp) range.rows(layers, w, h, y0, y1);
+    for (int y = y0; y < y1; ++y) {
+      if (may_clamp) range.row(y);
+      const std::size_t row = static_cast<std::size_t>(y) * w;
+      const bool rows_first = camera_still && settings.vectorised_rows;
+      if (rows_first) local_reused += blend_still_row(row, w, surfaces.entity, layers, range, light_changed ? 1.0f : 0.0f, blend, settings, plain, alpha3);
       for (int x = 0; x < w; ++x) {
-        const std::size_t p = static_cast<std::size_t>(y) * w + x;
+        if (rows_first && plain[static_cast<std::size_t>(x)]) continue;
+        const std::size_t p = row + x;
         // Where this pixel's point was in the previous frame, carried by
         // its object's motion. The point was traced through the jittered
         // film position; the pixel's centre is `jitter` away from it in
@@ -269,16 +403,7 @@ void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surface
           const image::ImageRGB& cur = *layers[l];
           glm::vec3 kept = history[l] / weight;
           if (clamp_amount > 0.0f) {
-            // The 3x3 neighbours' range: at a silhouette it spans both
-            // sides whichever way the edge runs, so the jitter's alternation
-            // there stays inside it.
-            glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-            for (int dy = -1; dy <= 1; ++dy) {
-              const glm::vec3* row = cur.pixels.data() + static_cast<std::size_t>(std::clamp(y + dy, 0, h - 1)) * w;
-              const glm::vec3 a = row[std::max(x - 1, 0)], b = row[x], c = row[std::min(x + 1, w - 1)];
-              lo = glm::min(lo, glm::min(glm::min(a, b), c));
-              hi = glm::max(hi, glm::max(glm::max(a, b), c));
-            }
+            glm::vec3 lo = range.lo(l, x), hi = range.hi(l, x);
             const glm::vec3 margin = settings.clamp_margin * 0.5f * (glm::abs(lo) + glm::abs(hi));
             lo -= margin;
             hi += margin;
@@ -287,6 +412,7 @@ void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surface
           out_[l].pixels[p] = kept + alpha * (cur.pixels[p] - kept);
         }
       }
+    }
     reused.fetch_add(local_reused, std::memory_order_relaxed);
     rejected.fetch_add(local_rejected, std::memory_order_relaxed);
   });

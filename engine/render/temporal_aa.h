@@ -45,6 +45,10 @@ struct TemporalAaSettings {
   // Sub-pixel points in the jitter cycle. Higher = finer antialiasing of a
   // still view, at the cost of a longer cycle to converge.
   int jitter_phases = 16;
+  // A still camera's pixels whose surface and history hold no moved object
+  // are blended a row at a time, vectorised. false = every pixel by the
+  // per-pixel path: the reference the fast path is tested against.
+  bool vectorised_rows = true;
 };
 
 // What the resolve needs to know of each pixel's surface, this frame. The
@@ -115,6 +119,15 @@ class TemporalAntialiasing {
   void mark_near_moved();
   std::vector<std::uint8_t> near_moved_;
   void keep_history(const CameraRays& camera, TaaSurfaces& surfaces, std::span<image::ImageRGB* const> layers);
+  class NeighbourRange;
+  // A still camera's row: blends every pixel whose surface and history
+  // hold no moved object with its history at the pixel itself (the common
+  // case, vectorised), marks them in `plain` and returns how many; the
+  // rest are left to resolve()'s per-pixel path.
+  std::size_t blend_still_row(std::size_t row, int w, const std::vector<ecs::Entity>& entity,
+                              std::span<image::ImageRGB* const> layers, const NeighbourRange& range, float clamp_amount,
+                              float blend, const TemporalAaSettings& settings, std::vector<std::uint8_t>& plain,
+                              std::vector<float>& alpha3);
 
   struct Previous {
     std::optional<CameraRays> camera;

@@ -199,3 +199,27 @@ TEST(TemporalAa, ASmallChangeOfLightBlendsAndALargeOneIsClamped) {
   const float clamped = 0.5f * (1.0f + margin);
   EXPECT_NEAR(large, clamped + 0.1f * (0.5f - clamped), 1e-5f) << "a halving is clamped to the margin around this frame";
 }
+
+TEST(TemporalAa, VectorisedRowsEqualThePerPixelPath) {
+  // A textured background, an object moving beside it now and then, the
+  // light changing every other frame: every branch of the still camera's
+  // rows, against the per-pixel path.
+  Synthetic fast, slow;
+  const auto shade = [](ecs::Entity e, float x) { return e == kFront ? 3.0f + std::sin(9.0f * x) : 0.5f + 0.4f * std::cos(13.0f * x); };
+  fast.shade = slow.shade = shade;
+  render::TemporalAaSettings per_pixel = on();
+  per_pixel.vectorised_rows = false;
+  render::TemporalAntialiasing a, b;
+  float worst = 0.0f;
+  for (int f = 0; f < 40; ++f) {
+    fast.a_offset = slow.a_offset = f % 7 < 3 ? 0.02f * static_cast<float>(f % 7) : 0.0f;
+    const bool light_changed = f % 2 == 0;
+    const image::ImageRGB x = fast.frame(a, on(), light_changed);
+    const image::ImageRGB y = slow.frame(b, per_pixel, light_changed);
+    for (std::size_t i = 0; i < x.size(); ++i)
+      for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(x.pixels[i][c] - y.pixels[i][c]));
+    EXPECT_EQ(a.stats().reused, b.stats().reused) << "frame " << f;
+    EXPECT_EQ(a.stats().rejected, b.stats().rejected) << "frame " << f;
+  }
+  EXPECT_LT(worst, 1e-5f) << "the same blend, only another order of float operations";
+}
