@@ -89,3 +89,40 @@ TEST(FrameHistory, TheFrameAfterAMoveShowsNoGhostWhereTheObjectWas) {
   EXPECT_LE(err_with, 1.1 * err_cleared + 1e-3) << "the histories kept some of the cube where it was";
   EXPECT_FALSE(cleared.frame().camera_cut) << "a cut is for one frame";
 }
+
+TEST(FrameHistory, AntialiasedPassesAreTheMeanOfTheFramesTheyHold) {
+  // A still camera over a still scene: no history is clamped, and a history
+  // of n <= 1 / blend frames is their plain mean. So with the passes
+  // antialiased, frame 8's gi and direct passes are the means of the eight
+  // raw passes a copy without them rendered, and the full image is the
+  // same in both.
+  runtime::TransGISettings settings = small_realtime(0, 1);
+  ASSERT_LE(8.0f * settings.taa.blend, 1.0f);
+  SunLevel raw(settings, 2), resolved(settings, 2);
+  resolved.frame().antialias_passes = true;
+  constexpr int kFrames = 8;
+  image::ImageRGB gi_mean(kW, kH), direct_mean(kW, kH);
+  for (int f = 0; f < kFrames; ++f) {
+    run_imaged(raw, 1);
+    for (std::size_t i = 0; i < gi_mean.size(); ++i) {
+      gi_mean.pixels[i] += raw.frame().gi.pixels[i] / static_cast<float>(kFrames);
+      direct_mean.pixels[i] += raw.frame().direct.pixels[i] / static_cast<float>(kFrames);
+    }
+  }
+  run_imaged(resolved, kFrames);
+  float worst_gi = 0, worst_direct = 0, worst_full = 0, jitter_spread = 0;
+  for (std::size_t i = 0; i < gi_mean.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const auto rel = [](float a, float b) { return std::abs(a - b) / (1e-3f + std::abs(b)); };
+      worst_gi = std::max(worst_gi, rel(resolved.frame().gi.pixels[i][c], gi_mean.pixels[i][c]));
+      worst_direct = std::max(worst_direct, rel(resolved.frame().direct.pixels[i][c], direct_mean.pixels[i][c]));
+      worst_full = std::max(worst_full, std::abs(resolved.frame().full.pixels[i][c] - raw.frame().full.pixels[i][c]));
+      jitter_spread = std::max(jitter_spread, rel(raw.frame().gi.pixels[i][c], gi_mean.pixels[i][c]));
+    }
+  std::printf("[ measured ] worst relative difference from the mean: gi %.2e, direct %.2e; the last raw frame's gi %.2e\n",
+              worst_gi, worst_direct, jitter_spread);
+  EXPECT_GT(jitter_spread, 0.05f) << "the jitter changes some pixels' passes, or this test shows nothing";
+  EXPECT_LT(worst_gi, 1e-4f);
+  EXPECT_LT(worst_direct, 1e-4f);
+  EXPECT_EQ(worst_full, 0.0f) << "the full image does not depend on whether the passes are resolved";
+}

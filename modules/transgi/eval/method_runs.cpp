@@ -114,6 +114,7 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
 
   auto& frame = world.resource<runtime::GiFrame>();
   frame.camera = scene.camera;
+  frame.antialias_passes = true;  // the passes are what render and eval write and measure
   int traced = 0;
   const auto samples = run_frames(
       // The temporal antialiasing's history builds over the frames that

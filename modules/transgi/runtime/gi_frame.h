@@ -36,6 +36,13 @@ struct GiFrame {
   // antialiasing's, the GI reuse's) for it instead of rejecting them pixel
   // by pixel. Cleared once that frame is rendered.
   bool camera_cut = false;
+  // Real-time path with antialiasing: the gi and direct passes are
+  // resolved with the full image (each clamped by its own neighbours), for
+  // a caller that shows or measures them (render, eval, a debug view).
+  // Off, only the full image is: what a player sees, at a third of the
+  // resolve's cost; the passes are then each frame's own, one sample per
+  // pixel, aliased on thin geometry.
+  bool antialias_passes = false;
 
   // Results of the last rendered frame.
   engine::image::ImageRGB gi, direct, full;

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <optional>
+#include <span>
 
 #include "engine/jobs/parallel_for.h"
 #include "engine/render/camera_rays.h"
@@ -192,14 +193,14 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   else
     add_stochastic_direct(rt, lights, rays, settings.direct_spp, seed, frame);
   compose_full(frame);
-  // The image a player sees is antialiased; the gi and direct passes stay
-  // this frame's own (one resolve, not three).
+  // The image a player sees is antialiased; the gi and direct passes too
+  // where the caller asks (GiFrame::antialias_passes).
   if (settings.taa.enabled) {
     t0 = std::chrono::steady_clock::now();
-    image::ImageRGB* layers[] = {&frame.full};
+    image::ImageRGB* all[] = {&frame.full, &frame.gi, &frame.direct};
+    const std::span<image::ImageRGB* const> layers(all, frame.antialias_passes ? 3 : 1);
     packed.taa.resolve(rays, render::TaaSurfaces{packed.gbuffer.position, packed.gbuffer.guide, packed.gbuffer.entity},
-                       render::objects_of(rt), layers, settings.taa,
-                       light_changed);
+                       render::objects_of(rt), layers, settings.taa, light_changed);
     t.antialiasing = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   } else {
     packed.taa.clear();
