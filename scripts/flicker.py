@@ -37,8 +37,8 @@ def main():
     second = np.abs(f[1:-1] - 0.5 * (f[:-2] + f[2:])).max(axis=3)
     step = np.abs(f[1:] - f[:-1]).max(axis=3)
     print(f"frames {a.first}-{a.last} of {d}: second difference > {a.threshold:g}/255 in "
-          f"{100 * (second > a.threshold).mean():.3f} % of pixels; frame-to-frame change > {a.threshold:g}/255 in "
-          f"{100 * (step > a.threshold).mean():.3f} %")
+          f"{100 * (second > a.threshold).mean():.4f} % of pixels; frame-to-frame change > {a.threshold:g}/255 in "
+          f"{100 * (step > a.threshold).mean():.4f} %")
 
 
 if __name__ == "__main__":

@@ -160,49 +160,140 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
 
 namespace {
 
-// Around each pixel, over the 3x3 blocks of 8x8 pixels centred on its own
-// (so at least 8 pixels either way): how many pattern rays are blocked, how
-// far the nearest blockers are (the least of the blocks' mean distances: a
-// table's shadow inside a window's keeps the table's narrow penumbra), and
-// how many rays are lit.
-struct BlockerCounts {
-  int blocks_x = 0;
-  std::vector<glm::vec3> around;  // per block: blocked, nearest mean blocker distance, lit
-  [[nodiscard]] const glm::vec3& at(int x, int y) const {
-    return around[static_cast<std::size_t>(y / 8) * static_cast<std::size_t>(blocks_x) + static_cast<std::size_t>(x / 8)];
+// The blocker search (PCSS's first step), per 2x2 cell of pixels, over the
+// 8x8 cells (16x16 pixels, which hold every point of the 8x8 pattern)
+// around it: how many pattern rays are blocked and how many lit (a pixel
+// whose window holds both is in or near a penumbra), and the blockers'
+// harmonic mean distance, which leans to the nearest (a table's shadow
+// inside a window's keeps the table's narrow penumbra). A ray blocked by its
+// own surface (distance 0: that part of the disk is below the surface's
+// horizon) counts as blocked but says nothing of the width. Window sums are
+// running sums along the cell rows, then down the cell columns: O(1) a
+// cell, the same whatever the thread count, and only over the bands of
+// 8 pixel rows that hold both blocked and lit rays, and the bands beside
+// them.
+constexpr int kCell = 2;
+constexpr int kWindowCells = 8;  // 16 pixels
+
+struct WindowSums {
+  std::int32_t blocked = 0, traced = 0, lit = 0;
+  float inverse_distance = 0;
+  void add(const WindowSums& o, int sign) {
+    blocked += sign * o.blocked;
+    traced += sign * o.traced;
+    lit += sign * o.lit;
+    inverse_distance += static_cast<float>(sign) * o.inverse_distance;
   }
 };
 
-BlockerCounts count_blockers(const std::vector<float>& blocker, int width, int height) {
-  BlockerCounts c;
-  c.blocks_x = (width + 7) / 8;
-  const int blocks_y = (height + 7) / 8;
-  std::vector<glm::vec3> own(static_cast<std::size_t>(c.blocks_x) * blocks_y);
-  engine::jobs::parallel_for(0, blocks_y, 1, [&](int b0, int b1) {
-    for (int by = b0; by < b1; ++by)
-      for (int y = by * 8; y < std::min(height, by * 8 + 8); ++y)
-        for (int x = 0; x < width; ++x) {
-          const float d = blocker[static_cast<std::size_t>(y) * width + x];
-          glm::vec3& o = own[static_cast<std::size_t>(by) * c.blocks_x + static_cast<std::size_t>(x / 8)];
-          if (std::isfinite(d)) o += glm::vec3(1.0f, d, 0.0f);
-          else if (std::isinf(d)) o.z += 1.0f;
+// Per pixel: the penumbra's half-width in pixels, 1 to 8 (0: not in or near
+// a penumbra, or not a receiver). A mean over a sliding window, it changes
+// smoothly from pixel to pixel.
+std::vector<std::uint8_t> penumbra_radius(const GBuffer& g, const std::vector<float>& blocker, float tan_radius,
+                                          float pixel_spread) {
+  const int w = g.width, h = g.height;
+  const int cw = (w + kCell - 1) / kCell, ch = (h + kCell - 1) / kCell;
+  const auto cell_at = [cw](int cx, int cy) { return static_cast<std::size_t>(cy) * static_cast<std::size_t>(cw) + static_cast<std::size_t>(cx); };
+  constexpr int kBandCells = 8 / kCell;
+  const int bands = (ch + kBandCells - 1) / kBandCells;
+  std::vector<WindowSums> cells(static_cast<std::size_t>(cw) * ch);  // each written once below
+  std::vector<std::uint8_t> band_blocked(static_cast<std::size_t>(bands), 0), band_lit(static_cast<std::size_t>(bands), 0);
+  engine::jobs::parallel_for(0, bands, 1, [&](int b0, int b1) {
+    for (int b = b0; b < b1; ++b) {
+      // Each cell written once from its pixels, branch-free (NaN, a
+      // non-receiver, fails every comparison).
+      for (int cy = b * kBandCells; cy < std::min(ch, (b + 1) * kBandCells); ++cy)
+        for (int cx = 0; cx < cw; ++cx) {
+          WindowSums cell;
+          for (int y = cy * kCell; y < std::min(h, cy * kCell + kCell); ++y)
+            for (int x = cx * kCell; x < std::min(w, cx * kCell + kCell); ++x) {
+              const float d = blocker[static_cast<std::size_t>(y) * w + x];
+              const bool blocked = d < kInf, traced = blocked && d > 0;
+              cell.lit += d == kInf;
+              cell.blocked += blocked;
+              cell.traced += traced;
+              cell.inverse_distance += traced ? 1.0f / d : 0.0f;
+            }
+          cells[cell_at(cx, cy)] = cell;
         }
-  });
-  c.around.assign(own.size(), glm::vec3(0.0f));
-  for (int by = 0; by < blocks_y; ++by)
-    for (int bx = 0; bx < c.blocks_x; ++bx) {
-      glm::vec3& sum = c.around[static_cast<std::size_t>(by) * c.blocks_x + static_cast<std::size_t>(bx)];
-      float nearest = std::numeric_limits<float>::infinity();
-      for (int ny = std::max(0, by - 1); ny <= std::min(blocks_y - 1, by + 1); ++ny)
-        for (int nx = std::max(0, bx - 1); nx <= std::min(c.blocks_x - 1, bx + 1); ++nx) {
-          const glm::vec3& b = own[static_cast<std::size_t>(ny) * c.blocks_x + static_cast<std::size_t>(nx)];
-          sum.x += b.x;
-          sum.z += b.z;
-          if (b.x > 0.5f) nearest = std::min(nearest, b.y / b.x);
+      bool any_blocked = false, any_lit = false;
+      for (int cy = b * kBandCells; cy < std::min(ch, (b + 1) * kBandCells); ++cy)
+        for (int cx = 0; cx < cw; ++cx) {
+          any_blocked = any_blocked || cells[cell_at(cx, cy)].blocked > 0;
+          any_lit = any_lit || cells[cell_at(cx, cy)].lit > 0;
         }
-      sum.y = nearest;
+      band_blocked[static_cast<std::size_t>(b)] = any_blocked;
+      band_lit[static_cast<std::size_t>(b)] = any_lit;
     }
-  return c;
+  });
+  // A cell's window reaches one band up and one down: its band is active
+  // where those three bands hold both, and the rows of the bands beside an
+  // active one are summed too.
+  std::vector<std::uint8_t> active(static_cast<std::size_t>(bands), 0), summed(static_cast<std::size_t>(bands), 0);
+  for (int b = 0; b < bands; ++b) {
+    bool blocked = false, lit = false;
+    for (int k = std::max(0, b - 1); k <= std::min(bands - 1, b + 1); ++k) {
+      blocked = blocked || band_blocked[static_cast<std::size_t>(k)];
+      lit = lit || band_lit[static_cast<std::size_t>(k)];
+    }
+    active[static_cast<std::size_t>(b)] = blocked && lit;
+  }
+  for (int b = 0; b < bands; ++b)
+    for (int k = std::max(0, b - 1); k <= std::min(bands - 1, b + 1); ++k) summed[static_cast<std::size_t>(b)] |= active[static_cast<std::size_t>(k)];
+  std::vector<std::uint8_t> radius(blocker.size(), 0);
+  if (std::find(active.begin(), active.end(), 1) == active.end()) return radius;
+  // Along the cell rows: cells [cx - 4, cx + 3].
+  std::vector<WindowSums> rows(cells.size());
+  engine::jobs::parallel_for(0, ch, 8, [&](int y0, int y1) {
+    for (int cy = y0; cy < y1; ++cy) {
+      if (!summed[static_cast<std::size_t>(cy / kBandCells)]) continue;
+      const WindowSums* row = &cells[cell_at(0, cy)];
+      WindowSums sum;
+      for (int cx = 0; cx < std::min(cw, kWindowCells / 2 - 1); ++cx) sum.add(row[cx], 1);
+      for (int cx = 0; cx < cw; ++cx) {
+        if (cx + kWindowCells / 2 - 1 < cw) sum.add(row[cx + kWindowCells / 2 - 1], 1);
+        rows[cell_at(cx, cy)] = sum;
+        if (cx - kWindowCells / 2 >= 0) sum.add(row[cx - kWindowCells / 2], -1);
+      }
+    }
+  });
+  // Down the cell columns over each run of active bands (the running float
+  // sum restarts with every run), then each pixel's radius from its cell's
+  // window and its own depth.
+  engine::jobs::parallel_for(0, bands, 1, [&](int b0, int b1) {
+    std::vector<WindowSums> column(static_cast<std::size_t>(cw));
+    for (int b = b0; b < b1; ++b) {
+      if (!active[static_cast<std::size_t>(b)]) continue;
+      // Each band sums its windows afresh: bands are independent, so any
+      // thread may take any band and the result does not depend on it.
+      std::fill(column.begin(), column.end(), WindowSums{});
+      const int first = b * kBandCells;
+      const auto add_row = [&](int cy, int sign) {
+        if (cy < 0 || cy >= ch) return;
+        const WindowSums* r = &rows[cell_at(0, cy)];
+        for (int cx = 0; cx < cw; ++cx) column[static_cast<std::size_t>(cx)].add(r[cx], sign);
+      };
+      for (int cy = first - kWindowCells / 2; cy < first + kWindowCells / 2 - 1; ++cy) add_row(cy, 1);
+      for (int cy = first; cy < std::min(ch, first + kBandCells); ++cy) {
+        add_row(cy + kWindowCells / 2 - 1, 1);
+        for (int cx = 0; cx < cw; ++cx) {
+          const WindowSums& c = column[static_cast<std::size_t>(cx)];
+          if (c.blocked == 0 || c.lit == 0 || c.traced == 0) continue;
+          const float mean = static_cast<float>(c.traced) / c.inverse_distance;
+          for (int y = cy * kCell; y < std::min(h, cy * kCell + kCell); ++y)
+            for (int x = cx * kCell; x < std::min(w, cx * kCell + kCell); ++x) {
+              const std::size_t p = static_cast<std::size_t>(y) * w + x;
+              const float depth = g.guide[p].w;
+              if (std::isnan(blocker[p]) || !(depth > 0)) continue;
+              const float r = std::ceil(mean * tan_radius / (depth * pixel_spread));
+              radius[p] = static_cast<std::uint8_t>(std::clamp(r, 1.0f, 8.0f));
+            }
+        }
+        add_row(cy - kWindowCells / 2, -1);
+      }
+    }
+  });
+  return radius;
 }
 
 // Whether pixel q lies on pixel p's surface: normals within ~25 degrees, q
@@ -228,45 +319,28 @@ std::vector<float> penumbra_filter(const GBuffer& g, const std::vector<float>& b
   });
   if (!(tan_radius > 0)) return out;
   const std::vector<float> lit = out;
-  // Only the 8x8 blocks whose neighbourhood holds both lit and blocked
-  // pattern rays change; the rest keep their own visibility.
-  const BlockerCounts counts = count_blockers(blocker, w, h);
-  const int blocks_x = counts.blocks_x;
-  std::vector<int> mixed;
-  for (std::size_t b = 0; b < counts.around.size(); ++b) {
-    const glm::vec3& c = counts.around[b];
-    if (c.x > 0.5f && c.z > 0.5f && std::isfinite(c.y)) mixed.push_back(static_cast<int>(b));
-  }
-  // Per pixel of those blocks: the penumbra's half-width in pixels from the
-  // nearest blockers' distance, at most 8 (a box 8 pixels wide or more covers
-  // the whole pattern).
-  std::vector<std::uint8_t> radius(n, 0);
-  const auto each_mixed_pixel = [&](auto&& fn) {
-    engine::jobs::parallel_for(0, static_cast<int>(mixed.size()), 4, [&](int m0, int m1) {
-      for (int m = m0; m < m1; ++m) {
-        const int bx = mixed[static_cast<std::size_t>(m)] % blocks_x, by = mixed[static_cast<std::size_t>(m)] / blocks_x;
-        for (int y = by * 8; y < std::min(h, by * 8 + 8); ++y)
-          for (int x = bx * 8; x < std::min(w, bx * 8 + 8); ++x) fn(x, y, static_cast<std::size_t>(y) * w + x);
-      }
+  const std::vector<std::uint8_t> radius = penumbra_radius(g, blocker, tan_radius, pixel_spread);
+  const auto each_pixel = [&](auto&& fn) {
+    engine::jobs::parallel_for(0, h, 4, [&](int y0, int y1) {
+      for (int y = y0; y < y1; ++y)
+        for (int x = 0; x < w; ++x) {
+          const std::size_t p = static_cast<std::size_t>(y) * w + x;
+          if (radius[p] != 0) fn(x, y, p);
+        }
     });
   };
-  each_mixed_pixel([&](int x, int y, std::size_t p) {
-    const float depth = g.guide[p].w;
-    if (std::isnan(lit[p]) || !(depth > 0)) return;
-    const float r = std::ceil(counts.at(x, y).y * tan_radius / (depth * pixel_spread));
-    radius[p] = static_cast<std::uint8_t>(std::clamp(r, 0.0f, 8.0f));
-  });
   const SurfaceTest same{g.guide, g.position};
   // A box of radius 4 or more is [-r, r - 1], an even width: 8 and 16
   // pixels hold each of the pattern's 8 columns (rows) equally often, where
   // 9 or 17 would count one more and leave its trace.
   const auto last = [](int r) { return r >= 4 ? r - 1 : r; };
   // Rows, then columns, each a box over the pixel's own radius on its own
-  // surface; the columns take the rows' means (a pixel outside the blocks
-  // that change is its own mean).
+  // surface; the columns take the rows' means (a pixel outside a penumbra
+  // is its own mean). The radius changes smoothly from pixel to pixel (a
+  // mean over a sliding window), so the columns read rows filtered at
+  // about their own width.
   std::vector<float> rows(lit);
-  each_mixed_pixel([&](int x, int, std::size_t p) {
-    if (radius[p] == 0) return;
+  each_pixel([&](int x, int, std::size_t p) {
     float sum = 0, count = 0;
     for (int dx = -radius[p]; dx <= last(radius[p]); ++dx) {
       const int qx = x + dx;
@@ -278,8 +352,7 @@ std::vector<float> penumbra_filter(const GBuffer& g, const std::vector<float>& b
     }
     rows[p] = sum / count;
   });
-  each_mixed_pixel([&](int x, int y, std::size_t p) {
-    if (radius[p] == 0) return;
+  each_pixel([&](int x, int y, std::size_t p) {
     float sum = 0, count = 0;
     for (int dy = -radius[p]; dy <= last(radius[p]); ++dy) {
       const int qy = y + dy;

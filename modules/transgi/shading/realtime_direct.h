@@ -106,10 +106,11 @@ glm::vec2 disk_pattern(int x, int y);
 // blocks its pattern ray (infinity: lit; NaN: not a receiver). Returns per
 // pixel the fraction of lit receivers around it on its own surface (a
 // normal within ~25 degrees, within 2 % of its depth of its plane) in a
-// square whose half-width is the penumbra's on screen (the nearest blockers'
-// distance x tan_radius over the pixel's footprint): a box of 8 or
-// 16 pixels, which holds every point of the 8x8 pattern, where the
-// penumbra is 4 pixels wide or more, one no wider than it where narrower.
+// square whose half-width is the penumbra's on screen (the blockers'
+// harmonic mean distance over the 16x16 pixels around it x tan_radius over
+// the pixel's footprint): a box of 8 or 16 pixels, which holds every point
+// of the 8x8 pattern, where the penumbra is 4 pixels wide or more, one no
+// wider than it where narrower.
 std::vector<float> penumbra_filter(const GBuffer& g, const std::vector<float>& blocker, float tan_radius,
                                    float pixel_spread);
 
