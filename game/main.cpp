@@ -3,6 +3,8 @@
 //   transgi-game [--frames N --screenshot F.png] [--scene ...]
 //   transgi-game --headless --frames N [--script-input replay.txt] [--record DIR] [--screenshot F.png]
 //                [--scene level.gltf] [--model M.tgm] [--game game.json] [--width W --height H] [--view full|gi|direct]
+//                [--method transgi|ddgi|reference]
+// Exit codes: kUsage below.
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -22,13 +24,18 @@ namespace {
 constexpr const char* kUsage =
     "usage: transgi-game [--headless] [--frames N] [--script-input replay.txt] [--record DIR] [--screenshot F.png]\n"
     "                    [--scene level.gltf] [--model M.tgm] [--game game.json] [--width W] [--height H]\n"
-    "                    [--view full|gi|direct] [--exposure STOPS] [--threads T]\n"
-    "  window only: [--select NAME] [--gizmo translate|rotate] (what the editor shows at start)\n";
+    "                    [--method transgi|ddgi|reference] [--view full|gi|direct] [--exposure STOPS] [--threads T]\n"
+    "  window only: [--select NAME] [--gizmo translate|rotate] (what the editor shows at start)\n"
+    "  headless only: [--script-input replay.txt] [--record DIR]\n"
+    "exit codes: 0 the run finished with no error logged; 1 it could not run (a missing or bad scene, model,\n"
+    "  manifest or replay file: the message names it); 2 a bad command line; 3 the run finished and wrote its\n"
+    "  outputs, but errors were logged on the way (a replay event that could not apply, a failing script: see\n"
+    "  the \"log:\" line and the messages above it).\n";
 
 engine::core::Args parse(int argc, char** argv) {
   return engine::core::Args("transgi-game", std::vector<std::string>(argv + 1, argv + argc),
                             {"frames", "script-input", "record", "screenshot", "scene", "model", "game", "width", "height", "view",
-                             "exposure", "threads", "select", "gizmo"},
+                             "method", "exposure", "threads", "select", "gizmo"},
                             {"headless", "help"});
 }
 
@@ -42,6 +49,7 @@ game::GameOptions game_options(const engine::core::Args& args) {
   o.height = static_cast<int>(args.integer("height", 16, 8192, 360));
   o.threads = static_cast<int>(args.integer("threads", 0, 1024, 0));
   o.view = args.choice("view", {"full", "gi", "direct"}, "full");
+  o.method = game::parse_method(args.choice("method", {"transgi", "ddgi", "reference"}, "transgi"));
   return o;
 }
 
@@ -60,7 +68,15 @@ int run_headless(const engine::core::Args& args) {
   double total_ms = 0;
   for (int f = 0; f < frames; ++f) {
     session.begin_input();
-    for (; next < events.size() && events[next].frame <= f; ++next) session.apply(events[next]);
+    // An event that cannot apply (no such entity, a handle out of view) is
+    // logged and skipped: the run goes on to write its frames, and exits 3.
+    for (; next < events.size() && events[next].frame <= f; ++next) {
+      try {
+        session.apply(events[next]);
+      } catch (const std::exception& e) {
+        session.world().resource<engine::core::Log>().error("replay", e.what());
+      }
+    }
     session.frame();
     total_ms += session.last_frame_ms();
     if (recorder) recorder->add_frame(session.image());
@@ -102,6 +118,10 @@ int main(int argc, char** argv) {
       w.gizmo = args.choice("gizmo", {"translate", "rotate"}, "translate");
       return game::run_window(game_options(args), w);
     }
+    for (const char* window_only : {"select", "gizmo"})
+      if (args.has(window_only))
+        throw engine::core::UsageError(std::string("transgi-game: --") + window_only +
+                                       " sets what the editor shows at start, and --headless has no editor: drop one of them");
     return run_headless(args);
   } catch (const engine::core::UsageError& e) {
     std::fprintf(stderr, "%s\n%s", e.what(), kUsage);

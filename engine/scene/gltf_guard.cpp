@@ -261,9 +261,38 @@ std::string check_image_buffer_views(const nlohmann::json& j, const FileAccess& 
 
 }  // namespace
 
+std::string json_syntax_error(std::string_view json_text) {
+  try {
+    (void)nlohmann::json::parse(json_text);
+    return {};
+  } catch (const nlohmann::json::parse_error& e) {
+    // e.byte is the 1-based position where the parser stopped.
+    const std::size_t at = std::min<std::size_t>(e.byte > 0 ? e.byte - 1 : 0, json_text.size());
+    std::size_t line = 1, column = 1;
+    for (std::size_t i = 0; i < at; ++i) {
+      if (json_text[i] == '\n') {
+        ++line;
+        column = 1;
+      } else {
+        ++column;
+      }
+    }
+    const std::string where = "line " + std::to_string(line) + ", column " + std::to_string(column);
+    if (at >= json_text.size() || std::string_view(e.what()).find("unexpected end of input") != std::string_view::npos)
+      return "the JSON ends at " + where + " (byte " + std::to_string(json_text.size()) +
+             ") with objects or arrays still open: the file looks truncated";
+    // The parser's own words after its "[json.exception...] " prefix.
+    std::string why = e.what();
+    if (const auto colon = why.find(": "); colon != std::string::npos) why = why.substr(colon + 2);
+    if (const auto dash = why.find(" - "); dash != std::string::npos) why = why.substr(dash + 3);
+    return "JSON syntax error at " + where + ": " + why;
+  }
+}
+
 std::string check_references(std::string_view json_text, const FileAccess& access, std::size_t bin_length) {
   const auto j = nlohmann::json::parse(json_text, nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded() || !j.is_object()) return {};  // tinygltf reports the syntax error itself
+  if (j.is_discarded()) return json_syntax_error(json_text);
+  if (!j.is_object()) return "the JSON's top level is not an object";
   if (std::string bad = check_external_uris(j, access); !bad.empty()) return bad;
   return check_image_buffer_views(j, access, bin_length);
 }

@@ -50,7 +50,13 @@ tinygltf::FsCallbacks make_fs_callbacks(FileAccess* access);
 // Returns "field: reason" for the first bad one, or an empty string. The JSON
 // must already have passed json_depth. bin_length: the GLB's BIN chunk length
 // (0 for .gltf).
+// A JSON syntax error also comes back from it, as json_syntax_error says it.
 std::string check_references(std::string_view json, const FileAccess& access, std::size_t bin_length);
+
+// Where the JSON text stops parsing, in words: "the JSON ends at line L,
+// column C ... truncated" for a cut-off file, "JSON syntax error at line L,
+// column C: why" otherwise; empty for valid JSON.
+std::string json_syntax_error(std::string_view json);
 
 struct ImageLimits {
   int max_dimension = 16384;

@@ -29,6 +29,13 @@ namespace game {
 namespace fs = std::filesystem;
 using engine::ecs::Entity;
 
+GameMethod parse_method(const std::string& name) {
+  if (name == "transgi") return GameMethod::TransGI;
+  if (name == "ddgi") return GameMethod::Ddgi;
+  if (name == "reference") return GameMethod::Reference;
+  throw std::runtime_error("method: expected transgi, ddgi or reference, got '" + name + "'");
+}
+
 const char* method_name(GameMethod m) {
   switch (m) {
     case GameMethod::TransGI: return "TransGI";
@@ -99,6 +106,7 @@ GameSession::GameSession(const GameOptions& options) : options_(options), refere
   frame.camera = camera_;
   frame.width = options_.width;
   frame.height = options_.height;
+  set_method(options_.method);
 }
 
 void GameSession::set_view(const std::string& view) {
@@ -216,10 +224,10 @@ void GameSession::apply(const ReplayEvent& e) {
   else if (e.kind == "mouse_up") in.set_key("mouse_" + e.name, false);
   else if (e.kind == "select") {
     const Entity s = find(e.name);
-    if (s.is_null()) throw std::runtime_error("replay line " + std::to_string(e.line) + ": select: no entity named '" + e.name + "'");
+    if (s.is_null()) throw std::runtime_error(e.where() + ": select: no entity named '" + e.name + "'");
     editor_.selected = s;
   } else if (e.kind == "method") {
-    set_method(e.name == "ddgi" ? GameMethod::Ddgi : e.name == "reference" ? GameMethod::Reference : GameMethod::TransGI);
+    set_method(parse_method(e.name));
   } else if (e.kind == "view") {
     set_view(e.name);
   } else if (e.kind == "backend") {
@@ -229,11 +237,11 @@ void GameSession::apply(const ReplayEvent& e) {
   } else if (e.kind == "gizmo_mode") editor_.mode = e.name == "rotate" ? GizmoMode::Rotate : GizmoMode::Translate;
   else if (e.kind == "gizmo_grab") {
     const auto px = handle_grab_pixel(world(), editor_, view(), parse_handle(e.name));
-    if (!px) throw std::runtime_error("replay line " + std::to_string(e.line) + ": gizmo_grab " + e.name +
+    if (!px) throw std::runtime_error(e.where() + ": gizmo_grab " + e.name +
                                       ": the handle is not visible (nothing selected, or edge-on)");
     in.move_mouse(*px);
   } else {
-    throw std::runtime_error("replay line " + std::to_string(e.line) + ": unknown event '" + e.kind + "'");
+    throw std::runtime_error(e.where() + ": unknown event '" + e.kind + "'");
   }
 }
 

@@ -28,7 +28,11 @@ struct GameOptions {
   int width = 640, height = 360;
   int threads = 0;                 // 0 = all cores
   std::string view = "full";       // full | gi | direct
+  GameMethod method = GameMethod::TransGI;  // what the view shows at start
 };
+
+// "transgi" | "ddgi" | "reference", as the command line and replays name them.
+GameMethod parse_method(const std::string& name);
 
 class GameSession {
  public:

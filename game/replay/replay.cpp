@@ -24,6 +24,7 @@ std::vector<ReplayEvent> parse_replay(const std::string& text, const std::string
     auto bad = [&](const std::string& why) { throw std::runtime_error(name + ":" + std::to_string(n) + ": " + why); };
     ReplayEvent e;
     e.line = n;
+    e.file = name;
     try {
       std::size_t used = 0;
       e.frame = std::stoi(frame_word, &used);

@@ -30,6 +30,9 @@ struct ReplayEvent {
   std::string name;      // key, button, entity, handle or mode
   glm::vec2 xy{0.0f};    // mouse_move(_by)
   int line = 0;
+  std::string file;      // the replay it came from, as given to parse_replay
+  // "file:line", for messages about this event.
+  [[nodiscard]] std::string where() const { return file + ":" + std::to_string(line); }
 };
 
 // Sorted by frame, file order kept within a frame. Throws naming the file

@@ -251,7 +251,16 @@ TEST(GltfLoader, EnvironmentFromSceneExtras) {
 TEST(GltfLoaderBadInput, MalformedJson) {
   TempDir d;
   std::ofstream(d.path / "broken.gltf") << "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [";
-  expect_rejected(d.path / "broken.gltf", {});
+  expect_rejected(d.path / "broken.gltf", {"the JSON ends at line 1, column 41 (byte 40)", "truncated"});
+  // A stray comma: where, and what the parser expected, without its exception's name.
+  std::ofstream(d.path / "comma.gltf") << "{\"asset\": {\"version\": \"2.0\"},\n  , \"nodes\": []}";
+  expect_rejected(d.path / "comma.gltf", {"JSON syntax error at line 2, column 3", "unexpected ','"});
+  ecs::World w;
+  try {
+    load_gltf(w, d.path / "comma.gltf");
+  } catch (const GltfError& e) {
+    EXPECT_EQ(std::string(e.what()).find("json.exception"), std::string::npos) << e.what();
+  }
 }
 
 TEST(GltfLoaderBadInput, AbsurdlyDeepJson) {

@@ -29,6 +29,7 @@
 #include "engine/scene/sun.h"
 #include "engine/image/metrics.h"
 #include "play/game_session.h"
+#include "runtime/gi_frame.h"
 #include "runtime/settings.h"
 #include "replay/replay.h"
 
@@ -302,6 +303,53 @@ TEST(LevelSave, AMovedObjectIsSavedAndTheModelStillFitsTheLevel) {
 int shell(const std::string& cmd) {
   const int status = std::system(cmd.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// Runs a shell command; its exit status, and its output (stdout and stderr) in `out`.
+int shell_output(const std::string& cmd, std::string& out) {
+  out.clear();
+  FILE* pipe = ::popen((cmd + " 2>&1").c_str(), "r");
+  if (!pipe) return -1;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, pipe)) out += buffer;
+  const int status = ::pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(HeadlessRun, AReplayEventThatCannotApplyIsLoggedAndTheRunStillWritesItsOutputs) {
+  const fs::path dir = fs::temp_directory_path() / ("replay_error_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path replay = dir / "replay.txt";
+  std::ofstream(replay) << "0 key_down W\n1 select NoSuchThing  # not in the level\n2 key_up W\n";
+  std::string out;
+  const int code = shell_output("ASAN_OPTIONS=detect_leaks=0 '" TRANSGI_GAME_BINARY "' --headless --frames 4 --width 32 --height 18 --script-input '" +
+                                    replay.string() + "' --record '" + (dir / "run").string() + "'",
+                                out);
+  EXPECT_EQ(code, 3) << "the run finished, with an error logged:\n" << out;
+  EXPECT_NE(out.find(replay.string() + ":2: select: no entity named 'NoSuchThing'"), std::string::npos)
+      << "the message names the file and line:\n" << out;
+  EXPECT_TRUE(fs::exists(dir / "run" / "frame_0003.png")) << "every frame was recorded";
+  EXPECT_TRUE(fs::exists(dir / "run" / "contact_sheet.png")) << "and the contact sheet written";
+  fs::remove_all(dir);
+}
+
+TEST(HeadlessRun, WindowOnlyOptionsAreRefusedWithAReason) {
+  for (const char* option : {"--select PlasticCube", "--gizmo rotate"}) {
+    std::string out;
+    const int code = shell_output("'" TRANSGI_GAME_BINARY "' --headless --frames 1 --width 16 --height 16 " + std::string(option), out);
+    EXPECT_EQ(code, 2) << option << ":\n" << out;
+    EXPECT_NE(out.find("--headless has no editor"), std::string::npos) << option << ":\n" << out;
+  }
+}
+
+TEST(GameSession, TheMethodAtStartIsTheOneAsked) {
+  game::GameOptions o = level_options(32, 18);
+  o.method = game::GameMethod::Ddgi;
+  game::GameSession s(o);
+  EXPECT_EQ(s.method(), game::GameMethod::Ddgi);
+  EXPECT_EQ(s.world().resource<transgi::runtime::GiFrame>().width, 0) << "TransGI renders no image while DDGI is shown";
+  EXPECT_THROW(game::parse_method("pathtracer"), std::runtime_error);
 }
 
 TEST(WindowSmoke, TheWindowRendersTenFramesAndItsScreenshotIsNotBlank) {
