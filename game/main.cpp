@@ -7,6 +7,7 @@
 // Exit codes: kUsage below.
 #include <cstdio>
 #include <cstdlib>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,7 @@ constexpr const char* kUsage =
     "usage: transgi-game [--headless] [--frames N] [--script-input replay.txt] [--record DIR] [--screenshot F.png]\n"
     "                    [--scene level.gltf] [--model M.tgm] [--game game.json] [--width W] [--height H]\n"
     "                    [--method transgi|ddgi|reference] [--view full|gi|direct] [--exposure STOPS] [--threads T]\n"
+    "                    [--script ENTITY=FILE[,ENTITY=FILE...]] (the entity runs that Lua file instead of its own)\n"
     "  window only: [--select NAME] [--gizmo translate|rotate] (what the editor shows at start)\n"
     "  headless only: [--script-input replay.txt] [--record DIR]\n"
     "exit codes: 0 the run finished with no error logged; 1 it could not run (a missing or bad scene, model,\n"
@@ -35,7 +37,7 @@ constexpr const char* kUsage =
 engine::core::Args parse(int argc, char** argv) {
   return engine::core::Args("transgi-game", std::vector<std::string>(argv + 1, argv + argc),
                             {"frames", "script-input", "record", "screenshot", "scene", "model", "game", "width", "height", "view",
-                             "method", "exposure", "threads", "select", "gizmo"},
+                             "method", "script", "exposure", "threads", "select", "gizmo"},
                             {"headless", "help"});
 }
 
@@ -50,6 +52,15 @@ game::GameOptions game_options(const engine::core::Args& args) {
   o.threads = static_cast<int>(args.integer("threads", 0, 1024, 0));
   o.view = args.choice("view", {"full", "gi", "direct"}, "full");
   o.method = game::parse_method(args.choice("method", {"transgi", "ddgi", "reference"}, "transgi"));
+  if (args.has("script")) {
+    std::stringstream list(args.str("script"));
+    for (std::string item; std::getline(list, item, ',');) {
+      const auto eq = item.find('=');
+      if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
+        throw engine::core::UsageError("transgi-game: --script: expected ENTITY=FILE, got '" + item + "'");
+      o.scripts.emplace_back(item.substr(0, eq), item.substr(eq + 1));
+    }
+  }
   return o;
 }
 

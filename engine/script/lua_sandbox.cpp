@@ -12,13 +12,16 @@ namespace {
 // Registry key of the sandbox's budget, read by the count hook.
 char kBudgetKey;
 
-void budget_exceeded(lua_State* L, lua_Debug*) {
+void budget_exceeded(lua_State* L, lua_Debug* ar) {
   // Off first, so the traceback handler that runs next is not stopped too.
   lua_sethook(L, nullptr, 0, 0);
   lua_rawgetp(L, LUA_REGISTRYINDEX, &kBudgetKey);
   const lua_Integer budget = lua_tointeger(L, -1);
   lua_pop(L, 1);
-  luaL_error(L, "instruction budget exceeded (%I instructions in one call): an endless loop?", budget);
+  lua_getinfo(L, "Sl", ar);  // where the loop is: the running function's file and line
+  lua_pushfstring(L, "%s:%d: instruction budget exceeded (%I instructions in one call): an endless loop?", ar->short_src,
+                  ar->currentline, budget);
+  lua_error(L);
 }
 
 int traceback(lua_State* L) {
@@ -30,25 +33,77 @@ int traceback(lua_State* L) {
 
 }  // namespace
 
+namespace {
+
+// Each block is preceded by a header that names its owner (16 bytes, so the
+// block keeps malloc's alignment).
+struct alignas(16) BlockHeader {
+  std::uint32_t owner;
+};
+static_assert(sizeof(BlockHeader) == 16);
+
+void owner_budget_exceeded(lua_State* L, lua_Debug* ar) {
+  lua_sethook(L, nullptr, 0, 0);  // off first, so the traceback handler runs freely
+  // The hook's record is the running function: its file and line lead the
+  // message, as luaL_error's would in the script itself.
+  lua_getinfo(L, "Sl", ar);
+  lua_pushfstring(L, "%s:%d: memory budget exceeded: this script holds more than its share "
+                     "(SandboxLimits::owner_memory_bytes); a table that only grows?",
+                  ar->short_src, ar->currentline);
+  lua_error(L);
+}
+
+}  // namespace
+
 void* LuaSandbox::allocate(void* ud, void* ptr, std::size_t old_size, std::size_t new_size) {
   auto* a = static_cast<Alloc*>(ud);
+  BlockHeader* old_block = ptr ? static_cast<BlockHeader*>(ptr) - 1 : nullptr;
   const std::size_t old_bytes = ptr ? old_size : 0;  // with no block, old_size names a type
+  const std::uint32_t old_owner = old_block ? old_block->owner : 0;
   if (new_size == 0) {
-    std::free(ptr);
+    std::free(old_block);
     a->used -= old_bytes;
+    a->owner_used[old_owner] -= old_bytes;
     return nullptr;
   }
+  // A block that grows is charged to whoever runs now; one that shrinks
+  // stays with its owner.
+  const std::uint32_t owner = new_size > old_bytes ? a->current : old_owner;
   if (new_size > old_bytes && a->used - old_bytes + new_size > a->limit) return nullptr;  // Lua raises "not enough memory"
-  void* p = std::realloc(ptr, new_size);
-  if (p) a->used = a->used - old_bytes + new_size;
-  return p;
+  auto* block = static_cast<BlockHeader*>(std::realloc(old_block, sizeof(BlockHeader) + new_size));
+  if (!block) return nullptr;
+  a->used = a->used - old_bytes + new_size;
+  a->owner_used[old_owner] -= old_bytes;
+  a->owner_used[owner] += new_size;
+  block->owner = owner;
+  // Past its own budget: the script stops at its next instruction, with its
+  // position in the message (no Lua call may run inside the allocator, but
+  // lua_sethook may be called from anywhere).
+  if (owner != 0 && a->owner_used[owner] > a->owner_limit && a->L) lua_sethook(a->L, owner_budget_exceeded, LUA_MASKCOUNT, 1);
+  return block + 1;
 }
+
+std::uint32_t LuaSandbox::add_owner() {
+  alloc_.owner_used.push_back(0);
+  return static_cast<std::uint32_t>(alloc_.owner_used.size() - 1);
+}
+
+LuaSandbox::OwnerScope::OwnerScope(LuaSandbox& sandbox, std::uint32_t owner) : sandbox_(sandbox), previous_(sandbox.alloc_.current) {
+  if (owner >= sandbox.alloc_.owner_used.size()) throw std::out_of_range("LuaSandbox::OwnerScope: no such owner");
+  sandbox.alloc_.current = owner;
+}
+LuaSandbox::OwnerScope::~OwnerScope() { sandbox_.alloc_.current = previous_; }
+
+void LuaSandbox::collect() const { lua_gc(L_, LUA_GCCOLLECT, 0); }
 
 LuaSandbox::LuaSandbox(SandboxLimits limits) : limits_(limits) {
   if (limits_.instruction_budget < 1000) throw std::invalid_argument("LuaSandbox: instruction_budget must be at least 1000");
   alloc_.limit = limits_.memory_bytes;
+  alloc_.owner_limit = limits_.owner_memory_bytes;
+  alloc_.owner_used.assign(1, 0);  // owner 0: the engine
   L_ = lua_newstate(&LuaSandbox::allocate, &alloc_);
   if (!L_) throw std::runtime_error("LuaSandbox: could not create a Lua state");
+  alloc_.L = L_;
   const luaL_Reg libs[] = {{LUA_GNAME, luaopen_base},       {LUA_MATHLIBNAME, luaopen_math}, {LUA_STRLIBNAME, luaopen_string},
                            {LUA_TABLIBNAME, luaopen_table}, {LUA_UTF8LIBNAME, luaopen_utf8}, {LUA_COLIBNAME, luaopen_coroutine}};
   for (const luaL_Reg& lib : libs) {

@@ -22,6 +22,7 @@ struct Instance {
   std::string path;  // Script::path as the component gave it
   fs::path file;     // resolved against ScriptSettings::root
   int env_ref = LUA_NOREF, self_ref = LUA_NOREF;
+  std::uint32_t owner = 0;  // LuaSandbox owner: what this script allocated is charged to it
   bool enabled = false;
   std::vector<ScriptProperty> properties;
   fs::file_time_type mtime{};
@@ -73,8 +74,21 @@ struct ScriptRuntime::Impl {
   }
 
   void error(const Instance& inst, ecs::Entity e, const std::string& what, const std::string& message) const {
+    const auto mb = [](std::size_t bytes) { return std::to_string(static_cast<double>(bytes) / (1 << 20)).substr(0, 5); };
     ctx.log(2, "script " + inst.path,
-            what + " failed on entity " + std::to_string(e.index) + "; the script is disabled until its file changes:\n" + message);
+            what + " failed on entity " + std::to_string(e.index) + " (" + inst.file.string() + "; it held " +
+                mb(sandbox.memory_used(inst.owner)) + " MB of its " + mb(settings.limits.owner_memory_bytes) +
+                " MB); the script is disabled until its file changes:\n" + message);
+  }
+
+  // A script whose hook failed is disabled and its tables dropped and
+  // collected: what it held is freed for the others (a leak does not outlive
+  // its script). Its file, once changed, starts it afresh (a new self, then
+  // init). A reload that does not compile only stops it (reload_changed).
+  void disable(Instance& inst) {
+    inst.enabled = false;
+    release(inst);
+    sandbox.collect();
   }
 
   // Runs the file in a fresh _ENV (declaring properties into self). False on error.
@@ -87,6 +101,7 @@ struct ScriptRuntime::Impl {
     std::ostringstream text;
     text << in.rdbuf();
     lua_State* L = this->L();
+    LuaSandbox::OwnerScope scope(sandbox, inst.owner);
     sandbox.push_new_env();
     if (std::string message = sandbox.load(text.str(), inst.path, -1); !message.empty()) {
       lua_pop(L, 1);
@@ -118,6 +133,7 @@ struct ScriptRuntime::Impl {
   void call_hook(ecs::Entity e, Instance& inst, const char* name, PushArgs&& push_args) {
     if (!inst.enabled) return;
     lua_State* L = this->L();
+    LuaSandbox::OwnerScope scope(sandbox, inst.owner);
     lua_rawgeti(L, LUA_REGISTRYINDEX, inst.env_ref);
     if (lua_getfield(L, -1, name) != LUA_TFUNCTION) {
       lua_pop(L, 2);
@@ -128,12 +144,22 @@ struct ScriptRuntime::Impl {
     const int extra = push_args(L);
     ctx.current = e;
     if (std::string message = sandbox.call(1 + extra, 0); !message.empty()) {
-      inst.enabled = false;
       error(inst, e, std::string(name) + "()", message);
+      disable(inst);
     }
   }
   void call_hook(ecs::Entity e, Instance& inst, const char* name) {
     call_hook(e, inst, name, [](lua_State*) { return 0; });
+  }
+
+  // A fresh self table for the instance, charged to its owner.
+  void make_self(ecs::Entity e, Instance& inst) {
+    lua_State* L = this->L();
+    LuaSandbox::OwnerScope scope(sandbox, inst.owner);
+    lua_createtable(L, 0, 4);
+    detail::push_entity(L, e);
+    lua_setfield(L, -2, "entity");
+    inst.self_ref = luaL_ref(L, LUA_REGISTRYINDEX);
   }
 
   void start(ecs::Entity e, const Script& script) {
@@ -141,13 +167,14 @@ struct ScriptRuntime::Impl {
     inst.path = script.path;
     inst.file = fs::path(script.path).is_absolute() ? fs::path(script.path) : settings.root / script.path;
     inst.mtime = mtime_of(inst.file);
-    lua_State* L = this->L();
-    lua_createtable(L, 0, 4);
-    detail::push_entity(L, e);
-    lua_setfield(L, -2, "entity");
-    inst.self_ref = luaL_ref(L, LUA_REGISTRYINDEX);
+    inst.owner = sandbox.add_owner();
+    make_self(e, inst);
     inst.enabled = run_file(e, inst, script.overrides);
     Instance& placed = instances.emplace(e, std::move(inst)).first->second;
+    if (!placed.enabled) {
+      disable(placed);
+      return;
+    }
     call_hook(e, placed, "init");
   }
 
@@ -168,13 +195,18 @@ struct ScriptRuntime::Impl {
       inst.mtime = it->second;
       const auto* script = world.try_get<Script>(e);
       static const std::map<std::string, PropertyValue> kNone;
+      // A disabled script's state was freed: it starts afresh.
+      const bool restart = inst.self_ref == LUA_NOREF;
+      if (restart) make_self(e, inst);
       if (!run_file(e, inst, script ? script->overrides : kNone)) {
-        inst.enabled = false;  // the old code stays, stopped: its file is broken
+        // The new file is broken: the script stops, but keeps its state for
+        // the fixed file (a typo while editing loses nothing).
+        inst.enabled = false;
         continue;
       }
       inst.enabled = true;
-      ctx.log(0, "script " + inst.path, "reloaded on entity " + std::to_string(e.index));
-      call_hook(e, inst, "on_reload");
+      ctx.log(0, "script " + inst.path, (restart ? "restarted on entity " : "reloaded on entity ") + std::to_string(e.index));
+      call_hook(e, inst, restart ? "init" : "on_reload");
     }
   }
 
@@ -260,6 +292,7 @@ std::vector<ScriptProperty> ScriptRuntime::properties(ecs::Entity e) const {
   auto it = impl_->instances.find(e);
   if (it == impl_->instances.end()) return {};
   std::vector<ScriptProperty> out = it->second.properties;
+  if (it->second.self_ref == LUA_NOREF) return out;  // disabled, its state freed: the values it last declared
   lua_State* L = impl_->L();
   lua_rawgeti(L, LUA_REGISTRYINDEX, it->second.self_ref);
   for (ScriptProperty& p : out) {
@@ -277,7 +310,7 @@ bool ScriptRuntime::set_property(ecs::World& world, ecs::Entity e, const std::st
   if (it == impl_->instances.end()) return false;
   auto p = std::find_if(it->second.properties.begin(), it->second.properties.end(),
                         [&](const ScriptProperty& q) { return q.name == name; });
-  if (p == it->second.properties.end() || p->value.index() != value.index()) return false;
+  if (p == it->second.properties.end() || p->value.index() != value.index() || it->second.self_ref == LUA_NOREF) return false;
   lua_State* L = impl_->L();
   lua_rawgeti(L, LUA_REGISTRYINDEX, it->second.self_ref);
   detail::push_property(L, value);

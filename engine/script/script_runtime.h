@@ -10,7 +10,11 @@
 //  4. update(self, dt) for every enabled script, in entity order;
 //  5. messages sent with send() are delivered to on_message(self, id, msg).
 // A hook that errors disables only its own script and logs the message with
-// its traceback; editing the file re-enables it.
+// its traceback, and the script's state (self, its globals) is freed;
+// editing the file starts it afresh. An edit that does not compile stops the
+// script but keeps its state for the fixed file. Each script's allocations
+// are charged to it (LuaSandbox owners): one that leaks stops at its own
+// budget, at its own line, and its memory goes back to the others.
 #include <filesystem>
 #include <functional>
 #include <memory>

@@ -90,6 +90,12 @@ GameSession::GameSession(const GameOptions& options) : options_(options), refere
     apply_manifest(world, manifest);
     script_settings.root = manifest.scripts_dir;
   }
+  for (const auto& [name, file] : options_.scripts) {
+    const Entity e = engine::scene::find_named(world, name);
+    if (e.is_null()) throw std::runtime_error("--script " + name + "=" + file.string() + ": the level has no entity named '" + name + "'");
+    if (!fs::exists(file)) throw std::runtime_error("--script " + name + "=" + file.string() + ": no such file");
+    world.emplace<engine::script::Script>(e, engine::script::Script{fs::absolute(file).string(), {}});
+  }
   app_->add_plugin<engine::script::ScriptPlugin>(script_settings);
   if (!model)
     world.resource<engine::core::Log>().warning(

@@ -29,6 +29,10 @@ struct GameOptions {
   int threads = 0;                 // 0 = all cores
   std::string view = "full";       // full | gi | direct
   GameMethod method = GameMethod::TransGI;  // what the view shows at start
+  // (entity name, Lua file): each named entity runs that script instead of
+  // its own (--script ENTITY=FILE), for quick tries; a relative file is
+  // taken from the working directory.
+  std::vector<std::pair<std::string, std::filesystem::path>> scripts;
 };
 
 // "transgi" | "ddgi" | "reference", as the command line and replays name them.

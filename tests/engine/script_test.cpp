@@ -307,6 +307,50 @@ TEST_F(ScriptTest, MemoryIsCapped) {
   EXPECT_LE(runtime().sandbox().memory_used(), std::size_t{32} << 20);
 }
 
+// Issue 32: all scripts share one Lua state; a leaking one used to take the
+// whole budget, keep it once disabled, and make an innocent script fail
+// with "not enough memory", with no file or line.
+TEST(ScriptMemory, ALeakingScriptStopsAtItsOwnBudgetAndTheOthersRunOn) {
+  const fs::path dir = fs::temp_directory_path() / ("engine_script_memory_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "leak.lua") << "local hoard = {}\n"
+                                     "function update(self, dt)\n"
+                                     "  for i = 1, 2000 do hoard[#hoard + 1] = {i} end\n"
+                                     "end\n";
+  std::ofstream(dir / "steady.lua") << "function update(self, dt)\n"
+                                       "  local t = {}\n"
+                                       "  for i = 1, 5000 do t[i] = {i} end\n"
+                                       "  self.count = #t\n"
+                                       "end\n";
+  script::ScriptSettings settings;
+  settings.root = dir;
+  settings.limits.memory_bytes = std::size_t{8} << 20;
+  settings.limits.owner_memory_bytes = std::size_t{2} << 20;
+  app::App app;
+  app.add_plugin<transform::TransformPlugin>();
+  app.add_plugin<script::ScriptPlugin>(settings);
+  ecs::World& world = app.world();
+  world.resource<core::Log>().set_echo(false);
+  Entity leak{}, steady{};
+  for (auto [e, file] : {std::pair{&leak, "leak.lua"}, std::pair{&steady, "steady.lua"}}) {
+    *e = world.spawn();
+    world.emplace<transform::Transform>(*e);
+    world.emplace<script::Script>(*e, script::Script{file, {}});
+  }
+  auto& runtime = world.resource<script::ScriptRuntime>();
+  for (int f = 0; f < 60; ++f) app.update();
+  std::string errors;
+  for (const core::LogEntry& e : world.resource<core::Log>().entries())
+    errors += std::string(core::log_level_name(e.level)) + " " + e.source + ": " + e.text + "\n";
+  EXPECT_FALSE(runtime.is_enabled(leak)) << errors;
+  EXPECT_TRUE(runtime.is_enabled(steady)) << "the leak must not take the other script down:\n" << errors;
+  EXPECT_NE(errors.find("leak.lua:3: memory budget exceeded"), std::string::npos) << "the error names the file and line:\n" << errors;
+  EXPECT_EQ(errors.find("steady.lua"), std::string::npos) << errors;
+  EXPECT_LT(runtime.sandbox().memory_used(), std::size_t{1} << 20)
+      << "the disabled script's hoard (2 MB) is freed; what is left is the engine's and the steady script's";
+  fs::remove_all(dir);
+}
+
 TEST_F(ScriptTest, AStaleHandleIsALuaErrorNotACrash) {
   write("stale.lua", R"(
     function init(self) self.other = scene.find("other") end

@@ -343,6 +343,28 @@ TEST(HeadlessRun, WindowOnlyOptionsAreRefusedWithAReason) {
   }
 }
 
+TEST(GameSession, AScriptAttachedFromTheCommandLineRunsOnItsEntity) {
+  const fs::path file = fs::temp_directory_path() / ("try_" + std::to_string(::getpid()) + ".lua");
+  std::ofstream(file) << "function update(self, dt) log.info('tried on the cube') end\n";
+  game::GameOptions o = level_options(32, 18);
+  o.scripts = {{"PlasticCube", file}};
+  game::GameSession s(o);
+  s.world().resource<engine::core::Log>().set_echo(false);
+  idle(s, 2);
+  std::string info;
+  for (const engine::core::LogEntry& e : s.world().resource<engine::core::Log>().entries()) info += e.text + "\n";
+  EXPECT_NE(info.find("tried on the cube"), std::string::npos) << info;
+  EXPECT_TRUE(s.world().resource<engine::script::ScriptRuntime>().is_enabled(s.find("PlasticCube")));
+  o.scripts = {{"NoSuchEntity", file}};
+  try {
+    game::GameSession bad(o);
+    ADD_FAILURE() << "an unknown entity must be refused";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no entity named 'NoSuchEntity'"), std::string::npos) << e.what();
+  }
+  fs::remove(file);
+}
+
 TEST(GameSession, TheMethodAtStartIsTheOneAsked) {
   game::GameOptions o = level_options(32, 18);
   o.method = game::GameMethod::Ddgi;
