@@ -42,12 +42,17 @@ void App::update() {
     schedule_.run_phase(world_, schedule::Phase::Startup, &jobs_);
     started_ = true;
   }
+  // A paused frame's systems see no time pass; the step comes back after it.
+  const double step = world_.resource<Time>().delta_seconds;
+  const bool paused = world_.resource<Time>().paused;
+  if (paused) world_.resource<Time>().delta_seconds = 0.0;
   for (schedule::Phase p : schedule::kFramePhases) schedule_.run_phase(world_, p, &jobs_);
 
   auto& time = world_.resource<Time>();
+  if (paused) time.delta_seconds = step;
   if (options_.fixed_delta_seconds <= 0)
     time.delta_seconds = std::chrono::duration<double>(clock::now() - start).count();
-  time.elapsed_seconds += time.delta_seconds;
+  if (!paused) time.elapsed_seconds += time.delta_seconds;
   ++time.frame;
 }
 

@@ -21,6 +21,10 @@ struct Time {
   std::uint64_t frame = 0;        // frames completed before this one
   double delta_seconds = 1.0 / 60.0;
   double elapsed_seconds = 0.0;   // simulated time at the start of this frame
+  // Game time stands still: systems run (rendering, the editor) but see a
+  // delta of 0, and elapsed_seconds does not advance. For a photo mode, or a
+  // progressive view that must not restart as the scene animates.
+  bool paused = false;
 };
 
 // Any system may ask the loop to stop after the current frame.

@@ -139,6 +139,16 @@ void GameSession::set_method(GameMethod m) {
   gi.width = m == GameMethod::TransGI ? options_.width : 0;
   gi.height = m == GameMethod::TransGI ? options_.height : 0;
   reference_->tracer.reset();
+  // The path tracer restarts whenever a light or an object moves, and the
+  // day-night script turns the sun ten times a second: while the reference
+  // is shown, game time stands still so that it converges (a photo mode).
+  const bool pause = m == GameMethod::Reference;
+  if (w.resource<engine::app::Time>().paused != pause) {
+    w.resource<engine::app::Time>().paused = pause;
+    w.resource<engine::core::Log>().info(
+        "game", pause ? "reference view: game time is paused while the path tracer accumulates (scripts see dt = 0)"
+                      : "game time runs again");
+  }
 }
 
 void GameSession::set_backend(const std::string& backend) {

@@ -103,7 +103,8 @@ void EditorUi::stats_overlay(const ViewRect& view) {
               session_.options().height);
   ImGui::Text("frame %.1f ms (%.0f fps)", static_cast<double>(last), last > 0 ? 1000.0 / static_cast<double>(last) : 0.0);
   ImGui::PlotLines("##frame", ms.data(), static_cast<int>(ms.size()), 0, "frame ms, last 240", 0.0f, 200.0f, ImVec2(300, 50));
-  if (session_.method() == GameMethod::Reference) ImGui::Text("reference: %d spp (restarts when anything moves)", session_.reference_spp());
+  if (session_.method() == GameMethod::Reference)
+    ImGui::Text("reference: %d spp (game time paused)", session_.reference_spp());
   const auto& t = f.times;
   ImGui::Text("G-buffer %.1f  inference %.1f  SH light %.1f  upsample %.1f", t.gbuffer + t.network_input, t.inference,
               t.sh_multiplication, t.upsample);

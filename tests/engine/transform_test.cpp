@@ -157,3 +157,28 @@ TEST(TransformPropagation, ParentCycleIsReportedNotLooped) {
   f.app.update();
   EXPECT_EQ(f.w().resource<TransformStats>().unreachable, 2u);
 }
+
+// engine::app::Time::paused: systems still run, but see no time pass.
+TEST(AppTime, APausedFrameRunsItsSystemsWithNoTimePassing) {
+  app::App app;
+  std::vector<double> seen;
+  app.add_system(schedule::Phase::Update, "test::record_dt",
+                 [&seen](ecs::World& w) { seen.push_back(w.resource<app::Time>().delta_seconds); });
+  app.update();
+  auto& time = app.world().resource<app::Time>();
+  const double step = time.delta_seconds, before = time.elapsed_seconds;
+  time.paused = true;
+  app.update();
+  app.update();
+  EXPECT_EQ(time.elapsed_seconds, before) << "paused: the clock stands";
+  EXPECT_EQ(time.delta_seconds, step) << "the step comes back after each paused frame";
+  time.paused = false;
+  app.update();
+  ASSERT_EQ(seen.size(), 4u);
+  EXPECT_EQ(seen[0], step);
+  EXPECT_EQ(seen[1], 0.0);
+  EXPECT_EQ(seen[2], 0.0);
+  EXPECT_EQ(seen[3], step);
+  EXPECT_EQ(time.elapsed_seconds, before + step);
+  EXPECT_EQ(time.frame, 4u) << "frames still count";
+}

@@ -365,6 +365,19 @@ TEST(GameSession, AScriptAttachedFromTheCommandLineRunsOnItsEntity) {
   fs::remove(file);
 }
 
+TEST(GameSession, TheReferenceViewPausesGameTimeAndReaches64Spp) {
+  // The default level's day-night script turns the sun ten times a second,
+  // which restarted the path tracer: it never passed 7 spp (issue 32).
+  game::GameSession s(level_options(32, 18));
+  idle(s, 4);  // the scripts start, the clock runs
+  s.set_method(game::GameMethod::Reference);
+  idle(s, 70);
+  EXPECT_GE(s.reference_spp(), 64);
+  EXPECT_TRUE(s.world().resource<engine::app::Time>().paused);
+  s.set_method(game::GameMethod::TransGI);
+  EXPECT_FALSE(s.world().resource<engine::app::Time>().paused) << "game time runs again when the reference is left";
+}
+
 TEST(GameSession, TheMethodAtStartIsTheOneAsked) {
   game::GameOptions o = level_options(32, 18);
   o.method = game::GameMethod::Ddgi;
