@@ -27,7 +27,7 @@ constexpr const char* kUsage =
     "                    [--scene level.gltf] [--model M.tgm] [--game game.json] [--width W] [--height H]\n"
     "                    [--method transgi|ddgi|reference] [--view full|gi|direct] [--exposure STOPS] [--threads T]\n"
     "                    [--script ENTITY=FILE[,ENTITY=FILE...]] (the entity runs that Lua file instead of its own)\n"
-    "  window only: [--select NAME] [--gizmo translate|rotate] (what the editor shows at start)\n"
+    "  window only: [--select NAME] [--gizmo translate|rotate] [--probes] (what the editor shows at start)\n"
     "  headless only: [--script-input replay.txt] [--record DIR]\n"
     "exit codes: 0 the run finished with no error logged; 1 it could not run (a missing or bad scene, model,\n"
     "  manifest or replay file: the message names it); 2 a bad command line; 3 the run finished and wrote its\n"
@@ -38,7 +38,7 @@ engine::core::Args parse(int argc, char** argv) {
   return engine::core::Args("transgi-game", std::vector<std::string>(argv + 1, argv + argc),
                             {"frames", "script-input", "record", "screenshot", "scene", "model", "game", "width", "height", "view",
                              "method", "script", "exposure", "threads", "select", "gizmo"},
-                            {"headless", "help"});
+                            {"headless", "help", "probes"});
 }
 
 // What the window and headless runs share.
@@ -127,9 +127,10 @@ int main(int argc, char** argv) {
       w.screenshot = args.str("screenshot", std::string());
       w.select = args.str("select", std::string());
       w.gizmo = args.choice("gizmo", {"translate", "rotate"}, "translate");
+      w.probes = args.has("probes");
       return game::run_window(game_options(args), w);
     }
-    for (const char* window_only : {"select", "gizmo"})
+    for (const char* window_only : {"select", "gizmo", "probes"})
       if (args.has(window_only))
         throw engine::core::UsageError(std::string("transgi-game: --") + window_only +
                                        " sets what the editor shows at start, and --headless has no editor: drop one of them");

@@ -38,6 +38,7 @@ class EditorUi {
   void draw(ImTextureID frame_texture);
   [[nodiscard]] float exposure() const { return exposure_; }
   [[nodiscard]] bool quit_requested() const { return quit_; }
+  void show_probes(bool on) { show_probes_ = on; }
 
  private:
   void menu_bar();

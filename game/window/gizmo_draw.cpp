@@ -1,4 +1,5 @@
-// The gizmo and the probe visualisation, drawn on ImGui's foreground list.
+// The gizmo, drawn on ImGui's foreground list, and the probe visualisation,
+// a debug overlay on the background list under the panels.
 #include <cmath>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -105,9 +106,17 @@ void EditorUi::draw_gizmo(const ViewRect& rect) {
 }
 
 void EditorUi::draw_probes(const ViewRect& rect) {
-  ImDrawList* dl = ImGui::GetForegroundDrawList();
+  // A debug overlay on the game view, under every panel and the menu bar
+  // (the background list, after the frame's image), clipped to the view.
+  ImDrawList* dl = ImGui::GetBackgroundDrawList();
+  dl->PushClipRect(ImVec2(rect.min.x, rect.min.y), ImVec2(rect.max.x, rect.max.y), true);
   const Projector project = projector(session_, rect);
   const glm::vec3 eye = project.view.camera.translation;
+  const glm::vec3 forward = project.view.camera.rotation * glm::vec3(0.0f, 0.0f, -1.0f);
+  // A probe closer than this (in front of the eye) is not drawn; farther
+  // ones shrink with distance, and none is drawn larger than max_radius.
+  constexpr float kNearest = 0.25f;
+  const float max_radius = 0.02f * (rect.max.y - rect.min.y);
   for (const auto& field : transgi::runtime::probe_fields(session_.world())) {
     const auto& grid = field->grid();
     // The volume's box.
@@ -127,10 +136,11 @@ void EditorUi::draw_probes(const ViewRect& rect) {
     const float radius_world = 0.06f;
     for (int i = 0; i < grid.count(); ++i) {
       const glm::vec3 p = grid.position(i);
+      if (glm::dot(p - eye, forward) < kNearest) continue;
       const auto c = project(p);
       const auto edge = project(p + radius_world * glm::normalize(glm::cross(p - eye, glm::vec3(0, 1, 0)) + glm::vec3(1e-6f)));
       if (!c || !edge) continue;
-      const float r = std::max(2.0f, std::hypot(edge->x - c->x, edge->y - c->y));
+      const float r = std::clamp(std::hypot(edge->x - c->x, edge->y - c->y), 2.0f, max_radius);
       const glm::vec3 to_eye = glm::normalize(eye - p);
       auto shade = [&](const glm::vec3& n) {
         const glm::vec3 e = transgi::shading::sh_irradiance(sh.data() + static_cast<std::size_t>(i) * 75, n) / 3.14159265f;
@@ -145,6 +155,7 @@ void EditorUi::draw_probes(const ViewRect& rect) {
         dl->AddCircleFilled(ImVec2(c->x + offs[k].x, c->y + offs[k].y), 0.4f * r, shade(glm::normalize(to_eye + dirs[k])), 12);
     }
   }
+  dl->PopClipRect();
 }
 
 }  // namespace game

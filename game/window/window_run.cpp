@@ -73,6 +73,7 @@ int run_window(const GameOptions& game_options, const WindowOptions& wo) {
     }
     if (wo.gizmo != "translate" && wo.gizmo != "rotate") throw std::runtime_error("--gizmo: expected translate or rotate, got '" + wo.gizmo + "'");
     session.editor().mode = wo.gizmo == "rotate" ? GizmoMode::Rotate : GizmoMode::Translate;
+    ui.show_probes(wo.probes);
     GLuint texture = 0;
     glGenTextures(1, &texture);
     glBindTexture(GL_TEXTURE_2D, texture);

@@ -14,6 +14,7 @@ struct WindowOptions {
   int window_width = 1280, window_height = 720;
   std::string select;                 // an entity selected at start (scripted screenshots)
   std::string gizmo = "translate";    // translate | rotate
+  bool probes = false;                // the probe overlay on at start (View > Probes)
 };
 
 // Returns the exit code. A missing display, a GL context that cannot be

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <optional>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
@@ -314,6 +315,34 @@ int shell_output(const std::string& cmd, std::string& out) {
   while (std::fgets(buffer, sizeof buffer, pipe)) out += buffer;
   const int status = ::pclose(pipe);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(WindowSmoke, TheProbeOverlayLeavesTheMenuBarAndPanelsAsTheyAre) {
+  // View > Probes drew on ImGui's foreground list: a probe near the eye
+  // became a window-sized disc over the menu bar (issue 32). The overlay is
+  // now under the panels, clipped to the view, its discs capped in size.
+  if (shell("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (Debian package xvfb)";
+  const fs::path dir = fs::temp_directory_path() / ("probe_overlay_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const auto shot = [&](const std::string& name, const std::string& extra) {
+    const fs::path png = dir / (name + ".png");
+    const std::string cmd = "ASAN_OPTIONS=detect_leaks=0 xvfb-run -a -s '-screen 0 1280x720x24' '" TRANSGI_GAME_BINARY
+                            "' --frames 3 --width 160 --height 90 " + extra + " --screenshot '" + png.string() + "' > /dev/null 2>&1";
+    const int code = shell(cmd);
+    return code == 0 && fs::exists(png) ? std::optional<engine::image::Rgb8Image>(engine::image::read_png(png)) : std::nullopt;
+  };
+  const auto plain = shot("plain", ""), probes = shot("probes", "--probes");
+  if (!plain || !probes) GTEST_SKIP() << "no X server could start under xvfb-run";
+  ASSERT_EQ(plain->width, probes->width);
+  // The menu bar (the top 19 rows) and the hierarchy panel's title, pixel for pixel.
+  double menu = 0;
+  std::size_t n = 0;
+  for (int y = 0; y < 19; ++y)
+    for (int x = 0; x < plain->width; ++x, ++n)
+      for (int c = 0; c < 3; ++c) menu += std::abs(plain->pixels[(static_cast<std::size_t>(y) * plain->width + x) * 3 + c] -
+                                                   probes->pixels[(static_cast<std::size_t>(y) * plain->width + x) * 3 + c]);
+  EXPECT_LT(menu / (3.0 * static_cast<double>(n)), 0.5) << "the menu bar must look the same with the overlay on";
+  fs::remove_all(dir);
 }
 
 TEST(HeadlessRun, AReplayEventThatCannotApplyIsLoggedAndTheRunStillWritesItsOutputs) {
