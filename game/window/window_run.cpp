@@ -14,6 +14,7 @@
 #include "engine/image/png.h"
 #include "engine/image/tonemap.h"
 #include "window/editor_ui.h"
+#include "play/input_queue.h"
 #include "window/window_input.h"
 
 namespace game {
@@ -34,6 +35,29 @@ void save_back_buffer(GLFWwindow* w, const std::filesystem::path& out) {
   for (int y = 0; y < fh; ++y)
     std::copy_n(rows.data() + static_cast<std::size_t>(fh - 1 - y) * fw * 3, static_cast<std::size_t>(fw) * 3, img.at(0, y));
   engine::image::write_png(out, img);
+}
+
+// GLFW's callbacks queue every key and button change for the frame loop
+// (play/input_queue.h). Installed before ImGui's, which chains to them.
+std::vector<InputEvent>& queued_events() {
+  static std::vector<InputEvent> events;
+  return events;
+}
+
+void on_key(GLFWwindow* w, int key, int, int action, int) {
+  if (action == GLFW_REPEAT) return;
+  const std::string name = key_name(key);
+  if (name.empty()) return;
+  // Both Ctrl keys are "ctrl": releasing one while the other is held is not a release.
+  if (name == "ctrl" && action == GLFW_RELEASE &&
+      (glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS))
+    return;
+  queued_events().push_back({name, action == GLFW_PRESS, false});
+}
+
+void on_mouse_button(GLFWwindow*, int button, int action, int) {
+  const char* name = button == GLFW_MOUSE_BUTTON_LEFT ? "mouse_left" : button == GLFW_MOUSE_BUTTON_RIGHT ? "mouse_right" : nullptr;
+  if (name) queued_events().push_back({name, action == GLFW_PRESS, true});
 }
 
 struct Glfw {
@@ -60,7 +84,9 @@ int run_window(const GameOptions& game_options, const WindowOptions& wo) {
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini beside whoever runs the game
   ImGui::StyleColorsDark();
-  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  glfwSetKeyCallback(window, on_key);
+  glfwSetMouseButtonCallback(window, on_mouse_button);
+  ImGui_ImplGlfw_InitForOpenGL(window, true);  // chains to the callbacks above
   ImGui_ImplOpenGL3_Init("#version 330");
 
   int code = 0;
@@ -89,25 +115,16 @@ int run_window(const GameOptions& game_options, const WindowOptions& wo) {
       // keys and the mouse only when ImGui does not want them.
       const ImGuiIO& io = ImGui::GetIO();
       engine::input::InputState& in = session.input();
-      if (!io.WantCaptureKeyboard)
-        for (int k = GLFW_KEY_SPACE; k <= GLFW_KEY_LAST; ++k)
-          if (const std::string name = key_name(k); !name.empty()) {
-            const bool down = glfwGetKey(window, k) == GLFW_PRESS;
-            if (down != in.is_down(name) && !(name == "ctrl" && !down && (glfwGetKey(window, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS ||
-                                                                       glfwGetKey(window, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS)))
-              in.set_key(name, down);
-          }
       const ViewRect view = ui.view_rect();
       double mx = 0, my = 0;
       glfwGetCursorPos(window, &mx, &my);
       const glm::vec2 game_mouse = view.to_game({static_cast<float>(mx), static_cast<float>(my)}, session.options());
       in.move_mouse(game_mouse);
       const bool mouse_free = !io.WantCaptureMouse && view.contains({static_cast<float>(mx), static_cast<float>(my)});
-      for (auto [button, name] : {std::pair{GLFW_MOUSE_BUTTON_LEFT, "mouse_left"}, std::pair{GLFW_MOUSE_BUTTON_RIGHT, "mouse_right"}}) {
-        const bool down = glfwGetMouseButton(window, button) == GLFW_PRESS;
-        if (down && !in.is_down(name) && !mouse_free) continue;  // a press on a panel is the panel's
-        if (down != in.is_down(name)) in.set_key(name, down);
-      }
+      // Every change since the last frame, in order: a tap shorter than a
+      // frame is not lost at a few frames a second.
+      apply_input_events(in, queued_events(), !io.WantCaptureKeyboard, mouse_free);
+      queued_events().clear();
       if (in.was_pressed("escape")) glfwSetWindowShouldClose(window, 1);
 
       session.frame();
