@@ -1,6 +1,8 @@
 #include "play/game_session.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
@@ -178,6 +180,31 @@ std::vector<std::string> GameSession::reload_shaders() {
 std::string GameSession::backend_status() {
   const auto& f = world().resource<transgi::runtime::GiFrame>();
   return f.backend + (f.backend_fallback.empty() ? "" : " (" + f.backend_fallback + ")");
+}
+
+std::vector<GameSession::StageTime> GameSession::stage_times() const {
+  const engine::ecs::World& w = app_->world();
+  if (method_ == GameMethod::Reference) return {{"path tracing", last_ms_}};
+  if (method_ == GameMethod::Ddgi) {
+    const auto* d = w.try_resource<transgi::ddgi::DdgiFrame>();
+    if (!d) return {};
+    return {{"probe rays", d->times.probe_trace}, {"probe blend", d->times.probe_blend}, {"shading", d->times.shading},
+            {"direct", d->times.direct}};
+  }
+  const auto& t = w.resource<transgi::runtime::GiFrame>().times;
+  return {{"G-buffer", t.gbuffer + t.network_input}, {"inference", t.inference}, {"SH light", t.sh_multiplication},
+          {"upsample", t.upsample},           {"direct", t.direct},          {"antialiasing", t.antialiasing},
+          {"probe rays", t.collect_points},   {"raster", t.probe_raster},    {"projection", t.probe_projection}};
+}
+
+float graph_top(const std::vector<float>& frame_ms) {
+  float top = 10.0f;
+  for (float v : frame_ms)
+    if (std::isfinite(v)) top = std::max(top, v);
+  const float decade = std::pow(10.0f, std::floor(std::log10(top)));
+  for (float step : {1.0f, 2.0f, 5.0f, 10.0f})
+    if (top <= step * decade) return step * decade;
+  return 10.0f * decade;
 }
 
 int GameSession::reference_spp() const { return reference_->tracer ? reference_->tracer->samples_per_pixel() : 0; }

@@ -38,6 +38,11 @@ struct GameOptions {
 // "transgi" | "ddgi" | "reference", as the command line and replays name them.
 GameMethod parse_method(const std::string& name);
 
+// The top of a graph of these frame times: the largest, rounded up to 1, 2
+// or 5 times a power of ten (at least 10 ms), so the scale reads easily and
+// follows the frame time from 5 ms to 5 s.
+float graph_top(const std::vector<float>& frame_ms);
+
 class GameSession {
  public:
   // Throws std::runtime_error naming the file and field on bad content.
@@ -69,6 +74,13 @@ class GameSession {
   [[nodiscard]] const std::string& view_name() const { return options_.view; }
   // Reference samples per pixel accumulated since the last change.
   [[nodiscard]] int reference_spp() const;
+  // The last frame's stage times of the method shown (TransGI's, DDGI's, or
+  // the path tracer's), named as the stats overlay shows them.
+  struct StageTime {
+    std::string name;
+    double ms = 0;
+  };
+  [[nodiscard]] std::vector<StageTime> stage_times() const;
   [[nodiscard]] const GameOptions& options() const { return options_; }
   [[nodiscard]] engine::ecs::World& world();
   [[nodiscard]] engine::input::InputState& input();

@@ -102,17 +102,26 @@ void EditorUi::stats_overlay(const ViewRect& view) {
   ImGui::Text("%s, %s pass, %dx%d", method_name(session_.method()), session_.view_name().c_str(), session_.options().width,
               session_.options().height);
   ImGui::Text("frame %.1f ms (%.0f fps)", static_cast<double>(last), last > 0 ? 1000.0 / static_cast<double>(last) : 0.0);
-  ImGui::PlotLines("##frame", ms.data(), static_cast<int>(ms.size()), 0, "frame ms, last 240", 0.0f, 200.0f, ImVec2(300, 50));
+  const float top = graph_top(ms);
+  const std::string scale = "0-" + std::to_string(static_cast<int>(top)) + " ms, last 240 frames";
+  ImGui::PlotLines("##frame", ms.data(), static_cast<int>(ms.size()), 0, scale.c_str(), 0.0f, top, ImVec2(300, 50));
   if (session_.method() == GameMethod::Reference)
     ImGui::Text("reference: %d spp (game time paused)", session_.reference_spp());
-  const auto& t = f.times;
-  ImGui::Text("G-buffer %.1f  inference %.1f  SH light %.1f  upsample %.1f", t.gbuffer + t.network_input, t.inference,
-              t.sh_multiplication, t.upsample);
-  ImGui::Text("probe rays %.1f  raster %.1f  projection %.1f  direct %.1f ms", t.collect_points, t.probe_raster,
-              t.probe_projection, t.direct);
+  // The shown method's own stages, three to a line.
+  const auto stages = session_.stage_times();
+  for (std::size_t i = 0; i < stages.size(); i += 3) {
+    std::string line;
+    for (std::size_t k = i; k < std::min(stages.size(), i + 3); ++k) {
+      char item[64];
+      std::snprintf(item, sizeof item, "%s%s %.1f", k > i ? "  " : "", stages[k].name.c_str(), stages[k].ms);
+      line += item;
+    }
+    ImGui::TextUnformatted((line + (i + 3 >= stages.size() ? " ms" : "")).c_str());
+  }
   const auto& p = f.probe_stats;
-  ImGui::Text("probes: %d traced, %d active, %d converged, %d skipped (buried %d, far %d)", p.traced, p.active, p.converged,
-              p.buried + p.far, p.buried, p.far);
+  if (session_.method() == GameMethod::TransGI)
+    ImGui::Text("probes: %d traced, %d active, %d converged, %d skipped (buried %d, far %d)", p.traced, p.active, p.converged,
+                p.buried + p.far, p.buried, p.far);
   ImGui::End();
 }
 

@@ -429,6 +429,34 @@ TEST(GameSession, TheReferenceViewPausesGameTimeAndReaches64Spp) {
   EXPECT_FALSE(s.world().resource<engine::app::Time>().paused) << "game time runs again when the reference is left";
 }
 
+TEST(GameSession, TheStatsShowTheShownMethodsOwnStagesOnAScaleThatFits) {
+  // The graph was fixed at 0-200 ms and the DDGI and reference views kept
+  // TransGI's stage times (issue 32).
+  EXPECT_FLOAT_EQ(game::graph_top({3.0f, 4.0f}), 10.0f);
+  EXPECT_FLOAT_EQ(game::graph_top({12.0f, 48.0f}), 50.0f);
+  EXPECT_FLOAT_EQ(game::graph_top({80.0f, 250.0f}), 500.0f);
+  EXPECT_FLOAT_EQ(game::graph_top({2400.0f}), 5000.0f);
+  game::GameSession s(level_options(32, 18));
+  idle(s, 2);
+  const auto names = [](const std::vector<game::GameSession::StageTime>& stages) {
+    std::string out;
+    for (const auto& t : stages) out += t.name + ",";
+    return out;
+  };
+  const std::string transgi = names(s.stage_times());
+  EXPECT_NE(transgi.find("inference"), std::string::npos) << transgi;
+  s.set_method(game::GameMethod::Ddgi);
+  idle(s, 1);
+  const auto ddgi = s.stage_times();
+  EXPECT_EQ(names(ddgi), "probe rays,probe blend,shading,direct,") << "DDGI's own stages, not TransGI's";
+  double sum = 0;
+  for (const auto& t : ddgi) sum += t.ms;
+  EXPECT_GT(sum, 0.0) << "measured this frame";
+  s.set_method(game::GameMethod::Reference);
+  idle(s, 1);
+  EXPECT_EQ(names(s.stage_times()), "path tracing,");
+}
+
 TEST(GameSession, TheMethodAtStartIsTheOneAsked) {
   game::GameOptions o = level_options(32, 18);
   o.method = game::GameMethod::Ddgi;
