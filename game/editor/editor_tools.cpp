@@ -1,8 +1,10 @@
 #include "editor/editor_tools.h"
 
 #include <cmath>
+#include <optional>
 #include <vector>
 
+#include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "engine/editor/gizmo_math.h"
@@ -54,6 +56,45 @@ tf::Similarity parent_world(const World& world, Entity e) {
   return {};
 }
 
+// A ring seen this close to edge-on (|cos| of its axis and the view) is a
+// thin ellipse or a line: the pick ray meets its plane at a grazing angle,
+// so it is picked and turned in screen space instead.
+constexpr float kRingEdgeOnCos = 0.3f;
+bool ring_near_edge_on(const HandleGeometry& g, const EditorView& view) {
+  return std::abs(glm::dot(glm::normalize(g.pivot - view.camera.translation), g.axis)) < kRingEdgeOnCos;
+}
+
+// The ring's points, `count` of them, by angle from ed::ring_reference.
+constexpr int kRingSamples = 64;
+glm::vec3 ring_sample(const HandleGeometry& g, float angle) {
+  const glm::vec3 ref = ed::ring_reference(g.axis), other = glm::cross(g.axis, ref);
+  return g.pivot + g.size * (std::cos(angle) * ref + std::sin(angle) * other);
+}
+
+struct RingOnScreen {
+  float pixels = INFINITY;  // from the cursor to the ring as drawn
+  float angle = 0.0f;       // the nearest sample's angle
+};
+// The cursor's distance to the ring's projected outline, and where on it.
+RingOnScreen ring_on_screen(const HandleGeometry& g, const glm::mat4& vp, const glm::vec2& viewport, const glm::vec2& mouse) {
+  RingOnScreen best;
+  std::optional<glm::vec2> prev = ed::project_to_pixels(vp, viewport, ring_sample(g, 0.0f));
+  for (int k = 1; k <= kRingSamples; ++k) {
+    const float a = 2.0f * glm::pi<float>() * static_cast<float>(k) / kRingSamples;
+    const auto cur = ed::project_to_pixels(vp, viewport, ring_sample(g, a));
+    if (prev && cur) {
+      const float d = ed::distance_to_segment(mouse, *prev, *cur);
+      if (d < best.pixels) {
+        best.pixels = d;
+        // The nearer end's angle.
+        best.angle = glm::length(mouse - *prev) < glm::length(mouse - *cur) ? a - 2.0f * glm::pi<float>() / kRingSamples : a;
+      }
+    }
+    prev = cur;
+  }
+  return best;
+}
+
 // The ring's point under the cursor, if the pick ray meets the ring's plane.
 std::optional<glm::vec3> ring_point(const ed::PickRay& ray, const HandleGeometry& g) {
   const auto t = ed::ray_plane(ray, g.pivot, g.axis);
@@ -87,10 +128,9 @@ GizmoHandle hovered_handle(const World& world, const EditorState& s, const Edito
       const auto a = ed::project_to_pixels(vp, view.viewport, g.pivot + 0.15f * g.size * g.axis);
       const auto b = ed::project_to_pixels(vp, view.viewport, g.pivot + g.size * g.axis);
       if (a && b) pixels = ed::distance_to_segment(mouse, *a, *b);
-    } else if (const auto p = ring_point(ray, g)) {
-      const float off = std::abs(glm::length(*p - g.pivot) - g.size);  // world units off the ring
-      const float per_pixel = g.size / (s.gizmo_fraction * view.viewport.y);
-      pixels = off / per_pixel;
+    } else {
+      // As drawn on screen, so a ring seen edge-on (a line) is picked too.
+      pixels = ring_on_screen(g, vp, view.viewport, mouse).pixels;
     }
     if (pixels < best_pixels) {
       best_pixels = pixels;
@@ -136,7 +176,9 @@ HandleGeometry handle_geometry(const World& world, const EditorState& s, const E
   const float distance = glm::length(g.pivot - view.camera.translation);
   g.size = ed::world_size_for_pixels(s.gizmo_fraction * view.viewport.y, std::max(distance, 1e-3f), view.fov_y, view.viewport.y);
   const glm::vec3 view_dir = glm::normalize(g.pivot - view.camera.translation);
-  g.visible = is_plane(h) ? !ed::edge_on(view_dir, glm::cross(g.axis, g.axis2), true) : !ed::edge_on(view_dir, g.axis, is_ring(h));
+  // Axes and squares seen end- or edge-on cannot be dragged and hide; a
+  // ring edge-on is a line that turns in screen space, so it always shows.
+  g.visible = is_plane(h) ? !ed::edge_on(view_dir, glm::cross(g.axis, g.axis2), true) : is_ring(h) || !ed::edge_on(view_dir, g.axis);
   return g;
 }
 
@@ -148,11 +190,20 @@ std::optional<glm::vec2> handle_grab_pixel(const World& world, const EditorState
     p = g.pivot + 0.5f * (kPlaneFrom + kPlaneTo) * g.size * (g.axis + g.axis2);
   } else if (!is_ring(h)) {
     p = g.pivot + 0.8f * g.size * g.axis;
-  } else {  // the ring's point facing most across the view
+  } else {
     const glm::vec3 to_camera = glm::normalize(view.camera.translation - g.pivot);
     const glm::vec3 across = glm::cross(g.axis, to_camera);
-    if (glm::length(across) < 1e-4f) return std::nullopt;
-    p = g.pivot + g.size * glm::normalize(across);
+    if (glm::length(across) < 1e-4f) {
+      p = ring_sample(g, 0.0f);  // seen face-on: any point of the circle
+    } else if (ring_near_edge_on(g, view)) {
+      // Seen as a line through the pivot: halfway out along it, 30 degrees
+      // from the point nearest the camera, clear of the other rings.
+      glm::vec3 toward = to_camera - glm::dot(to_camera, g.axis) * g.axis;
+      toward = glm::length(toward) > 1e-4f ? glm::normalize(toward) : glm::normalize(glm::cross(across, g.axis));
+      p = g.pivot + g.size * (0.5f * glm::normalize(across) + 0.8660254f * toward);
+    } else {  // the ring's point facing most across the view
+      p = g.pivot + g.size * glm::normalize(across);
+    }
   }
   return ed::project_to_pixels(view_projection(view), view.viewport, p);
 }
@@ -213,9 +264,24 @@ void update_editor(World& world, EditorState& s, const engine::input::InputState
       const auto p = ed::closest_on_axis(ray, g.pivot, g.axis);
       if (!p) return;
       s.start_param = *p;
+    } else if (ring_near_edge_on(g, view)) {
+      // In screen space: the cursor's motion along the ring's tangent where
+      // it was grabbed, one radian per ring radius on screen.
+      const glm::mat4 vp = view_projection(view);
+      const float a = ring_on_screen(g, vp, view.viewport, mouse).angle;
+      const glm::vec3 at = ring_sample(g, a), tangent = glm::normalize(glm::cross(g.axis, at - g.pivot));
+      const auto p0 = ed::project_to_pixels(vp, view.viewport, at), p1 = ed::project_to_pixels(vp, view.viewport, at + 0.05f * g.size * tangent);
+      const auto centre = ed::project_to_pixels(vp, view.viewport, g.pivot), rim = ed::project_to_pixels(vp, view.viewport, g.pivot + g.size * glm::normalize(glm::cross(g.axis, view.camera.translation - g.pivot)));
+      if (!p0 || !p1 || !centre || !rim || glm::length(*p1 - *p0) < 1e-3f) return;
+      s.ring_by_screen = true;
+      s.grab_mouse = mouse;
+      s.screen_tangent = glm::normalize(*p1 - *p0);
+      s.pixels_per_radian = std::max(glm::length(*rim - *centre), 1.0f);
+      s.angle = 0.0f;
     } else {
       const auto p = ring_point(ray, g);
       if (!p) return;
+      s.ring_by_screen = false;
       s.last_angle = ed::ring_angle(*p, g.pivot, g.axis, ed::ring_reference(g.axis));
       s.angle = 0.0f;
     }
@@ -240,6 +306,9 @@ void update_editor(World& world, EditorState& s, const engine::input::InputState
     } else if (!is_ring(s.active)) {
       if (const auto p = ed::closest_on_axis(ray, g.pivot, g.axis))
         *t = ed::translated(s.start, s.parent, (*p - s.start_param) * g.axis, ctrl ? s.translate_snap : 0.0f);
+    } else if (s.ring_by_screen) {
+      s.angle = glm::dot(mouse - s.grab_mouse, s.screen_tangent) / s.pixels_per_radian;
+      *t = ed::rotated(s.start, s.parent, g.axis, s.angle, s.pivot, ctrl ? glm::radians(s.rotate_snap_degrees) : 0.0f);
     } else if (const auto p = ring_point(ray, g)) {
       const float a = ed::ring_angle(*p, g.pivot, g.axis, ed::ring_reference(g.axis));
       s.angle += ed::wrap_angle(a - s.last_angle);  // unwrapped total since the press

@@ -49,6 +49,11 @@ struct EditorState {
   glm::vec3 pivot{0.0f};
   float start_param = 0.0f, angle = 0.0f, last_angle = 0.0f;
   glm::vec3 start_hit{0.0f};  // plane drags: where the press met the plane
+  // Ring drags of a ring seen near edge-on: by the cursor's motion along the
+  // ring's tangent on screen where it was grabbed, one radian per ring radius.
+  bool ring_by_screen = false;
+  glm::vec2 grab_mouse{0.0f}, screen_tangent{0.0f};
+  float pixels_per_radian = 1.0f;
   std::size_t drags = 0;  // finished drags, for tests and the stats overlay
 };
 
@@ -62,7 +67,7 @@ struct HandleGeometry {
   // identity transform, common in converted content).
   glm::vec3 pivot{0.0f}, axis{0.0f}, axis2{0.0f};
   float size = 0.0f;
-  bool visible = false;  // false when edge-on
+  bool visible = false;  // false for an axis or square seen end- or edge-on (a ring always shows)
 };
 HandleGeometry handle_geometry(const engine::ecs::World& world, const EditorState& s, const EditorView& view, GizmoHandle h);
 // Where a person would grab the handle, in pixels (for replays and tests).

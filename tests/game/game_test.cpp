@@ -231,6 +231,49 @@ TEST(GameSession, PlaneAndRingDragsMoveAndTurnAsAsked) {
   EXPECT_EQ(s.world().get<engine::transform::Transform>(cube), start) << "two undos restore the start";
 }
 
+// A ring seen edge-on was hidden (issue 32: the Y ring of a hinge at eye
+// height could not be turned from the start camera). It now shows as a line
+// and turns by the cursor's motion along it.
+TEST(GameSession, ARingSeenEdgeOnCanStillBeGrabbedAndTurned) {
+  game::GameSession s(level_options(320, 180));
+  idle(s, 1);
+  const auto cube = s.find("PlasticCube");
+  // The cube straight ahead of the camera at its height: the Y ring exactly edge-on.
+  const game::EditorView v0 = s.view();
+  const glm::vec3 forward = v0.camera.rotation * glm::vec3(0, 0, -1);
+  glm::vec3 ahead = v0.camera.translation + 2.0f * glm::normalize(glm::vec3(forward.x, 0.0f, forward.z));
+  s.world().get_mut<engine::transform::Transform>(cube).translation = ahead;
+  idle(s, 1);
+  s.begin_input();
+  s.apply({0, "select", "PlasticCube", {}, 1});
+  s.apply({0, "gizmo_mode", "rotate", {}, 2});
+  const game::HandleGeometry g = game::handle_geometry(s.world(), s.editor(), s.view(), game::GizmoHandle::RY);
+  EXPECT_LT(std::abs(glm::dot(glm::normalize(g.pivot - s.view().camera.translation), g.axis)), 0.05f) << "edge-on";
+  ASSERT_TRUE(g.visible);
+  const auto grab = game::handle_grab_pixel(s.world(), s.editor(), s.view(), game::GizmoHandle::RY);
+  ASSERT_TRUE(grab.has_value()) << "the edge-on ring has a place to grab";
+  s.apply({0, "gizmo_grab", "ry", {}, 3});
+  const engine::transform::Transform start = s.world().get<engine::transform::Transform>(cube);
+  s.apply({0, "mouse_down", "left", {}, 4});
+  s.frame();
+  EXPECT_EQ(s.editor().active, game::GizmoHandle::RY) << "the press took the ring";
+  for (int i = 0; i < 4; ++i) {
+    s.begin_input();
+    s.apply({0, "mouse_move_by", "", glm::vec2(6.0f, 0.0f), 5});
+    s.frame();
+  }
+  s.begin_input();
+  s.apply({0, "mouse_up", "left", {}, 6});
+  s.frame();
+  const engine::transform::Transform turned = s.world().get<engine::transform::Transform>(cube);
+  const glm::quat delta = turned.rotation * glm::inverse(start.rotation);
+  const float angle = 2.0f * std::acos(std::min(1.0f, std::abs(delta.w)));
+  EXPECT_GT(angle, 0.1f) << "24 pixels along the ring turned the cube";
+  const glm::vec3 axis = glm::normalize(glm::vec3(delta.x, delta.y, delta.z));
+  EXPECT_NEAR(std::abs(axis.y), 1.0f, 1e-4f) << "about +Y only";
+  EXPECT_EQ(turned.translation, start.translation);
+}
+
 TEST(GameSession, SwitchingToDdgiAndTheReferenceShowsTheirImages) {
   game::GameSession s(level_options(64, 36));
   auto mean = [](const engine::image::ImageRGB& img) {
