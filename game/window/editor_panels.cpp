@@ -69,12 +69,17 @@ void EditorUi::hierarchy() {
 
 void EditorUi::inspector() {
   const ImGuiIO& io = ImGui::GetIO();
-  ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 288, 40), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(280, 520), ImGuiCond_FirstUseEver);
+  // Wide enough for its longest labels at the default font, and every
+  // widget leaves its label a fixed column (ImGui's default gives widgets
+  // 65 % of the width and cuts the labels off).
+  const float width = 26.0f * ImGui::GetFontSize();
+  ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - width - 8.0f, 40), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(width, 520), ImGuiCond_FirstUseEver);
   if (!ImGui::Begin("Inspector")) {
     ImGui::End();
     return;
   }
+  ImGui::PushItemWidth(-11.0f * ImGui::GetFontSize());
   engine::ecs::World& w = session_.world();
   EditorState& ed = session_.editor();
   const Entity e = ed.selected;
@@ -148,6 +153,7 @@ void EditorUi::inspector() {
     }
   }
   gi_settings();
+  ImGui::PopItemWidth();
   ImGui::End();
 }
 
