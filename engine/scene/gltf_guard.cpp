@@ -263,7 +263,7 @@ std::string check_image_buffer_views(const nlohmann::json& j, const FileAccess& 
 
 std::string json_syntax_error(std::string_view json_text) {
   try {
-    (void)nlohmann::json::parse(json_text);
+    [[maybe_unused]] const nlohmann::json parsed = nlohmann::json::parse(json_text);  // throws where it stops
     return {};
   } catch (const nlohmann::json::parse_error& e) {
     // e.byte is the 1-based position where the parser stopped.
