@@ -9,6 +9,23 @@ namespace engine::core {
 Args::Args(std::string command, const std::vector<std::string>& argv, std::set<std::string> known,
            std::set<std::string> flags)
     : command_(std::move(command)) {
+  if (!flags.contains("help") && !known.contains("help"))
+    for (const std::string& a : argv)
+      if (a == "--help") {
+        std::string text = command_ + ": the options it accepts:\n ";
+        std::size_t column = 1;
+        const auto add = [&](const std::string& item) {
+          if (column + item.size() + 1 > 110) {
+            text += "\n ";
+            column = 1;
+          }
+          text += " " + item;
+          column += item.size() + 1;
+        };
+        for (const std::string& name : known) add("--" + name + " V");
+        for (const std::string& name : flags) add("--" + name);
+        throw HelpRequested(text + "\n");
+      }
   for (std::size_t i = 0; i < argv.size(); ++i) {
     const std::string& a = argv[i];
     if (a.rfind("--", 0) != 0) {

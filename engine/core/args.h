@@ -17,9 +17,18 @@ class UsageError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Thrown by Args when the command line asks for --help and the command
+// declares no --help of its own: what() lists every option it accepts, from
+// the same declarations that parse them (so it cannot drift from them).
+class HelpRequested : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 class Args {
  public:
   // `known` lists accepted options with a value; `flags` those without.
+  // --help anywhere throws HelpRequested unless "help" is one of them.
   Args(std::string command, const std::vector<std::string>& argv, std::set<std::string> known,
        std::set<std::string> flags = {});
 

@@ -8,35 +8,56 @@
 #include "cli/commands.h"
 
 namespace {
-void usage() {
-  std::fprintf(stderr,
-               "usage: transgi <command> [options]\n"
-               "  render   --scene S.gltf --method reference --pass full|direct|gi|all --spp N --width W --height H\n"
-               "           --out F.exr [--camera NAME] [--seed K] [--threads T] [--png F.png] [--exposure EV]\n"
-               "  render   --scene S.gltf --method transgi --model M.tgm [--lighting probes|environment] [--frames F]\n"
-               "           [--pass gi|direct|full] [--probe-grid N] [--probe-rays M] [--direct-spp N] [--direct deterministic|stochastic]\n"
-               "           [--transfer network|ground-truth] [--gt-rays N] [--coefficient-maps PREFIX] ...\n"
-               "  compare  A.exr B.exr [--heatmap out.png] [--heatmap-max E]\n"
-               "  tonemap  IN.exr OUT.png [--exposure EV] [--signed SCALE] [--minus B.exr]\n"
-               "  bake     --scene S.gltf --out M.tgm [--points N] [--dirs D] [--outgoing K] [--iters I] [--batch B]\n"
-               "           [--max-points-per-vertex P (default 8192; 0 = by area alone)]\n"
-               "           [--lr R] [--latent-dim K] [--width W] [--depth L] [--threads T] [--seed S] [--resume] [--keep-dataset]\n"
-               "  render   --scene S.gltf --method ddgi [--frames F] [--probe-grid N] [--probe-rays M] [--warmup-frames W] ...\n"
-               "  transfer-study --scene S.gltf [--points N] [--outgoing K] [--reference-rays R]\n"
-               "  eval     --scene S.gltf --model M.tgm --out DIR [--width W --height H --spp N --frames F --ddgi-frames F2]\n"
-               "           [--probe-grid N] [--cache DIR] [--reference-error E] [--temporal N] [--decompose]\n"
-               "  bench-pareto --scene S.gltf --model M.tgm --out DIR [--width W --height H --spp N] [--quick]\n"
-               "  bench-frame --scene S.gltf --model M.tgm [--width W --height H --frames N --warmup W --preset realtime|quality --csv F]\n"
-               "  sun-sweep --scene S.gltf --model M.tgm --out DIR [--positions 8 --frames 96 --warmup 96 --elevation-from E0\n"
-               "           --elevation-to E1 --azimuth-from A0 --azimuth-to A1 --reference-spp N --settle-tolerance 0.05]\n"
-               "  fly-through --scene S.gltf --model M.tgm --out DIR --path x,y,z;x,y,z;... [--frames 300 --stops F1,F2,F3\n"
-               "           --reference-spp N --pitch DEG]\n"
-               "  render also takes --sun-elevation DEG --sun-azimuth DEG (turns the scene's directional light)\n"
-               "  render, eval and bench-frame also take: --probe-volume cascades|scene|authored (default cascades; a scene small\n"
-               "           enough for 2 m cells gets one grid over it) [--cascades N] [--cascade-cell M] [--cascade-look-ahead F]\n"
-               "           [--cascade-fit-scene M], and --allow-unbaked (meshes added after the bake are shaded diffusely)\n"
-               "  render and eval (quality path) also take --near-field-rays N (default 16; 0 = off) --near-field-reach CELLS\n"
-               "           --near-field-filter RADIUS: contact light by short rays where probes cannot see it\n");
+constexpr const char* kUsage =
+    "usage: transgi <command> [options]\n"
+    "  render   --scene S.gltf --method reference --pass full|direct|gi|all --spp N --width W --height H\n"
+    "           --out F.exr [--camera NAME] [--seed K] [--threads T] [--png F.png] [--exposure EV]\n"
+    "  render   --scene S.gltf --method transgi --model M.tgm [--lighting probes|environment] [--frames F]\n"
+    "           [--pass gi|direct|full] [--probe-grid N] [--probe-rays M] [--direct-spp N] [--direct deterministic|stochastic]\n"
+    "           [--transfer network|ground-truth] [--gt-rays N] [--coefficient-maps PREFIX] ...\n"
+    "  compare  A.exr B.exr [--heatmap out.png] [--heatmap-max E]\n"
+    "  tonemap  IN.exr OUT.png [--exposure EV] [--signed SCALE] [--minus B.exr]\n"
+    "  bake     --scene S.gltf --out M.tgm [--points N] [--dirs D] [--outgoing K] [--iters I] [--batch B]\n"
+    "           [--max-points-per-vertex P (default 8192; 0 = by area alone)]\n"
+    "           [--lr R] [--latent-dim K] [--width W] [--depth L] [--threads T] [--seed S] [--resume] [--keep-dataset]\n"
+    "  render   --scene S.gltf --method ddgi [--frames F] [--probe-grid N] [--probe-rays M] [--warmup-frames W] ...\n"
+    "  transfer-study --scene S.gltf [--points N] [--outgoing K] [--reference-rays R]\n"
+    "  eval     --scene S.gltf --model M.tgm --out DIR [--width W --height H --spp N --frames F --ddgi-frames F2]\n"
+    "           [--probe-grid N] [--cache DIR] [--reference-error E] [--temporal N] [--decompose]\n"
+    "  bench-pareto --scene S.gltf --model M.tgm --out DIR [--width W --height H --spp N] [--quick]\n"
+    "  bench-frame --scene S.gltf --model M.tgm [--width W --height H --frames N --warmup W --preset realtime|quality --csv F]\n"
+    "  sun-sweep --scene S.gltf --model M.tgm --out DIR [--positions 8 --frames 96 --warmup 96 --elevation-from E0\n"
+    "           --elevation-to E1 --azimuth-from A0 --azimuth-to A1 --reference-spp N --settle-tolerance 0.05]\n"
+    "  fly-through --scene S.gltf --model M.tgm --out DIR --path x,y,z;x,y,z;... [--frames 300 --stops F1,F2,F3\n"
+    "           --reference-spp N --pitch DEG]\n"
+    "  render also takes --sun-elevation DEG --sun-azimuth DEG (turns the scene's directional light)\n"
+    "  render, eval and bench-frame also take: --probe-volume cascades|scene|authored (default cascades; a scene small\n"
+    "           enough for 2 m cells gets one grid over it) [--cascades N] [--cascade-cell M] [--cascade-look-ahead F]\n"
+    "           [--cascade-fit-scene M], and --allow-unbaked (meshes added after the bake are shaded diffusely)\n"
+    "  render and eval (quality path) also take --near-field-rays N (default 16; 0 = off) --near-field-reach CELLS\n"
+    "           --near-field-filter RADIUS: contact light by short rays where probes cannot see it\n"
+    "  transgi --version; transgi COMMAND --help lists every option COMMAND accepts\n"
+    "exit codes: 0 done; 1 a bad or missing input file, or a failure while running (the message names it);\n"
+    "  2 a bad command line\n";
+
+void usage() { std::fputs(kUsage, stderr); }
+
+// The usage lines of one command: from its "  command " line to the next command's.
+std::string usage_of(const std::string& command) {
+  std::string out, line;
+  bool in = false;
+  for (const char* c = kUsage;; ++c) {
+    if (*c != '\n' && *c != '\0') {
+      line += *c;
+      continue;
+    }
+    const bool starts_command = line.size() > 2 && line[0] == ' ' && line[1] == ' ' && line[2] != ' ';
+    if (starts_command) in = line.rfind("  " + command + " ", 0) == 0;
+    if (in) out += line + "\n";
+    line.clear();
+    if (*c == '\0') break;
+  }
+  return out;
 }
 }  // namespace
 
@@ -59,12 +80,19 @@ int main(int argc, char** argv) {
     if (command == "sun-sweep") return transgi::cli::run_sun_sweep(args);
     if (command == "fly-through") return transgi::cli::run_fly_through(args);
     if (command == "--help" || command == "help") {
-      usage();
+      std::fputs(kUsage, stdout);
+      return 0;
+    }
+    if (command == "--version") {
+      std::printf("transgi %s\n", TRANSGI_VERSION);
       return 0;
     }
     std::fprintf(stderr, "transgi: unknown command '%s'\n", command.c_str());
     usage();
     return 2;
+  } catch (const engine::core::HelpRequested& e) {
+    std::printf("usage:\n%s%s", usage_of(command).c_str(), e.what());
+    return 0;
   } catch (const transgi::cli::UsageError& e) {
     std::fprintf(stderr, "transgi %s\n", e.what());
     return 2;
