@@ -8,7 +8,11 @@ namespace game {
 std::string key_name(int k) {
   if (k >= GLFW_KEY_A && k <= GLFW_KEY_Z) return std::string(1, static_cast<char>('A' + (k - GLFW_KEY_A)));
   if (k >= GLFW_KEY_0 && k <= GLFW_KEY_9) return std::string(1, static_cast<char>('0' + (k - GLFW_KEY_0)));
-  if (k >= GLFW_KEY_F1 && k <= GLFW_KEY_F12) return "F" + std::to_string(k - GLFW_KEY_F1 + 1);
+  if (k >= GLFW_KEY_F1 && k <= GLFW_KEY_F12) {
+    std::string name = "F";  // appended, not "F" + ...: GCC 12 warns of a bogus memcpy on that form
+    name += std::to_string(k - GLFW_KEY_F1 + 1);
+    return name;
+  }
   switch (k) {
     case GLFW_KEY_SPACE: return "space";
     case GLFW_KEY_LEFT_CONTROL: case GLFW_KEY_RIGHT_CONTROL: return "ctrl";
