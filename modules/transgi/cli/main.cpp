@@ -6,6 +6,8 @@
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "engine/core/cpu_isa.h"
+#include "engine/gpu/vulkan_context.h"
 
 namespace {
 constexpr const char* kUsage =
@@ -84,7 +86,13 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (command == "--version") {
-      std::printf("transgi %s\n", TRANSGI_VERSION);
+      // The version, then what this machine offers the frame: the CPU's
+      // instruction sets (and any TRANSGI_MAX_ISA cap) and the Vulkan device
+      // the GPU backend would take, or why there is none.
+      std::printf("transgi %s\ncpu: %s\n", TRANSGI_VERSION, engine::cpu::isa_summary().c_str());
+      std::string why;
+      const auto gpu = engine::gpu::VulkanContext::create(engine::gpu::GpuOptions{}, &why);
+      std::printf("gpu: %s\n", gpu ? engine::gpu::describe(gpu->info()).c_str() : ("none (" + why + "): the cpu backend").c_str());
       return 0;
     }
     std::fprintf(stderr, "transgi: unknown command '%s'\n", command.c_str());
