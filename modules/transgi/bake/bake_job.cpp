@@ -6,6 +6,8 @@
 #include <optional>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "engine/io/atomic_file.h"
 #include "model/model_file.h"
 
@@ -125,11 +127,6 @@ bool load_checkpoint(const fs::path& out, const engine::scene::SceneAssets& asse
   }
 }
 
-std::string json_bands(const BandErrors& e) {
-  std::ostringstream o;
-  o << "[" << e.rmse[0] << ", " << e.rmse[1] << ", " << e.rmse[2] << ", " << e.rmse[3] << ", " << e.rmse[4] << "]";
-  return o.str();
-}
 
 }  // namespace
 
@@ -186,20 +183,29 @@ BakeReport run_bake(const engine::scene::SceneAssets& assets, const fs::path& ou
   report.latent_bytes = m.latent_bytes();
   for (const auto& mesh : m.meshes) report.latent_rows += mesh.latents.rows();
 
-  std::ostringstream settings_json, metrics_json;
   const auto& l = m.decoder.layout();
-  settings_json << "{\"points\": " << s.data.points << ", \"outgoing_per_point\": " << s.data.outgoing_per_point
-                << ", \"rays\": " << s.data.rays << ", \"visibility_fraction\": " << s.data.visibility_fraction
-                << ", \"iterations\": " << s.train.iterations << ", \"batch\": " << s.train.batch
-                << ", \"learning_rate\": " << s.train.learning_rate << ", \"latent_dim\": " << s.latent_dim
-                << ", \"width\": " << l.width << ", \"hidden_layers\": " << l.hidden_layers << ", \"seed\": " << s.data.seed
-                << ", \"demodulated\": " << (s.data.demodulate ? "true" : "false") << "}";
-  metrics_json << "{\"data_seconds\": " << report.data_seconds << ", \"train_seconds\": " << report.train_seconds
-               << ", \"samples\": " << report.samples << ", \"rollbacks\": " << report.rollbacks
-               << ", \"validation_rmse\": " << report.validation.total << ", \"validation_rmse_per_band\": " << json_bands(report.validation)
-               << ", \"constant_rmse_per_band\": " << json_bands(report.constant) << "}";
-  m.bake_settings_json = settings_json.str();
-  m.metrics_json = metrics_json.str();
+  const auto bands = [](const BandErrors& e) { return nlohmann::json(std::vector<double>(e.rmse.begin(), e.rmse.end())); };
+  m.bake_settings_json = nlohmann::json{{"points", s.data.points},
+                                        {"outgoing_per_point", s.data.outgoing_per_point},
+                                        {"rays", s.data.rays},
+                                        {"visibility_fraction", s.data.visibility_fraction},
+                                        {"iterations", s.train.iterations},
+                                        {"batch", s.train.batch},
+                                        {"learning_rate", s.train.learning_rate},
+                                        {"latent_dim", s.latent_dim},
+                                        {"width", l.width},
+                                        {"hidden_layers", l.hidden_layers},
+                                        {"seed", s.data.seed},
+                                        {"demodulated", s.data.demodulate}}
+                             .dump();
+  m.metrics_json = nlohmann::json{{"data_seconds", report.data_seconds},
+                                  {"train_seconds", report.train_seconds},
+                                  {"samples", report.samples},
+                                  {"rollbacks", report.rollbacks},
+                                  {"validation_rmse", report.validation.total},
+                                  {"validation_rmse_per_band", bands(report.validation)},
+                                  {"constant_rmse_per_band", bands(report.constant)}}
+                       .dump();
   model::save_model(out, m);
 
   std::error_code ec;

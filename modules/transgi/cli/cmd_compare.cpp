@@ -1,11 +1,20 @@
 #include <cstdio>
 
+#include <nlohmann/json.hpp>
+
 #include "cli/args.h"
 #include "cli/commands.h"
 #include "engine/image/exr.h"
 #include "engine/image/metrics.h"
 
 namespace transgi::cli {
+
+namespace {
+
+// One JSON object a line, through nlohmann-json (a NaN metric prints as null).
+void print_json(const nlohmann::ordered_json& j) { std::printf("%s\n", j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str()); }
+
+}  // namespace
 
 int run_compare(const std::vector<std::string>& argv) {
   const Args args("compare", argv, {"heatmap", "heatmap-max", "top-error", "edge-band-of", "band"}, {"colour"});
@@ -33,24 +42,25 @@ int run_compare(const std::vector<std::string>& argv) {
     const auto band = engine::image::edge_band(guide, static_cast<int>(args.integer("band", 0, 64, 3)));
     std::size_t n = 0;
     for (auto v : band) n += v;
-    std::printf("{\"edge_band_rmse\": %.8g, \"edge_band_pixels\": %zu}\n", engine::image::rmse_clamped_in(a, b, band), n);
+    print_json({{"edge_band_rmse", engine::image::rmse_clamped_in(a, b, band)}, {"edge_band_pixels", n}});
   }
   if (args.has("colour")) {
     // Hue and texture against the reference (engine/image/metrics.h), a line of their own.
     const auto c = engine::image::compare_colour(a, b);
-    std::printf("{\"chroma_error\": %.6g, \"detail\": %.6g, \"detail_reference\": %.6g, \"detail_ratio\": %.4f, \"colour_pixels\": %zu, "
-                "\"speckles\": %.6g, \"speckles_reference\": %.6g}\n",
-                c.chroma_error, c.detail_a, c.detail_b, c.detail_b > 0 ? c.detail_a / c.detail_b : 0.0, c.pixels,
-                engine::image::speckle_fraction(a), engine::image::speckle_fraction(b));
+    print_json({{"chroma_error", c.chroma_error},
+                {"detail", c.detail_a},
+                {"detail_reference", c.detail_b},
+                {"detail_ratio", c.detail_b > 0 ? c.detail_a / c.detail_b : 0.0},
+                {"colour_pixels", c.pixels},
+                {"speckles", engine::image::speckle_fraction(a)},
+                {"speckles_reference", engine::image::speckle_fraction(b)}});
   }
-  if (args.has("top-error")) {
-    const double f = args.number("top-error", 0.0, 100.0) / 100.0;
-    std::printf("{\"rmse\": %.8g, \"l1\": %.8g, \"ssim\": %.8g, \"relmse\": %.8g, \"mean_ratio\": %.6g, \"top_error_share\": %.6g}\n",
-                m.rmse, m.l1, m.ssim, m.relmse, m.mean_ratio, engine::image::top_error_share(a, b, f));
-  } else {
-    std::printf("{\"rmse\": %.8g, \"l1\": %.8g, \"ssim\": %.8g, \"relmse\": %.8g, \"mean_ratio\": %.6g, \"mean_ratio_rgb\": [%.4f, %.4f, %.4f]}\n",
-                m.rmse, m.l1, m.ssim, m.relmse, m.mean_ratio, m.mean_ratio_rgb.r, m.mean_ratio_rgb.g, m.mean_ratio_rgb.b);
-  }
+  nlohmann::ordered_json line{{"rmse", m.rmse}, {"l1", m.l1}, {"ssim", m.ssim}, {"relmse", m.relmse}, {"mean_ratio", m.mean_ratio}};
+  if (args.has("top-error"))
+    line["top_error_share"] = engine::image::top_error_share(a, b, args.number("top-error", 0.0, 100.0) / 100.0);
+  else
+    line["mean_ratio_rgb"] = {m.mean_ratio_rgb.r, m.mean_ratio_rgb.g, m.mean_ratio_rgb.b};
+  print_json(line);
   return 0;
 }
 

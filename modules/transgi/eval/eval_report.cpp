@@ -3,28 +3,16 @@
 #include <cstdio>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "eval/text_output.h"
 
 namespace transgi::eval {
 
 namespace {
 
-std::string json_string(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    if (c == '\n') {
-      o += "\\n";
-      continue;
-    }
-    o += c;
-  }
-  return o + "\"";
-}
-
-std::string json_metrics(const engine::image::ErrorMetrics& m) {
-  return "{\"rmse\": " + fmt("%.6g", m.rmse) + ", \"l1\": " + fmt("%.6g", m.l1) + ", \"ssim\": " + fmt("%.6g", m.ssim) +
-         ", \"relmse\": " + fmt("%.6g", m.relmse) + ", \"mean_ratio\": " + fmt("%.4f", m.mean_ratio) + "}";
+nlohmann::ordered_json json_metrics(const engine::image::ErrorMetrics& m) {
+  return {{"rmse", m.rmse}, {"l1", m.l1}, {"ssim", m.ssim}, {"relmse", m.relmse}, {"mean_ratio", m.mean_ratio}};
 }
 
 std::string html_escape(const std::string& s) {
@@ -67,27 +55,50 @@ std::string timing_table(const EvalReport& r) {
 
 }  // namespace
 
+// Through nlohmann-json: strings escaped whatever they hold, a non-finite
+// number written as null (JSON has no NaN).
 void write_results_json(const std::filesystem::path& path, const EvalReport& r) {
-  std::ostringstream o;
-  o << "{\n  \"scene\": " << json_string(r.scene) << ",\n  \"command\": " << json_string(r.command) << ",\n  \"width\": " << r.width
-    << ", \"height\": " << r.height << ",\n  \"reference\": {\"spp\": " << r.reference_spp
-    << ", \"seconds\": " << fmt("%.3f", r.reference_seconds) << ", \"cached\": " << (r.reference_cached ? "true" : "false")
-    << ", \"key\": " << json_string(r.reference_key) << ", \"mean_spp\": " << fmt("%.1f", r.reference_mean_spp)
-    << ", \"target_error\": " << fmt("%g", r.reference_target_error) << ", \"noise_rmse_gi\": " << fmt("%.6f", r.reference_noise_gi)
-    << ", \"noise_rmse_full\": " << fmt("%.6f", r.reference_noise_full) << "},\n  \"methods\": [\n";
-  for (std::size_t i = 0; i < r.methods.size(); ++i) {
-    const auto& m = r.methods[i];
-    o << "    {\"name\": " << json_string(m.name) << ", \"settings\": " << json_string(m.settings) << ",\n     \"gi\": " << json_metrics(m.gi)
-      << ",\n     \"gi_di\": " << json_metrics(m.gi_di) << ",\n     \"frame_ms\": " << fmt("%.4f", m.run.frame_ms) << ", \"stages_ms\": {";
-    for (std::size_t s = 0; s < m.run.stages.size(); ++s)
-      o << (s ? ", " : "") << json_string(m.run.stages[s].name) << ": " << fmt("%.4f", m.run.stages[s].ms);
-    o << "},\n     \"probe_bytes\": " << m.run.probe_bytes << ", \"probes\": " << json_string(m.run.probe_summary) << "}"
-      << (i + 1 < r.methods.size() ? "," : "") << "\n";
+  nlohmann::ordered_json methods = nlohmann::ordered_json::array();
+  for (const auto& m : r.methods) {
+    nlohmann::ordered_json stages = nlohmann::ordered_json::object();
+    for (const auto& s : m.run.stages) stages[s.name] = s.ms;
+    methods.push_back({{"name", m.name},
+                       {"settings", m.settings},
+                       {"gi", json_metrics(m.gi)},
+                       {"gi_di", json_metrics(m.gi_di)},
+                       {"frame_ms", m.run.frame_ms},
+                       {"stages_ms", stages},
+                       {"probe_bytes", m.run.probe_bytes},
+                       {"probes", m.run.probe_summary}});
   }
-  o << "  ],\n  \"memory\": {\"vertices\": " << r.vertices << ", \"latent_rows\": " << r.latent_rows << ", \"latent_dim\": " << r.latent_dim
-    << ", \"decoder_bytes\": " << r.decoder_bytes << ", \"latent_bytes\": " << r.latent_bytes << "},\n  \"bake_settings\": "
-    << (r.bake_settings.empty() ? "null" : r.bake_settings) << "\n}\n";
-  write_text(path, o.str());
+  // The model's bake settings are JSON already; kept as text where they do not parse.
+  nlohmann::ordered_json bake = nullptr;
+  if (!r.bake_settings.empty()) {
+    bake = nlohmann::ordered_json::parse(r.bake_settings, nullptr, /*allow_exceptions=*/false);
+    if (bake.is_discarded()) bake = r.bake_settings;
+  }
+  const nlohmann::ordered_json j{{"scene", r.scene},
+                         {"command", r.command},
+                         {"width", r.width},
+                         {"height", r.height},
+                         {"reference",
+                          {{"spp", r.reference_spp},
+                           {"seconds", r.reference_seconds},
+                           {"cached", r.reference_cached},
+                           {"key", r.reference_key},
+                           {"mean_spp", r.reference_mean_spp},
+                           {"target_error", r.reference_target_error},
+                           {"noise_rmse_gi", r.reference_noise_gi},
+                           {"noise_rmse_full", r.reference_noise_full}}},
+                         {"methods", methods},
+                         {"memory",
+                          {{"vertices", r.vertices},
+                           {"latent_rows", r.latent_rows},
+                           {"latent_dim", r.latent_dim},
+                           {"decoder_bytes", r.decoder_bytes},
+                           {"latent_bytes", r.latent_bytes}}},
+                         {"bake_settings", bake}};
+  write_text(path, j.dump(2) + "\n");
 }
 
 void write_results_markdown(const std::filesystem::path& path, const EvalReport& r) {

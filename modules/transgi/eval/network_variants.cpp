@@ -1,5 +1,7 @@
 #include "eval/network_variants.h"
 
+#include <nlohmann/json.hpp>
+
 #include <cstdio>
 
 #include "bake/trainer.h"
@@ -49,9 +51,9 @@ std::shared_ptr<const model::TransferModel> NetworkVariantBaker::get(const Netwo
   }
   const bake::BandErrors val = trainer.validate();
   bar.finish("validation RMSE " + std::to_string(val.total));
-  m.bake_settings_json = "{\"variant\": \"" + v.name + "\", \"iterations\": " + std::to_string(iterations_) + ", \"points\": " +
-                         std::to_string(data_settings_.points) + ", \"rays\": " + std::to_string(data_settings_.rays) + "}";
-  m.metrics_json = "{\"validation_rmse\": " + std::to_string(val.total) + "}";
+  m.bake_settings_json =
+      nlohmann::json{{"variant", v.name}, {"iterations", iterations_}, {"points", data_settings_.points}, {"rays", data_settings_.rays}}.dump();
+  m.metrics_json = nlohmann::json{{"validation_rmse", val.total}}.dump();
   std::filesystem::create_directories(cache_dir_);
   model::save_model(path, m);
   return std::make_shared<const model::TransferModel>(std::move(m));
