@@ -112,9 +112,32 @@ GameSession::GameSession(const GameOptions& options) : options_(options), refere
 
   auto& frame = world.resource<transgi::runtime::GiFrame>();
   frame.camera = camera_;
+  warm_up_probes();
   frame.width = options_.width;
   frame.height = options_.height;
   set_method(options_.method);
+}
+
+void GameSession::warm_up_probes() {
+  engine::ecs::World& w = world();
+  const int frames = options_.probe_warmup_frames >= 0 ? options_.probe_warmup_frames
+                                                       : w.resource<transgi::runtime::TransGISettings>().probes.settle_frames;
+  if (frames <= 0) return;
+  auto& gi = w.resource<transgi::runtime::GiFrame>();
+  auto& time = w.resource<engine::app::Time>();
+  const int width = gi.width, height = gi.height;
+  const bool paused = time.paused;
+  gi.width = gi.height = 0;  // the probes update; no image is made
+  time.paused = true;        // scripts start, but no game time passes
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int f = 0; f < frames; ++f) app_->jobs().run([&] { app_->update(); });
+  time.paused = paused;
+  gi.width = width;
+  gi.height = height;
+  w.resource<engine::core::Log>().info(
+      "game", "probes warmed up over " + std::to_string(frames) + " updates in " +
+                  std::to_string(static_cast<int>(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count())) +
+                  " ms, before the first frame");
 }
 
 void GameSession::set_view(const std::string& view) {

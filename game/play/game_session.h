@@ -29,6 +29,12 @@ struct GameOptions {
   int threads = 0;                 // 0 = all cores
   std::string view = "full";       // full | gi | direct
   GameMethod method = GameMethod::TransGI;  // what the view shows at start
+  // Probe updates run before the first frame a player sees, as a loading
+  // screen would (game time paused, no image made): the first frames
+  // showed probe-sized bright squares while the probes settled. -1 = the
+  // real-time preset's settle_frames; 0 = none. Higher = a better-settled
+  // first frame, at the cost of that many probe updates of load time.
+  int probe_warmup_frames = -1;
   // (entity name, Lua file): each named entity runs that script instead of
   // its own (--script ENTITY=FILE), for quick tries; a relative file is
   // taken from the working directory.
@@ -74,6 +80,8 @@ class GameSession {
   [[nodiscard]] const std::string& view_name() const { return options_.view; }
   // Reference samples per pixel accumulated since the last change.
   [[nodiscard]] int reference_spp() const;
+  // The level's first probe updates, before the first frame (GameOptions::probe_warmup_frames).
+  void warm_up_probes();
   // The last frame's stage times of the method shown (TransGI's, DDGI's, or
   // the path tracer's), named as the stats overlay shows them.
   struct StageTime {

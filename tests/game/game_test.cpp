@@ -47,6 +47,7 @@ game::GameOptions level_options(int width, int height) {
   o.scene = kLevel / "scene.gltf";
   o.width = width;
   o.height = height;
+  o.probe_warmup_frames = 0;  // as before the warm-up existed; GameSession.TheFirstFrameIsSettled tests it
   return o;
 }
 
@@ -498,6 +499,33 @@ TEST(GameSession, TheStatsShowTheShownMethodsOwnStagesOnAScaleThatFits) {
   s.set_method(game::GameMethod::Reference);
   idle(s, 1);
   EXPECT_EQ(names(s.stage_times()), "path tracing,");
+}
+
+TEST(GameSession, TheFirstFrameIsSettled) {
+  // The first frames showed probe-sized bright squares while the probes
+  // settled (issue 37). With the warm-up, frame 0's GI is already close to
+  // the GI 30 frames on; without it, far from it.
+  const auto first_vs_later = [](int warmup) {
+    game::GameOptions o = level_options(64, 36);
+    o.view = "gi";
+    o.probe_warmup_frames = warmup;
+    game::GameSession s(o);
+    idle(s, 1);
+    const engine::image::ImageRGB first = s.image();
+    idle(s, 30);
+    const engine::image::ImageRGB& later = s.image();
+    double diff = 0, level = 0;
+    for (std::size_t i = 0; i < first.pixels.size(); ++i)
+      for (int c = 0; c < 3; ++c) {
+        diff += std::abs(first.pixels[i][c] - later.pixels[i][c]);
+        level += std::abs(later.pixels[i][c]);
+      }
+    return diff / level;
+  };
+  const double warm = first_vs_later(-1), cold = first_vs_later(0);
+  std::printf("[ measured ] frame 0 against frame 30, mean |difference| / mean: %.3f warmed, %.3f cold\n", warm, cold);
+  EXPECT_LT(warm, 0.10);
+  EXPECT_LT(warm, 0.5 * cold);
 }
 
 TEST(GameSession, TheMethodAtStartIsTheOneAsked) {
