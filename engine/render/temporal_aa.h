@@ -33,8 +33,10 @@ struct TemporalAaSettings {
   // The current frame's weight where the history matches (a history of
   // fewer than 1 / blend frames is their plain mean). Higher = follows
   // changing light sooner, at the cost of more aliasing and of more of the
-  // jitter's alternation at edges left in (UE4's default is 0.04).
-  float blend = 0.1f;
+  // jitter's alternation at edges left in (UE4's default is 0.04). 1/16:
+  // one jitter cycle (jitter_phases) is averaged evenly before the blend
+  // takes over, and an edge pixel's alternation moves it by 1/16 a frame.
+  float blend = 0.0625f;
   // Where the history is clamped, the range of the current neighbours is
   // widened by this fraction of its middle: a change of light smaller than
   // that (a probe's update, the sun a little further on) is blended over
