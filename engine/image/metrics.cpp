@@ -25,9 +25,7 @@ double box3_luminance(const ImageRGB& img, int x, int y) {
     }
   return s / n;
 }
-}  // namespace
 
-namespace {
 
 void check_sizes(const ImageRGB& a, const ImageRGB& b) {
   if (a.width != b.width || a.height != b.height)

@@ -22,13 +22,6 @@ float radical_inverse(std::uint64_t i, std::uint64_t base) {
   return r;
 }
 
-// The range of the 3x3 neighbours of each pixel of one row, per layer: at a
-// silhouette it spans both sides whichever way the edge runs, so the
-// jitter's alternation there stays inside it. Rows beyond the image repeat
-// its edge. Separable: each of the three rows' horizontal ranges, then
-// their vertical one, over flat float rows (a pixel's neighbours are 3
-// floats away) so that the loops vectorise.
-
 }  // namespace
 
 glm::vec2 taa_jitter(std::uint64_t index, int phases) {
@@ -42,6 +35,12 @@ std::vector<TaaObject> objects_of(const rt::RtScene& scene) {
   return out;
 }
 
+// The range of the 3x3 neighbours of each pixel of one row, per layer: at a
+// silhouette it spans both sides whichever way the edge runs, so the
+// jitter's alternation there stays inside it. Rows beyond the image repeat
+// its edge. Separable: each of the three rows' horizontal ranges, then
+// their vertical one, over flat float rows (a pixel's neighbours are 3
+// floats away) so that the loops vectorise.
 static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "a row of pixels is read as a row of floats");
 class TemporalAntialiasing::NeighbourRange {
  public:
@@ -287,6 +286,7 @@ void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surface
   // Where some pixel's history may be clamped, each row's 3x3 range per
   // layer is found first, as flat float rows the compiler vectorises.
   const bool may_clamp = light_changed || !camera_still || any_moved_;
+  const bool rows_first = camera_still && settings.vectorised_rows;
   jobs::parallel_for(0, h, 16, [&](int y0, int y1) {
     std::size_t local_reused = 0, local_rejected = 0;
     NeighbourRange range;
@@ -296,7 +296,6 @@ void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surface
     for (int y = y0; y < y1; ++y) {
       if (may_clamp) range.row(y);
       const std::size_t row = static_cast<std::size_t>(y) * w;
-      const bool rows_first = camera_still && settings.vectorised_rows;
       if (rows_first) local_reused += blend_still_row(row, w, surfaces.entity, layers, range, light_changed ? 1.0f : 0.0f, blend, settings, plain, alpha3);
       for (int x = 0; x < w; ++x) {
         if (rows_first && plain[static_cast<std::size_t>(x)]) continue;

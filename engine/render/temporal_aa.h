@@ -8,10 +8,10 @@
 // sample counts only where the previous frame saw the same object there,
 // on the same tangent plane, with a similar normal. Where the pixel moved on
 // screen, or the caller says the light changed, the history is clamped to
-// the range of the current frame's pixel and its four edge neighbours
-// (widened by a margin, so small changes of light blend instead of
-// flickering), so what changed does not linger; where neither holds it is not, so a feature thinner than a pixel,
-// which only some jitter points hit, keeps its average instead of being
+// the range of the current frame's pixel and its eight neighbours (widened
+// by a margin, so small changes of light blend instead of flickering), so
+// what changed does not linger; where neither holds it is not, so a feature
+// thinner than a pixel, which only some jitter points hit, keeps its average instead of being
 // clamped away by the frames that miss it. Where nothing in the history
 // matches (an object moved away, a cut, a resize) the pixel restarts from
 // this frame: no ghost. A still view converges to the mean over the jitter

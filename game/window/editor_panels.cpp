@@ -72,7 +72,7 @@ void EditorUi::inspector() {
   // Wide enough for its longest labels at the default font, and every
   // widget leaves its label a fixed column (ImGui's default gives widgets
   // 65 % of the width and cuts the labels off).
-  const float width = 26.0f * ImGui::GetFontSize();
+  const float width = kInspectorWidthEms * ImGui::GetFontSize();
   ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - width - 8.0f, 40), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(width, 520), ImGuiCond_FirstUseEver);
   if (!ImGui::Begin("Inspector")) {

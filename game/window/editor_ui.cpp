@@ -128,8 +128,9 @@ void EditorUi::stats_overlay(const ViewRect& view) {
 void EditorUi::log_panel() {
   const ImGuiIO& io = ImGui::GetIO();
   ImGui::SetNextWindowPos(ImVec2(260, io.DisplaySize.y - 170), ImGuiCond_FirstUseEver);
-  // Between the hierarchy and the inspector (26 font heights wide, editor_panels.cpp).
-  ImGui::SetNextWindowSize(ImVec2(std::max(200.0f, io.DisplaySize.x - 260 - 26.0f * ImGui::GetFontSize() - 16), 160), ImGuiCond_FirstUseEver);
+  // Between the hierarchy and the inspector.
+  ImGui::SetNextWindowSize(ImVec2(std::max(200.0f, io.DisplaySize.x - 260 - kInspectorWidthEms * ImGui::GetFontSize() - 16), 160),
+                           ImGuiCond_FirstUseEver);
   if (!ImGui::Begin("Log")) {
     ImGui::End();
     return;

@@ -39,6 +39,9 @@ class EditorUi {
   [[nodiscard]] float exposure() const { return exposure_; }
   [[nodiscard]] bool quit_requested() const { return quit_; }
   void show_probes(bool on) { show_probes_ = on; }
+  // The inspector's width in font heights: wide enough for its longest
+  // labels; the log panel sits between it and the hierarchy.
+  static constexpr float kInspectorWidthEms = 26.0f;
 
  private:
   void menu_bar();

@@ -257,9 +257,9 @@ std::vector<std::uint8_t> penumbra_radius(const GBuffer& g, const std::vector<fl
       }
     }
   });
-  // Down the cell columns over each run of active bands (the running float
-  // sum restarts with every run), then each pixel's radius from its cell's
-  // window and its own depth.
+  // Down the cell columns, band by band (each band's float sums start
+  // afresh, so rounding does not drift down the image), then each pixel's
+  // radius from its cell's window and its own depth.
   engine::jobs::parallel_for(0, bands, 1, [&](int b0, int b1) {
     std::vector<WindowSums> column(static_cast<std::size_t>(cw));
     for (int b = b0; b < b1; ++b) {
@@ -318,7 +318,6 @@ std::vector<float> penumbra_filter(const GBuffer& g, const std::vector<float>& b
     for (std::size_t p = b; p < e; ++p) out[p] = std::isnan(blocker[p]) ? kNotReceiver : std::isinf(blocker[p]) ? 1.0f : 0.0f;
   });
   if (!(tan_radius > 0)) return out;
-  const std::vector<float> lit = out;
   const std::vector<std::uint8_t> radius = penumbra_radius(g, blocker, tan_radius, pixel_spread);
   const auto each_pixel = [&](auto&& fn) {
     engine::jobs::parallel_for(0, h, 4, [&](int y0, int y1) {
@@ -339,15 +338,17 @@ std::vector<float> penumbra_filter(const GBuffer& g, const std::vector<float>& b
   // is its own mean). The radius changes smoothly from pixel to pixel (a
   // mean over a sliding window), so the columns read rows filtered at
   // about their own width.
-  std::vector<float> rows(lit);
+  // The rows read the pattern's visibility (`out` as it stands) and the
+  // columns write `out` only where they read `rows`: one copy, not two.
+  std::vector<float> rows(out);
   each_pixel([&](int x, int, std::size_t p) {
     float sum = 0, count = 0;
     for (int dx = -radius[p]; dx <= last(radius[p]); ++dx) {
       const int qx = x + dx;
       if (qx < 0 || qx >= w) continue;
       const std::size_t q = p + static_cast<std::size_t>(static_cast<std::ptrdiff_t>(dx));
-      if (std::isnan(lit[q]) || !same(p, q)) continue;
-      sum += lit[q];
+      if (std::isnan(out[q]) || !same(p, q)) continue;
+      sum += out[q];
       count += 1;
     }
     rows[p] = sum / count;
