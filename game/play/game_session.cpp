@@ -115,6 +115,7 @@ GameSession::GameSession(const GameOptions& options) : options_(options), refere
   warm_up_probes();
   frame.width = options_.width;
   frame.height = options_.height;
+  frame.antialias_passes = options_.view != "full";  // as set_view says
   set_method(options_.method);
 }
 
@@ -143,6 +144,9 @@ void GameSession::warm_up_probes() {
 void GameSession::set_view(const std::string& view) {
   if (view != "full" && view != "gi" && view != "direct") throw std::runtime_error("view: expected full, gi or direct, got '" + view + "'");
   options_.view = view;
+  // A pass shown on its own is antialiased with the full image, or it shows
+  // each frame's jittered sample (a fifth of its pixels flickering).
+  world().resource<transgi::runtime::GiFrame>().antialias_passes = view != "full";
   reference_->lights_version = UINT64_MAX;  // re-read the pass
 }
 
