@@ -5,7 +5,7 @@
 # oracles, on the real GPU), every shared library they load except glibc's
 # and the Vulkan loader (the loader comes from .gl, see
 # /work/.library/device/README.md), and Bitterli's Living Room with its model
-# when they are there. The device machine's image is not Debian, and nothing
+# when they are there (the model: \$BITTERLI_MODEL, else out/bitterli/bitterli.tgm). The device machine's image is not Debian, and nothing
 # can be installed there. Usage: scripts/gpu_pack.sh [build dir]
 set -euo pipefail
 build=${1:-build/release}
@@ -25,11 +25,12 @@ for bin in "$build/modules/transgi/transgi" "$build/benchmarks/gpu_bench" "$buil
   done
 done
 scene=../shared/scenes/bitterli-living-room
-if [ -f "$scene/scene.gltf" ] && [ -f out/bitterli/bitterli.tgm ]; then
+model=${BITTERLI_MODEL:-out/bitterli/bitterli.tgm}
+if [ -f "$scene/scene.gltf" ] && [ -f "$model" ]; then
   cp -r "$scene/scene.gltf" "$scene/scene.bin" "$scene/textures" "$scene/Sky_19.exr" "$stage/bitterli/"
-  cp out/bitterli/bitterli.tgm "$stage/bitterli/"
+  cp "$model" "$stage/bitterli/bitterli.tgm"
 else
-  echo "gpu_pack: no Bitterli room or out/bitterli/bitterli.tgm; packing without it" >&2
+  echo "gpu_pack: no Bitterli room or $model; packing without it" >&2
 fi
 tar -cf - -C "$stage" . | xz -T2 -6 > .devpack/pk.tar.xz.tmp
 mv .devpack/pk.tar.xz.tmp .devpack/pk.tar.xz

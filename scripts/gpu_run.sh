@@ -29,5 +29,8 @@ run level_vk_di $L --backend vulkan --device-inference on
 run level_vk2 $L --backend vulkan
 run bitterli_vk $B --backend vulkan
 run bitterli_cpu $B --backend cpu
+ddgi() { name=$1; shift; echo "== $name: $*"; t0=$(date +%s); timeout 90 $T render "$@" --method ddgi --width 1920 --height 1080 --frames 24 --out $R/$name.exr > $R/$name.txt 2>&1; echo "rc $? in $(( $(date +%s) - t0 )) s"; grep -iE "stage|ms" $R/$name.txt | tail -8; rm -f $R/$name.exr; }
+ddgi level_ddgi_vk --scene content/levels/living_room/scene.gltf --probe-volume scene --backend vulkan
+ddgi level_ddgi_cpu --scene content/levels/living_room/scene.gltf --probe-volume scene --backend cpu
 kill $(cat /tmp/dmon.pid) 2>/dev/null
 tar -czf $OUT/results.tgz -C $OUT r && rm -rf $R
