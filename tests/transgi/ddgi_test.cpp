@@ -91,6 +91,67 @@ TEST(Ddgi, FurnaceConvergesToTheAnalyticIrradiance) {
   }
 }
 
+// The same furnace with the sky sampled at the floor's hits (EscapedRays::
+// Zero, the light set holds the sky) and emitted maps on: the irradiance is
+// the indirect light alone (0 looking up, a pi down, a pi / 2 sideways) and
+// the emitted maps hold the sky's direct light (pi up, 0 down, pi / 2
+// sideways), which sum to the furnace above.
+TEST(Ddgi, EmittedMapsHoldTheSkysDirectLightAndTheIrradianceTheRest) {
+  const float a = 0.5f;
+  FloorUnderSky s(a);
+  const auto& assets = s.app.world().resource<scene::SceneAssets>();
+  const auto& rt_scene = s.app.world().resource<rt::RtScene>();
+  DdgiSettings settings;
+  settings.emitted_maps = true;
+  DdgiVolume volume(transgi::probes::ProbeGrid{{-1, 0.5f, -1}, {1, 1.5f, 1}, {2, 2, 2}}, settings);
+  const render::LightSet sky(rt_scene, {}, &*assets.environment);
+  s.app.jobs().run([&] {
+    for (int f = 0; f < 800; ++f) volume.update(rt_scene, sky);
+  });
+  ASSERT_TRUE(volume.has_emitted_maps());
+  const double pi = 3.14159265358979323846;
+  const glm::vec3 p(0.1f, 1.0f, -0.2f), view = glm::normalize(glm::vec3(0.3f, -0.2f, -1.0f));
+  const struct {
+    glm::vec3 n;
+    double indirect, emitted;
+  } cases[] = {{{0, 1, 0}, 0.0, pi}, {{0, -1, 0}, a * pi, 0.0}, {{1, 0, 0}, a * pi / 2, pi / 2}, {{0, 0, -1}, a * pi / 2, pi / 2}};
+  for (const auto& c : cases) {
+    glm::vec3 emitted(-1.0f);
+    const glm::vec3 e = volume.irradiance(p, c.n, view, nullptr, &emitted);
+    std::printf("normal (%g, %g, %g): indirect %.4f (analytic %.4f), emitted %.4f (analytic %.4f)\n", c.n.x, c.n.y, c.n.z, e.g,
+                c.indirect, emitted.g, c.emitted);
+    // The emitted maps' linear running mean is within 1.2 % of pi (measured).
+    // The irradiance reads 6-9 % low (measured): RTXGI's running mean of
+    // gamma-encoded texels is biased low when each update's radiance is
+    // noisy, as one next-event sample of the sky at each hit makes it.
+    EXPECT_NEAR(emitted.g, c.emitted, 0.02 * pi) << "normal " << c.n.x << " " << c.n.y << " " << c.n.z;
+    EXPECT_NEAR(e.g, c.indirect, 0.1 * a * pi) << "normal " << c.n.x << " " << c.n.y << " " << c.n.z;
+  }
+}
+
+// With probes_per_update, an update after the warm-up traces that many
+// probes' rays, and a full turn of updates reaches every probe once.
+TEST(Ddgi, AProbeBudgetTracesItsShareAndReachesEveryProbeInATurn) {
+  FloorUnderSky s(0.5f);
+  const auto& assets = s.app.world().resource<scene::SceneAssets>();
+  const auto& rt_scene = s.app.world().resource<rt::RtScene>();
+  DdgiSettings settings;
+  settings.rays_per_probe = 32;
+  settings.warmup_frames = 2;
+  settings.probes_per_update = 2;
+  settings.classification = false;
+  DdgiVolume volume(transgi::probes::ProbeGrid{{-1, 0.5f, -1}, {1, 1.5f, 1}, {2, 2, 2}}, settings);
+  const render::LightSet sky(rt_scene, {}, &*assets.environment);
+  std::vector<OctahedralMap<glm::vec3>> before;
+  s.app.jobs().run([&] {
+    for (int f = 0; f < 2; ++f) EXPECT_EQ(volume.update(rt_scene, sky).rays, 8u * 32u) << "warm-up update " << f << " traces all";
+    for (int q = 0; q < 8; ++q) before.push_back(volume.irradiance_map(q));
+    for (int f = 0; f < 4; ++f) EXPECT_EQ(volume.update(rt_scene, sky).rays, 2u * 32u) << "budgeted update " << f;
+  });
+  for (int q = 0; q < 8; ++q)
+    EXPECT_NE(volume.irradiance_map(q).texels, before[static_cast<std::size_t>(q)].texels) << "probe " << q << " updated in the turn";
+}
+
 // Classification (on here, off by default in RTXGI): a probe inside a closed
 // single-sided box sees only back faces and becomes inactive; an outside one
 // stays. (Double-sided content: open_space_test.cpp.)

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "engine/jobs/parallel_for.h"
 #include "engine/math/rng.h"
@@ -25,6 +26,14 @@ constexpr float kMissDistance = 1e27f;
 // Backface hits are stored negative and shortened (RTXGI's ProbeTraceRGS).
 constexpr float kBackfaceDistanceScale = -0.2f;
 
+// x^(gamma / 2): a stored texel (gamma-encoded) re-encoded with gamma 2.
+// RTXGI's gamma 5 is x^2 sqrt(x), which costs a square root where pow costs
+// a fifth of the whole lookup.
+glm::vec3 to_gamma_two(const glm::vec3& x, float gamma) {
+  if (gamma == 5.0f) return x * x * glm::sqrt(x);
+  return glm::pow(x, glm::vec3(0.5f * gamma));
+}
+
 }  // namespace
 
 DdgiVolume::DdgiVolume(const probes::ProbeGrid& grid, const DdgiSettings& settings)
@@ -33,6 +42,7 @@ DdgiVolume::DdgiVolume(const probes::ProbeGrid& grid, const DdgiSettings& settin
   irradiance_.assign(count, OctahedralMap<glm::vec3>(settings.irradiance_texels, glm::vec3(0.0f)));
   // Until measured, distances read as "far": nothing is occluded.
   distance_.assign(count, OctahedralMap<glm::vec2>(settings.distance_texels, glm::vec2(0.0f)));
+  if (settings.emitted_maps) emitted_.assign(count, OctahedralMap<glm::vec3>(settings.irradiance_texels, glm::vec3(0.0f)));
   active_.assign(count, 1);
 }
 
@@ -40,6 +50,7 @@ std::size_t DdgiVolume::memory_bytes() const {
   std::size_t b = 0;
   for (const auto& m : irradiance_) b += m.texels.size() * sizeof(glm::vec3);
   for (const auto& m : distance_) b += m.texels.size() * sizeof(glm::vec2);
+  for (const auto& m : emitted_) b += m.texels.size() * sizeof(glm::vec3);
   return b;
 }
 
@@ -69,10 +80,26 @@ int DdgiVolume::scroll(glm::ivec3 cells, const DdgiVolume* seed) {
       update_border(irr);
     }
     std::fill(distance_[i].texels.begin(), distance_[i].texels.end(), glm::vec2(0.0f));
+    if (!emitted_.empty()) std::fill(emitted_[i].texels.begin(), emitted_[i].texels.end(), glm::vec3(0.0f));
   }
   // Entered probes may stand inside walls: classify again (per cascade).
   if (settings_.classification) classified_ = false;
   return entered;
+}
+
+std::vector<int> DdgiVolume::probes_to_trace(bool all) {
+  std::vector<int> active;
+  for (int q = 0; q < grid_.count(); ++q)
+    if (active_[static_cast<std::size_t>(q)]) active.push_back(q);
+  const auto budget = static_cast<std::size_t>(std::max(settings_.probes_per_update, 0));
+  if (all || budget == 0 || active.size() <= budget) return active;
+  // Every stride-th active probe from this turn's offset: after `stride`
+  // updates each active probe has been traced once.
+  const std::size_t stride = (active.size() + budget - 1) / budget;
+  const std::size_t offset = budget_turn_++ % stride;
+  std::vector<int> turn;
+  for (std::size_t i = offset; i < active.size(); i += stride) turn.push_back(active[i]);
+  return turn;
 }
 
 DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
@@ -98,12 +125,13 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
   };
   std::vector<glm::vec3> ray_directions(static_cast<std::size_t>(M));
   for (int i = 0; i < M; ++i) ray_directions[static_cast<std::size_t>(i)] = glm::normalize(rotation * directions_[static_cast<std::size_t>(i)]);
-  std::vector<int> tracing;
-  for (int q = 0; q < probes; ++q)
-    if (active_[static_cast<std::size_t>(q)]) {
-      tracing.push_back(q);
-      records[static_cast<std::size_t>(q)].resize(static_cast<std::size_t>(M));
-    }
+  const bool warming = frame_ < static_cast<std::uint64_t>(settings_.warmup_frames);
+  const std::vector<int> tracing = probes_to_trace(warming || classify_now);
+  for (int q : tracing) records[static_cast<std::size_t>(q)].resize(static_cast<std::size_t>(M));
+  // With emitted maps: the same rays, carrying what they met straight from emitters and the sky.
+  std::vector<std::vector<RayRecord>> emitted_records(emitted_.empty() ? 0 : static_cast<std::size_t>(probes));
+  for (int q : tracing)
+    if (!emitted_.empty()) emitted_records[static_cast<std::size_t>(q)].resize(static_cast<std::size_t>(M));
   probes::trace_probe_rays(
       scene, lights, kernels_ ? kernels_->tracer() : nullptr, tracing, ray_directions,
       [&](int q) { return placed_.position(q); }, ray_rng, feedback, [&](int q, int i, const probes::ProbeRayHit& h) {
@@ -121,6 +149,9 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
           r.radiance = h.radiance;
           r.distance = h.distance;
         }
+        if (!emitted_.empty())
+          emitted_records[static_cast<std::size_t>(q)][static_cast<std::size_t>(i)] = {
+              dir, h.back_face ? glm::vec3(0.0f) : h.emitted, r.distance};
       });
   stats.rays = tracing.size() * static_cast<std::size_t>(M);
   stats.trace_ms = ms_since(t0);
@@ -138,13 +169,15 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
       active_[i] = static_cast<float>(backfaces) <= settings_.fixed_ray_backface_threshold * static_cast<float>(M) && open.open[i];
       if (active_[i]) placed_.offsets[i] = open.offsets[i];
       // A moved probe's rays this frame left from its old place.
-      if (!active_[i] || placed_.offsets[i] != glm::vec3(0.0f)) records[i].clear();
+      if (!active_[i] || placed_.offsets[i] != glm::vec3(0.0f)) {
+        records[i].clear();
+        if (!emitted_.empty()) emitted_records[i].clear();
+      }
     }
     classified_ = true;
   }
 
   t0 = Clock::now();
-  const bool warming = frame_ < static_cast<std::uint64_t>(settings_.warmup_frames);
   const float h = warming ? std::min(settings_.hysteresis, 0.5f + (settings_.hysteresis - 0.5f) * static_cast<float>(frame_) /
                                                                        static_cast<float>(settings_.warmup_frames))
                           : settings_.hysteresis;
@@ -162,6 +195,23 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
       }
     });
   }
+  if (!emitted_.empty()) {
+    // A small emitter is met by a ray now and then: a bright texel one
+    // update, dark the next. RTXGI's running mean of gamma-encoded texels,
+    // its brightness clamp and its faster darkening all bias that towards
+    // black (they made a ceiling lamp's light vanish); a plain running mean
+    // of linear values keeps it.
+    DdgiSettings plain = settings_;
+    plain.irradiance_gamma = 1.0f;
+    plain.irradiance_threshold = std::numeric_limits<float>::infinity();
+    jobs::parallel_for(0, probes, 1, [&](int b, int e) {
+      for (int q = b; q < e; ++q) {
+        const auto& rec = emitted_records[static_cast<std::size_t>(q)];
+        if (rec.empty() || !active_[static_cast<std::size_t>(q)]) continue;
+        blend_irradiance(emitted_[static_cast<std::size_t>(q)], rec, plain, h, false);
+      }
+    });
+  }
   stats.blend_ms = ms_since(t0);
   for (std::uint8_t a : active_) stats.inactive += a ? 0 : 1;
   ++frame_;
@@ -173,8 +223,12 @@ glm::vec2 DdgiVolume::biases() const {
   return {std::min(settings_.normal_bias, cap), std::min(settings_.view_bias, cap)};
 }
 
-glm::vec3 DdgiVolume::irradiance(const glm::vec3& position, const glm::vec3& n, const glm::vec3& view_dir, bool* lit) const {
+glm::vec3 DdgiVolume::irradiance(const glm::vec3& position, const glm::vec3& n, const glm::vec3& view_dir, bool* lit,
+                                  glm::vec3* emitted) const {
   if (lit) *lit = false;
+  if (emitted) *emitted = glm::vec3(0.0f);
+  const bool with_emitted = emitted && !emitted_.empty();
+  glm::vec3 emitted_sum(0.0f);
   const glm::vec2 b = biases();
   const glm::vec3 bias = n * b.x - view_dir * b.y;
   const glm::vec3 biased = position + bias;
@@ -187,6 +241,7 @@ glm::vec3 DdgiVolume::irradiance(const glm::vec3& position, const glm::vec3& n, 
     base[a] = std::clamp(static_cast<int>(std::floor(rel)), 0, grid_.dims[a] - 1);
     alpha[a] = std::clamp(rel - static_cast<float>(base[a]), 0.0f, 1.0f);
   }
+  const glm::vec2 normal_oct = octahedral_coordinates(n);  // the same texel position in every probe's map
   glm::vec3 sum(0.0f);
   float weights = 0.0f;
   for (int i = 0; i < 8; ++i) {
@@ -219,13 +274,19 @@ glm::vec3 DdgiVolume::irradiance(const glm::vec3& position, const glm::vec3& n, 
     if (w < kCrush) w *= w * w / (kCrush * kCrush);
     w *= trilinear;
     // Undo the tone curve but keep gamma 2, to blend in a perceptual space.
-    const glm::vec3 e = glm::pow(glm::max(sample_bilinear(irradiance_[static_cast<std::size_t>(q)], n), glm::vec3(0.0f)),
-                                 glm::vec3(0.5f * settings_.irradiance_gamma));
+    const glm::vec3 e = to_gamma_two(glm::max(sample_bilinear_at(irradiance_[static_cast<std::size_t>(q)], normal_oct), glm::vec3(0.0f)),
+                                     settings_.irradiance_gamma);
     sum += w * e;
     weights += w;
+    if (with_emitted)
+      emitted_sum += w * glm::sqrt(glm::max(sample_bilinear_at(emitted_[static_cast<std::size_t>(q)], normal_oct), glm::vec3(0.0f)));
   }
   if (weights <= 0) return glm::vec3(0.0f);
   if (lit) *lit = true;
+  if (with_emitted) {
+    const glm::vec3 em = emitted_sum / weights;
+    *emitted = em * em * engine::math::kTwoPi;
+  }
   glm::vec3 e = sum / weights;
   return e * e * engine::math::kTwoPi;
 }

@@ -77,6 +77,20 @@ struct DdgiSettings {
   // 50 % of the reference GI after 400, 77 % after 1000). Higher = a
   // smoother start, at the cost of slower convergence.
   int warmup_frames = 0;
+  // Not in RTXGI's base loop: after the warm-up, each update traces and
+  // blends at most this many probes, taking every active probe in turn (0 =
+  // all, every update). Warm-up and classification updates trace all.
+  // Higher = faster reaction to changed light, at the cost of tracing and
+  // blending time per frame.
+  int probes_per_update = 0;
+  // Not in RTXGI: each probe also keeps a map of the light its rays met
+  // straight from emitters and the (residual) sky, blended as the
+  // irradiance is, so that a pixel can take that light as direct light (as
+  // TransGI's probes keep their direct SH) while the irradiance stays
+  // indirect (EscapedRays::Zero). On = a GI pass that means what the path
+  // tracer's means, at the cost of one more map per probe and its blend (on
+  // the CPU).
+  bool emitted_maps = false;
   std::uint64_t seed = 1;
   // Where several volumes hold a point (cascades, authored volumes;
   // probes/cascades.h), the band inside this grid's faces across which it
@@ -111,8 +125,10 @@ class DdgiVolume {
   // (from the eye towards the point), as RTXGI's DDGIGetVolumeIrradiance.
   // `lit`, if given, says whether any active probe weighed in (false: every
   // probe around is inactive, and the result is zero).
+  // With `emitted` (and settings().emitted_maps), the emitted maps' value
+  // there too, with the same probe weights; 0 without the maps.
   [[nodiscard]] glm::vec3 irradiance(const glm::vec3& position, const glm::vec3& normal, const glm::vec3& view_dir,
-                                     bool* lit = nullptr) const;
+                                     bool* lit = nullptr, glm::vec3* emitted = nullptr) const;
 
   // The grid moved by whole cells (a cascade following the camera): probes
   // still inside keep their maps; the entered slab starts from `seed`'s
@@ -131,12 +147,17 @@ class DdgiVolume {
   [[nodiscard]] const probes::ProbeGrid& placed_grid() const { return placed_; }
   [[nodiscard]] const DdgiSettings& settings() const { return settings_; }
   [[nodiscard]] const OctahedralMap<glm::vec3>& irradiance_map(int probe) const { return irradiance_[static_cast<std::size_t>(probe)]; }
+  [[nodiscard]] bool has_emitted_maps() const { return !emitted_.empty(); }
   [[nodiscard]] const OctahedralMap<glm::vec2>& distance_map(int probe) const { return distance_[static_cast<std::size_t>(probe)]; }
   [[nodiscard]] bool active(int probe) const { return active_[static_cast<std::size_t>(probe)] != 0; }
   [[nodiscard]] std::uint64_t frame() const { return frame_; }
   [[nodiscard]] std::size_t memory_bytes() const;
 
  private:
+  // The active probes this update traces: all of them, or this turn's share
+  // of settings().probes_per_update.
+  std::vector<int> probes_to_trace(bool all);
+
   std::shared_ptr<DdgiKernels> kernels_;
   probes::ProbeGrid grid_;
   probes::ProbeGrid placed_;
@@ -144,9 +165,11 @@ class DdgiVolume {
   std::vector<glm::vec3> directions_;  // unrotated spherical Fibonacci set
   std::vector<OctahedralMap<glm::vec3>> irradiance_;  // gamma-encoded E / (2 pi)
   std::vector<OctahedralMap<glm::vec2>> distance_;    // mean distance, mean squared distance
+  std::vector<OctahedralMap<glm::vec3>> emitted_;     // linear E / (2 pi) of emitted light (emitted_maps; else empty)
   std::vector<std::uint8_t> active_;
   bool classified_ = false;
   std::uint64_t frame_ = 0;
+  std::uint64_t budget_turn_ = 0;  // updates made under probes_per_update: whose turn it is
 };
 
 }  // namespace transgi::ddgi

@@ -48,15 +48,21 @@ void update_border(OctahedralMap<T>& m) {
 
 // Bilinear lookup in direction `d`, as a GPU sampler would read the atlas
 // at RTXGI's DDGIGetProbeUV.
+// The same at octahedral coordinates already found (octahedral_coordinates),
+// for several maps looked up in one direction.
 template <class T>
-T sample_bilinear(const OctahedralMap<T>& m, const glm::vec3& d) {
-  const glm::vec2 oct = octahedral_coordinates(d);
+T sample_bilinear_at(const OctahedralMap<T>& m, const glm::vec2& oct) {
   const float half = 0.5f * static_cast<float>(m.size());
   const glm::vec2 p = glm::vec2(half) + oct * (0.5f * static_cast<float>(m.interior)) - glm::vec2(0.5f);
   const glm::vec2 c = glm::clamp(p, glm::vec2(0.0f), glm::vec2(static_cast<float>(m.size() - 1)));
   const int x0 = std::min(static_cast<int>(c.x), m.size() - 2), y0 = std::min(static_cast<int>(c.y), m.size() - 2);
   const float fx = c.x - static_cast<float>(x0), fy = c.y - static_cast<float>(y0);
   return (m.at(x0, y0) * (1 - fx) + m.at(x0 + 1, y0) * fx) * (1 - fy) + (m.at(x0, y0 + 1) * (1 - fx) + m.at(x0 + 1, y0 + 1) * fx) * fy;
+}
+
+template <class T>
+T sample_bilinear(const OctahedralMap<T>& m, const glm::vec3& d) {
+  return sample_bilinear_at(m, octahedral_coordinates(d));
 }
 
 }  // namespace transgi::ddgi
