@@ -2,6 +2,8 @@
 // on Vulkan (--backend vulkan): the Cornell box after 16 frames.
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
@@ -142,8 +144,14 @@ TEST(VulkanBackend, ACornellBoxGiFrameEqualsTheCpuBackends) {
 namespace {
 
 // DDGI's GI after 16 updates on one backend, its probes placed as asked.
-eval::MethodRun cornell_ddgi(bool gpu, const runtime::ProbePlacement& placement) {
+// `realtime`: the game's shape (ddgi::DdgiRenderOptions::realtime, a probe
+// budget, emitted maps if asked) instead of eval's.
+eval::MethodRun cornell_ddgi(bool gpu, const runtime::ProbePlacement& placement, bool realtime = false, int width = 48,
+                             bool emitted_maps = false) {
   eval::DdgiRunOptions d;
+  d.render.realtime = realtime;
+  d.settings.emitted_maps = emitted_maps;
+  d.settings.probes_per_update = realtime ? 64 : 0;
   d.frames = 16;
   d.progress = false;
   d.render.direct_spp = 0;
@@ -154,7 +162,7 @@ eval::MethodRun cornell_ddgi(bool gpu, const runtime::ProbePlacement& placement)
   if (gpu) d.kernels = gpu::make_ddgi_kernels("vulkan", "", &why);
   EXPECT_TRUE(!gpu || d.kernels) << why;
   eval::LoadedScene scene = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/test_scenes/cornell_box/scene.gltf", "", 2);
-  return eval::run_ddgi(scene, 48, 48, d);
+  return eval::run_ddgi(scene, width, 48, d);
 }
 
 double mean_of(const engine::image::ImageRGB& img) {
@@ -178,6 +186,33 @@ TEST(VulkanBackend, ACornellBoxDdgiFrameEqualsTheCpuBackends) {
   const double rmse = engine::image::rmse_clamped(cpu.gi, gpu.gi);
   std::printf("Cornell box DDGI, 16 updates, 48x48: GI RMSE between backends %.3g, mean GI %.4f\n", rmse, mean);
   EXPECT_LT(rmse, 1e-4 * mean) << "expected the backends within 1e-4 of the mean GI, got RMSE " << rmse;
+}
+
+// The game's real-time DDGI frame (one G-buffer ray a pixel, deterministic
+// direct light, a probe budget after the warm-up) on both backends: the
+// G-buffer's and the probes' rays traced on the device, the blend as a
+// kernel, the lookups as a kernel (without emitted maps; with them, on the
+// CPU). The full image and both passes. 51 pixels wide: at an even width the
+// box's corner edges run through pixel centres, where the compute traversal
+// and Embree pick different ones of two tied walls.
+TEST(VulkanBackend, ACornellBoxRealtimeDdgiFrameEqualsTheCpuBackends) {
+  GPU_TEST_CONTEXT_OR_SKIP(ctx);
+  runtime::ProbePlacement placement;
+  placement.mode = runtime::ProbeVolumeMode::Scene;
+  placement.scene_dims = glm::ivec3(6);
+  for (bool emitted : {false, true}) {
+    const eval::MethodRun cpu = cornell_ddgi(false, placement, true, 51, emitted),
+                          gpu = cornell_ddgi(true, placement, true, 51, emitted);
+    for (const auto& [name, a, b] : {std::tuple{"full", &cpu.full, &gpu.full}, std::tuple{"direct", &cpu.direct, &gpu.direct},
+                                     std::tuple{"gi", &cpu.gi, &gpu.gi}}) {
+      const double mean = mean_of(*a);
+      ASSERT_GT(mean, 1e-3) << name;
+      const double rmse = engine::image::rmse_clamped(*a, *b);
+      std::printf("Cornell box real-time DDGI, emitted maps %s, 16 updates, 51x48, %s: RMSE between backends %.3g, mean %.4f\n",
+                  emitted ? "on" : "off", name, rmse, mean);
+      EXPECT_LT(rmse, 1e-4 * mean) << name << (emitted ? ", emitted maps" : "");
+    }
+  }
 }
 
 // Several volumes (camera-centred cascades, handing points over across their

@@ -7,7 +7,9 @@
 #include "engine/render/temporal_accumulation.h"
 #include "engine/render/path_tracer.h"
 #include "engine/scene/components.h"
+#include "engine/scene/scene_assets.h"
 #include "engine/transform/transform.h"
+#include "shading/realtime_direct.h"
 
 namespace transgi::ddgi {
 
@@ -92,9 +94,55 @@ void update_volumes(View<Get<DdgiProbeVolume>> volumes, View<Get<DdgiCascades>> 
   ++frame->frames;
 }
 
+// The offline shape: filtered primary rays, DDGI's light at their hits,
+// averaged over still frames, and path-traced direct light.
+void render_offline(const rt::RtScene& rt, const render::LightSet& lights, const render::CameraRays& rays,
+                    std::span<const DdgiVolume* const> all, DdgiKernels* kernels, std::uint64_t geometry_version,
+                    std::uint64_t lights_version, const DdgiRenderOptions& options, render::TemporalAccumulation& history,
+                    DdgiFrame& frame) {
+  const std::uint64_t seed = options.seed + frame.frames;
+  auto t0 = Clock::now();
+  frame.gi = render::accumulate(history, render_ddgi_gi(rt, all, rays, frame.width, frame.height, {.spp = options.gbuffer_spp, .seed = seed},
+                                                        kernels),
+                                render::view_key(rays.to_world(), frame.width, frame.height, geometry_version, lights_version),
+                                options.temporal_window);
+  frame.times.shading = ms_since(t0);
+  t0 = Clock::now();
+  frame.direct = options.direct_spp > 0
+                     ? render::render_direct_light(rt, lights, rays, frame.width, frame.height, options.direct_spp, seed)
+                     : image::ImageRGB(frame.width, frame.height);
+  frame.times.direct = options.direct_spp > 0 ? ms_since(t0) : 0.0;
+}
+
+// What the real-time shape keeps from frame to frame.
+struct DdgiRealtimeScratch {
+  shading::GBuffer gbuffer;
+  shading::UpsamplingPlan plan;
+};
+
+// The real-time shape (DdgiRenderOptions::realtime): one G-buffer, its
+// direct light shaded tile by tile as it is traced, then DDGI's light at its
+// pixels.
+void render_realtime(const rt::RtScene& rt, const scene::SceneAssets& assets, const render::LightSet& lights,
+                     const render::CameraRays& rays, std::span<const DdgiVolume* const> volumes, DdgiKernels* kernels,
+                     const shading::RealtimeGiSettings& upsampling, DdgiRealtimeScratch& scratch, DdgiFrame& frame) {
+  shading::GBuffer& g = scratch.gbuffer;
+  auto t0 = Clock::now();
+  shading::DirectTileShader direct(rt, lights, rays, frame.width, frame.height);
+  shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, g, &direct, kernels ? kernels->tracer() : nullptr);
+  frame.direct = direct.take(g);
+  frame.times.direct = ms_since(t0);
+  t0 = Clock::now();
+  DdgiPixels pixels = shade_ddgi_gbuffer(g, volumes, upsampling, scratch.plan, kernels);
+  frame.gi = std::move(pixels.gi);
+  shading::add_image(frame.direct, pixels.emitted);
+  frame.times.shading = ms_since(t0);
+}
+
 void render_frame(CameraView cameras, View<Get<const DdgiProbeVolume>> volumes, View<Get<const DdgiCascades>> cascades,
-                  Res<rt::RtScene> rt, Res<render::SceneLights> lights, Res<DdgiRenderOptions> options, ResMut<DdgiFrame> frame,
-                  Res<DdgiBackend> backend, Local<render::TemporalAccumulation> history) {
+                  Res<rt::RtScene> rt, Res<scene::SceneAssets> assets, Res<render::SceneLights> lights,
+                  Res<DdgiRenderOptions> options, ResMut<DdgiFrame> frame, Res<DdgiBackend> backend,
+                  Local<render::TemporalAccumulation> history, Local<DdgiRealtimeScratch> scratch) {
   if (frame->width <= 0 || frame->height <= 0) return;
   const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
   if (!rays) throw std::runtime_error("ddgi::render: DdgiFrame asks for an image but the world has no camera");
@@ -108,20 +156,14 @@ void render_frame(CameraView cameras, View<Get<const DdgiProbeVolume>> volumes, 
       if (f) all.push_back(f.get());
   });
   if (all.empty()) throw std::runtime_error("ddgi::render: no DdgiProbeVolume or DdgiCascades in the world");
-  const std::uint64_t seed = options->seed + frame->frames;
-  auto t0 = Clock::now();
-  frame->gi = render::accumulate(*history, render_ddgi_gi(*rt, all, *rays, frame->width, frame->height, {.spp = options->gbuffer_spp, .seed = seed},
-                                                                backend->kernels.get()),
-                                 render::view_key(rays->to_world(), frame->width, frame->height, lights->geometry_version, lights->version),
-                                 options->temporal_window);
-  frame->times.shading = ms_since(t0);
-  t0 = Clock::now();
-  frame->direct = options->direct_spp > 0 ? render::render_direct_light(*rt, lights->set, *rays, frame->width, frame->height,
-                                                                        options->direct_spp, seed)
-                                          : image::ImageRGB(frame->width, frame->height);
-  frame->times.direct = options->direct_spp > 0 ? ms_since(t0) : 0.0;
+  if (options->realtime) {
+    render_realtime(*rt, *assets, lights->set, *rays, all, backend->kernels.get(), options->upsampling, *scratch, *frame);
+  } else {
+    render_offline(*rt, lights->set, *rays, all, backend->kernels.get(), lights->geometry_version, lights->version, *options,
+                   *history, *frame);
+  }
   frame->full = frame->gi;
-  for (std::size_t i = 0; i < frame->full.size(); ++i) frame->full.pixels[i] += frame->direct.pixels[i];
+  shading::add_image(frame->full, frame->direct);
 }
 
 }  // namespace

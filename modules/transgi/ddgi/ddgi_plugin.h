@@ -13,6 +13,7 @@
 
 #include "ddgi/ddgi_kernels.h"
 #include "ddgi/ddgi_volume.h"
+#include "shading/realtime_gi.h"
 #include "probes/cascade_follow.h"
 #include "engine/app/app.h"
 #include "engine/image/image.h"
@@ -35,6 +36,18 @@ struct DdgiCascades {
 };
 
 struct DdgiRenderOptions {
+  // On = the real-time frame's shape, for the game: one G-buffer ray through
+  // each pixel centre, every punctual light's direct light deterministic
+  // with TransGI's soft sun shadows (shading/realtime_direct.h), and DDGI's
+  // light per pixel (shade_ddgi_gbuffer); gbuffer_spp, direct_spp and
+  // temporal_window are then unused. Pair it with DdgiSettings::emitted_maps,
+  // which bring the sky's and the emitters' direct light. Off = the offline
+  // shape that eval compares: filtered rays and path-traced direct samples.
+  bool realtime = false;
+  // With realtime: the grid DDGI's irradiance is looked up on and how it is
+  // upsampled, as TransGI's (only resolution_scale and the upsampling's
+  // fields are read). resolution_scale 1 = a lookup at every pixel.
+  shading::RealtimeGiSettings upsampling{};
   int gbuffer_spp = 1;  // higher = antialiased edges, at the cost of that many irradiance lookups
   int direct_spp = 4;   // higher = less direct-light noise, at the cost of tracing time; 0 = GI only
   // While the view is still, the GI image is the mean of the last this many
@@ -44,6 +57,8 @@ struct DdgiRenderOptions {
 };
 
 struct DdgiStageTimes {
+  // shading: DDGI's light at the pixels. direct: the direct light (with
+  // DdgiRenderOptions::realtime, the G-buffer it is shaded in as well).
   double probe_trace = 0, probe_blend = 0, shading = 0, direct = 0;
 };
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "engine/jobs/parallel_for.h"
+#include "engine/material/specular_albedo.h"
 #include "engine/math/rng.h"
 #include "engine/math/sampling.h"
 #include "engine/render/surface.h"
@@ -15,20 +16,23 @@ namespace {
 // The volumes' irradiance at p, blended as mix_at says; a volume with no
 // active probe weighing in hands its weight to the next holding p.
 // lookup(volume, &lit) is that volume's DdgiVolume::irradiance at the point.
+// The value may be a glm::vec3 or several (a glm::mat2x3 of indirect and
+// emitted irradiance).
 template <class Lookup>
-glm::vec3 mixed_irradiance(std::span<const DdgiVolume* const> volumes, const glm::vec3& p, Lookup&& lookup) {
+auto mixed_irradiance(std::span<const DdgiVolume* const> volumes, const glm::vec3& p, Lookup&& lookup) {
+  using Value = decltype(lookup(volumes[0], nullptr));
   const probes::FieldMixOf<DdgiVolume> m = probes::mix_at(volumes, p);
   const DdgiVolume* first = m.field[0];
   bool lit = false;
-  glm::vec3 e = lookup(first, &lit);
+  Value e = lookup(first, &lit);
   while (!lit) {
     first = probes::next_holding(volumes, first, p);
-    if (!first) return glm::vec3(0.0f);
+    if (!first) return Value(0.0f);
     e = lookup(first, &lit);
   }
   if (m.count == 1 || first != m.field[0]) return e;
   bool second_lit = false;
-  const glm::vec3 e2 = lookup(m.field[1], &second_lit);
+  const Value e2 = lookup(m.field[1], &second_lit);
   return second_lit ? m.weight[0] * e + m.weight[1] * e2 : e;
 }
 
@@ -128,6 +132,127 @@ engine::image::ImageRGB render_ddgi_gi(const engine::rt::RtScene& scene, std::sp
       }
   });
   return img;
+}
+
+namespace {
+
+// One irradiance lookup of shade_ddgi_gbuffer: at a G-buffer pixel's surface
+// point, about `normal` (its own, or a metal's mirror direction).
+struct Lookup {
+  std::size_t pixel = 0;
+  glm::vec3 normal{0.0f};
+};
+
+// Every lookup's indirect irradiance (column 0) and emitted irradiance
+// (column 1: DdgiSettings::emitted_maps, else 0) through the volumes: with
+// `kernels`, one batch per volume; the emitted maps have no kernel, so a
+// volume that keeps them is looked up point by point on the CPU.
+std::vector<glm::mat2x3> look_up(const shading::GBuffer& g, std::span<const Lookup> lookups,
+                                 std::span<const DdgiVolume* const> volumes, DdgiKernels* kernels) {
+  using namespace engine;
+  std::vector<glm::mat2x3> e(lookups.size(), glm::mat2x3(0.0f));
+  const auto position = [&](std::size_t k) { return g.samples[lookups[k].pixel].position; };
+  const auto view = [&](std::size_t k) { return -g.samples[lookups[k].pixel].wo_world; };
+  const bool emitted = std::any_of(volumes.begin(), volumes.end(), [](const DdgiVolume* v) { return v->has_emitted_maps(); });
+  if (kernels && !emitted) {
+    std::vector<glm::vec3> positions(lookups.size()), normals(lookups.size()), views(lookups.size());
+    for (std::size_t k = 0; k < lookups.size(); ++k) {
+      positions[k] = position(k);
+      normals[k] = lookups[k].normal;
+      views[k] = view(k);
+    }
+    std::vector<std::vector<glm::vec3>> per_volume(volumes.size(), std::vector<glm::vec3>(lookups.size()));
+    std::vector<std::vector<std::uint8_t>> lit(volumes.size(), std::vector<std::uint8_t>(lookups.size()));
+    bool batched = true;
+    for (std::size_t v = 0; v < volumes.size() && batched; ++v)
+      batched = kernels->irradiance(*volumes[v], positions, normals, views, per_volume[v], lit[v]);
+    if (batched) {
+      jobs::parallel_for<std::size_t>(0, lookups.size(), 256, [&](std::size_t b, std::size_t end) {
+        for (std::size_t k = b; k < end; ++k)
+          e[k][0] = mixed_irradiance(volumes, positions[k], [&](const DdgiVolume* volume, bool* is_lit) {
+            const auto v = static_cast<std::size_t>(std::find(volumes.begin(), volumes.end(), volume) - volumes.begin());
+            *is_lit = lit[v][k] != 0;
+            return per_volume[v][k];
+          });
+      });
+      return e;
+    }
+  }
+  jobs::parallel_for<std::size_t>(0, lookups.size(), 256, [&](std::size_t b, std::size_t end) {
+    for (std::size_t k = b; k < end; ++k) {
+      const glm::vec3 p = position(k), n = lookups[k].normal, v = view(k);
+      e[k] = mixed_irradiance(volumes, p, [&](const DdgiVolume* volume, bool* is_lit) {
+        glm::mat2x3 both(0.0f);
+        both[0] = volume->irradiance(p, n, v, is_lit, &both[1]);
+        return both;
+      });
+    }
+  });
+  return e;
+}
+
+// A metal's specular albedo (GGX with Schlick's Fresnel) at its view angle.
+glm::vec3 metal_albedo(const shading::GSample& s) {
+  using namespace engine;
+  const float mu = std::max(glm::dot(s.normal_world, s.wo_world), 1e-4f);
+  const float alpha = std::max(s.brdf.roughness * s.brdf.roughness, material::kMinAlpha);
+  const material::SpecularAlbedo a = material::ggx_albedo(mu, alpha);
+  return s.brdf.metallic * (s.brdf.base_color * a.a + glm::vec3(a.b));
+}
+
+}  // namespace
+
+DdgiPixels shade_ddgi_gbuffer(const shading::GBuffer& g, std::span<const DdgiVolume* const> volumes,
+                              const shading::RealtimeGiSettings& upsampling, shading::UpsamplingPlan& plan, DdgiKernels* kernels) {
+  using namespace engine;
+  using shading::UpsamplingPlan;
+  DdgiPixels out{image::ImageRGB(g.width, g.height), image::ImageRGB(g.width, g.height)};
+  if (volumes.empty()) return out;
+  shading::plan_upsampling(g.guide, g.width, g.height, upsampling, plan);
+  // The lookups: each grid cell's pixel, each pixel decoded on its own, and
+  // each metal pixel's mirror direction, in that order.
+  std::vector<Lookup> lookups;
+  for (std::size_t c = 0; c < plan.cell_pixel.size(); ++c)
+    if (plan.cell_guide[c].w > 0) lookups.push_back({plan.cell_pixel[c], g.samples[plan.cell_pixel[c]].normal_world});
+  const std::size_t cells_end = lookups.size();
+  for (std::size_t p = 0; p < g.samples.size(); ++p)
+    if (plan.kind[p] == UpsamplingPlan::kOwn) lookups.push_back({p, g.samples[p].normal_world});
+  const std::size_t own_end = lookups.size();
+  for (std::size_t p = 0; p < g.samples.size(); ++p)
+    if (g.samples[p].hit && g.samples[p].brdf.metallic > 0.0f)
+      lookups.push_back({p, glm::reflect(-g.samples[p].wo_world, g.samples[p].normal_world)});
+  const std::vector<glm::mat2x3> e = look_up(g, lookups, volumes, kernels);
+
+  // Irradiance per grid cell (a miss stays 0) and per pixel decoded on its own.
+  std::vector<glm::mat2x3> cell_e(plan.cell_pixel.size(), glm::mat2x3(0.0f));
+  std::size_t k = 0;
+  for (std::size_t c = 0; c < plan.cell_pixel.size(); ++c)
+    if (plan.cell_guide[c].w > 0) cell_e[c] = e[k++];
+  std::vector<glm::mat2x3> own_e(g.samples.size(), glm::mat2x3(0.0f));
+  for (k = cells_end; k < own_end; ++k) own_e[lookups[k].pixel] = e[k];
+  // Upsampled irradiance x the pixel's own diffuse albedo / pi: textures keep
+  // their full resolution.
+  jobs::parallel_for(0, g.height, 4, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < g.width; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(g.width) + static_cast<std::size_t>(x);
+        glm::mat2x3 irradiance(0.0f);
+        if (plan.kind[p] == UpsamplingPlan::kOwn) {
+          irradiance = own_e[p];
+        } else if (plan.kind[p] == UpsamplingPlan::kUpsampled) {
+          for (int tap = 0; tap < 4; ++tap) irradiance += plan.weight[static_cast<std::size_t>(tap)][p] * cell_e[plan.cell(tap, x, y)];
+        }
+        const glm::vec3 albedo = g.samples[p].diffuse * math::kInvPi;
+        out.gi.pixels[p] = albedo * irradiance[0];
+        out.emitted.pixels[p] = albedo * irradiance[1];
+      }
+  });
+  for (k = own_end; k < lookups.size(); ++k) {
+    const glm::vec3 albedo = metal_albedo(g.samples[lookups[k].pixel]) * math::kInvPi;
+    out.gi.pixels[lookups[k].pixel] += albedo * e[k][0];
+    out.emitted.pixels[lookups[k].pixel] += albedo * e[k][1];
+  }
+  return out;
 }
 
 }  // namespace transgi::ddgi

@@ -8,6 +8,8 @@
 #include "ddgi/ddgi_volume.h"
 #include "engine/image/image.h"
 #include "engine/render/camera_rays.h"
+#include "shading/realtime_gi.h"
+#include "shading/upsampling.h"
 
 namespace transgi::ddgi {
 
@@ -30,5 +32,27 @@ glm::vec3 irradiance_from(std::span<const DdgiVolume* const> volumes, const glm:
 engine::image::ImageRGB render_ddgi_gi(const engine::rt::RtScene& scene, std::span<const DdgiVolume* const> volumes,
                                        const engine::render::CameraRays& camera, int width, int height,
                                        const DdgiRenderSettings& settings, DdgiKernels* kernels = nullptr);
+
+// DDGI's light on a real-time G-buffer (one sample per pixel, as TransGI's
+// real-time frame traces it): diffuse albedo / pi x the volumes' irradiance,
+// looked up on a grid at `upsampling.resolution_scale` of the image (and at
+// every pixel no cell represents) and upsampled to each pixel exactly as
+// TransGI's GI is (shading/upsampling.h: bilinear x depth x normal weights),
+// then multiplied by the pixel's own albedo. The emitted maps
+// (DdgiSettings::emitted_maps) are looked up and upsampled with it: the sky's
+// and the emitters' direct light; the punctual lights' is the caller's
+// (shading::DirectTileShader). A metal has no diffuse albedo and would be
+// black: it gets its GGX specular albedo x the irradiance about its mirror
+// direction / pi at its own pixel, a blurred reflection (engines use
+// reflection probes there; DDGI has none). With `kernels` every lookup goes
+// to its irradiance kernel in one batch per volume. `plan` is scratch kept
+// between frames.
+struct DdgiPixels {
+  engine::image::ImageRGB gi;       // from the irradiance maps: indirect light
+  engine::image::ImageRGB emitted;  // from the emitted maps (DdgiSettings::emitted_maps): direct light, else 0
+};
+DdgiPixels shade_ddgi_gbuffer(const shading::GBuffer& g, std::span<const DdgiVolume* const> volumes,
+                                           const shading::RealtimeGiSettings& upsampling, shading::UpsamplingPlan& plan,
+                                           DdgiKernels* kernels = nullptr);
 
 }  // namespace transgi::ddgi
