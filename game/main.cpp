@@ -5,6 +5,7 @@
 //                [--scene level.gltf] [--model M.tgm] [--game game.json] [--width W --height H] [--view full|gi|direct]
 //                [--method transgi|ddgi|reference]
 // Exit codes: kUsage below.
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -77,6 +78,7 @@ int run_headless(const engine::core::Args& args) {
   engine::core::ProgressBar bar("transgi-game", static_cast<std::uint64_t>(frames), true);
   std::size_t next = 0;
   double total_ms = 0;
+  std::vector<double> frame_ms;
   for (int f = 0; f < frames; ++f) {
     session.begin_input();
     // An event that cannot apply (no such entity, a handle out of view) is
@@ -90,6 +92,7 @@ int run_headless(const engine::core::Args& args) {
     }
     session.frame();
     total_ms += session.last_frame_ms();
+    frame_ms.push_back(session.last_frame_ms());
     if (recorder) recorder->add_frame(session.image());
     bar.update(static_cast<std::uint64_t>(f + 1));
   }
@@ -97,6 +100,13 @@ int run_headless(const engine::core::Args& args) {
     std::fprintf(stderr, "warning: %zu replay events after frame %d were not played\n", events.size() - next, frames - 1);
   std::printf("%d frames at %dx%d, mean frame %.1f ms (engine frame: editor, scripts, GI, direct light, composite)\n", frames,
               o.width, o.height, total_ms / frames);
+  // The first frames warm probes up; the second half is the steady state.
+  std::vector<double> late(frame_ms.begin() + frames / 2, frame_ms.end());
+  std::nth_element(late.begin(), late.begin() + static_cast<std::ptrdiff_t>(late.size() / 2), late.end());
+  std::printf("median frame of the last %zu: %.1f ms; %s stages of the last frame (ms):", late.size(),
+              late[late.size() / 2], game::method_name(session.method()));
+  for (const auto& st : session.stage_times()) std::printf(" %s %.2f;", st.name.c_str(), st.ms);
+  std::printf("\n");
   const auto& log = session.world().resource<engine::core::Log>();
   std::printf("log: %zu errors, %zu warnings\n", log.count(engine::core::LogLevel::Error), log.count(engine::core::LogLevel::Warning));
   if (args.has("screenshot")) {

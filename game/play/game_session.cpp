@@ -150,12 +150,28 @@ void GameSession::set_view(const std::string& view) {
   reference_->lights_version = UINT64_MAX;  // re-read the pass
 }
 
+namespace {
+// DDGI as a game would run it, added on first use (its probes cost time
+// every frame): the real-time frame's deterministic direct light
+// (DdgiRenderOptions::realtime) plus the sky's and the emitters' light from
+// the probes' emitted maps, so its GI view means what the others' do; a
+// cold start over the first updates, then a quarter of the probes a frame.
+transgi::ddgi::DdgiSettings game_ddgi_settings() {
+  transgi::ddgi::DdgiSettings s;
+  s.emitted_maps = true;
+  s.rays_per_probe = 128;
+  s.warmup_frames = 32;
+  s.probes_per_update = 128;
+  return s;
+}
+}  // namespace
+
 void GameSession::set_method(GameMethod m) {
   if (m == method_) return;
   method_ = m;
   engine::ecs::World& w = world();
   if (m == GameMethod::Ddgi && !app_->has_plugin("transgi::DdgiPlugin")) {
-    app_->add_plugin<transgi::ddgi::DdgiPlugin>();  // on first use: its probes cost time every frame
+    app_->add_plugin<transgi::ddgi::DdgiPlugin>(game_ddgi_settings(), transgi::ddgi::DdgiRenderOptions{.realtime = true});
     w.emplace<transgi::ddgi::DdgiProbeVolume>(w.spawn(), transgi::ddgi::DdgiProbeVolume{});
     if (ddgi_backend_ != "cpu") set_backend(ddgi_backend_);  // the backend chosen before DDGI was first shown
   }
@@ -216,7 +232,7 @@ std::vector<GameSession::StageTime> GameSession::stage_times() const {
     const auto* d = w.try_resource<transgi::ddgi::DdgiFrame>();
     if (!d) return {};
     return {{"probe rays", d->times.probe_trace}, {"probe blend", d->times.probe_blend}, {"shading", d->times.shading},
-            {"direct", d->times.direct}};
+            {"G-buffer, direct", d->times.direct}};
   }
   const auto& t = w.resource<transgi::runtime::GiFrame>().times;
   return {{"G-buffer", t.gbuffer + t.network_input}, {"inference", t.inference}, {"SH light", t.sh_multiplication},
