@@ -32,6 +32,7 @@
 #include "play/game_session.h"
 #include "play/input_queue.h"
 #include "runtime/gi_frame.h"
+#include "runtime/probe_placement.h"
 #include "runtime/settings.h"
 #include "replay/replay.h"
 
@@ -416,7 +417,8 @@ int shell_output(const std::string& cmd, std::string& out) {
 TEST(WindowSmoke, TheProbeOverlayLeavesTheMenuBarAndPanelsAsTheyAre) {
   // View > Probes drew on ImGui's foreground list: a probe near the eye
   // became a window-sized disc over the menu bar (issue 32). The overlay is
-  // now under the panels, clipped to the view, its discs capped in size.
+  // now under the panels, clipped to the view, its discs capped in size,
+  // and a probe nearer than 0.25 m is not drawn.
   if (shell("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (Debian package xvfb)";
   const fs::path dir = fs::temp_directory_path() / ("probe_overlay_" + std::to_string(::getpid()));
   fs::create_directories(dir);
@@ -427,7 +429,24 @@ TEST(WindowSmoke, TheProbeOverlayLeavesTheMenuBarAndPanelsAsTheyAre) {
     const int code = shell(cmd);
     return code == 0 && fs::exists(png) ? std::optional<engine::image::Rgb8Image>(engine::image::read_png(png)) : std::nullopt;
   };
-  const auto plain = shot("plain", ""), probes = shot("probes", "--probes");
+  // The camera 0.12 m behind a probe, facing it: the case that blanked the
+  // window (a Lua script on the camera moves it there at start).
+  glm::vec3 eye(0.0f);
+  {
+    game::GameSession s(level_options(160, 90));
+    idle(s, 1);
+    const auto fields = transgi::runtime::probe_fields(s.world());
+    ASSERT_FALSE(fields.empty());
+    const auto& grid = fields.front()->grid();
+    const glm::vec3 probe = grid.position(grid.count() / 2);
+    const auto& cam = s.world().get<engine::transform::Transform>(s.find("Camera"));
+    eye = probe - 0.12f * (cam.rotation * glm::vec3(0.0f, 0.0f, -1.0f));
+  }
+  const fs::path script = dir / "near_probe.lua";
+  std::ofstream(script) << "function init(self) self.entity.transform:set_position(" << eye.x << ", " << eye.y << ", " << eye.z
+                        << ") end\n";
+  const std::string at_probe = "--script Camera=" + script.string() + " ";
+  const auto plain = shot("plain", at_probe), probes = shot("probes", at_probe + "--probes");
   if (!plain || !probes) GTEST_SKIP() << "no X server could start under xvfb-run";
   ASSERT_EQ(plain->width, probes->width);
   // The menu bar (the top 19 rows) and the hierarchy panel's title, pixel for pixel.
