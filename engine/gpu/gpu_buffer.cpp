@@ -91,9 +91,18 @@ void GpuBuffer::check_mapped(std::size_t bytes) const {
   if (bytes > bytes_) throw GpuError("GpuBuffer: mapped_as of " + std::to_string(bytes) + " bytes in " + std::to_string(bytes_));
 }
 
+void GpuBuffer::count_traffic(std::size_t bytes, bool device_to_host) const {
+  if (!ctx_) return;
+  if (device_to_host)
+    ctx_->count_device_to_host(bytes);
+  else
+    ctx_->count_host_to_device(bytes);
+}
+
 void GpuBuffer::write_bytes(const void* src, std::size_t n) {
   if (n > bytes_) throw GpuError("GpuBuffer: upload of " + std::to_string(n) + " bytes into " + std::to_string(bytes_));
   if (!n) return;
+  ctx_->count_host_to_device(n);
   if (mapped_) {
     std::memcpy(mapped_, src, n);
     return;
@@ -113,6 +122,7 @@ void GpuBuffer::write_bytes(const void* src, std::size_t n) {
 void GpuBuffer::read_bytes(void* dst, std::size_t n) const {
   if (n > bytes_) throw GpuError("GpuBuffer: download of " + std::to_string(n) + " bytes from " + std::to_string(bytes_));
   if (!n) return;
+  ctx_->count_device_to_host(n);
   if (mapped_) {
     std::memcpy(dst, mapped_, n);
     return;

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstring>
 #include <span>
+#include <type_traits>
 
 #include <vulkan/vulkan_core.h>
 
@@ -41,9 +42,12 @@ class GpuBuffer {
   // The mapped memory as `count` T's, for callers that fill or read it in
   // parallel without a copy. Throws GpuError on an unmapped buffer or one
   // too small.
+  // The span counts as traffic (VulkanContext::traffic): read from the
+  // device where T is const, written to it otherwise.
   template <class T>
   [[nodiscard]] std::span<T> mapped_as(std::size_t count) const {
     check_mapped(count * sizeof(T));
+    count_traffic(count * sizeof(T), std::is_const_v<T>);
     return {static_cast<T*>(mapped_), count};
   }
 
@@ -60,6 +64,7 @@ class GpuBuffer {
   void read_bytes(void* dst, std::size_t n) const;
   void release();
   void check_mapped(std::size_t bytes) const;
+  void count_traffic(std::size_t bytes, bool device_to_host) const;
 
   VulkanContext* ctx_ = nullptr;
   VkDevice device_ = VK_NULL_HANDLE;

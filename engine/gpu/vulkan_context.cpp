@@ -346,6 +346,7 @@ double VulkanContext::submit_and_wait(const std::function<void(VkCommandBuffer)>
   si.pCommandBuffers = &cmd_;
   ENGINE_VK_CHECK(vkResetFences(device_, 1, &fence_));
   ENGINE_VK_CHECK(vkQueueSubmit(queue_, 1, &si, fence_));
+  submissions_.fetch_add(1, std::memory_order_relaxed);
   ENGINE_VK_CHECK(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX));
   if (!timestamps_) return -1.0;
   std::uint64_t ticks[2] = {0, 0};

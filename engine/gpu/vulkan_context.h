@@ -4,6 +4,7 @@
 // loader, no driver, no match for the requested name): callers and tests fall
 // back to the CPU or skip, they do not crash. Every later failure throws
 // GpuError naming the Vulkan call.
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -99,6 +100,20 @@ std::vector<std::uint32_t> rank_buffer_memory_types(const VkPhysicalDeviceMemory
 // "vulkan (NAME; DRIVER; buffers: ...)" for logs and benchmark output.
 std::string describe(const DeviceInfo& info);
 
+// What crossed between host and device, counted where it happens (issue 36:
+// counted, not assumed): command buffers submitted; bytes the host wrote to
+// and read from buffers. A mapped buffer's bytes count when the host takes a
+// span of them (GpuBuffer::mapped_as: a span of const T is read, any other
+// written), so a span taken but only partly touched still counts whole: an
+// upper bound. upload() and download() count what they copy.
+struct GpuTraffic {
+  std::uint64_t submissions = 0, host_to_device_bytes = 0, device_to_host_bytes = 0;
+  [[nodiscard]] GpuTraffic operator-(const GpuTraffic& o) const {
+    return {submissions - o.submissions, host_to_device_bytes - o.host_to_device_bytes,
+            device_to_host_bytes - o.device_to_host_bytes};
+  }
+};
+
 class VulkanContext {
  public:
   // Null and *why_not set when no usable device exists.
@@ -129,6 +144,15 @@ class VulkanContext {
   // -1 where the queue has none.
   double submit_and_wait(const std::function<void(VkCommandBuffer)>& record);
 
+  // The traffic since the context was made (thread-safe); a frame's is the
+  // difference of two readings.
+  [[nodiscard]] GpuTraffic traffic() const {
+    return {submissions_.load(std::memory_order_relaxed), host_to_device_.load(std::memory_order_relaxed),
+            device_to_host_.load(std::memory_order_relaxed)};
+  }
+  void count_host_to_device(std::uint64_t bytes) { host_to_device_.fetch_add(bytes, std::memory_order_relaxed); }
+  void count_device_to_host(std::uint64_t bytes) { device_to_host_.fetch_add(bytes, std::memory_order_relaxed); }
+
  private:
   VulkanContext() = default;
   static VKAPI_ATTR VkBool32 VKAPI_CALL on_validation(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
@@ -148,6 +172,7 @@ class VulkanContext {
   DeviceInfo info_;
   AccelerationStructureApi as_api_;
   int validation_errors_ = 0;
+  std::atomic<std::uint64_t> submissions_{0}, host_to_device_{0}, device_to_host_{0};
 };
 
 }  // namespace engine::gpu

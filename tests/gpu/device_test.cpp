@@ -156,6 +156,31 @@ TEST(GpuBuffer, ADeviceOnlyBufferRoundTripsThroughStagingCopies) {
   EXPECT_EQ(ctx->validation_errors(), 0);
 }
 
+// The traffic a frame reports is counted where it happens: each submission,
+// each upload and download by its bytes (a staging copy is one more
+// submission), each mapped span by its size and constness.
+TEST(GpuTraffic, CountsSubmissionsUploadsDownloadsAndMappedSpans) {
+  std::string why;
+  VulkanContext* ctx = gpu_test::staging_context(&why);
+  if (!ctx) GTEST_SKIP() << "no Vulkan device: " << why;
+  GpuBuffer mapped(*ctx, 64 * sizeof(float));
+  GpuBuffer device(*ctx, 100 * sizeof(std::uint32_t), GpuBuffer::Placement::DeviceOnly);
+  const GpuTraffic before = ctx->traffic();
+  std::vector<float> f(64, 1.0f);
+  mapped.upload(std::span<const float>(f));                 // 256 bytes up
+  mapped.download(std::span<float>(f).first(10));           // 40 bytes down
+  (void)mapped.mapped_as<float>(16);                        // written: 64 bytes up
+  (void)mapped.mapped_as<const float>(8);                   // read: 32 bytes down
+  std::vector<std::uint32_t> u(100, 3u);
+  device.upload(std::span<const std::uint32_t>(u));         // 400 up, one staging submission
+  device.download(std::span<std::uint32_t>(u).first(50));   // 200 down, one more
+  ctx->submit_and_wait([](VkCommandBuffer) {});             // one more
+  const GpuTraffic t = ctx->traffic() - before;
+  EXPECT_EQ(t.host_to_device_bytes, 256u + 64u + 400u);
+  EXPECT_EQ(t.device_to_host_bytes, 40u + 32u + 200u);
+  EXPECT_EQ(t.submissions, 3u);
+}
+
 TEST(VulkanContext, SaysWhichDeviceItRunsOnAndWhetherValidationIsOn) {
   GPU_TEST_CONTEXT_OR_SKIP(ctx);
   const auto& info = ctx->info();

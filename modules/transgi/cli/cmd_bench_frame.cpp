@@ -193,6 +193,12 @@ int run_bench_frame(const std::vector<std::string>& argv) {
                 "total %.2f\n",
                 frame.gpu_gbuffer_ms, frame.gpu_trace_ms, frame.gpu_shading_ms, frame.gpu_raster_ms, frame.gpu_accumulation_ms,
                 frame.gpu_projection_ms, frame.gpu_inference_ms, frame.gpu_ms());
+  if (frame.backend != "cpu")
+    std::printf("host-device traffic, last frame: %llu submissions, %.2f MB to the device, %.2f MB back (the final image: "
+                "%.2f MB)\n",
+                static_cast<unsigned long long>(frame.gpu_submissions), static_cast<double>(frame.gpu_upload_bytes) * 1e-6,
+                static_cast<double>(frame.gpu_download_bytes) * 1e-6,
+                static_cast<double>(frame.full.pixels.size() * sizeof(glm::vec3)) * 1e-6);
   std::printf("direct light, last frame: %zu shadow rays to %zu punctual lights\n", frame.direct_stats.shadow_rays,
               frame.direct_stats.lights);
   // The NaN guards (docs/reliability.md): what each stage's boundary replaced in the last frame.

@@ -58,6 +58,13 @@ class VulkanProbeKernels : public probes::ProbeKernels {
     double trace = 0, raster = 0, projection = 0, shading = 0, accumulation = 0;
     [[nodiscard]] double total() const { return trace + raster + projection + shading + accumulation; }
   };
+  // Submissions and bytes between host and device since the last call
+  // (engine::gpu::GpuTraffic; all of this context's users).
+  engine::gpu::GpuTraffic take_traffic() {
+    const engine::gpu::GpuTraffic now = ctx_->traffic(), since = now - traffic_taken_;
+    traffic_taken_ = now;
+    return since;
+  }
   StageMs take_stage_ms() {
     StageMs s{tracer_.take_device_ms(), raster_ms_, project_ms_, shading_ ? shading_->take_gpu_ms() : 0.0, accumulate_ms_};
     raster_ms_ = project_ms_ = accumulate_ms_ = 0.0;
@@ -78,6 +85,7 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   std::string shading_why_;
   std::string name_;
   double raster_ms_ = 0.0, project_ms_ = 0.0, accumulate_ms_ = 0.0;
+  engine::gpu::GpuTraffic traffic_taken_;
 };
 
 // The Vulkan kernels on the chosen device (empty: ENGINE_GPU_DEVICE, then

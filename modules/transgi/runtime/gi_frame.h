@@ -71,6 +71,10 @@ struct GiFrame {
   // accumulation.
   double gpu_gbuffer_ms = 0.0, gpu_trace_ms = 0.0, gpu_raster_ms = 0.0, gpu_projection_ms = 0.0, gpu_inference_ms = 0.0,
          gpu_shading_ms = 0.0, gpu_accumulation_ms = 0.0;
+  // Host-device traffic since the last image (the probe updates and this
+  // image; engine::gpu::GpuTraffic says how it is counted): command buffers
+  // submitted, bytes written to the device and read back. 0 on the CPU.
+  std::uint64_t gpu_submissions = 0, gpu_upload_bytes = 0, gpu_download_bytes = 0;
   [[nodiscard]] double gpu_ms() const {
     return gpu_gbuffer_ms + gpu_trace_ms + gpu_raster_ms + gpu_projection_ms + gpu_inference_ms + gpu_shading_ms +
            gpu_accumulation_ms;
