@@ -8,11 +8,13 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "engine/core/args.h"
+#include "engine/core/install_paths.h"
 #include "engine/core/log.h"
 #include "engine/core/progress.h"
 #include "engine/image/tonemap.h"
@@ -43,9 +45,16 @@ engine::core::Args parse(int argc, char** argv) {
 }
 
 // What the window and headless runs share.
+// The sample level: installed beside the program (bin/ ->
+// share/transgi/levels), else in the source tree.
+std::filesystem::path default_level() {
+  if (auto level = engine::core::beside_executable("../share/transgi/levels/living_room/scene.gltf")) return *level;
+  return TRANSGI_DEFAULT_LEVEL;
+}
+
 game::GameOptions game_options(const engine::core::Args& args) {
   game::GameOptions o;
-  o.scene = args.str("scene", TRANSGI_DEFAULT_LEVEL);
+  o.scene = args.str("scene", default_level().string());
   o.model = args.str("model", std::string());
   o.manifest = args.str("game", std::string());
   o.width = static_cast<int>(args.integer("width", 16, 8192, 640));

@@ -3,7 +3,9 @@
 #include <cstddef>
 #include <cstdlib>
 #include <limits>
+#include <string_view>
 
+#include "engine/core/install_paths.h"
 #include "engine/gpu/gpu_error.h"
 #include "engine/gpu/shader_compiler.h"
 #include "engine/jobs/parallel_for.h"
@@ -17,8 +19,12 @@ BvhNodeGpu to_gpu(const rt::BvhNode& n) {
   return {n.bounds.min.x, n.bounds.min.y, n.bounds.min.z, n.first, n.bounds.max.x, n.bounds.max.y, n.bounds.max.z, n.count};
 }
 
+// ENGINE_SHADER_DIR, else the installed folder beside the program (bin/ ->
+// ../ENGINE_INSTALLED_SHADER_DIR), else the source tree's.
 std::filesystem::path engine_shader_dir() {
   if (const char* env = std::getenv("ENGINE_SHADER_DIR"); env && *env) return env;
+  if (const std::string_view installed = ENGINE_INSTALLED_SHADER_DIR; !installed.empty())
+    if (auto dir = core::beside_executable(std::filesystem::path("..") / installed)) return *dir;
   return ENGINE_SOURCE_SHADER_DIR;
 }
 

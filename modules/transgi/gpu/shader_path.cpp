@@ -3,10 +3,14 @@
 #include <cstdlib>
 #include <exception>
 
+#include "engine/core/install_paths.h"
+
 namespace transgi::gpu {
 
 std::filesystem::path shader_dir() {
   if (const char* env = std::getenv("TRANSGI_SHADER_DIR"); env && *env) return env;
+  // An installed program: bin/ beside share/transgi/shaders.
+  if (auto dir = engine::core::beside_executable("../share/transgi/shaders")) return *dir;
   return TRANSGI_SOURCE_SHADER_DIR;
 }
 

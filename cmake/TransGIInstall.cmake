@@ -1,0 +1,42 @@
+# cmake --install: the tools, the libraries and their headers, the shaders,
+# the sample level, and a CMake package (find_package(TransGI)) whose
+# targets are TransGI::engine, TransGI::engine_gpu, TransGI::engine_script
+# and TransGI::transgi. Installed programs find the shaders and the level
+# relative to themselves (engine/core/install_paths.h), so the tree may be
+# moved. Layout:
+#   bin/transgi, bin/transgi-game
+#   lib/libengine*.a, lib/libtransgi_module.a, lib/cmake/TransGI/
+#   include/engine/...   (#include "engine/app/app.h")
+#   include/transgi/...  (#include "runtime/transgi_plugin.h"; the GLSL-shared headers beside)
+#   share/transgi/shaders, share/transgi/levels/living_room
+include(CMakePackageConfigHelpers)
+set(TRANSGI_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/TransGI)
+set(TRANSGI_INSTALL_DATADIR ${CMAKE_INSTALL_DATADIR}/transgi)
+
+set_target_properties(transgi_module PROPERTIES EXPORT_NAME transgi)
+install(TARGETS engine engine_gpu engine_script transgi_module EXPORT TransGITargets
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} ${CMAKE_INSTALL_INCLUDEDIR}/transgi)
+install(TARGETS transgi RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+if(TARGET transgi-game)
+  install(TARGETS transgi-game RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+endif()
+
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/engine/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/engine
+  FILES_MATCHING PATTERN "*.h" PATTERN "demo" EXCLUDE)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/modules/transgi/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/transgi
+  FILES_MATCHING PATTERN "*.h" PATTERN "cli" EXCLUDE)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/shaders/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/transgi FILES_MATCHING PATTERN "*.h")
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/shaders/ DESTINATION ${TRANSGI_INSTALL_DATADIR}/shaders
+  FILES_MATCHING PATTERN "*.comp" PATTERN "*.glsl" PATTERN "*.h")
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/content/levels/living_room DESTINATION ${TRANSGI_INSTALL_DATADIR}/levels)
+install(FILES ${PROJECT_SOURCE_DIR}/LICENSE DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/transgi)
+
+install(EXPORT TransGITargets NAMESPACE TransGI:: DESTINATION ${TRANSGI_INSTALL_CMAKEDIR})
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/TransGIConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/TransGIConfig.cmake INSTALL_DESTINATION ${TRANSGI_INSTALL_CMAKEDIR}
+  PATH_VARS TRANSGI_INSTALL_DATADIR)
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/TransGIConfigVersion.cmake COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/TransGIConfig.cmake ${PROJECT_BINARY_DIR}/TransGIConfigVersion.cmake
+  DESTINATION ${TRANSGI_INSTALL_CMAKEDIR})
