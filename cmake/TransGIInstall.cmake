@@ -28,8 +28,10 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/engine/ DESTINATION ${CMAKE_INSTALL_INCL
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/modules/transgi/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/transgi
   FILES_MATCHING PATTERN "*.h" PATTERN "cli" EXCLUDE)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/shaders/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/transgi FILES_MATCHING PATTERN "*.h")
+# The kernels; the headers they share with C++ are only under include/transgi,
+# where an installed program's shader compiler also looks (install_paths.h).
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/shaders/ DESTINATION ${TRANSGI_INSTALL_DATADIR}/shaders
-  FILES_MATCHING PATTERN "*.comp" PATTERN "*.glsl" PATTERN "*.h")
+  FILES_MATCHING PATTERN "*.comp" PATTERN "*.glsl")
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/content/levels/living_room DESTINATION ${TRANSGI_INSTALL_DATADIR}/levels)
 install(FILES ${PROJECT_SOURCE_DIR}/LICENSE DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/transgi)
 

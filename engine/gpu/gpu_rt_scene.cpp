@@ -87,6 +87,9 @@ GpuRtScene::GpuRtScene(VulkanContext& ctx) : ctx_(ctx) {
   const auto dir = engine_shader_dir();
   ShaderCompileOptions options;
   options.include_dirs.push_back(dir);
+  // Installed, the headers the kernels share with C++ are with the C++ headers.
+  if (auto shared = core::installed_twin(dir, ENGINE_INSTALLED_SHADER_DIR, ENGINE_INSTALLED_SHADER_INCLUDE_DIR))
+    options.include_dirs.push_back(*shared);
   options.defines = shader_defines(ctx);
   query_ = std::make_unique<ComputePipeline>(ctx, compile_compute_shader(dir / "rt_query.comp", options),
                                              binding_types(ctx, 2, 2 + kBindings),

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "engine/image/png.h"
+#include "engine/core/install_paths.h"
 #include "engine/io/atomic_file.h"
 
 namespace fs = std::filesystem;
@@ -61,4 +62,26 @@ TEST(Png, WritesAValidSignature) {
   EXPECT_EQ(data.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
   EXPECT_THROW(image::write_png(dir / "bad.png", image::Rgb8Image{}), io::IoError);
   fs::remove_all(dir);
+}
+
+// An installed program's folders (engine/core/install_paths.h).
+TEST(InstallPaths, TheExecutablesFolderAndAnInstalledFoldersTwin) {
+  const fs::path exe_dir = core::executable_dir();
+  ASSERT_FALSE(exe_dir.empty());
+  EXPECT_TRUE(fs::exists(exe_dir)) << exe_dir;
+  EXPECT_FALSE(core::beside_executable("no/such/folder").has_value());
+  EXPECT_EQ(core::beside_executable("."), exe_dir.lexically_normal() / "");
+  const fs::path prefix = temp_dir() / "prefix";
+  fs::create_directories(prefix / "share/transgi/shaders");
+  fs::create_directories(prefix / "include/transgi");
+  const auto twin = core::installed_twin(prefix / "share/transgi/shaders", "share/transgi/shaders", "include/transgi");
+  ASSERT_TRUE(twin.has_value());
+  EXPECT_TRUE(fs::equivalent(*twin, prefix / "include/transgi"));
+  EXPECT_TRUE(core::installed_twin(prefix / "share/transgi/shaders/", "share/transgi/shaders", "include/transgi").has_value())
+      << "a trailing slash";
+  EXPECT_FALSE(core::installed_twin(prefix / "share/other/shaders", "share/transgi/shaders", "include/transgi").has_value())
+      << "a folder that is not the installed one";
+  EXPECT_FALSE(core::installed_twin(prefix / "share/transgi/shaders", "share/transgi/shaders", "include/none").has_value())
+      << "no twin there";
+  fs::remove_all(prefix);
 }

@@ -18,6 +18,9 @@ std::vector<std::uint32_t> compile_module_shader(const char* name, std::vector<e
   const auto dir = shader_dir();
   engine::gpu::ShaderCompileOptions options;
   options.include_dirs.push_back(dir);
+  // Installed (share/transgi/shaders), the headers the kernels share with
+  // C++ are with the C++ headers (include/transgi), not beside the kernels.
+  if (auto shared = engine::core::installed_twin(dir, "share/transgi/shaders", "include/transgi")) options.include_dirs.push_back(*shared);
   options.defines = std::move(defines);
   return engine::gpu::compile_compute_shader(dir / name, options);
 }
