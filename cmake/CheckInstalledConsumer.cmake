@@ -23,6 +23,16 @@ foreach(h IN LISTS headers)
   if(NOT h MATCHES "^include/")
     message(FATAL_ERROR "a header installed outside include/: ${h}")
   endif()
+  # Each quoted include resolves in the installed tree: beside the header, or
+  # under include/ or include/transgi (the package's include directories).
+  file(STRINGS ${prefix}/${h} includes REGEX "^[ \t]*#[ \t]*include[ \t]*\"")
+  get_filename_component(here ${prefix}/${h} DIRECTORY)
+  foreach(line IN LISTS includes)
+    string(REGEX REPLACE "^[ \t]*#[ \t]*include[ \t]*\"([^\"]+)\".*" "\\1" name "${line}")
+    if(NOT EXISTS ${here}/${name} AND NOT EXISTS ${prefix}/include/${name} AND NOT EXISTS ${prefix}/include/transgi/${name})
+      message(FATAL_ERROR "the installed ${h} includes \"${name}\", which is not installed")
+    endif()
+  endforeach()
 endforeach()
 
 run(${CMAKE_COMMAND} -S ${SOURCE}/examples/consumer -B ${WORK}/consumer -G ${GENERATOR} -DCMAKE_PREFIX_PATH=${prefix}
