@@ -117,6 +117,8 @@ glm::vec2 TemporalAntialiasing::next_jitter(const TemporalAaSettings& settings) 
 void TemporalAntialiasing::clear() {
   prev_ = Previous{};
   stats_ = Stats{};
+  cycle_count_.clear();
+  cycle_ramp_.clear();
 }
 
 void TemporalAntialiasing::plan_motion(std::span<const TaaObject> objects) {
@@ -228,6 +230,7 @@ std::size_t TemporalAntialiasing::blend_still_row(std::size_t row, int w, const 
     plain[static_cast<std::size_t>(x)] = is_plain ? 1 : 0;
     float alpha = 1.0f;
     if (is_plain) {
+      still_plain_[p] = 1;
       frames_[p] = static_cast<std::uint8_t>(std::min(255, prev_.frames[p] + 1));
       alpha = std::max(blend, 1.0f / static_cast<float>(frames_[p]));
       ++count;
@@ -266,6 +269,8 @@ void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surface
   const int w = camera.width(), h = camera.height();
   const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
   const glm::vec2 jitter = next_jitter(settings);
+  const int phases = std::max(settings.jitter_phases, 1);
+  const std::uint64_t phase = frame_ % static_cast<std::uint64_t>(phases);  // of the frame resolved now
   ++frame_;
   plan_motion(objects);
   const bool have_history = prev_.camera && prev_.camera->width() == w && prev_.camera->height() == h &&
@@ -277,6 +282,7 @@ void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surface
   }
   out_.resize(layers.size());
   frames_.resize(n);
+  still_plain_.assign(n, 0);
   mark_near_moved();
   for (std::size_t l = 0; l < layers.size(); ++l) out_[l].pixels.resize(n);
   const CameraRays& before = *prev_.camera;
@@ -342,6 +348,7 @@ void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surface
           const ecs::Entity was = prev_.entity[p];
           if ((was == self || !moved(was)) && !(!near_moved_.empty() && near_moved_[p] && moved_beside(p, self))) {
             weight = 1.0f;
+            still_plain_[p] = 1;
             frames = prev_.frames[p];
             for (std::size_t l = 0; l < layers.size(); ++l) history[l] = prev_.layers[l].pixels[p];
           }
@@ -416,8 +423,59 @@ void TemporalAntialiasing::resolve(const CameraRays& camera, TaaSurfaces surface
     rejected.fetch_add(local_rejected, std::memory_order_relaxed);
   });
   stats_ = Stats{reused.load(), rejected.load()};
+  if (settings.cycle_mean) apply_cycle_mean(layers, phases, phase, light_changed);
   for (std::size_t l = 0; l < layers.size(); ++l) layers[l]->pixels.swap(out_[l].pixels);
   keep_history(camera, surfaces, layers);
+}
+
+void TemporalAntialiasing::apply_cycle_mean(std::span<image::ImageRGB* const> layers, int phases, std::uint64_t phase,
+                                            bool light_changed) {
+  const std::size_t n = still_plain_.size();
+  if (cycle_count_.size() != n || cycle_sum_.size() != layers.size() || (n && cycle_sum_[0].pixels.size() != n)) {
+    cycle_count_.assign(n, 0);
+    cycle_ramp_.assign(n, 0);
+    const image::ImageRGB blank(layers[0]->width, layers[0]->height);
+    cycle_sum_.assign(layers.size(), blank);
+    cycle_from_.assign(layers.size(), blank);
+    cycle_to_.assign(layers.size(), blank);
+  }
+  const auto full = static_cast<std::uint8_t>(std::clamp(phases, 1, 254));
+  const float inv = 1.0f / static_cast<float>(full);
+  jobs::parallel_for<std::size_t>(0, n, 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t p = b; p < e; ++p) {
+      if (!still_plain_[p] || light_changed) {
+        cycle_count_[p] = cycle_ramp_[p] = 0;
+        continue;
+      }
+      // This frame's own sample (before the blend) joins the cycle's sum.
+      if (phase == 0 || cycle_count_[p] > 0) {
+        for (std::size_t l = 0; l < layers.size(); ++l)
+          cycle_sum_[l].pixels[p] = (phase == 0 ? glm::vec3(0.0f) : cycle_sum_[l].pixels[p]) + layers[l]->pixels[p];
+        cycle_count_[p] = phase == 0 ? 1 : static_cast<std::uint8_t>(cycle_count_[p] + 1);
+        if (cycle_count_[p] == full) {
+          // A whole cycle: fade from what the pixel shows now to its mean.
+          for (std::size_t l = 0; l < layers.size(); ++l) {
+            const glm::vec3 shown = cycle_ramp_[p] ? cycle_from_[l].pixels[p] + (cycle_to_[l].pixels[p] - cycle_from_[l].pixels[p]) *
+                                                                                    (static_cast<float>(std::min(cycle_ramp_[p], full)) * inv)
+                                                   : out_[l].pixels[p];
+            cycle_from_[l].pixels[p] = shown;
+            cycle_to_[l].pixels[p] = cycle_sum_[l].pixels[p] * inv;
+          }
+          cycle_ramp_[p] = 0;
+          cycle_count_[p] = 0;
+          for (std::size_t l = 0; l < layers.size(); ++l) out_[l].pixels[p] = cycle_from_[l].pixels[p];
+          cycle_ramp_[p] = 1;  // shown: from; the next frames walk to the mean
+          continue;
+        }
+      }
+      if (cycle_ramp_[p]) {
+        cycle_ramp_[p] = static_cast<std::uint8_t>(std::min(cycle_ramp_[p] + 1, full + 1));
+        const float t = static_cast<float>(std::min(cycle_ramp_[p] - 1, static_cast<int>(full))) * inv;
+        for (std::size_t l = 0; l < layers.size(); ++l)
+          out_[l].pixels[p] = cycle_from_[l].pixels[p] + (cycle_to_[l].pixels[p] - cycle_from_[l].pixels[p]) * t;
+      }
+    }
+  });
 }
 
 }  // namespace engine::render

@@ -47,6 +47,17 @@ struct TemporalAaSettings {
   // Sub-pixel points in the jitter cycle. Higher = finer antialiasing of a
   // still view, at the cost of a longer cycle to converge.
   int jitter_phases = 16;
+  // Where the camera, the pixel's surface and the light have stayed still
+  // for a whole jitter cycle, the pixel shows the plain mean of a cycle's
+  // samples, the same in every frame while nothing changes: each new
+  // cycle's mean is faded in linearly over the next cycle, so what drifts
+  // (the probes settling) moves smoothly instead of stepping once a cycle.
+  // The exponential history alone keeps a ripple of the jitter at
+  // high-contrast edges (each phase's weight rises and decays in turn: 2-3 %
+  // of a room's pixels flickered by more than 2/255). On = no ripple, at the
+  // cost of still pixels following slow drift up to two cycles late. Off =
+  // the exponential history everywhere.
+  bool cycle_mean = true;
   // A still camera's pixels whose surface and history hold no moved object
   // are blended a row at a time, vectorised. false = every pixel by the
   // per-pixel path: the reference the fast path is tested against.
@@ -145,6 +156,15 @@ class TemporalAntialiasing {
   bool any_moved_ = false;
   std::vector<image::ImageRGB> out_;  // the resolve's output, kept to reuse its storage
   std::vector<std::uint8_t> frames_;  // this frame's per-pixel frame counts
+  // TemporalAaSettings::cycle_mean. Per pixel: whether this frame blended it
+  // with its own history at the pixel itself (a still camera, nothing moved
+  // there); samples summed in the current cycle (0: not summing; a sum
+  // starts at phase 0); frames since the last cycle's mean was complete
+  // (0: none yet), over which the shown value fades from cycle_from_ to
+  // cycle_to_ (that mean).
+  std::vector<std::uint8_t> still_plain_, cycle_count_, cycle_ramp_;
+  std::vector<image::ImageRGB> cycle_sum_, cycle_from_, cycle_to_;  // per layer
+  void apply_cycle_mean(std::span<image::ImageRGB* const> layers, int phases, std::uint64_t phase, bool light_changed);
   std::uint64_t frame_ = 0;
   Stats stats_;
 };

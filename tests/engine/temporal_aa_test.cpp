@@ -127,6 +127,45 @@ TEST(TemporalAa, AStillSilhouetteConvergesToItsCoverage) {
   EXPECT_FLOAT_EQ(out.at(x_edge + 3, kH / 2).r, 0.0f);
 }
 
+TEST(TemporalAa, AStillEdgeShowsItsExactCoverageEveryFrameOnceACycleIsAveraged) {
+  // With the cycle mean (the default) the edge pixel shows exactly the mean
+  // of the 16 jitter samples, the same in every frame; the exponential
+  // history alone keeps a ripple of the jitter (measured here too, so the
+  // test shows what it guards).
+  Synthetic v;
+  v.edge = 0.03f;
+  const int x_edge = static_cast<int>(std::floor(v.edge_film_x()));
+  const float want = covered(x_edge, v.edge_film_x(), 16);
+  const auto spread = [&](bool cycle_mean, float* last_value) {
+    render::TemporalAntialiasing taa;
+    render::TemporalAaSettings s{.enabled = true, .cycle_mean = cycle_mean};  // the default blend, 1/16
+    float lo = 1, hi = 0;
+    for (int f = 0; f < 96; ++f) {
+      const float value = v.frame(taa, s).at(x_edge, kH / 2).r;
+      if (f >= 64) {
+        lo = std::min(lo, value);
+        hi = std::max(hi, value);
+      }
+      *last_value = value;
+    }
+    return hi - lo;
+  };
+  float with = 0, without = 0;
+  const float ripple_with = spread(true, &with), ripple_without = spread(false, &without);
+  std::printf("[ measured ] edge pixel %d, coverage %.4f: frames 64-95 range %.2g with the cycle mean (shows %.4f), "
+              "%.2g without\n", x_edge, want, ripple_with, with, ripple_without);
+  EXPECT_LT(ripple_with, 1e-6f) << "the same value every frame";
+  EXPECT_NEAR(with, want, 1e-5f) << "the exact mean over the jitter cycle";
+  EXPECT_GT(ripple_without, 0.01f) << "the exponential history ripples (else this test shows nothing)";
+  // Changed light drops the cycle: the next frame follows the exponential path.
+  render::TemporalAntialiasing taa;
+  render::TemporalAaSettings s{.enabled = true};
+  for (int f = 0; f < 64; ++f) v.frame(taa, s);
+  v.shade = [](ecs::Entity e, float) { return e == kFront ? 0.5f : 0.0f; };
+  const float after = v.frame(taa, s, true).at(x_edge - 3, kH / 2).r;
+  EXPECT_LT(after, 0.99f) << "a light change shows at once, not after the cycle";
+}
+
 TEST(TemporalAa, WhereAnObjectMovedAwayThePixelsRestartWithNoGhost) {
   Synthetic v;
   v.shade = [](ecs::Entity e, float) { return e == kFront ? 5.0f : 1.0f; };
