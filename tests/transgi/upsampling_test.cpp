@@ -72,40 +72,47 @@ TEST(Upsampling, APixelNoCellResemblesIsDecodedOnItsOwn) {
 }
 
 TEST(Upsampling, VectorKernelEqualsTheReferenceBitForBit) {
-  if (best_upsampling_isa() == UpsamplingIsa::Scalar) GTEST_SKIP() << "no AVX-512 on " << engine::cpu::isa_summary() << ": only the reference runs";
-  engine::math::Pcg32 rng(21, 5);
-  // Sizes that are and are not multiples of 16, scales that are not halves,
-  // normal powers from 0, and guides with misses, depth steps and NaN.
-  const int sizes[][2] = {{64, 36}, {77, 41}, {16, 3}, {15, 9}};
-  const float scales[] = {0.5f, 0.37f, 1.0f, 0.25f};
-  const int powers[] = {8, 0, 1, 5};
-  int compared = 0, own = 0;
-  for (int c = 0; c < 4; ++c) {
-    const int w = sizes[c][0], h = sizes[c][1];
-    std::vector<glm::vec4> guide(static_cast<std::size_t>(w) * h);
-    for (glm::vec4& g : guide) {
-      const glm::vec3 n = engine::math::sample_uniform_sphere({rng.next_float(), rng.next_float()});
-      const float r = rng.next_float();
-      const float depth = r < 0.1f ? 0.0f : r < 0.5f ? 1.0f + 0.01f * rng.next_float() : 3.0f + rng.next_float();
-      g = glm::vec4(n, depth);
+  // Every vector kernel this machine may run (TRANSGI_MAX_ISA caps them).
+  std::vector<UpsamplingIsa> kernels;
+  if (engine::cpu::isa_enabled(engine::cpu::Isa::Avx512)) kernels.push_back(UpsamplingIsa::Avx512);
+  if (engine::cpu::isa_enabled(engine::cpu::Isa::Avx2)) kernels.push_back(UpsamplingIsa::Avx2);
+  if (kernels.empty()) GTEST_SKIP() << "no AVX2 or AVX-512 on " << engine::cpu::isa_summary() << ": only the reference runs";
+  for (const UpsamplingIsa isa : kernels) {
+    SCOPED_TRACE(isa == UpsamplingIsa::Avx512 ? "avx512" : "avx2");
+    engine::math::Pcg32 rng(21, 5);
+    // Sizes that are and are not multiples of 16, scales that are not halves,
+    // normal powers from 0, and guides with misses, depth steps and NaN.
+    const int sizes[][2] = {{64, 36}, {77, 41}, {16, 3}, {15, 9}};
+    const float scales[] = {0.5f, 0.37f, 1.0f, 0.25f};
+    const int powers[] = {8, 0, 1, 5};
+    int compared = 0, own = 0;
+    for (int c = 0; c < 4; ++c) {
+      const int w = sizes[c][0], h = sizes[c][1];
+      std::vector<glm::vec4> guide(static_cast<std::size_t>(w) * h);
+      for (glm::vec4& g : guide) {
+        const glm::vec3 n = engine::math::sample_uniform_sphere({rng.next_float(), rng.next_float()});
+        const float r = rng.next_float();
+        const float depth = r < 0.1f ? 0.0f : r < 0.5f ? 1.0f + 0.01f * rng.next_float() : 3.0f + rng.next_float();
+        g = glm::vec4(n, depth);
+      }
+      guide[3].x = NAN;
+      RealtimeGiSettings s;
+      s.resolution_scale = scales[c];
+      s.normal_power = powers[c];
+      UpsamplingPlan ref, fast;
+      plan_upsampling(guide, w, h, s, ref, UpsamplingIsa::Scalar);
+      plan_upsampling(guide, w, h, s, fast, isa);
+      for (std::size_t p = 0; p < guide.size(); ++p) {
+        ASSERT_EQ(static_cast<int>(fast.kind[p]), static_cast<int>(ref.kind[p])) << "case " << c << ", pixel " << p;
+        own += ref.kind[p] == UpsamplingPlan::kOwn;
+        if (ref.kind[p] != UpsamplingPlan::kUpsampled) continue;
+        for (std::size_t k = 0; k < 4; ++k)
+          ASSERT_EQ(bits(fast.weight[k][p]), bits(ref.weight[k][p]))
+              << "case " << c << ", pixel " << p << ", tap " << k << ": " << fast.weight[k][p] << " against " << ref.weight[k][p];
+        ++compared;
+      }
     }
-    guide[3].x = NAN;
-    RealtimeGiSettings s;
-    s.resolution_scale = scales[c];
-    s.normal_power = powers[c];
-    UpsamplingPlan ref, fast;
-    plan_upsampling(guide, w, h, s, ref, UpsamplingIsa::Scalar);
-    plan_upsampling(guide, w, h, s, fast, UpsamplingIsa::Avx512);
-    for (std::size_t p = 0; p < guide.size(); ++p) {
-      ASSERT_EQ(static_cast<int>(fast.kind[p]), static_cast<int>(ref.kind[p])) << "case " << c << ", pixel " << p;
-      own += ref.kind[p] == UpsamplingPlan::kOwn;
-      if (ref.kind[p] != UpsamplingPlan::kUpsampled) continue;
-      for (std::size_t k = 0; k < 4; ++k)
-        ASSERT_EQ(bits(fast.weight[k][p]), bits(ref.weight[k][p]))
-            << "case " << c << ", pixel " << p << ", tap " << k << ": " << fast.weight[k][p] << " against " << ref.weight[k][p];
-      ++compared;
-    }
+    EXPECT_GT(compared, 1000) << "too few upsampled pixels to compare";
+    EXPECT_GT(own, 100) << "the lone-pixel path went untested";
   }
-  EXPECT_GT(compared, 1000) << "too few upsampled pixels to compare";
-  EXPECT_GT(own, 100) << "the lone-pixel path went untested";
 }

@@ -57,7 +57,8 @@ UpsamplingIsa best_upsampling_isa() {
   static const UpsamplingIsa isa = [] {
     const char* forced = std::getenv("TRANSGI_UPSAMPLING_ISA");
     if (forced && std::strcmp(forced, "scalar") == 0) return UpsamplingIsa::Scalar;
-    return engine::cpu::isa_enabled(engine::cpu::Isa::Avx512) ? UpsamplingIsa::Avx512 : UpsamplingIsa::Scalar;
+    if (engine::cpu::isa_enabled(engine::cpu::Isa::Avx512)) return UpsamplingIsa::Avx512;
+    return engine::cpu::isa_enabled(engine::cpu::Isa::Avx2) ? UpsamplingIsa::Avx2 : UpsamplingIsa::Scalar;
   }();
   return isa;
 }
@@ -101,12 +102,14 @@ void plan_upsampling(const std::vector<glm::vec4>& guide, int width, int height,
   const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   u.kind.resize(n);
   for (auto& w : u.weight) w.resize(n);
-  const bool vector = isa == UpsamplingIsa::Avx512 && s.edge_aware;
+  const bool vector = isa != UpsamplingIsa::Scalar && s.edge_aware;
   engine::jobs::parallel_for(0, height, 8, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y) {
       const detail::PlanRow r{guide.data() + static_cast<std::size_t>(y) * width, &u, y, s.depth_tolerance, s.normal_power,
                               s.min_weight, s.edge_aware};
-      const int done = vector ? detail::plan_row_avx512(r, u) : 0;
+      const int done = !vector                         ? 0
+                       : isa == UpsamplingIsa::Avx512 ? detail::plan_row_avx512(r, u)
+                                                      : detail::plan_row_avx2(r, u);
       detail::plan_row_scalar(r, u, done, width);
     }
   });

@@ -6,9 +6,9 @@
 // (a silhouette, a thin object) is decoded on its own instead.
 //
 // plan_upsampling decides, per pixel, which of those it is and its four
-// weights. It runs once a frame over every output pixel, so it has a vector
-// kernel (AVX-512, 16 pixels at once) beside the scalar reference; the two
-// give bit-identical plans (tested), and the scalar one is the definition.
+// weights. It runs once a frame over every output pixel, so it has vector
+// kernels (AVX-512, 16 pixels at once; AVX2, 8) beside the scalar reference;
+// they give bit-identical plans (tested), and the scalar one is the definition.
 #include <algorithm>
 #include <array>
 #include <cstddef>
@@ -61,7 +61,7 @@ struct UpsamplingPlan {
   }
 };
 
-enum class UpsamplingIsa { Scalar, Avx512 };
+enum class UpsamplingIsa { Scalar, Avx2, Avx512 };
 // The fastest kernel the effective ISA allows (TRANSGI_MAX_ISA caps it;
 // TRANSGI_UPSAMPLING_ISA=scalar forces the reference).
 UpsamplingIsa best_upsampling_isa();
@@ -86,6 +86,8 @@ void plan_row_scalar(const PlanRow& r, UpsamplingPlan& u, int x0, int x1);
 // Pixels from 0 in whole vectors of 16 (edge-aware settings only); returns
 // where it stopped, for the scalar kernel to finish the row.
 int plan_row_avx512(const PlanRow& r, UpsamplingPlan& u);
+// The same in vectors of 8, for CPUs with AVX2 and no AVX-512.
+int plan_row_avx2(const PlanRow& r, UpsamplingPlan& u);
 }  // namespace detail
 
 }  // namespace transgi::shading
