@@ -79,7 +79,7 @@ void EditorUi::inspector() {
     ImGui::End();
     return;
   }
-  ImGui::PushItemWidth(-11.0f * ImGui::GetFontSize());
+  ImGui::PushItemWidth(-kLabelColumnEms * ImGui::GetFontSize());
   engine::ecs::World& w = session_.world();
   EditorState& ed = session_.editor();
   const Entity e = ed.selected;

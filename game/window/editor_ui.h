@@ -41,7 +41,9 @@ class EditorUi {
   void show_probes(bool on) { show_probes_ = on; }
   // The inspector's width in font heights: wide enough for its longest
   // labels; the log panel sits between it and the hierarchy.
-  static constexpr float kInspectorWidthEms = 26.0f;
+  static constexpr float kInspectorWidthEms = 28.0f;
+  // The column every inspector widget leaves its label, in font heights.
+  static constexpr float kLabelColumnEms = 11.5f;
 
  private:
   void menu_bar();

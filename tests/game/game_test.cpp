@@ -31,6 +31,7 @@
 #include "engine/image/metrics.h"
 #include "play/game_session.h"
 #include "play/input_queue.h"
+#include "window/editor_ui.h"
 #include "runtime/gi_frame.h"
 #include "runtime/probe_placement.h"
 #include "runtime/settings.h"
@@ -458,6 +459,57 @@ TEST(WindowSmoke, TheProbeOverlayLeavesTheMenuBarAndPanelsAsTheyAre) {
                                                    probes->pixels[(static_cast<std::size_t>(y) * plain->width + x) * 3 + c]);
   EXPECT_LT(menu / (3.0 * static_cast<double>(n)), 0.5) << "the menu bar must look the same with the overlay on";
   fs::remove_all(dir);
+}
+
+// Issue 32: at the old 280 px the inspector's widgets took ImGui's default
+// 65 % and cut labels such as "range (0 = infinite)" off. Every widget label
+// in editor_panels.cpp, measured with ImGui's default font, fits the column
+// the inspector leaves it, and every checkbox (whose label follows the box)
+// fits the panel. At the old layout (a 98 px column, 35 % of 280 px) the
+// first check fails for the longest labels; this test prints them.
+TEST(EditorLayout, EveryInspectorLabelFitsItsColumn) {
+  std::ifstream in(std::string(TRANSGI_SOURCE_DIR) + "/game/window/editor_panels.cpp");
+  ASSERT_TRUE(in) << "cannot read editor_panels.cpp";
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string source = text.str();
+  ImGui::CreateContext();
+  ImGuiIO& io = ImGui::GetIO();
+  io.DisplaySize = ImVec2(1280, 720);
+  unsigned char* pixels = nullptr;
+  int tw = 0, th = 0;
+  io.Fonts->GetTexDataAsRGBA32(&pixels, &tw, &th);
+  ImGui::NewFrame();
+  const ImGuiStyle& style = ImGui::GetStyle();
+  const float em = ImGui::GetFontSize();
+  const float column = game::EditorUi::kLabelColumnEms * em - style.ItemInnerSpacing.x;
+  const float panel = game::EditorUi::kInspectorWidthEms * em - 2 * style.WindowPadding.x - style.ScrollbarSize;
+  int columned = 0, boxes = 0, over_old_column = 0;
+  for (const char* widget : {"DragFloat(", "DragFloat3(", "SliderFloat(", "SliderInt(", "ColorEdit3(", "Combo(", "Checkbox("}) {
+    const std::string call = std::string("ImGui::") + widget + "\"";
+    for (std::size_t at = source.find(call); at != std::string::npos; at = source.find(call, at + 1)) {
+      const std::size_t begin = at + call.size(), end = source.find('"', begin);
+      std::string label = source.substr(begin, end - begin);
+      label = label.substr(0, label.find("##"));  // ImGui hides what follows ##
+      const float width = ImGui::CalcTextSize(label.c_str()).x;
+      if (std::string(widget) == "Checkbox(") {
+        ++boxes;
+        EXPECT_LE(ImGui::GetFrameHeight() + style.ItemInnerSpacing.x + width, panel) << "checkbox \"" << label << "\"";
+      } else {
+        ++columned;
+        EXPECT_LE(width, column) << "\"" << label << "\" (" << width << " px) in a " << column << " px column";
+        if (width > 0.35f * 280.0f - style.ItemInnerSpacing.x) {
+          ++over_old_column;
+          std::printf("[ measured ] \"%s\" (%.0f px) did not fit the old 98 px column\n", label.c_str(), width);
+        }
+      }
+    }
+  }
+  ImGui::EndFrame();
+  ImGui::DestroyContext();
+  EXPECT_GE(columned, 12) << "too few labelled widgets found: the parse missed them";
+  EXPECT_GE(boxes, 4);
+  EXPECT_GT(over_old_column, 0) << "the old layout fitted every label: this test would not have failed";
 }
 
 TEST(InputQueue, ATapShorterThanAFrameStillReadsAsPressed) {
