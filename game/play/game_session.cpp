@@ -147,6 +147,7 @@ void GameSession::set_view(const std::string& view) {
   // A pass shown on its own is antialiased with the full image, or it shows
   // each frame's jittered sample (a fifth of its pixels flickering).
   world().resource<transgi::runtime::GiFrame>().antialias_passes = view != "full";
+  if (auto* d = world().try_resource<transgi::ddgi::DdgiRenderOptions>()) d->antialias_passes = view != "full";
   reference_->lights_version = UINT64_MAX;  // re-read the pass
 }
 
@@ -171,7 +172,8 @@ void GameSession::set_method(GameMethod m) {
   method_ = m;
   engine::ecs::World& w = world();
   if (m == GameMethod::Ddgi && !app_->has_plugin("transgi::DdgiPlugin")) {
-    app_->add_plugin<transgi::ddgi::DdgiPlugin>(game_ddgi_settings(), transgi::ddgi::DdgiRenderOptions{.realtime = true});
+    app_->add_plugin<transgi::ddgi::DdgiPlugin>(game_ddgi_settings(),
+                                                transgi::ddgi::DdgiRenderOptions{.realtime = true, .antialias_passes = options_.view != "full"});
     w.emplace<transgi::ddgi::DdgiProbeVolume>(w.spawn(), transgi::ddgi::DdgiProbeVolume{});
     if (ddgi_backend_ != "cpu") set_backend(ddgi_backend_);  // the backend chosen before DDGI was first shown
   }
@@ -232,7 +234,7 @@ std::vector<GameSession::StageTime> GameSession::stage_times() const {
     const auto* d = w.try_resource<transgi::ddgi::DdgiFrame>();
     if (!d) return {};
     return {{"probe rays", d->times.probe_trace}, {"probe blend", d->times.probe_blend}, {"shading", d->times.shading},
-            {"G-buffer, direct", d->times.direct}};
+            {"G-buffer, direct", d->times.direct}, {"antialiasing", d->times.antialiasing}};
   }
   const auto& t = w.resource<transgi::runtime::GiFrame>().times;
   return {{"G-buffer", t.gbuffer + t.network_input}, {"inference", t.inference}, {"SH light", t.sh_multiplication},

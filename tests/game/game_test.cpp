@@ -614,7 +614,7 @@ TEST(GameSession, TheStatsShowTheShownMethodsOwnStagesOnAScaleThatFits) {
   s.set_method(game::GameMethod::Ddgi);
   idle(s, 1);
   const auto ddgi = s.stage_times();
-  EXPECT_EQ(names(ddgi), "probe rays,probe blend,shading,G-buffer, direct,") << "DDGI's own stages, not TransGI's";
+  EXPECT_EQ(names(ddgi), "probe rays,probe blend,shading,G-buffer, direct,antialiasing,") << "DDGI's own stages, not TransGI's";
   double sum = 0;
   for (const auto& t : ddgi) sum += t.ms;
   EXPECT_GT(sum, 0.0) << "measured this frame";

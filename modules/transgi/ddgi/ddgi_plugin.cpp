@@ -118,25 +118,46 @@ void render_offline(const rt::RtScene& rt, const render::LightSet& lights, const
 struct DdgiRealtimeScratch {
   shading::GBuffer gbuffer;
   shading::UpsamplingPlan plan;
+  render::TemporalAntialiasing taa;
+  std::uint64_t lights_version = UINT64_MAX, geometry_version = UINT64_MAX;
 };
 
 // The real-time shape (DdgiRenderOptions::realtime): one G-buffer, its
 // direct light shaded tile by tile as it is traced, then DDGI's light at its
 // pixels.
-void render_realtime(const rt::RtScene& rt, const scene::SceneAssets& assets, const render::LightSet& lights,
+void render_realtime(const rt::RtScene& rt, const scene::SceneAssets& assets, const render::SceneLights& scene_lights,
                      const render::CameraRays& rays, std::span<const DdgiVolume* const> volumes, DdgiKernels* kernels,
-                     const shading::RealtimeGiSettings& upsampling, DdgiRealtimeScratch& scratch, DdgiFrame& frame) {
+                     const DdgiRenderOptions& options, DdgiRealtimeScratch& scratch, DdgiFrame& frame) {
+  const render::LightSet& lights = scene_lights.set;
   shading::GBuffer& g = scratch.gbuffer;
   auto t0 = Clock::now();
   shading::DirectTileShader direct(rt, lights, rays, frame.width, frame.height);
-  shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, g, &direct, kernels ? kernels->tracer() : nullptr);
+  const glm::vec2 jitter = options.taa.enabled ? scratch.taa.next_jitter(options.taa) : glm::vec2(0.0f);
+  shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, g, &direct, kernels ? kernels->tracer() : nullptr,
+                         jitter);
   frame.direct = direct.take(g);
   frame.times.direct = ms_since(t0);
   t0 = Clock::now();
-  DdgiPixels pixels = shade_ddgi_gbuffer(g, volumes, upsampling, scratch.plan, kernels);
+  DdgiPixels pixels = shade_ddgi_gbuffer(g, volumes, options.upsampling, scratch.plan, kernels);
   frame.gi = std::move(pixels.gi);
   shading::add_image(frame.direct, pixels.emitted);
   frame.times.shading = ms_since(t0);
+  frame.full = frame.gi;
+  shading::add_image(frame.full, frame.direct);
+  t0 = Clock::now();
+  if (options.taa.enabled) {
+    // Lights or geometry that changed clamp every pixel's history.
+    const bool light_changed = scene_lights.version != scratch.lights_version || scene_lights.geometry_version != scratch.geometry_version;
+    scratch.lights_version = scene_lights.version;
+    scratch.geometry_version = scene_lights.geometry_version;
+    image::ImageRGB* all[] = {&frame.full, &frame.gi, &frame.direct};
+    const std::span<image::ImageRGB* const> layers(all, options.antialias_passes ? 3 : 1);
+    scratch.taa.resolve(rays, render::TaaSurfaces{g.position, g.guide, g.entity}, render::objects_of(rt), layers, options.taa,
+                        light_changed);
+  } else {
+    scratch.taa.clear();
+  }
+  frame.times.antialiasing = ms_since(t0);
 }
 
 void render_frame(CameraView cameras, View<Get<const DdgiProbeVolume>> volumes, View<Get<const DdgiCascades>> cascades,
@@ -157,11 +178,11 @@ void render_frame(CameraView cameras, View<Get<const DdgiProbeVolume>> volumes, 
   });
   if (all.empty()) throw std::runtime_error("ddgi::render: no DdgiProbeVolume or DdgiCascades in the world");
   if (options->realtime) {
-    render_realtime(*rt, *assets, lights->set, *rays, all, backend->kernels.get(), options->upsampling, *scratch, *frame);
-  } else {
-    render_offline(*rt, lights->set, *rays, all, backend->kernels.get(), lights->geometry_version, lights->version, *options,
-                   *history, *frame);
+    render_realtime(*rt, *assets, *lights, *rays, all, backend->kernels.get(), *options, *scratch, *frame);
+    return;
   }
+  render_offline(*rt, lights->set, *rays, all, backend->kernels.get(), lights->geometry_version, lights->version, *options,
+                 *history, *frame);
   frame->full = frame->gi;
   shading::add_image(frame->full, frame->direct);
 }

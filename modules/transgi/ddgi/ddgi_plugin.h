@@ -17,6 +17,7 @@
 #include "probes/cascade_follow.h"
 #include "engine/app/app.h"
 #include "engine/image/image.h"
+#include "engine/render/temporal_aa.h"
 
 namespace transgi::ddgi {
 
@@ -48,6 +49,12 @@ struct DdgiRenderOptions {
   // upsampled, as TransGI's (only resolution_scale and the upsampling's
   // fields are read). resolution_scale 1 = a lookup at every pixel.
   shading::RealtimeGiSettings upsampling{};
+  // With realtime: the same temporal antialiasing as TransGI's real-time
+  // frame (jittered G-buffer, reprojected history, a still view's cycle
+  // mean), over the full image, and over the gi and direct passes when
+  // antialias_passes. Off = one ray through each pixel centre, aliased.
+  engine::render::TemporalAaSettings taa{.enabled = true};
+  bool antialias_passes = false;
   int gbuffer_spp = 1;  // higher = antialiased edges, at the cost of that many irradiance lookups
   int direct_spp = 4;   // higher = less direct-light noise, at the cost of tracing time; 0 = GI only
   // While the view is still, the GI image is the mean of the last this many
@@ -59,7 +66,7 @@ struct DdgiRenderOptions {
 struct DdgiStageTimes {
   // shading: DDGI's light at the pixels. direct: the direct light (with
   // DdgiRenderOptions::realtime, the G-buffer it is shaded in as well).
-  double probe_trace = 0, probe_blend = 0, shading = 0, direct = 0;
+  double probe_trace = 0, probe_blend = 0, shading = 0, direct = 0, antialiasing = 0;
 };
 
 // Where the DDGI volumes trace and blend: null kernels = the CPU (the
