@@ -102,19 +102,19 @@ std::vector<int> DdgiVolume::probes_to_trace(bool all) {
   return turn;
 }
 
-DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
-                                  const engine::scene::Environment* sky, const DdgiVolume* outer) {
+// The probe rays of this update (all active probes, or this turn's share),
+// traced and shaded: one record per ray and probe, and with emitted maps
+// what each ray met straight from emitters and the sky.
+DdgiVolume::UpdateRays DdgiVolume::trace(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                                         const engine::scene::Environment* sky, const DdgiVolume* outer, bool all) {
   using namespace engine;
-  DdgiFrameStats stats;
   const int probes = grid_.count(), M = settings_.rays_per_probe;
   math::Pcg32 frame_rng = math::make_rng(settings_.seed, 0xDD61, frame_);
   const glm::quat rotation = probes::random_rotation(frame_rng);
-  const float max_distance = 1.5f * glm::length(grid_.spacing());
-  const bool classify_now = settings_.classification && !classified_;
-
-  auto t0 = Clock::now();
-  std::vector<std::vector<RayRecord>> records(static_cast<std::size_t>(probes));
-  std::vector<std::uint8_t> saw_light(static_cast<std::size_t>(probes), 0);
+  UpdateRays u;
+  u.records.resize(static_cast<std::size_t>(probes));
+  u.emitted.resize(emitted_.empty() ? 0 : static_cast<std::size_t>(probes));
+  u.saw_light.assign(static_cast<std::size_t>(probes), 0);
   const auto ray_rng = [&](int q, int i) {
     return math::make_rng(settings_.seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
   };
@@ -125,19 +125,17 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
   };
   std::vector<glm::vec3> ray_directions(static_cast<std::size_t>(M));
   for (int i = 0; i < M; ++i) ray_directions[static_cast<std::size_t>(i)] = glm::normalize(rotation * directions_[static_cast<std::size_t>(i)]);
-  const bool warming = frame_ < static_cast<std::uint64_t>(settings_.warmup_frames);
-  const std::vector<int> tracing = probes_to_trace(warming || classify_now);
-  for (int q : tracing) records[static_cast<std::size_t>(q)].resize(static_cast<std::size_t>(M));
-  // With emitted maps: the same rays, carrying what they met straight from emitters and the sky.
-  std::vector<std::vector<RayRecord>> emitted_records(emitted_.empty() ? 0 : static_cast<std::size_t>(probes));
-  for (int q : tracing)
-    if (!emitted_.empty()) emitted_records[static_cast<std::size_t>(q)].resize(static_cast<std::size_t>(M));
+  const std::vector<int> tracing = probes_to_trace(all);
+  for (int q : tracing) {
+    u.records[static_cast<std::size_t>(q)].resize(static_cast<std::size_t>(M));
+    if (!emitted_.empty()) u.emitted[static_cast<std::size_t>(q)].resize(static_cast<std::size_t>(M));
+  }
   probes::trace_probe_rays(
       scene, lights, kernels_ ? kernels_->tracer() : nullptr, tracing, ray_directions,
       [&](int q) { return placed_.position(q); }, ray_rng, feedback, [&](int q, int i, const probes::ProbeRayHit& h) {
-        if (h.saw_light) saw_light[static_cast<std::size_t>(q)] = 1;
+        if (h.saw_light) u.saw_light[static_cast<std::size_t>(q)] = 1;
         const glm::vec3& dir = ray_directions[static_cast<std::size_t>(i)];
-        RayRecord& r = records[static_cast<std::size_t>(q)][static_cast<std::size_t>(i)];
+        RayRecord& r = u.records[static_cast<std::size_t>(q)][static_cast<std::size_t>(i)];
         r.direction = dir;
         if (!h.hit) {
           r.radiance = settings_.escaped == EscapedRays::Environment && sky ? sky->radiance(dir) : glm::vec3(0.0f);
@@ -150,68 +148,88 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
           r.distance = h.distance;
         }
         if (!emitted_.empty())
-          emitted_records[static_cast<std::size_t>(q)][static_cast<std::size_t>(i)] = {
-              dir, h.back_face ? glm::vec3(0.0f) : h.emitted, r.distance};
+          u.emitted[static_cast<std::size_t>(q)][static_cast<std::size_t>(i)] = {dir, h.back_face ? glm::vec3(0.0f) : h.emitted,
+                                                                                r.distance};
       });
-  stats.rays = tracing.size() * static_cast<std::size_t>(M);
-  stats.trace_ms = ms_since(t0);
+  u.rays = tracing.size() * static_cast<std::size_t>(M);
+  return u;
+}
 
-  if (classify_now) {
-    // Back faces (single-sided materials only) as RTXGI counts them, and the
-    // winding-proof link to light for double-sided content (open_space.h).
-    const probes::OpenSpace open =
-        probes::find_open_space(scene, grid_, saw_light, settings_.relocation, kernels_ ? kernels_->tracer() : nullptr);
-    placed_.offsets.assign(static_cast<std::size_t>(probes), glm::vec3(0.0f));
-    for (int q = 0; q < probes; ++q) {
-      const auto i = static_cast<std::size_t>(q);
-      int backfaces = 0;
-      for (const RayRecord& r : records[i]) backfaces += r.distance < 0 ? 1 : 0;
-      active_[i] = static_cast<float>(backfaces) <= settings_.fixed_ray_backface_threshold * static_cast<float>(M) && open.open[i];
-      if (active_[i]) placed_.offsets[i] = open.offsets[i];
-      // A moved probe's rays this frame left from its old place.
-      if (!active_[i] || placed_.offsets[i] != glm::vec3(0.0f)) {
-        records[i].clear();
-        if (!emitted_.empty()) emitted_records[i].clear();
-      }
+// Back faces (single-sided materials only) as RTXGI counts them, and the
+// winding-proof link to light for double-sided content (open_space.h).
+void DdgiVolume::classify(const engine::rt::RtScene& scene, UpdateRays& u) {
+  const int probes = grid_.count(), M = settings_.rays_per_probe;
+  const probes::OpenSpace open =
+      probes::find_open_space(scene, grid_, u.saw_light, settings_.relocation, kernels_ ? kernels_->tracer() : nullptr);
+  placed_.offsets.assign(static_cast<std::size_t>(probes), glm::vec3(0.0f));
+  for (int q = 0; q < probes; ++q) {
+    const auto i = static_cast<std::size_t>(q);
+    int backfaces = 0;
+    for (const RayRecord& r : u.records[i]) backfaces += r.distance < 0 ? 1 : 0;
+    active_[i] = static_cast<float>(backfaces) <= settings_.fixed_ray_backface_threshold * static_cast<float>(M) && open.open[i];
+    if (active_[i]) placed_.offsets[i] = open.offsets[i];
+    // A moved probe's rays this frame left from its old place.
+    if (!active_[i] || placed_.offsets[i] != glm::vec3(0.0f)) {
+      u.records[i].clear();
+      if (!emitted_.empty()) u.emitted[i].clear();
     }
-    classified_ = true;
   }
+  classified_ = true;
+}
 
-  t0 = Clock::now();
-  const float h = warming ? std::min(settings_.hysteresis, 0.5f + (settings_.hysteresis - 0.5f) * static_cast<float>(frame_) /
-                                                                       static_cast<float>(settings_.warmup_frames))
-                          : settings_.hysteresis;
+// The records into the maps with hysteresis h: irradiance and distance
+// (through the kernels where set), then the emitted maps.
+void DdgiVolume::blend(UpdateRays& u, float h, bool warming) {
+  const int probes = grid_.count();
+  const float max_distance = 1.5f * glm::length(grid_.spacing());
   if (kernels_) {
     for (int q = 0; q < probes; ++q)
-      if (!active_[static_cast<std::size_t>(q)]) records[static_cast<std::size_t>(q)].clear();
-    kernels_->blend(irradiance_, distance_, records, settings_, h, !warming, max_distance);
+      if (!active_[static_cast<std::size_t>(q)]) u.records[static_cast<std::size_t>(q)].clear();
+    kernels_->blend(irradiance_, distance_, u.records, settings_, h, !warming, max_distance);
   } else {
-    jobs::parallel_for(0, probes, 1, [&](int b, int e) {
+    engine::jobs::parallel_for(0, probes, 1, [&](int b, int e) {
       for (int q = b; q < e; ++q) {
-        const auto& rec = records[static_cast<std::size_t>(q)];
+        const auto& rec = u.records[static_cast<std::size_t>(q)];
         if (rec.empty() || !active_[static_cast<std::size_t>(q)]) continue;
         blend_irradiance(irradiance_[static_cast<std::size_t>(q)], rec, settings_, h, !warming);
         blend_distance(distance_[static_cast<std::size_t>(q)], rec, settings_, max_distance, h);
       }
     });
   }
-  if (!emitted_.empty()) {
-    // A small emitter is met by a ray now and then: a bright texel one
-    // update, dark the next. RTXGI's running mean of gamma-encoded texels,
-    // its brightness clamp and its faster darkening all bias that towards
-    // black (they made a ceiling lamp's light vanish); a plain running mean
-    // of linear values keeps it.
-    DdgiSettings plain = settings_;
-    plain.irradiance_gamma = 1.0f;
-    plain.irradiance_threshold = std::numeric_limits<float>::infinity();
-    jobs::parallel_for(0, probes, 1, [&](int b, int e) {
-      for (int q = b; q < e; ++q) {
-        const auto& rec = emitted_records[static_cast<std::size_t>(q)];
-        if (rec.empty() || !active_[static_cast<std::size_t>(q)]) continue;
-        blend_irradiance(emitted_[static_cast<std::size_t>(q)], rec, plain, h, false);
-      }
-    });
-  }
+  if (emitted_.empty()) return;
+  // A small emitter is met by a ray now and then: a bright texel one
+  // update, dark the next. RTXGI's running mean of gamma-encoded texels,
+  // its brightness clamp and its faster darkening all bias that towards
+  // black (they made a ceiling lamp's light vanish); a plain running mean
+  // of linear values keeps it.
+  DdgiSettings plain = settings_;
+  plain.irradiance_gamma = 1.0f;
+  plain.irradiance_threshold = std::numeric_limits<float>::infinity();
+  engine::jobs::parallel_for(0, probes, 1, [&](int b, int e) {
+    for (int q = b; q < e; ++q) {
+      const auto& rec = u.emitted[static_cast<std::size_t>(q)];
+      if (rec.empty() || !active_[static_cast<std::size_t>(q)]) continue;
+      blend_irradiance(emitted_[static_cast<std::size_t>(q)], rec, plain, h, false);
+    }
+  });
+}
+
+DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                                  const engine::scene::Environment* sky, const DdgiVolume* outer) {
+  DdgiFrameStats stats;
+  const bool classify_now = settings_.classification && !classified_;
+  const bool warming = frame_ < static_cast<std::uint64_t>(settings_.warmup_frames);
+  auto t0 = Clock::now();
+  UpdateRays u = trace(scene, lights, sky, outer, warming || classify_now);
+  stats.rays = u.rays;
+  stats.trace_ms = ms_since(t0);
+  if (classify_now) classify(scene, u);
+  t0 = Clock::now();
+  // The cold start: hysteresis rising from 0.5 over the warm-up.
+  const float h = warming ? std::min(settings_.hysteresis, 0.5f + (settings_.hysteresis - 0.5f) * static_cast<float>(frame_) /
+                                                                       static_cast<float>(settings_.warmup_frames))
+                          : settings_.hysteresis;
+  blend(u, h, warming);
   stats.blend_ms = ms_since(t0);
   for (std::uint8_t a : active_) stats.inactive += a ? 0 : 1;
   ++frame_;

@@ -12,6 +12,8 @@
 
 #include "ddgi/octahedral.h"
 namespace transgi::ddgi {
+
+struct RayRecord;  // ddgi_blend.h
 class DdgiKernels;
 }  // namespace transgi::ddgi
 
@@ -157,6 +159,16 @@ class DdgiVolume {
   // The active probes this update traces: all of them, or this turn's share
   // of settings().probes_per_update.
   std::vector<int> probes_to_trace(bool all);
+  // update()'s stages: trace, classify (the first update), blend.
+  struct UpdateRays {
+    std::vector<std::vector<RayRecord>> records, emitted;  // per probe (empty: not traced)
+    std::vector<std::uint8_t> saw_light;                   // per probe
+    std::size_t rays = 0;
+  };
+  UpdateRays trace(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                   const engine::scene::Environment* sky, const DdgiVolume* outer, bool all);
+  void classify(const engine::rt::RtScene& scene, UpdateRays& u);
+  void blend(UpdateRays& u, float hysteresis, bool warming);
 
   std::shared_ptr<DdgiKernels> kernels_;
   probes::ProbeGrid grid_;
