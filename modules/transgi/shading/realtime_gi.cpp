@@ -2,6 +2,7 @@
 
 #include "probes/cascades.h"
 
+#include <bit>
 #include <chrono>
 #include <atomic>
 #include <cmath>
@@ -476,17 +477,28 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   });
   stats.upsample_ms = plan_ms + ms_since(t0);
 
-  // Mirrors at full resolution (transfer_renderer.h's MirrorRay).
+  // Mirrors and glossy metals at full resolution (transfer_renderer.h's MirrorRay).
   if (mirror.max_roughness >= 0) {
     t0 = Clock::now();
     const LightAt light_at = [&](const glm::vec3& p, const glm::vec3& n, float* out) { probes::interpolate_fields(fields, p, n, out); };
+    const float max_roughness = std::max(mirror.max_roughness, mirror.glossy_max_roughness);
+    // The glossy rays' stream: the antialiasing's jitter phase, so each of
+    // its points sees another ray and the resolve averages them; no seed.
+    const auto phase = static_cast<std::uint64_t>(std::bit_cast<std::uint32_t>(g.jitter.x)) << 32 |
+                       std::bit_cast<std::uint32_t>(g.jitter.y);
     engine::jobs::parallel_for<std::size_t>(0, g.samples.size(), 1024, [&](std::size_t b, std::size_t e) {
       for (std::size_t p = b; p < e; ++p) {
         // metal_roughness <= max_roughness is is_mirror() on the pixel's material.
-        if (!(g.metal_roughness[p] <= mirror.max_roughness)) continue;
+        if (!(g.metal_roughness[p] <= max_roughness)) continue;
         const GSample& s = g.samples[p];
-        engine::math::Pcg32 rng = engine::math::make_rng(0x4D1Bull, p, 0);  // fixed: the real-time image has no seed
-        image.pixels[p] = shade_mirror_gi(scene, s, light_at, mirror_lights, mirror, rng);
+        if (g.metal_roughness[p] <= mirror.max_roughness) {
+          engine::math::Pcg32 rng = engine::math::make_rng(0x4D1Bull, p, 0);  // fixed: the real-time image has no seed
+          image.pixels[p] = shade_mirror_gi(scene, s, light_at, mirror_lights, mirror, rng);
+        } else {
+          engine::math::Pcg32 rng = engine::math::make_rng(0x6105ull, p, phase);
+          const glm::vec2 u{rng.next_float(), rng.next_float()};
+          image.pixels[p] = shade_glossy_gi(scene, s, light_at, mirror_lights, mirror, u, rng);
+        }
       }
     });
     stats.upsample_ms += ms_since(t0);

@@ -32,14 +32,14 @@ bool is_mirror(const engine::material::BrdfParams& brdf, const MirrorRay& mirror
   return mirror.max_roughness >= 0 && brdf.metallic >= 0.5f && brdf.roughness <= mirror.max_roughness;
 }
 
-glm::vec3 shade_mirror_gi(const engine::rt::RtScene& scene, const GSample& smp, const LightAt& light_at,
-                          const engine::render::LightSet* lights, const MirrorRay& mirror, engine::math::Pcg32& rng) {
-  const int light_samples = mirror.light_samples;
+namespace {
+
+// What a reflection ray from `smp` along wi finds, as GI: the hit's diffuse
+// albedo / pi x its irradiance (the probes' SH, plus light_samples
+// next-event samples of the lights); emitters and the sky are direct light.
+glm::vec3 reflected_gi(const engine::rt::RtScene& scene, const GSample& smp, const glm::vec3& wi, const LightAt& light_at,
+                       const engine::render::LightSet* lights, int light_samples, engine::math::Pcg32& rng) {
   using namespace engine;
-  const glm::vec3 n = smp.normal_world, wo = smp.wo_world;
-  const float cos_o = glm::dot(n, wo);
-  if (cos_o <= 0) return glm::vec3(0.0f);
-  const glm::vec3 wi = glm::normalize(2.0f * cos_o * n - wo);
   if (glm::dot(wi, smp.geometric_normal) <= 0) return glm::vec3(0.0f);
   rt::Hit hit;
   if (!scene.intersect(rt::Ray{rt::offset_ray_origin(smp.position, smp.geometric_normal, scene.offset_scale()), wi}, hit)) return glm::vec3(0.0f);
@@ -66,7 +66,40 @@ glm::vec3 shade_mirror_gi(const engine::rt::RtScene& scene, const GSample& smp, 
     }
     irradiance += direct / static_cast<float>(light_samples);
   }
-  return material::schlick_fresnel(smp.brdf.base_color, cos_o) * albedo * math::kInvPi * glm::max(irradiance, glm::vec3(0.0f));
+  return albedo * math::kInvPi * glm::max(irradiance, glm::vec3(0.0f));
+}
+
+}  // namespace
+
+glm::vec3 shade_mirror_gi(const engine::rt::RtScene& scene, const GSample& smp, const LightAt& light_at,
+                          const engine::render::LightSet* lights, const MirrorRay& mirror, engine::math::Pcg32& rng) {
+  const glm::vec3 n = smp.normal_world, wo = smp.wo_world;
+  const float cos_o = glm::dot(n, wo);
+  if (cos_o <= 0) return glm::vec3(0.0f);
+  const glm::vec3 wi = glm::normalize(2.0f * cos_o * n - wo);
+  return engine::material::schlick_fresnel(smp.brdf.base_color, cos_o) *
+         reflected_gi(scene, smp, wi, light_at, lights, mirror.light_samples, rng);
+}
+
+glm::vec3 shade_glossy_gi(const engine::rt::RtScene& scene, const GSample& smp, const LightAt& light_at,
+                          const engine::render::LightSet* lights, const MirrorRay& mirror, glm::vec2 u,
+                          engine::math::Pcg32& rng) {
+  using namespace engine;
+  const math::Frame frame = math::Frame::from_normal(smp.normal_world);
+  const glm::vec3 wo = frame.to_local(smp.wo_world);
+  if (wo.z <= 0) return glm::vec3(0.0f);
+  const float alpha = std::max(smp.brdf.roughness * smp.brdf.roughness, material::kMinAlpha);
+  const glm::vec3 h = material::sample_ggx_vndf(alpha, wo, u);
+  const float wo_h = glm::dot(wo, h);
+  const glm::vec3 wi = 2.0f * wo_h * h - wo;
+  if (wi.z <= 0 || wo_h <= 0) return glm::vec3(0.0f);
+  // Sampling the visible normals, f cos / pdf = F(wo.h) G2(wo, wi) / G1(wo),
+  // which separable Smith makes G1(wi).
+  const glm::vec3 weight = material::schlick_fresnel(smp.brdf.base_color, wo_h) * material::smith_g1(alpha, wi.z);
+  // The mirror's light samples: with one, the choice of light left the
+  // reflections speckled after the antialiasing's 16-phase mean
+  // (docs/image-quality.md, "Glossy metals").
+  return weight * reflected_gi(scene, smp, glm::normalize(frame.to_world(wi)), light_at, lights, mirror.light_samples, rng);
 }
 
 TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,

@@ -36,6 +36,14 @@ enum class TransferSource {
 struct MirrorRay {
   float max_roughness = 0.05f;
   int light_samples = 4;
+  // The real-time path only: metals rougher than max_roughness up to this
+  // reflect by one GGX-sampled ray a pixel, a different one at each phase
+  // of the antialiasing's jitter, which averages them (a still view shows
+  // the mean of one cycle's 16). SH-4 transfer cannot hold a glossy metal's
+  // reflections (the gold sphere was a matte orange ball). Higher = more
+  // metals with real reflections, at the cost of a ray and its light samples
+  // per such pixel, and noise in motion. Below max_roughness = off.
+  float glossy_max_roughness = 0.5f;
   bool operator==(const MirrorRay&) const = default;
 };
 
@@ -67,6 +75,12 @@ struct TransferRenderSettings {
 // the sky seen in the mirror are direct light (the reference's passes), not GI.
 glm::vec3 shade_mirror_gi(const engine::rt::RtScene& scene, const GSample& sample, const LightAt& light_at,
                           const engine::render::LightSet* lights, const MirrorRay& mirror, engine::math::Pcg32& rng);
+// The same for a glossy metal (roughness alpha = roughness^2), by one ray
+// sampled from the GGX distribution of visible normals with u: its Fresnel
+// and shadowing (F(wo.h) G1(wi), the sample's weight) times what it finds.
+glm::vec3 shade_glossy_gi(const engine::rt::RtScene& scene, const GSample& sample, const LightAt& light_at,
+                          const engine::render::LightSet* lights, const MirrorRay& mirror, glm::vec2 u,
+                          engine::math::Pcg32& rng);
 // Whether a sample takes the mirror path.
 bool is_mirror(const engine::material::BrdfParams& brdf, const MirrorRay& mirror);
 
