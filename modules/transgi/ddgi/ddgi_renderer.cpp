@@ -145,34 +145,44 @@ struct Lookup {
 
 // Every lookup's indirect irradiance (column 0) and emitted irradiance
 // (column 1: DdgiSettings::emitted_maps, else 0) through the volumes: with
-// `kernels`, one batch per volume; the emitted maps have no kernel, so a
-// volume that keeps them is looked up point by point on the CPU.
+// `kernels`, one batch per volume and per emitted view; where they decline,
+// point by point on the CPU.
 std::vector<glm::mat2x3> look_up(const shading::GBuffer& g, std::span<const Lookup> lookups,
                                  std::span<const DdgiVolume* const> volumes, DdgiKernels* kernels) {
   using namespace engine;
   std::vector<glm::mat2x3> e(lookups.size(), glm::mat2x3(0.0f));
   const auto position = [&](std::size_t k) { return g.samples[lookups[k].pixel].position; };
   const auto view = [&](std::size_t k) { return -g.samples[lookups[k].pixel].wo_world; };
-  const bool emitted = std::any_of(volumes.begin(), volumes.end(), [](const DdgiVolume* v) { return v->has_emitted_maps(); });
-  if (kernels && !emitted) {
+  if (kernels) {
     std::vector<glm::vec3> positions(lookups.size()), normals(lookups.size()), views(lookups.size());
     for (std::size_t k = 0; k < lookups.size(); ++k) {
       positions[k] = position(k);
       normals[k] = lookups[k].normal;
       views[k] = view(k);
     }
-    std::vector<std::vector<glm::vec3>> per_volume(volumes.size(), std::vector<glm::vec3>(lookups.size()));
+    // Per volume: its irradiance (and lit flags), then its emitted view's.
+    std::vector<std::vector<glm::vec3>> per_volume(volumes.size(), std::vector<glm::vec3>(lookups.size())),
+        per_emitted(volumes.size());
     std::vector<std::vector<std::uint8_t>> lit(volumes.size(), std::vector<std::uint8_t>(lookups.size()));
+    std::vector<std::uint8_t> unused(lookups.size());
     bool batched = true;
-    for (std::size_t v = 0; v < volumes.size() && batched; ++v)
+    for (std::size_t v = 0; v < volumes.size() && batched; ++v) {
       batched = kernels->irradiance(*volumes[v], positions, normals, views, per_volume[v], lit[v]);
+      if (const DdgiVolume* ev = volumes[v]->emitted_view(); batched && ev) {
+        per_emitted[v].resize(lookups.size());
+        batched = kernels->irradiance(*ev, positions, normals, views, per_emitted[v], unused);
+      }
+    }
     if (batched) {
       jobs::parallel_for<std::size_t>(0, lookups.size(), 256, [&](std::size_t b, std::size_t end) {
         for (std::size_t k = b; k < end; ++k)
-          e[k][0] = mixed_irradiance(volumes, positions[k], [&](const DdgiVolume* volume, bool* is_lit) {
+          e[k] = mixed_irradiance(volumes, positions[k], [&](const DdgiVolume* volume, bool* is_lit) {
             const auto v = static_cast<std::size_t>(std::find(volumes.begin(), volumes.end(), volume) - volumes.begin());
             *is_lit = lit[v][k] != 0;
-            return per_volume[v][k];
+            glm::mat2x3 both(0.0f);
+            both[0] = per_volume[v][k];
+            if (!per_emitted[v].empty()) both[1] = per_emitted[v][k];
+            return both;
           });
       });
       return e;

@@ -233,7 +233,27 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
   stats.blend_ms = ms_since(t0);
   for (std::uint8_t a : active_) stats.inactive += a ? 0 : 1;
   ++frame_;
+  // Only a backend's kernel reads the view; the CPU reads the maps themselves.
+  if (!emitted_.empty() && kernels_)
+    make_emitted_view();
+  else
+    emitted_view_.reset();
   return stats;
+}
+
+void DdgiVolume::make_emitted_view() {
+  DdgiSettings linear = settings_;
+  linear.emitted_maps = false;
+  linear.irradiance_gamma = 1.0f;
+  auto view = std::make_shared<DdgiVolume>(grid_, linear);
+  view->placed_ = placed_;
+  view->irradiance_ = emitted_;
+  view->distance_ = distance_;
+  view->active_ = active_;
+  view->classified_ = classified_;
+  view->frame_ = frame_;
+  view->kernels_ = kernels_;
+  emitted_view_ = std::move(view);
 }
 
 glm::vec2 DdgiVolume::biases() const {

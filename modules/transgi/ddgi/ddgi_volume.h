@@ -150,6 +150,12 @@ class DdgiVolume {
   [[nodiscard]] const DdgiSettings& settings() const { return settings_; }
   [[nodiscard]] const OctahedralMap<glm::vec3>& irradiance_map(int probe) const { return irradiance_[static_cast<std::size_t>(probe)]; }
   [[nodiscard]] bool has_emitted_maps() const { return !emitted_.empty(); }
+  // With emitted maps: a volume whose irradiance maps are these emitted maps
+  // (linear, so gamma 1), made at the end of each update, so that a
+  // backend's irradiance kernel looks them up as it looks up any volume:
+  // the same weights, the same sums as irradiance()'s `emitted`. Null
+  // without emitted maps or kernels, or before the first update.
+  [[nodiscard]] const DdgiVolume* emitted_view() const { return emitted_view_.get(); }
   [[nodiscard]] const OctahedralMap<glm::vec2>& distance_map(int probe) const { return distance_[static_cast<std::size_t>(probe)]; }
   [[nodiscard]] bool active(int probe) const { return active_[static_cast<std::size_t>(probe)] != 0; }
   [[nodiscard]] std::uint64_t frame() const { return frame_; }
@@ -182,6 +188,8 @@ class DdgiVolume {
   bool classified_ = false;
   std::uint64_t frame_ = 0;
   std::uint64_t budget_turn_ = 0;  // updates made under probes_per_update: whose turn it is
+  std::shared_ptr<const DdgiVolume> emitted_view_;
+  void make_emitted_view();
 };
 
 }  // namespace transgi::ddgi
