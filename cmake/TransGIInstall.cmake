@@ -29,11 +29,13 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/modules/transgi/ DESTINATION ${CMAKE_INS
   FILES_MATCHING PATTERN "*.h" PATTERN "cli" EXCLUDE)
 # The headers C++ shares with the kernels: the installed tools compile the
 # kernels with them at run time, so they are the runtime's, not only dev's.
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/shaders/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/transgi COMPONENT runtime
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/shaders/ DESTINATION ${ENGINE_INSTALLED_SHADER_INCLUDE_DIR} COMPONENT runtime
   FILES_MATCHING PATTERN "*.h")
 # The kernels; the headers they share with C++ are only under include/transgi,
 # where an installed program's shader compiler also looks (install_paths.h).
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/shaders/ DESTINATION ${TRANSGI_INSTALL_DATADIR}/shaders COMPONENT runtime
+# Both folders are named once, in CMakeLists.txt (ENGINE_INSTALLED_SHADER_*),
+# which the programs are compiled with.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/shaders/ DESTINATION ${ENGINE_INSTALLED_SHADER_DIR} COMPONENT runtime
   FILES_MATCHING PATTERN "*.comp" PATTERN "*.glsl")
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/content/levels/living_room DESTINATION ${TRANSGI_INSTALL_DATADIR}/levels
   COMPONENT runtime)

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <numeric>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -44,7 +45,6 @@ engine::core::Args parse(int argc, char** argv) {
                             {"headless", "help", "probes"});
 }
 
-// What the window and headless runs share.
 // The sample level: installed beside the program (bin/ ->
 // share/transgi/levels), else in the source tree.
 std::filesystem::path default_level() {
@@ -52,6 +52,7 @@ std::filesystem::path default_level() {
   return TRANSGI_DEFAULT_LEVEL;
 }
 
+// What the window and headless runs share.
 game::GameOptions game_options(const engine::core::Args& args) {
   game::GameOptions o;
   o.scene = args.str("scene", default_level().string());
@@ -86,7 +87,6 @@ int run_headless(const engine::core::Args& args) {
   game::GameSession session(o);
   engine::core::ProgressBar bar("transgi-game", static_cast<std::uint64_t>(frames), true);
   std::size_t next = 0;
-  double total_ms = 0;
   std::vector<double> frame_ms;
   for (int f = 0; f < frames; ++f) {
     session.begin_input();
@@ -100,7 +100,6 @@ int run_headless(const engine::core::Args& args) {
       }
     }
     session.frame();
-    total_ms += session.last_frame_ms();
     frame_ms.push_back(session.last_frame_ms());
     if (recorder) recorder->add_frame(session.image());
     bar.update(static_cast<std::uint64_t>(f + 1));
@@ -108,7 +107,7 @@ int run_headless(const engine::core::Args& args) {
   if (next < events.size())
     std::fprintf(stderr, "warning: %zu replay events after frame %d were not played\n", events.size() - next, frames - 1);
   std::printf("%d frames at %dx%d, mean frame %.1f ms (engine frame: editor, scripts, GI, direct light, composite)\n", frames,
-              o.width, o.height, total_ms / frames);
+              o.width, o.height, std::accumulate(frame_ms.begin(), frame_ms.end(), 0.0) / frames);
   // The first frames warm probes up; the second half is the steady state.
   std::vector<double> late(frame_ms.begin() + frames / 2, frame_ms.end());
   std::nth_element(late.begin(), late.begin() + static_cast<std::ptrdiff_t>(late.size() / 2), late.end());

@@ -26,7 +26,6 @@ double box3_luminance(const ImageRGB& img, int x, int y) {
   return s / n;
 }
 
-
 void check_sizes(const ImageRGB& a, const ImageRGB& b) {
   if (a.width != b.width || a.height != b.height)
     throw ImageError("image sizes differ: " + std::to_string(a.width) + "x" + std::to_string(a.height) + " vs " +

@@ -461,7 +461,6 @@ void TemporalAntialiasing::apply_cycle_mean(std::span<image::ImageRGB* const> la
             cycle_from_[l].pixels[p] = shown;
             cycle_to_[l].pixels[p] = cycle_sum_[l].pixels[p] * inv;
           }
-          cycle_ramp_[p] = 0;
           cycle_count_[p] = 0;
           for (std::size_t l = 0; l < layers.size(); ++l) out_[l].pixels[p] = cycle_from_[l].pixels[p];
           cycle_ramp_[p] = 1;  // shown: from; the next frames walk to the mean

@@ -1,6 +1,7 @@
 #include "ddgi/ddgi_renderer.h"
 
 #include <algorithm>
+#include <limits>
 
 #include "engine/jobs/parallel_for.h"
 #include "engine/material/specular_albedo.h"
@@ -44,6 +45,27 @@ glm::vec3 irradiance_from(std::span<const DdgiVolume* const> volumes, const glm:
 
 namespace {
 
+// Every point's irradiance through `kernels`, one batch per volume (cascades
+// hand points on, so any may be asked), blended across the volumes as
+// irradiance_from does. False, `out` untouched, where the backend declines.
+bool irradiance_batched(DdgiKernels& kernels, std::span<const DdgiVolume* const> volumes, std::span<const glm::vec3> positions,
+                        std::span<const glm::vec3> normals, std::span<const glm::vec3> views, std::vector<glm::vec3>& out) {
+  std::vector<std::vector<glm::vec3>> per_volume(volumes.size(), std::vector<glm::vec3>(positions.size()));
+  std::vector<std::vector<std::uint8_t>> lit(volumes.size(), std::vector<std::uint8_t>(positions.size()));
+  for (std::size_t v = 0; v < volumes.size(); ++v)
+    if (!kernels.irradiance(*volumes[v], positions, normals, views, per_volume[v], lit[v])) return false;
+  out.resize(positions.size());
+  engine::jobs::parallel_for<std::size_t>(0, positions.size(), 256, [&](std::size_t b, std::size_t end) {
+    for (std::size_t k = b; k < end; ++k)
+      out[k] = mixed_irradiance(volumes, positions[k], [&](const DdgiVolume* volume, bool* is_lit) {
+        const auto v = static_cast<std::size_t>(std::find(volumes.begin(), volumes.end(), volume) - volumes.begin());
+        *is_lit = lit[v][k] != 0;
+        return per_volume[v][k];
+      });
+  });
+  return true;
+}
+
 // The batched path: every sample's ray traced by the backend, its surface
 // made here, the irradiance looked up by the backend in every volume and
 // blended here as irradiance_from does. False where the backend declines;
@@ -79,22 +101,8 @@ bool render_batched(const engine::rt::RtScene& scene, std::span<const DdgiVolume
       albedo[k] = material::diffuse_albedo(surf.brdf) * math::kInvPi;
     }
   });
-  // Each volume at every point: cascades hand points on, so any may be asked.
-  std::vector<std::vector<glm::vec3>> per_volume(volumes.size(), std::vector<glm::vec3>(rays.size()));
-  std::vector<std::vector<std::uint8_t>> lit(volumes.size(), std::vector<std::uint8_t>(rays.size()));
-  for (std::size_t v = 0; v < volumes.size(); ++v)
-    if (!kernels.irradiance(*volumes[v], position, normal, view, per_volume[v], lit[v])) return false;
-  std::vector<glm::vec3> e(rays.size());
-  jobs::parallel_for<std::size_t>(0, rays.size(), 256, [&](std::size_t b, std::size_t end) {
-    for (std::size_t k = b; k < end; ++k) {
-      if (!found[k]) continue;
-      e[k] = mixed_irradiance(volumes, position[k], [&](const DdgiVolume* volume, bool* is_lit) {
-        const auto v = static_cast<std::size_t>(std::find(volumes.begin(), volumes.end(), volume) - volumes.begin());
-        *is_lit = lit[v][k] != 0;
-        return per_volume[v][k];
-      });
-    }
-  });
+  std::vector<glm::vec3> e;
+  if (!irradiance_batched(kernels, volumes, position, normal, view, e)) return false;
   for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
     glm::vec3 sum(0.0f);
     for (std::size_t si = 0; si < spp; ++si) {
@@ -145,8 +153,9 @@ struct Lookup {
 
 // Every lookup's indirect irradiance (column 0) and emitted irradiance
 // (column 1: DdgiSettings::emitted_maps, else 0) through the volumes: with
-// `kernels`, one batch per volume and per emitted view; where they decline,
-// point by point on the CPU.
+// `kernels`, batches through irradiance_batched, the emitted maps through the
+// volumes' emitted views (the same weights); where they decline, point by
+// point on the CPU.
 std::vector<glm::mat2x3> look_up(const shading::GBuffer& g, std::span<const Lookup> lookups,
                                  std::span<const DdgiVolume* const> volumes, DdgiKernels* kernels) {
   using namespace engine;
@@ -160,31 +169,19 @@ std::vector<glm::mat2x3> look_up(const shading::GBuffer& g, std::span<const Look
       normals[k] = lookups[k].normal;
       views[k] = view(k);
     }
-    // Per volume: its irradiance (and lit flags), then its emitted view's.
-    std::vector<std::vector<glm::vec3>> per_volume(volumes.size(), std::vector<glm::vec3>(lookups.size())),
-        per_emitted(volumes.size());
-    std::vector<std::vector<std::uint8_t>> lit(volumes.size(), std::vector<std::uint8_t>(lookups.size()));
-    std::vector<std::uint8_t> unused(lookups.size());
-    bool batched = true;
-    for (std::size_t v = 0; v < volumes.size() && batched; ++v) {
-      batched = kernels->irradiance(*volumes[v], positions, normals, views, per_volume[v], lit[v]);
-      if (const DdgiVolume* ev = volumes[v]->emitted_view(); batched && ev) {
-        per_emitted[v].resize(lookups.size());
-        batched = kernels->irradiance(*ev, positions, normals, views, per_emitted[v], unused);
+    std::vector<const DdgiVolume*> emitted_views;
+    for (const DdgiVolume* v : volumes)
+      if (v->has_emitted_maps()) emitted_views.push_back(v->emitted_view());
+    const bool with_emitted = !emitted_views.empty();
+    const bool views_complete = emitted_views.size() == volumes.size() &&
+                                std::find(emitted_views.begin(), emitted_views.end(), nullptr) == emitted_views.end();
+    std::vector<glm::vec3> indirect, emitted;
+    if ((!with_emitted || views_complete) && irradiance_batched(*kernels, volumes, positions, normals, views, indirect) &&
+        (!with_emitted || irradiance_batched(*kernels, emitted_views, positions, normals, views, emitted))) {
+      for (std::size_t k = 0; k < lookups.size(); ++k) {
+        e[k][0] = indirect[k];
+        if (with_emitted) e[k][1] = emitted[k];
       }
-    }
-    if (batched) {
-      jobs::parallel_for<std::size_t>(0, lookups.size(), 256, [&](std::size_t b, std::size_t end) {
-        for (std::size_t k = b; k < end; ++k)
-          e[k] = mixed_irradiance(volumes, positions[k], [&](const DdgiVolume* volume, bool* is_lit) {
-            const auto v = static_cast<std::size_t>(std::find(volumes.begin(), volumes.end(), volume) - volumes.begin());
-            *is_lit = lit[v][k] != 0;
-            glm::mat2x3 both(0.0f);
-            both[0] = per_volume[v][k];
-            if (!per_emitted[v].empty()) both[1] = per_emitted[v][k];
-            return both;
-          });
-      });
       return e;
     }
   }
@@ -228,35 +225,36 @@ DdgiPixels shade_ddgi_gbuffer(const shading::GBuffer& g, std::span<const DdgiVol
   for (std::size_t p = 0; p < g.samples.size(); ++p)
     if (plan.kind[p] == UpsamplingPlan::kOwn) lookups.push_back({p, g.samples[p].normal_world});
   const std::size_t own_end = lookups.size();
+  // Metals as the G-buffer marks them (metallic >= 0.5), as TransGI's mirror pass finds them.
   for (std::size_t p = 0; p < g.samples.size(); ++p)
-    if (g.samples[p].hit && g.samples[p].brdf.metallic > 0.0f)
+    if (g.metal_roughness[p] < std::numeric_limits<float>::infinity())
       lookups.push_back({p, glm::reflect(-g.samples[p].wo_world, g.samples[p].normal_world)});
   const std::vector<glm::mat2x3> e = look_up(g, lookups, volumes, kernels);
 
-  // Irradiance per grid cell (a miss stays 0) and per pixel decoded on its own.
+  // Irradiance per grid cell (a miss stays 0).
   std::vector<glm::mat2x3> cell_e(plan.cell_pixel.size(), glm::mat2x3(0.0f));
   std::size_t k = 0;
   for (std::size_t c = 0; c < plan.cell_pixel.size(); ++c)
     if (plan.cell_guide[c].w > 0) cell_e[c] = e[k++];
-  std::vector<glm::mat2x3> own_e(g.samples.size(), glm::mat2x3(0.0f));
-  for (k = cells_end; k < own_end; ++k) own_e[lookups[k].pixel] = e[k];
   // Upsampled irradiance x the pixel's own diffuse albedo / pi: textures keep
-  // their full resolution.
+  // their full resolution. Pixels decoded on their own are written after.
   jobs::parallel_for(0, g.height, 4, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < g.width; ++x) {
         const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(g.width) + static_cast<std::size_t>(x);
+        if (plan.kind[p] != UpsamplingPlan::kUpsampled) continue;
         glm::mat2x3 irradiance(0.0f);
-        if (plan.kind[p] == UpsamplingPlan::kOwn) {
-          irradiance = own_e[p];
-        } else if (plan.kind[p] == UpsamplingPlan::kUpsampled) {
-          for (int tap = 0; tap < 4; ++tap) irradiance += plan.weight[static_cast<std::size_t>(tap)][p] * cell_e[plan.cell(tap, x, y)];
-        }
+        for (int tap = 0; tap < 4; ++tap) irradiance += plan.weight[static_cast<std::size_t>(tap)][p] * cell_e[plan.cell(tap, x, y)];
         const glm::vec3 albedo = g.samples[p].diffuse * math::kInvPi;
         out.gi.pixels[p] = albedo * irradiance[0];
         out.emitted.pixels[p] = albedo * irradiance[1];
       }
   });
+  for (k = cells_end; k < own_end; ++k) {
+    const glm::vec3 albedo = g.samples[lookups[k].pixel].diffuse * math::kInvPi;
+    out.gi.pixels[lookups[k].pixel] = albedo * e[k][0];
+    out.emitted.pixels[lookups[k].pixel] = albedo * e[k][1];
+  }
   for (k = own_end; k < lookups.size(); ++k) {
     const glm::vec3 albedo = metal_albedo(g.samples[lookups[k].pixel]) * math::kInvPi;
     out.gi.pixels[lookups[k].pixel] += albedo * e[k][0];

@@ -41,12 +41,13 @@ engine::image::ImageRGB render_ddgi_gi(const engine::rt::RtScene& scene, std::sp
 // then multiplied by the pixel's own albedo. The emitted maps
 // (DdgiSettings::emitted_maps) are looked up and upsampled with it: the sky's
 // and the emitters' direct light; the punctual lights' is the caller's
-// (shading::DirectTileShader). A metal has no diffuse albedo and would be
-// black: it gets its GGX specular albedo x the irradiance about its mirror
-// direction / pi at its own pixel, a blurred reflection (engines use
-// reflection probes there; DDGI has none). With `kernels` every lookup goes
-// to its irradiance kernel in one batch per volume. `plan` is scratch kept
-// between frames.
+// (shading::DirectTileShader). A metal (metallic >= 0.5, as the G-buffer
+// marks it) has little diffuse albedo and would be black: it gets its GGX
+// specular albedo x the irradiance about its mirror direction / pi at its
+// own pixel, a blurred reflection (engines use reflection probes there; DDGI
+// has none). With `kernels` every lookup goes to its irradiance kernel in one
+// batch per volume (and per emitted view). `plan` is scratch kept between
+// frames.
 struct DdgiPixels {
   engine::image::ImageRGB gi;       // from the irradiance maps: indirect light
   engine::image::ImageRGB emitted;  // from the emitted maps (DdgiSettings::emitted_maps): direct light, else 0

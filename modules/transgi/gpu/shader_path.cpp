@@ -9,8 +9,9 @@ namespace transgi::gpu {
 
 std::filesystem::path shader_dir() {
   if (const char* env = std::getenv("TRANSGI_SHADER_DIR"); env && *env) return env;
-  // An installed program: bin/ beside share/transgi/shaders.
-  if (auto dir = engine::core::beside_executable("../share/transgi/shaders")) return *dir;
+  // An installed program: bin/ beside the installed shaders (the layout
+  // cmake/TransGIInstall.cmake makes, named once in CMakeLists.txt).
+  if (auto dir = engine::core::beside_executable(std::filesystem::path("..") / TRANSGI_INSTALLED_SHADER_DIR)) return *dir;
   return TRANSGI_SOURCE_SHADER_DIR;
 }
 
@@ -18,9 +19,10 @@ std::vector<std::uint32_t> compile_module_shader(const char* name, std::vector<e
   const auto dir = shader_dir();
   engine::gpu::ShaderCompileOptions options;
   options.include_dirs.push_back(dir);
-  // Installed (share/transgi/shaders), the headers the kernels share with
-  // C++ are with the C++ headers (include/transgi), not beside the kernels.
-  if (auto shared = engine::core::installed_twin(dir, "share/transgi/shaders", "include/transgi")) options.include_dirs.push_back(*shared);
+  // Installed, the headers the kernels share with C++ are with the C++
+  // headers, not beside the kernels.
+  if (auto shared = engine::core::installed_twin(dir, TRANSGI_INSTALLED_SHADER_DIR, TRANSGI_INSTALLED_SHADER_INCLUDE_DIR))
+    options.include_dirs.push_back(*shared);
   options.defines = std::move(defines);
   return engine::gpu::compile_compute_shader(dir / name, options);
 }
