@@ -25,28 +25,8 @@ float texture_lod(float footprint, int w, int h) {
   return std::log2(footprint * std::sqrt(static_cast<float>(w) * static_cast<float>(h)));
 }
 
-namespace {
 glm::vec4 sample_texture(const scene::Texture& t, glm::vec2 uv, bool srgb, float footprint) {
   return footprint > 0 ? t.sample(uv, srgb, texture_lod(footprint, t.width, t.height)) : t.sample(uv, srgb);
-}
-}  // namespace
-
-material::BrdfParams evaluate_material(const scene::SceneAssets& assets, std::uint32_t index, glm::vec2 uv, float footprint) {
-  const material::Material& m = assets.materials[index];
-  material::BrdfParams p;
-  glm::vec4 base = m.base_color_factor;
-  if (m.base_color_texture >= 0) base *= sample_texture(assets.textures[static_cast<std::size_t>(m.base_color_texture)], uv, true, footprint);
-  p.base_color = glm::vec3(base);
-  p.metallic = m.metallic_factor;
-  p.roughness = m.roughness_factor;
-  if (m.metallic_roughness_texture >= 0) {
-    const glm::vec4 mr = sample_texture(assets.textures[static_cast<std::size_t>(m.metallic_roughness_texture)], uv, false, footprint);
-    p.roughness *= mr.g;
-    p.metallic *= mr.b;
-  }
-  p.specular = m.specular_factor;
-  p.specular_color = m.specular_color_factor;
-  return p;
 }
 
 glm::vec3 evaluate_emission(const scene::SceneAssets& assets, std::uint32_t index, glm::vec2 uv, float footprint) {

@@ -34,7 +34,11 @@ Surface make_surface(const rt::RtScene& scene, const rt::Hit& hit, const glm::ve
 // the width of the area to average, in UV units (0 = a point sample, as
 // Monte Carlo renderers take); textures are then read at the mip level it
 // asks for (Texture::sample with lod).
-material::BrdfParams evaluate_material(const scene::SceneAssets& assets, std::uint32_t material, glm::vec2 uv, float uv_footprint = 0);
+// Inline: a G-buffer builds one per pixel and reads fields of it back at
+// once; returned from another unit, each read waits on a store it cannot
+// forward.
+inline material::BrdfParams evaluate_material(const scene::SceneAssets& assets, std::uint32_t material, glm::vec2 uv,
+                                              float uv_footprint = 0);
 glm::vec3 evaluate_emission(const scene::SceneAssets& assets, std::uint32_t material, glm::vec2 uv, float uv_footprint = 0);
 
 // Ray cones (Akenine-Moller et al. 2019, "Texture Level of Detail Strategies
@@ -43,6 +47,28 @@ glm::vec3 evaluate_emission(const scene::SceneAssets& assets, std::uint32_t mate
 // whose cosine is cos_theta covers this width in UV units. 0 when the mesh
 // has no UVs or the triangle no area.
 float uv_footprint(const scene::MeshAsset& mesh, std::uint32_t triangle, float scale, float cone_width, float cos_theta);
+
+// A texture read at the mip level a footprint asks for (0: the finest).
+glm::vec4 sample_texture(const scene::Texture& t, glm::vec2 uv, bool srgb, float footprint);
+
+inline material::BrdfParams evaluate_material(const scene::SceneAssets& assets, std::uint32_t index, glm::vec2 uv,
+                                              float footprint) {
+  const material::Material& m = assets.materials[index];
+  material::BrdfParams p;
+  glm::vec4 base = m.base_color_factor;
+  if (m.base_color_texture >= 0) base *= sample_texture(assets.textures[static_cast<std::size_t>(m.base_color_texture)], uv, true, footprint);
+  p.base_color = glm::vec3(base);
+  p.metallic = m.metallic_factor;
+  p.roughness = m.roughness_factor;
+  if (m.metallic_roughness_texture >= 0) {
+    const glm::vec4 mr = sample_texture(assets.textures[static_cast<std::size_t>(m.metallic_roughness_texture)], uv, false, footprint);
+    p.roughness *= mr.g;
+    p.metallic *= mr.b;
+  }
+  p.specular = m.specular_factor;
+  p.specular_color = m.specular_color_factor;
+  return p;
+}
 // The mip level for a footprint on a texture of w x h texels.
 float texture_lod(float uv_footprint, int w, int h);
 
