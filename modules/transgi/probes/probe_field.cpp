@@ -232,7 +232,10 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   std::vector<int> backfaces(static_cast<std::size_t>(probes), 0);
   saw_light_.resize(static_cast<std::size_t>(probes), 0);
   std::vector<float> nearest(static_cast<std::size_t>(probes), std::numeric_limits<float>::infinity());
-  std::atomic<std::size_t> hits{0}, nonfinite_rays{0};
+  // Hits per probe (each probe's rays are one thread's), summed below: a
+  // shared counter added to per ray bounces its cache line between cores.
+  std::vector<int> hits(static_cast<std::size_t>(probes), 0);
+  std::atomic<std::size_t> nonfinite_rays{0};  // rare
   std::vector<float> direct_frame(static_cast<std::size_t>(probes) * 75, 0.0f);
   // This frame's ray set, and the probes that trace it.
   std::vector<glm::vec3> directions(static_cast<std::size_t>(M));
@@ -272,7 +275,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
         sp.normal = h.normal;
         if (h.replaced_non_finite) nonfinite_rays.fetch_add(1, std::memory_order_relaxed);
         if (h.hit) {
-          hits.fetch_add(1, std::memory_order_relaxed);
+          ++hits[static_cast<std::size_t>(q)];
           backfaces[static_cast<std::size_t>(q)] += h.back_face ? 1 : 0;
           nearest[static_cast<std::size_t>(q)] = std::min(nearest[static_cast<std::size_t>(q)], h.distance);
         }
@@ -309,7 +312,8 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
         ray_rng, feedback, consume);
   for (std::uint8_t t : traced) stats.traced += t;
   stats.rays = static_cast<std::size_t>(stats.traced) * static_cast<std::size_t>(M);
-  stats.hits = hits.load();
+  stats.hits = 0;
+  for (const int n : hits) stats.hits += static_cast<std::size_t>(n);
   stats.nonfinite_rays = nonfinite_rays.load();
   std::vector<std::uint8_t> skip_this_frame(static_cast<std::size_t>(probes), 0);  // relocated probes
   if (classify || budgeted) {

@@ -30,7 +30,12 @@ glm::vec2 disk_pattern(int x, int y) {
 
 DirectTileShader::DirectTileShader(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
                                    const engine::render::CameraRays& camera, int width, int height)
-    : scene_(scene), lights_(lights), camera_(camera), out_(width, height), n_lights_(lights.punctual_count()) {
+    : scene_(scene),
+      lights_(lights),
+      camera_(camera),
+      out_(width, height),
+      n_lights_(lights.punctual_count()),
+      rays_per_tile_(static_cast<std::size_t>((width + 3) / 4) * static_cast<std::size_t>((height + 3) / 4), 0) {
   using namespace engine;
   // A directional light's sample does not depend on the point: its 64
   // pattern directions are computed once per frame, not per pixel.
@@ -155,7 +160,7 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
       ++bad;
     }
   if (bad) nonfinite_.fetch_add(bad, std::memory_order_relaxed);
-  rays_traced_.fetch_add(traced, std::memory_order_relaxed);
+  rays_per_tile_[tile] = static_cast<std::uint32_t>(traced);
 }
 
 namespace {
@@ -393,7 +398,8 @@ engine::image::ImageRGB DirectTileShader::take(const GBuffer& g, RealtimeDirectS
     nonfinite_.fetch_add(bad.load(), std::memory_order_relaxed);
   }
   if (stats) {
-    stats->shadow_rays = rays_traced_.load();
+    stats->shadow_rays = 0;
+    for (const std::uint32_t n : rays_per_tile_) stats->shadow_rays += n;
     stats->lights = n_lights_;
     stats->nonfinite_pixels = nonfinite_.load();
   }
