@@ -60,16 +60,16 @@ DirectTileShader::DirectTileShader(const engine::rt::RtScene& scene, const engin
   }
 }
 
-void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty) {
+void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty, Scratch& scratch) {
   using namespace engine;
-  rt::Ray rays[16];
-  rt::Hit hits[16];
-  bool found[16];
-  float distance[16];
-  std::size_t pixel[16];
-  const GSample* samples[16];
-  std::array<glm::vec3, 2> local[16];  // wo, wi in the shading frame
-  glm::vec3 light[16];
+  rt::Ray* rays = scratch.rays;
+  rt::Hit* hits = scratch.hits;
+  bool* found = scratch.found;
+  float* distance = scratch.distance;
+  std::size_t* pixel = scratch.pixel;
+  const GSample** samples = scratch.samples;
+  std::array<glm::vec3, 2>* local = scratch.local;
+  glm::vec3* light = scratch.light;
   std::size_t traced = 0;
   const scene::Environment* background = lights_.background();
   const std::size_t tile = static_cast<std::size_t>(ty / 4) * static_cast<std::size_t>((g.width + 3) / 4) + static_cast<std::size_t>(tx / 4);
@@ -414,7 +414,8 @@ engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt
   const int tiles_x = (g.width + 3) / 4, tiles_y = (g.height + 3) / 4;
   auto each_tile = [&] {
     engine::jobs::parallel_for(0, tiles_x * tiles_y, 16, [&](int t0, int t1) {
-      for (int t = t0; t < t1; ++t) shader.shade_tile(g, t % tiles_x * 4, t / tiles_x * 4);
+      DirectTileShader::Scratch scratch;
+      for (int t = t0; t < t1; ++t) shader.shade_tile(g, t % tiles_x * 4, t / tiles_x * 4, scratch);
     });
   };
   // The shader reads `distances` and `first` in the second pass: they live

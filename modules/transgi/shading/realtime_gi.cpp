@@ -162,6 +162,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
     engine::rt::Hit hits[16];
     bool found[16];
     std::size_t pixel[16];
+    DirectTileShader::Scratch direct_scratch;
     for (int t = t0; t < t1; ++t) {
       const int tx = t % tiles_x * 4, ty = t / tiles_x * 4;
       int n = 0;
@@ -204,7 +205,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
         g.metal_roughness[pixel[i]] = s.hit && s.brdf.metallic >= 0.5f ? s.brdf.roughness : std::numeric_limits<float>::infinity();
         g.entity[pixel[i]] = s.entity;
       }
-      if (direct) direct->shade_tile(g, tx, ty);
+      if (direct) direct->shade_tile(g, tx, ty, direct_scratch);
     }
   });
 }
