@@ -368,9 +368,12 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
     return state_[static_cast<std::size_t>(q)] == ProbeState::Active && (!budgeted || traced[static_cast<std::size_t>(q)]) &&
            !skip_this_frame[static_cast<std::size_t>(q)];
   };
-  for (int q = 0; q < probes; ++q)
-    if (updates(q))
-      update_own_depth(states_[static_cast<std::size_t>(q)], settings_.map, points[static_cast<std::size_t>(q)], settings_.accumulation);
+  // Each probe's depth map from its own rays only: probes in parallel.
+  engine::jobs::parallel_for(0, probes, 8, [&](int q0, int q1) {
+    for (int q = q0; q < q1; ++q)
+      if (updates(q))
+        update_own_depth(states_[static_cast<std::size_t>(q)], settings_.map, points[static_cast<std::size_t>(q)], settings_.accumulation);
+  });
   std::vector<const DepthMap*> depth(static_cast<std::size_t>(probes));
   for (int q = 0; q < probes; ++q) depth[static_cast<std::size_t>(q)] = &states_[static_cast<std::size_t>(q)].depth;
   std::vector<FrameSamples> frame;  // only the updated probes' maps are filled (and allocated)

@@ -241,7 +241,10 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   std::vector<std::size_t>& decode = sc.decode;
   decode.clear();
   std::vector<std::size_t>& slot_of_pixel = sc.slot_of_pixel;
-  slot_of_pixel.assign(g.samples.size(), kNone);
+  slot_of_pixel.resize(g.samples.size());
+  engine::jobs::parallel_for<std::size_t>(0, slot_of_pixel.size(), 16384, [&](std::size_t b, std::size_t e) {
+    std::fill(slot_of_pixel.begin() + static_cast<std::ptrdiff_t>(b), slot_of_pixel.begin() + static_cast<std::ptrdiff_t>(e), kNone);
+  });
   // guide[p].w > 0 is samples[p].hit, read from 16 bytes a pixel instead of a GSample.
   auto want = [&](std::size_t p) {
     if (slot_of_pixel[p] != kNone || !(guide[p].w > 0)) return;
