@@ -1,8 +1,11 @@
 #include "engine/core/args.h"
 
 #include <cerrno>
+#include <climits>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <stdexcept>
 
 namespace engine::core {
 
@@ -26,6 +29,55 @@ Args::Args(std::string command, const std::vector<std::string>& argv, std::set<s
         for (const std::string& name : flags) add("--" + name);
         throw HelpRequested(text + "\n");
       }
+  parse(argv, known, flags);
+}
+
+namespace {
+
+std::string format_bound(double v) {
+  if (v == static_cast<double>(INT64_MAX)) return "2^63-1";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+}  // namespace
+
+std::string describe_options(const std::vector<OptionSpec>& specs) {
+  std::string text;
+  for (const OptionSpec& o : specs) {
+    std::string head = "  --" + o.name + (o.flag ? "" : " " + o.value);
+    if (head.size() < 30) head.resize(30, ' ');
+    std::string accepts;
+    if (o.range) accepts = format_bound(o.range->first) + ".." + format_bound(o.range->second);
+    for (const std::string& c : o.choices) accepts += (accepts.empty() ? "" : "|") + c;
+    std::string line = head + " " + o.help;
+    std::string facts;
+    if (!accepts.empty()) facts = accepts;
+    if (!o.flag) facts += (facts.empty() ? "" : "; ") + (o.default_text.empty() ? std::string("required") : "default " + o.default_text);
+    if (!facts.empty()) line += " [" + facts + "]";
+    text += line + "\n";
+  }
+  return text;
+}
+
+Args::Args(std::string command, const std::vector<std::string>& argv, std::vector<OptionSpec> specs, const std::string& synopsis)
+    : command_(std::move(command)), specs_(std::move(specs)) {
+  std::set<std::string> known, flags;
+  for (const OptionSpec& o : specs_) (o.flag ? flags : known).insert(o.name);
+  for (const std::string& a : argv)
+    if (a == "--help") throw HelpRequested(synopsis + describe_options(specs_), true);
+  parse(argv, known, flags);
+}
+
+const OptionSpec* Args::declared(const std::string& name) const {
+  if (specs_.empty()) return nullptr;
+  for (const OptionSpec& o : specs_)
+    if (o.name == name) return &o;
+  throw std::logic_error(command_ + ": --" + name + " is read but not declared");
+}
+
+void Args::parse(const std::vector<std::string>& argv, const std::set<std::string>& known, const std::set<std::string>& flags) {
   for (std::size_t i = 0; i < argv.size(); ++i) {
     const std::string& a = argv[i];
     if (a.rfind("--", 0) != 0) {
@@ -50,6 +102,7 @@ void Args::fail(const std::string& name, const std::string& why) const {
 }
 
 std::string Args::str(const std::string& name, std::optional<std::string> fallback) const {
+  (void)declared(name);
   auto it = values_.find(name);
   if (it != values_.end()) return it->second;
   if (fallback) return *fallback;
@@ -58,6 +111,10 @@ std::string Args::str(const std::string& name, std::optional<std::string> fallba
 
 std::int64_t Args::integer(const std::string& name, std::int64_t lo, std::int64_t hi,
                            std::optional<std::int64_t> fallback) const {
+  if (const OptionSpec* o = declared(name);
+      o && (!o->range || o->range->first != static_cast<double>(lo) || o->range->second != static_cast<double>(hi)))
+    throw std::logic_error(command_ + ": --" + name + " is read with the range [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                           "], not the one it is declared with");
   auto it = values_.find(name);
   if (it == values_.end()) {
     if (fallback) return *fallback;
@@ -73,6 +130,9 @@ std::int64_t Args::integer(const std::string& name, std::int64_t lo, std::int64_
 }
 
 double Args::number(const std::string& name, double lo, double hi, std::optional<double> fallback) const {
+  if (const OptionSpec* o = declared(name); o && (!o->range || o->range->first != lo || o->range->second != hi))
+    throw std::logic_error(command_ + ": --" + name + " is read with the range [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                           "], not the one it is declared with");
   auto it = values_.find(name);
   if (it == values_.end()) {
     if (fallback) return *fallback;
@@ -88,6 +148,8 @@ double Args::number(const std::string& name, double lo, double hi, std::optional
 
 std::string Args::choice(const std::string& name, const std::vector<std::string>& allowed,
                          std::optional<std::string> fallback) const {
+  if (const OptionSpec* o = declared(name); o && o->choices != allowed)
+    throw std::logic_error(command_ + ": --" + name + " is read with other choices than it is declared with");
   const std::string v = str(name, fallback);
   for (const auto& a : allowed)
     if (a == v) return v;

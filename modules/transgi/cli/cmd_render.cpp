@@ -4,6 +4,7 @@
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "cli/option_specs.h"
 #include "cli/runtime_options.h"
 #include "gpu/vulkan_ddgi_kernels.h"
 #include "cli/sun_options.h"
@@ -75,7 +76,7 @@ int render_object_scale(const Args& args, eval::LoadedScene& scene, transgi::mod
   const auto& rt_scene = world.resource<rt::RtScene>();
   const std::string transfer = args.choice("transfer", {"network", "ground-truth"}, "network");
   transgi::shading::TransferRenderSettings rs;
-  rs.spp = static_cast<int>(args.integer("spp", 1, 4096, 4));
+  rs.spp = static_cast<int>(args.integer("spp", 1, 1'000'000, 4));
   rs.ground_truth_rays = static_cast<int>(args.integer("gt-rays", 1, 1'000'000, 2048));
   rs.seed = static_cast<std::uint64_t>(args.integer("seed", 0, INT64_MAX, 0));
   const engine::render::CameraRays camera(world.get<scene::Camera>(scene.camera), world.get<transform::WorldTransform>(scene.camera),
@@ -118,7 +119,7 @@ int render_transgi(const Args& args, eval::LoadedScene& scene, int width, int he
 
   eval::TransgiRunOptions t;
   t.settings = runtime_settings_from(args, "quality");
-  t.settings.gbuffer_spp = static_cast<int>(args.integer("spp", 1, 4096, 1));
+  t.settings.gbuffer_spp = static_cast<int>(args.integer("spp", 1, 1'000'000, 1));
   t.settings.seed = static_cast<std::uint64_t>(args.integer("seed", 0, INT64_MAX, 0));
   t.settings.direct_spp = o.pass == "gi" ? 0 : static_cast<int>(args.integer("direct-spp", 1, 100000, 16));
   t.settings.probes.rays_per_probe = static_cast<int>(args.integer("probe-rays", 1, 100000, 100));
@@ -144,7 +145,7 @@ int render_transgi(const Args& args, eval::LoadedScene& scene, int width, int he
 
 int render_ddgi(const Args& args, eval::LoadedScene& scene, int width, int height, const Outputs& o) {
   eval::DdgiRunOptions d;
-  d.render.gbuffer_spp = static_cast<int>(args.integer("spp", 1, 4096, 1));
+  d.render.gbuffer_spp = static_cast<int>(args.integer("spp", 1, 1'000'000, 1));
   d.render.seed = static_cast<std::uint64_t>(args.integer("seed", 0, INT64_MAX, 0));
   d.render.direct_spp = o.pass == "gi" ? 0 : static_cast<int>(args.integer("direct-spp", 1, 100000, 16));
   d.settings.rays_per_probe = static_cast<int>(args.integer("probe-rays", 1, 100000, 256));
@@ -201,12 +202,7 @@ int render_reference(const Args& args, eval::LoadedScene& scene, int width, int 
 }  // namespace
 
 int run_render(const std::vector<std::string>& argv) {
-  const Args args("render", argv,
-                  {"scene", "method", "pass", "spp", "width", "height", "out", "camera", "seed", "threads", "png", "exposure",
-                   "model", "transfer", "gt-rays", "coefficient-maps", "lighting", "frames", "probe-grid", "probe-rays",
-                   "direct-spp", "probe-skip", "sharing", "no-latent", "timing-frames", "map-width", "hysteresis", "irradiance-gamma", "warmup-frames", "brightness-threshold", "preset", "gi-scale", "gi-reuse", "taa", "probe-budget", "probe-settle", "backend", "device", "device-inference", "device-shading", "device-lights", "direct", "near-field-rays", "near-field-reach", "near-field-filter",
-                   "probe-volume", "cascades", "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "cascade-map-width", "sun-elevation", "sun-azimuth"},
-                  {"allow-unbaked"});
+  const Args args("render", argv, render_option_specs(), kRenderSynopsis);
   const std::string scene_path = args.str("scene");
   const std::string method = args.choice("method", {"reference", "transgi", "ddgi"}, "reference");
   Outputs o;

@@ -12,17 +12,12 @@
 namespace {
 constexpr const char* kUsage =
     "usage: transgi <command> [options]\n"
-    "  render   --scene S.gltf --method reference --pass full|direct|gi|all --spp N --width W --height H\n"
-    "           --out F.exr [--camera NAME] [--seed K] [--threads T] [--png F.png] [--exposure EV]\n"
-    "  render   --scene S.gltf --method transgi --model M.tgm [--lighting probes|environment] [--frames F]\n"
-    "           [--pass gi|direct|full] [--probe-grid N] [--probe-rays M] [--direct-spp N] [--direct deterministic|stochastic]\n"
-    "           [--transfer network|ground-truth] [--gt-rays N] [--coefficient-maps PREFIX] ...\n"
+    "  render   --scene S.gltf --out F.exr [--method reference|transgi|ddgi] [options]: transgi render --help\n"
     "  compare  A.exr B.exr [--heatmap out.png] [--heatmap-max E]\n"
     "  tonemap  IN.exr OUT.png [--exposure EV] [--signed SCALE] [--minus B.exr]\n"
     "  bake     --scene S.gltf --out M.tgm [--points N] [--dirs D] [--outgoing K] [--iters I] [--batch B]\n"
     "           [--max-points-per-vertex P (default 8192; 0 = by area alone)]\n"
     "           [--lr R] [--latent-dim K] [--width W] [--depth L] [--threads T] [--seed S] [--resume] [--keep-dataset]\n"
-    "  render   --scene S.gltf --method ddgi [--frames F] [--probe-grid N] [--probe-rays M] [--warmup-frames W] ...\n"
     "  transfer-study --scene S.gltf [--points N] [--outgoing K] [--reference-rays R]\n"
     "  eval     --scene S.gltf --model M.tgm --out DIR [--width W --height H --spp N --frames F --ddgi-frames F2]\n"
     "           [--probe-grid N] [--cache DIR] [--reference-error E] [--temporal N] [--decompose]\n"
@@ -32,12 +27,10 @@ constexpr const char* kUsage =
     "           --elevation-to E1 --azimuth-from A0 --azimuth-to A1 --reference-spp N --settle-tolerance 0.05]\n"
     "  fly-through --scene S.gltf --model M.tgm --out DIR --path x,y,z;x,y,z;... [--frames 300 --stops F1,F2,F3\n"
     "           --reference-spp N --pitch DEG]\n"
-    "  render also takes --sun-elevation DEG --sun-azimuth DEG (turns the scene's directional light)\n"
-    "  render, eval and bench-frame also take: --probe-volume cascades|scene|authored (default cascades; a scene small\n"
+    "  eval and bench-frame also take: --probe-volume cascades|scene|authored (default cascades; a scene small\n"
     "           enough for 2 m cells gets one grid over it) [--cascades N] [--cascade-cell M] [--cascade-look-ahead F]\n"
     "           [--cascade-fit-scene M], and --allow-unbaked (meshes added after the bake are shaded diffusely)\n"
-    "  render and eval (quality path) also take --near-field-rays N (default 16; 0 = off) --near-field-reach CELLS\n"
-    "           --near-field-filter RADIUS: contact light by short rays where probes cannot see it\n"
+    "  eval also takes --near-field-rays N --near-field-reach CELLS --near-field-filter RADIUS (contact light)\n"
     "  transgi --version; transgi COMMAND --help lists every option COMMAND accepts\n"
     "exit codes: 0 done; 1 a bad or missing input file, or a failure while running (the message names it);\n"
     "  2 a bad command line\n";
@@ -99,7 +92,10 @@ int main(int argc, char** argv) {
     usage();
     return 2;
   } catch (const engine::core::HelpRequested& e) {
-    std::printf("usage:\n%s%s", usage_of(command).c_str(), e.what());
+    if (e.complete())
+      std::fputs(e.what(), stdout);
+    else
+      std::printf("usage:\n%s%s", usage_of(command).c_str(), e.what());
     return 0;
   } catch (const transgi::cli::UsageError& e) {
     std::fprintf(stderr, "transgi %s\n", e.what());

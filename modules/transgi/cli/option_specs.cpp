@@ -1,0 +1,166 @@
+#include "cli/option_specs.h"
+
+#include <climits>
+#include <cstdio>
+#include <utility>
+
+#include "ddgi/ddgi_volume.h"
+#include "runtime/transgi_plugin.h"
+
+namespace transgi::cli {
+
+namespace {
+
+std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+// "X" when both presets agree, else "X (quality), Y (realtime)".
+std::string by_preset(double quality, double realtime) {
+  if (quality == realtime) return number_text(quality);
+  return number_text(quality) + " (quality), " + number_text(realtime) + " (realtime)";
+}
+std::string by_preset(int quality, int realtime) { return by_preset(static_cast<double>(quality), static_cast<double>(realtime)); }
+std::string on_off_by_preset(bool quality, bool realtime) {
+  const char* q = quality ? "on" : "off";
+  const char* r = realtime ? "on" : "off";
+  if (quality == realtime) return q;
+  return std::string(q) + " (quality), " + r + " (realtime)";
+}
+
+OptionSpec integer(std::string name, std::string value, double lo, double hi, std::string default_text, std::string help) {
+  return {std::move(name), std::move(value), std::move(default_text), std::move(help), std::pair{lo, hi}, {}, false};
+}
+OptionSpec number(std::string name, std::string value, double lo, double hi, std::string default_text, std::string help) {
+  return integer(std::move(name), std::move(value), lo, hi, std::move(default_text), std::move(help));
+}
+OptionSpec choice(std::string name, std::vector<std::string> choices, std::string default_text, std::string help) {
+  return {std::move(name), "WORD", std::move(default_text), std::move(help), std::nullopt, std::move(choices), false};
+}
+OptionSpec text(std::string name, std::string value, std::string default_text, std::string help) {
+  return {std::move(name), std::move(value), std::move(default_text), std::move(help), std::nullopt, {}, false};
+}
+OptionSpec flag(std::string name, std::string help) { return {std::move(name), "", "", std::move(help), std::nullopt, {}, true}; }
+
+void append(std::vector<OptionSpec>& to, std::vector<OptionSpec> from) {
+  for (OptionSpec& o : from) to.push_back(std::move(o));
+}
+
+}  // namespace
+
+std::vector<OptionSpec> runtime_option_specs() {
+  const runtime::TransGISettings q = runtime::quality_preset(), r = runtime::realtime_preset();
+  const auto direct = [](runtime::DirectLight d) { return d == runtime::DirectLight::Deterministic ? "deterministic" : "stochastic"; };
+  return {
+      choice("preset", {"quality", "realtime"}, "quality",
+             "the settings the options below change: quality is the paper's path, realtime the game's"),
+      number("gi-scale", "S", 0.05, 1.0, by_preset(q.realtime.resolution_scale, r.realtime.resolution_scale),
+             "real-time GI resolution over the image's: higher = finer GI, at the cost of more decoded points"),
+      integer("probe-budget", "K", 0, 1 << 20, by_preset(q.probes.update_budget, r.probes.update_budget),
+              "probes traced a frame (0 = all): higher = light follows changes sooner, at the cost of probe time"),
+      choice("gi-reuse", {"on", "off"}, on_off_by_preset(q.realtime.reuse_history, r.realtime.reuse_history),
+             "real-time GI cells taken from the frame before where nothing changed: about half the decoding"),
+      choice("taa", {"on", "off"}, on_off_by_preset(q.taa.enabled, r.taa.enabled),
+             "temporal antialiasing of the real-time frame (off shows one frame's samples)"),
+      integer("probe-settle", "F", 0, 4096, by_preset(q.probes.settle_frames, r.probes.settle_frames),
+              "first frames that trace every probe before the budget applies"),
+      integer("map-width", "W", 4, 4096, by_preset(q.probes.map.width, r.probes.map.width),
+              "probe radiance map width (height half): higher = sharper probe light, at the cost of raster time"),
+      choice("changed-first", {"on", "off"}, on_off_by_preset(q.probes.changed_first, r.probes.changed_first),
+             "spend the probe budget on the probes whose light changed first"),
+      choice("direct", {"deterministic", "stochastic"},
+             q.direct_light == r.direct_light ? std::string(direct(q.direct_light))
+                                              : std::string(direct(q.direct_light)) + " (quality), " + direct(r.direct_light) + " (realtime)",
+             "direct light: a fixed light-sample pattern filtered into penumbrae, or Monte Carlo samples"),
+      choice("backend", {"cpu", "vulkan"}, "cpu", "where probe rays, the G-buffer's rays and the probe kernels run"),
+      text("device", "NAME", "the first discrete GPU", "the Vulkan device to take (a part of its name)"),
+      choice("device-inference", {"on", "off"}, on_off_by_preset(q.device_inference, r.device_inference),
+             "run the real-time transfer inference on the Vulkan device"),
+      choice("device-shading", {"on", "off"}, on_off_by_preset(q.device_shading, r.device_shading),
+             "shade the probe rays' hits on the Vulkan device"),
+      choice("device-lights", {"on", "off"}, on_off_by_preset(q.realtime.device_lights, r.realtime.device_lights),
+             "interpolate the network samples' light on the device (32 bytes a sample cross the bus, not 600)"),
+      integer("near-field-rays", "N", 0, 1024, by_preset(q.near_field.rays, r.near_field.rays),
+              "contact-light rays per GI cell (0 = off): higher = less noise, at the cost of ray time"),
+      number("near-field-reach", "CELLS", 0.01, 16.0, by_preset(q.near_field.reach_cells, r.near_field.reach_cells),
+             "near-field ray length in probe cells: higher = more contact light found, at the cost of overlap with the probes"),
+      integer("near-field-filter", "R", 0, 16, by_preset(q.near_field.filter_radius, r.near_field.filter_radius),
+              "near-field filter radius in GI cells: higher = smoother, at the cost of detail"),
+  };
+}
+
+std::vector<OptionSpec> placement_option_specs(runtime::ProbeVolumeMode default_mode) {
+  const runtime::ProbePlacement placement;
+  const auto& c = placement.cascades;
+  return {
+      choice("probe-volume", {"cascades", "scene", "authored"}, std::string(runtime::name_of(default_mode)),
+             "where probes go: grids around the camera, one grid over the scene, or the level's volumes"),
+      integer("probe-grid", "N", 1, 64, "8", "probes along each axis of the scene grid (--probe-volume scene)"),
+      integer("cascades", "N", 1, 8, std::to_string(c.count),
+              "camera-centred grids, each twice the last's extent: higher = GI reaches further, at the cost of more probes"),
+      number("cascade-cell", "METRES", 0.01, 100.0, number_text(c.finest_cell),
+             "finest cascade's cell: smaller = finer light near the camera, at the cost of more probes"),
+      number("cascade-fit-scene", "METRES", 0.0, 1e6, number_text(c.fit_scene_cell),
+             "one grid over the scene, not cascades, when its cells would be this small or smaller (0 = never)"),
+      integer("cascade-map-width", "W", 0, 4096, std::to_string(c.map_width),
+              "cascade probes' map width on the real-time path (0 = --map-width): higher = finer light, at the cost of memory"),
+      number("cascade-look-ahead", "F", 0.0, 1.0, number_text(c.look_ahead),
+             "cascade centres ahead of the camera, in half extents: higher = more probes in view, at the cost of more entering on a turn"),
+  };
+}
+
+std::vector<OptionSpec> sun_option_specs() {
+  return {
+      number("sun-elevation", "DEG", -90.0, 90.0, "the scene's", "turns the scene's directional light: its elevation"),
+      number("sun-azimuth", "DEG", -360.0, 360.0, "the scene's", "turns the scene's directional light: its azimuth"),
+  };
+}
+
+const char* const kRenderSynopsis =
+    "usage: transgi render --scene S.gltf --out F.exr [--method reference|transgi|ddgi] [options]\n"
+    "  An image of the scene: the path tracer's (reference), TransGI's (--model M.tgm) or DDGI's.\n";
+
+std::vector<OptionSpec> render_option_specs() {
+  const ddgi::DdgiSettings d;
+  std::vector<OptionSpec> o = {
+      text("scene", "PATH", "", "the glTF scene"),
+      text("out", "PATH", "", "the EXR written (through a temporary file)"),
+      choice("method", {"reference", "transgi", "ddgi"}, "reference", "who renders: the path tracer, TransGI or DDGI"),
+      choice("pass", {"full", "direct", "gi", "all"}, "full", "what is written; all writes OUT, OUT_direct and OUT_gi"),
+      text("png", "PATH", "none", "an sRGB PNG of the same image"),
+      number("exposure", "EV", -30, 30, "0", "the PNG's exposure"),
+      integer("width", "W", 1, 16384, "320", "image width in pixels"),
+      integer("height", "H", 1, 16384, "180", "image height in pixels"),
+      integer("threads", "T", 0, 1024, "0 (every core)", "worker threads; the image is the same for any count"),
+      text("camera", "NAME", "the scene's first", "the camera node to render from"),
+      integer("spp", "N", 1, 1'000'000, "64 (reference), 4 (--lighting environment), 1 (transgi, ddgi)",
+              "samples per pixel (the G-buffer's for transgi and ddgi): higher = less noise, at the cost of time"),
+      integer("seed", "K", 0, static_cast<double>(INT64_MAX), "0", "the random streams' seed"),
+      text("model", "PATH", "none: required with --method transgi", "the baked transfer model (.tgm)"),
+      choice("lighting", {"probes", "environment"}, "probes", "transgi: light from the probes, or the environment's SH only"),
+      choice("transfer", {"network", "ground-truth"}, "network", "transgi --lighting environment: decoded or traced transfer"),
+      integer("gt-rays", "N", 1, 1'000'000, "2048", "rays per point for --transfer ground-truth"),
+      text("coefficient-maps", "PREFIX", "none", "transgi --lighting environment: write three SH coefficient images"),
+      flag("allow-unbaked", "transgi: shade meshes the model has no latents for diffusely instead of refusing"),
+      text("no-latent", "NODE,...", "none", "transgi: shade these nodes as if unbaked"),
+      integer("frames", "F", 1, 100000, "32 (transgi), 400 (ddgi)", "frames run before the image is taken"),
+      integer("timing-frames", "N", 1, 1000, "3", "last frames whose stage times are reported"),
+      integer("direct-spp", "N", 1, 100000, "16", "direct-light samples per pixel (--direct stochastic, quality path)"),
+      integer("probe-rays", "M", 1, 100000, "100 (transgi), 256 (ddgi)",
+              "rays per probe a frame: higher = less probe noise, at the cost of probe time"),
+      choice("probe-skip", {"on", "off"}, "on", "transgi: skip probes in walls and probes whose light has converged"),
+      choice("sharing", {"depth-guard", "paper"}, "depth-guard", "transgi: radiance sharing across probes, guarded by depth or as the paper"),
+      number("hysteresis", "H", 0.0, 1.0, number_text(d.hysteresis), "ddgi: weight of the old irradiance: higher = steadier, at the cost of lag"),
+      number("brightness-threshold", "B", 0.0, 1e30, number_text(d.brightness_threshold), "ddgi: largest change a frame before hysteresis is lowered"),
+      integer("warmup-frames", "W", 0, 100000, "64", "ddgi: first frames blended without hysteresis"),
+      number("irradiance-gamma", "G", 0.1, 20.0, number_text(d.irradiance_gamma), "ddgi: the irradiance maps' encoding gamma"),
+  };
+  append(o, runtime_option_specs());
+  append(o, placement_option_specs(runtime::ProbeVolumeMode::Cascades));
+  append(o, sun_option_specs());
+  return o;
+}
+
+}  // namespace transgi::cli

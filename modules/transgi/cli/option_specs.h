@@ -1,0 +1,27 @@
+#pragma once
+// The transgi tool's options, declared once each (engine::core::OptionSpec):
+// the parser checks every read against these, and `transgi render --help`
+// and the README's synopsis of `render` are printed from them.
+#include <string>
+#include <vector>
+
+#include "engine/core/args.h"
+#include "runtime/probe_placement.h"
+
+namespace transgi::cli {
+
+using engine::core::OptionSpec;
+
+// What runtime_settings_from and near_field_from read (--preset, --gi-scale,
+// --probe-budget, ..., --near-field-*); defaults from the presets.
+std::vector<OptionSpec> runtime_option_specs();
+// What probe_placement_from reads (--probe-volume, --probe-grid, --cascade-*).
+std::vector<OptionSpec> placement_option_specs(runtime::ProbeVolumeMode default_mode);
+// What apply_sun_options reads (--sun-elevation, --sun-azimuth).
+std::vector<OptionSpec> sun_option_specs();
+
+// Every option `render` accepts, and the line --help prints above them.
+std::vector<OptionSpec> render_option_specs();
+extern const char* const kRenderSynopsis;
+
+}  // namespace transgi::cli
