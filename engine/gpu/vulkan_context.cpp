@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <initializer_list>
+#include <string>
 #include <vector>
 
 #include "engine/gpu/gpu_error.h"
@@ -53,7 +54,126 @@ bool layer_installed(const char* name) {
   return false;
 }
 
+
 }  // namespace
+
+// What a physical device can do, of what the kernels use.
+struct DeviceFeatures {
+  bool ray_query = false;  // the three extensions, rayQuery, accelerationStructure, bufferDeviceAddress
+  bool float16 = false;
+  bool int64 = false;
+  std::string driver;
+  std::uint32_t scratch_alignment = 0;
+};
+
+static DeviceFeatures query_features(VkPhysicalDevice physical) {
+  // Ray queries need three extensions and three features; the feature
+  // structs are chained only where the extensions exist, as the spec asks.
+  const bool has_ray_query_extensions =
+      has_extensions(physical, {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_QUERY_EXTENSION_NAME,
+                                VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME});
+  VkPhysicalDeviceRayQueryFeaturesKHR frq{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR fas{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+  fas.pNext = &frq;
+  VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  if (has_ray_query_extensions) f12.pNext = &fas;
+  VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  f2.pNext = &f12;
+  vkGetPhysicalDeviceFeatures2(physical, &f2);
+  VkPhysicalDeviceAccelerationStructurePropertiesKHR pas{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR};
+  VkPhysicalDeviceVulkan12Properties p12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_PROPERTIES};
+  if (has_ray_query_extensions) p12.pNext = &pas;
+  VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  p2.pNext = &p12;
+  vkGetPhysicalDeviceProperties2(physical, &p2);
+  DeviceFeatures f;
+  f.ray_query = has_ray_query_extensions && frq.rayQuery && fas.accelerationStructure && f12.bufferDeviceAddress;
+  f.float16 = f12.shaderFloat16 == VK_TRUE;
+  f.int64 = f2.features.shaderInt64 == VK_TRUE;
+  f.driver = std::string(p12.driverName) + " " + p12.driverInfo;
+  f.scratch_alignment = pas.minAccelerationStructureScratchOffsetAlignment;
+  return f;
+}
+
+std::string VulkanContext::describe_device(const GpuOptions& options, const DeviceFeatures& features, bool ray_query_enabled) {
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(physical_, &props);
+  bool want_ray_query = options.ray_query;
+  if (const char* env = std::getenv("ENGINE_GPU_RAY_QUERY")) {
+    if (std::strcmp(env, "off") == 0) want_ray_query = false;
+    else if (std::strcmp(env, "on") != 0) return std::string("ENGINE_GPU_RAY_QUERY=") + env + ": expected on or off";
+  }
+  info_.ray_query = want_ray_query && ray_query_enabled;
+  info_.scratch_alignment = features.scratch_alignment;
+  info_.name = props.deviceName;
+  info_.kind = kind_of(props.deviceType);
+  info_.driver = features.driver;
+  info_.shader_float16 = features.float16;
+  info_.shader_int64 = features.int64;
+  info_.max_shared_memory = props.limits.maxComputeSharedMemorySize;
+  info_.max_storage_buffer_range = props.limits.maxStorageBufferRange;
+  if (options.storage_buffer_range_cap > 0) info_.max_storage_buffer_range = std::min(info_.max_storage_buffer_range, options.storage_buffer_range_cap);
+  info_.buffer_memory = options.buffer_memory;
+  info_.stage_device_only = options.stage_device_only;
+  VkPhysicalDeviceMemoryProperties mem;
+  vkGetPhysicalDeviceMemoryProperties(physical_, &mem);
+  for (std::uint32_t i = 0; i < mem.memoryTypeCount; ++i) {
+    const VkMemoryPropertyFlags f = mem.memoryTypes[i].propertyFlags;
+    constexpr VkMemoryPropertyFlags kWanted =
+        VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    if ((f & kWanted) == kWanted)
+      info_.mappable_device_local_bytes = std::max<std::uint64_t>(info_.mappable_device_local_bytes, mem.memoryHeaps[mem.memoryTypes[i].heapIndex].size);
+  }
+  if (const char* env = std::getenv("ENGINE_GPU_MEMORY")) {
+    if (std::strcmp(env, "cached") == 0) info_.buffer_memory = BufferMemory::Cached;
+    else if (std::strcmp(env, "write-combined") == 0) info_.buffer_memory = BufferMemory::WriteCombined;
+    else if (std::strcmp(env, "bar") == 0) info_.buffer_memory = BufferMemory::Bar;
+    else return std::string("ENGINE_GPU_MEMORY=") + env + ": expected cached, write-combined or bar";
+  }
+  return {};
+}
+
+std::string VulkanContext::make_submission_objects(const VkPhysicalDeviceProperties& props) {
+  if (info_.ray_query) {
+    auto& api = as_api_;
+    const VkDevice dev = device_;
+    api.create = reinterpret_cast<PFN_vkCreateAccelerationStructureKHR>(vkGetDeviceProcAddr(dev, "vkCreateAccelerationStructureKHR"));
+    api.destroy = reinterpret_cast<PFN_vkDestroyAccelerationStructureKHR>(vkGetDeviceProcAddr(dev, "vkDestroyAccelerationStructureKHR"));
+    api.build_sizes = reinterpret_cast<PFN_vkGetAccelerationStructureBuildSizesKHR>(
+        vkGetDeviceProcAddr(dev, "vkGetAccelerationStructureBuildSizesKHR"));
+    api.cmd_build = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresKHR>(
+        vkGetDeviceProcAddr(dev, "vkCmdBuildAccelerationStructuresKHR"));
+    api.device_address = reinterpret_cast<PFN_vkGetAccelerationStructureDeviceAddressKHR>(
+        vkGetDeviceProcAddr(dev, "vkGetAccelerationStructureDeviceAddressKHR"));
+    if (!api.create || !api.destroy || !api.build_sizes || !api.cmd_build || !api.device_address)
+      return "the device lists VK_KHR_acceleration_structure but its entry points are missing";
+  }
+
+  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pci.queueFamilyIndex = queue_family_;
+  ENGINE_VK_CHECK(vkCreateCommandPool(device_, &pci, nullptr, &pool_));
+  VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  cai.commandPool = pool_;
+  cai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  cai.commandBufferCount = 1;
+  ENGINE_VK_CHECK(vkAllocateCommandBuffers(device_, &cai, &cmd_));
+  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  ENGINE_VK_CHECK(vkCreateFence(device_, &fci, nullptr, &fence_));
+
+  std::uint32_t families = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, nullptr);
+  std::vector<VkQueueFamilyProperties> fam(families);
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, fam.data());
+  if (fam[queue_family_].timestampValidBits > 0 && props.limits.timestampPeriod > 0) {
+    VkQueryPoolCreateInfo qpi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    qpi.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    qpi.queryCount = 2;
+    ENGINE_VK_CHECK(vkCreateQueryPool(device_, &qpi, nullptr, &timestamps_));
+    info_.timestamp_period_ns = props.limits.timestampPeriod;
+  }
+  return {};
+}
 
 VKAPI_ATTR VkBool32 VKAPI_CALL VulkanContext::on_validation(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                             VkDebugUtilsMessageTypeFlagsEXT,
@@ -125,68 +245,16 @@ std::unique_ptr<VulkanContext> VulkanContext::create(const GpuOptions& options, 
 
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(ctx->physical_, &props);
-  // Ray queries need three extensions and three features; the feature
-  // structs are chained only where the extensions exist, as the spec asks.
-  const bool has_ray_query_extensions =
-      has_extensions(ctx->physical_, {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_QUERY_EXTENSION_NAME,
-                                      VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME});
-  VkPhysicalDeviceRayQueryFeaturesKHR frq{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
-  VkPhysicalDeviceAccelerationStructureFeaturesKHR fas{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
-  fas.pNext = &frq;
-  VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
-  if (has_ray_query_extensions) f12.pNext = &fas;
-  VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
-  f2.pNext = &f12;
-  vkGetPhysicalDeviceFeatures2(ctx->physical_, &f2);
-  VkPhysicalDeviceAccelerationStructurePropertiesKHR pas{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR};
-  VkPhysicalDeviceVulkan12Properties p12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_PROPERTIES};
-  if (has_ray_query_extensions) p12.pNext = &pas;
-  VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
-  p2.pNext = &p12;
-  vkGetPhysicalDeviceProperties2(ctx->physical_, &p2);
-  bool want_ray_query = options.ray_query;
-  if (const char* env = std::getenv("ENGINE_GPU_RAY_QUERY")) {
-    if (std::strcmp(env, "off") == 0) want_ray_query = false;
-    else if (std::strcmp(env, "on") != 0) return fail(std::string("ENGINE_GPU_RAY_QUERY=") + env + ": expected on or off");
-  }
-  ctx->info_.ray_query = want_ray_query && has_ray_query_extensions && frq.rayQuery && fas.accelerationStructure &&
-                         f12.bufferDeviceAddress;
-  ctx->info_.scratch_alignment = pas.minAccelerationStructureScratchOffsetAlignment;
-  ctx->info_.name = props.deviceName;
-  ctx->info_.kind = kind_of(props.deviceType);
-  ctx->info_.driver = std::string(p12.driverName) + " " + p12.driverInfo;
-  ctx->info_.shader_float16 = f12.shaderFloat16 == VK_TRUE;
-  ctx->info_.shader_int64 = f2.features.shaderInt64 == VK_TRUE;
-  ctx->info_.max_shared_memory = props.limits.maxComputeSharedMemorySize;
-  ctx->info_.max_storage_buffer_range = props.limits.maxStorageBufferRange;
-  if (options.storage_buffer_range_cap > 0)
-    ctx->info_.max_storage_buffer_range = std::min(ctx->info_.max_storage_buffer_range, options.storage_buffer_range_cap);
-  ctx->info_.buffer_memory = options.buffer_memory;
-  ctx->info_.stage_device_only = options.stage_device_only;
-  VkPhysicalDeviceMemoryProperties mem;
-  vkGetPhysicalDeviceMemoryProperties(ctx->physical_, &mem);
-  for (std::uint32_t i = 0; i < mem.memoryTypeCount; ++i) {
-    const VkMemoryPropertyFlags f = mem.memoryTypes[i].propertyFlags;
-    constexpr VkMemoryPropertyFlags kWanted =
-        VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-    if ((f & kWanted) == kWanted)
-      ctx->info_.mappable_device_local_bytes =
-          std::max<std::uint64_t>(ctx->info_.mappable_device_local_bytes, mem.memoryHeaps[mem.memoryTypes[i].heapIndex].size);
-  }
-  if (const char* env = std::getenv("ENGINE_GPU_MEMORY")) {
-    if (std::strcmp(env, "cached") == 0) ctx->info_.buffer_memory = BufferMemory::Cached;
-    else if (std::strcmp(env, "write-combined") == 0) ctx->info_.buffer_memory = BufferMemory::WriteCombined;
-    else if (std::strcmp(env, "bar") == 0) ctx->info_.buffer_memory = BufferMemory::Bar;
-    else return fail(std::string("ENGINE_GPU_MEMORY=") + env + ": expected cached, write-combined or bar");
-  }
+  const DeviceFeatures features = query_features(ctx->physical_);
+  if (std::string why = ctx->describe_device(options, features, features.ray_query); !why.empty()) return fail(why);
 
   // Enable only what the kernels use, so a device without float16 still runs
   // the fp32 variants.
   VkPhysicalDeviceVulkan12Features enable12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
-  enable12.shaderFloat16 = f12.shaderFloat16;
+  enable12.shaderFloat16 = features.float16 ? VK_TRUE : VK_FALSE;
   // 64-bit integers: the shading kernels draw Pcg32's numbers bit for bit.
   VkPhysicalDeviceFeatures2 enable2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
-  enable2.features.shaderInt64 = f2.features.shaderInt64;
+  enable2.features.shaderInt64 = features.int64 ? VK_TRUE : VK_FALSE;
   enable2.pNext = &enable12;
   VkPhysicalDeviceRayQueryFeaturesKHR enable_rq{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
   VkPhysicalDeviceAccelerationStructureFeaturesKHR enable_as{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
@@ -212,56 +280,57 @@ std::unique_ptr<VulkanContext> VulkanContext::create(const GpuOptions& options, 
   dci.enabledExtensionCount = static_cast<std::uint32_t>(device_extensions.size());
   dci.ppEnabledExtensionNames = device_extensions.data();
   ENGINE_VK_CHECK(vkCreateDevice(ctx->physical_, &dci, nullptr, &ctx->device_));
-  if (ctx->info_.ray_query) {
-    auto& api = ctx->as_api_;
-    const VkDevice dev = ctx->device_;
-    api.create = reinterpret_cast<PFN_vkCreateAccelerationStructureKHR>(vkGetDeviceProcAddr(dev, "vkCreateAccelerationStructureKHR"));
-    api.destroy = reinterpret_cast<PFN_vkDestroyAccelerationStructureKHR>(vkGetDeviceProcAddr(dev, "vkDestroyAccelerationStructureKHR"));
-    api.build_sizes = reinterpret_cast<PFN_vkGetAccelerationStructureBuildSizesKHR>(
-        vkGetDeviceProcAddr(dev, "vkGetAccelerationStructureBuildSizesKHR"));
-    api.cmd_build = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresKHR>(
-        vkGetDeviceProcAddr(dev, "vkCmdBuildAccelerationStructuresKHR"));
-    api.device_address = reinterpret_cast<PFN_vkGetAccelerationStructureDeviceAddressKHR>(
-        vkGetDeviceProcAddr(dev, "vkGetAccelerationStructureDeviceAddressKHR"));
-    if (!api.create || !api.destroy || !api.build_sizes || !api.cmd_build || !api.device_address)
-      return fail("the device lists VK_KHR_acceleration_structure but its entry points are missing");
-  }
   vkGetDeviceQueue(ctx->device_, ctx->queue_family_, 0, &ctx->queue_);
+  if (std::string why = ctx->make_submission_objects(props); !why.empty()) return fail(why);
+  return ctx;
+}
 
-  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  pci.queueFamilyIndex = ctx->queue_family_;
-  ENGINE_VK_CHECK(vkCreateCommandPool(ctx->device_, &pci, nullptr, &ctx->pool_));
-  VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  cai.commandPool = ctx->pool_;
-  cai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  cai.commandBufferCount = 1;
-  ENGINE_VK_CHECK(vkAllocateCommandBuffers(ctx->device_, &cai, &ctx->cmd_));
-  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  ENGINE_VK_CHECK(vkCreateFence(ctx->device_, &fci, nullptr, &ctx->fence_));
-
+std::unique_ptr<VulkanContext> VulkanContext::adopt(const HostVulkanDevice& host, const GpuOptions& options, std::string* why_not) {
+  auto fail = [&](std::string why) {
+    if (why_not) *why_not = std::move(why);
+    return std::unique_ptr<VulkanContext>();
+  };
+  if (!host.instance || !host.physical_device || !host.device || !host.queue)
+    return fail("the host's Vulkan device is incomplete: instance, physical device, device and queue are all needed");
   std::uint32_t families = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(ctx->physical_, &families, nullptr);
+  vkGetPhysicalDeviceQueueFamilyProperties(host.physical_device, &families, nullptr);
   std::vector<VkQueueFamilyProperties> fam(families);
-  vkGetPhysicalDeviceQueueFamilyProperties(ctx->physical_, &families, fam.data());
-  if (fam[ctx->queue_family_].timestampValidBits > 0 && props.limits.timestampPeriod > 0) {
-    VkQueryPoolCreateInfo qpi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
-    qpi.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    qpi.queryCount = 2;
-    ENGINE_VK_CHECK(vkCreateQueryPool(ctx->device_, &qpi, nullptr, &ctx->timestamps_));
-    ctx->info_.timestamp_period_ns = props.limits.timestampPeriod;
-  }
+  vkGetPhysicalDeviceQueueFamilyProperties(host.physical_device, &families, fam.data());
+  if (host.queue_family >= families || !(fam[host.queue_family].queueFlags & VK_QUEUE_COMPUTE_BIT))
+    return fail("the host's queue family " + std::to_string(host.queue_family) + " has no compute");
+  std::unique_ptr<VulkanContext> ctx(new VulkanContext());
+  ctx->owns_device_ = false;
+  ctx->instance_ = host.instance;
+  ctx->physical_ = host.physical_device;
+  ctx->device_ = host.device;
+  ctx->queue_ = host.queue;
+  ctx->queue_family_ = host.queue_family;
+  // What the device supports, narrowed to what the host says it enabled.
+  DeviceFeatures features = query_features(host.physical_device);
+  features.float16 = features.float16 && host.enabled_shader_float16;
+  features.int64 = features.int64 && host.enabled_shader_int64;
+  if (std::string why = ctx->describe_device(options, features, features.ray_query && host.enabled_ray_query); !why.empty())
+    return fail(why);
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(ctx->physical_, &props);
+  if (std::string why = ctx->make_submission_objects(props); !why.empty()) return fail(why);
   return ctx;
 }
 
 VulkanContext::~VulkanContext() {
   if (device_) {
-    vkDeviceWaitIdle(device_);
+    // A host's device keeps running the host's work: wait for our queue
+    // only (every submission of ours has already been waited for).
+    if (owns_device_)
+      vkDeviceWaitIdle(device_);
+    else if (queue_)
+      vkQueueWaitIdle(queue_);
     if (timestamps_) vkDestroyQueryPool(device_, timestamps_, nullptr);
     if (fence_) vkDestroyFence(device_, fence_, nullptr);
     if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
-    vkDestroyDevice(device_, nullptr);
+    if (owns_device_) vkDestroyDevice(device_, nullptr);
   }
+  if (!owns_device_) return;  // the host's instance, and no messenger of ours
   if (messenger_) {
     auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
         vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));

@@ -114,10 +114,37 @@ struct GpuTraffic {
   }
 };
 
+// A Vulkan device the host engine made and keeps (as the RTXGI SDK runs on
+// its host's device). The context records and submits on `queue` and never
+// destroys what it did not create; the host must not submit to that queue
+// from another thread while the context's work runs, and destroys the
+// device after the context. The kernels need shaderInt64 enabled (the
+// shading kernels draw Pcg32's numbers bit for bit); float16 is used where
+// enabled, and rays are traced with VK_KHR_ray_query where the host enabled
+// VK_KHR_acceleration_structure, VK_KHR_ray_query and
+// VK_KHR_deferred_host_operations with their features and
+// bufferDeviceAddress, else by the compute-shader BVH traversal.
+struct HostVulkanDevice {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;
+  std::uint32_t queue_family = 0;  // must support compute
+  bool enabled_shader_int64 = false;
+  bool enabled_shader_float16 = false;
+  bool enabled_ray_query = false;
+};
+
+struct DeviceFeatures;
+
 class VulkanContext {
  public:
   // Null and *why_not set when no usable device exists.
   static std::unique_ptr<VulkanContext> create(const GpuOptions& options, std::string* why_not);
+  // On the host's device (HostVulkanDevice); null and *why_not set when it
+  // cannot serve (no compute on the queue's family, a handle missing).
+  // options.device is ignored: the host chose the device.
+  static std::unique_ptr<VulkanContext> adopt(const HostVulkanDevice& host, const GpuOptions& options, std::string* why_not);
   ~VulkanContext();
   VulkanContext(const VulkanContext&) = delete;
   VulkanContext& operator=(const VulkanContext&) = delete;
@@ -155,10 +182,17 @@ class VulkanContext {
 
  private:
   VulkanContext() = default;
+  // info_ from the physical device, the options and the environment's
+  // overrides; an error message, or empty.
+  std::string describe_device(const GpuOptions& options, const DeviceFeatures& features, bool ray_query_enabled);
+  // The ray-query entry points, command pool and buffer, fence and
+  // timestamp queries on device_ and queue_family_; an error message, or empty.
+  std::string make_submission_objects(const VkPhysicalDeviceProperties& props);
   static VKAPI_ATTR VkBool32 VKAPI_CALL on_validation(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                       VkDebugUtilsMessageTypeFlagsEXT,
                                                       const VkDebugUtilsMessengerCallbackDataEXT* data, void* self);
 
+  bool owns_device_ = true;  // false: adopted from the host, which destroys it
   VkInstance instance_ = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
   VkPhysicalDevice physical_ = VK_NULL_HANDLE;

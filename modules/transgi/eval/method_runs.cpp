@@ -99,7 +99,7 @@ LoadedScene load_scene(const std::string& path, const std::string& camera_name, 
 MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::TransferModel>& model, int width, int height,
                       const TransgiRunOptions& o) {
   ecs::World& world = scene.app->world();
-  scene.app->add_plugin<runtime::TransGIPlugin>(o.settings);
+  scene.app->add_plugin<runtime::TransGIPlugin>(o.settings, o.host_gpu);
   runtime::attach_latent_meshes(world, model);
   for (const std::string& name : o.no_latent) {
     std::vector<ecs::Entity> matches;

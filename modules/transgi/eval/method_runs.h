@@ -48,6 +48,9 @@ struct TransgiRunOptions {
   runtime::ProbePlacement placement{.mode = runtime::ProbeVolumeMode::Scene};
   std::vector<std::string> no_latent;  // node names whose LatentMesh is removed
   bool progress = true;
+  // Backend::Vulkan on a device the caller made (TransGIPlugin's host_gpu);
+  // null: the plugin makes its own.
+  std::shared_ptr<engine::gpu::VulkanContext> host_gpu;
 };
 
 MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::TransferModel>& model, int width, int height,

@@ -83,12 +83,21 @@ shading::TransferBatchDecoder* VulkanProbeKernels::transfer_decoder(const std::s
   return decoder_.get();
 }
 
+std::shared_ptr<VulkanProbeKernels> make_probe_kernels(std::shared_ptr<engine::gpu::VulkanContext> context, std::string* why) {
+  if (!context) return nullptr;
+  try {
+    return std::make_shared<VulkanProbeKernels>(std::move(context));
+  } catch (const std::exception& e) {  // a kernel the device cannot build: the CPU runs them, and says why
+    if (why) *why = e.what();
+  }
+  return nullptr;
+}
+
 std::shared_ptr<VulkanProbeKernels> make_probe_kernels(const std::string& device, std::string* why) {
   engine::gpu::GpuOptions options;
   options.device = device;
   try {
-    if (auto ctx = engine::gpu::VulkanContext::create(options, why))
-      return std::make_shared<VulkanProbeKernels>(std::shared_ptr<engine::gpu::VulkanContext>(std::move(ctx)));
+    if (auto ctx = engine::gpu::VulkanContext::create(options, why)) return make_probe_kernels(std::shared_ptr<engine::gpu::VulkanContext>(std::move(ctx)), why);
   } catch (const std::exception& e) {
     if (why) *why = e.what();
   }

@@ -91,5 +91,7 @@ class VulkanProbeKernels : public probes::ProbeKernels {
 // The Vulkan kernels on the chosen device (empty: ENGINE_GPU_DEVICE, then
 // the ranked default), or null with *why set where no device can be had.
 std::shared_ptr<VulkanProbeKernels> make_probe_kernels(const std::string& device, std::string* why);
+// The same on a context the caller made (a host engine's device).
+std::shared_ptr<VulkanProbeKernels> make_probe_kernels(std::shared_ptr<engine::gpu::VulkanContext> context, std::string* why);
 
 }  // namespace transgi::gpu

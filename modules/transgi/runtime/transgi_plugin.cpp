@@ -47,6 +47,7 @@ struct ProbeBackend {
   std::uint32_t shader_generation = 0;
   std::shared_ptr<gpu::VulkanProbeKernels> kernels;  // null: the CPU functions
   std::string fallback;
+  std::shared_ptr<engine::gpu::VulkanContext> host;  // the host engine's device, if it gave one
 };
 
 void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> cascades, Res<rt::RtScene> rt,
@@ -55,10 +56,10 @@ void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> casc
   if (settings->freeze_probes) return;
   if (backend->made_for != settings->backend || backend->device != settings->gpu_device ||
       backend->shader_generation != settings->shader_generation) {
-    *backend = ProbeBackend{settings->backend, settings->gpu_device, settings->shader_generation, nullptr, ""};
+    *backend = ProbeBackend{settings->backend, settings->gpu_device, settings->shader_generation, nullptr, "", backend->host};
     if (settings->backend == Backend::Vulkan) {
       std::string why;
-      backend->kernels = gpu::make_probe_kernels(settings->gpu_device, &why);
+      backend->kernels = backend->host ? gpu::make_probe_kernels(backend->host, &why) : gpu::make_probe_kernels(settings->gpu_device, &why);
       if (!backend->kernels) backend->fallback = "Vulkan backend unavailable, the CPU runs the probes: " + why;
     }
   }
@@ -341,6 +342,7 @@ void TransGIPlugin::build(app::App& app) {
   if (!w.has_resource<TransGISettings>()) w.insert_resource<TransGISettings>(settings_);
   if (!w.has_resource<GiFrame>()) w.insert_resource<GiFrame>();
   if (!w.has_resource<ProbeBackend>()) w.insert_resource<ProbeBackend>();
+  if (host_gpu_) w.resource<ProbeBackend>().host = host_gpu_;
   app.add_system(Phase::PostUpdate, "transgi::request_light_settings", request_light_settings);
   app.add_system(Phase::PrepareRender, "transgi::sync_probe_volumes", sync_probe_volumes);
   app.add_system(Phase::PrepareRender, "transgi::sync_probe_cascades", sync_probe_cascades);

@@ -21,16 +21,26 @@
 #include "runtime/gi_frame.h"
 #include "runtime/settings.h"
 
+namespace engine::gpu {
+class VulkanContext;
+}
+
 namespace transgi::runtime {
 
 class TransGIPlugin final : public engine::app::Plugin {
  public:
   explicit TransGIPlugin(TransGISettings settings = {}) : settings_(std::move(settings)) {}
+  // With Backend::Vulkan, the kernels run on `host_gpu` (a context on the
+  // host engine's own device: engine::gpu::VulkanContext::adopt) instead of
+  // a device of their own; settings.gpu_device is then ignored.
+  TransGIPlugin(TransGISettings settings, std::shared_ptr<engine::gpu::VulkanContext> host_gpu)
+      : settings_(std::move(settings)), host_gpu_(std::move(host_gpu)) {}
   void build(engine::app::App& app) override;
   [[nodiscard]] std::string_view name() const override { return "transgi::TransGIPlugin"; }
 
  private:
   TransGISettings settings_;
+  std::shared_ptr<engine::gpu::VulkanContext> host_gpu_;
 };
 
 // Gives every entity whose MeshInstance has latents in `model` a LatentMesh.
