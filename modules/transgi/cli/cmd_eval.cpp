@@ -66,7 +66,7 @@ int run_eval(const std::vector<std::string>& argv) {
   t.settings.probes.map.height = std::max(2, t.settings.probes.map.width / 2);
   // Both methods alike: the GI image of the last N frames averaged, each with
   // its own jittered G-buffer sample (a still view's temporal antialiasing).
-  const int temporal = static_cast<int>(args.integer("temporal", 1, 1024, 1));
+  const int temporal = static_cast<int>(args.integer("temporal", 1, 1024, runtime::quality_preset().temporal_window));
   t.settings.temporal_window = temporal;
   t.timing_frames = std::max(t.timing_frames, temporal);
   eval::DdgiRunOptions d;

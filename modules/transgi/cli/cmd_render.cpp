@@ -131,6 +131,7 @@ int render_transgi(const Args& args, eval::LoadedScene& scene, int width, int he
                                        : transgi::probes::SharingMode::DepthGuard;
   t.frames = static_cast<int>(args.integer("frames", 1, 100000, 32));
   t.timing_frames = static_cast<int>(args.integer("timing-frames", 1, 1000, 3));
+  t.settings.temporal_window = static_cast<int>(args.integer("temporal-window", 1, 1024, t.settings.temporal_window));
   t.placement = probe_placement_from(args, runtime::ProbeVolumeMode::Cascades);
   t.no_latent = split_names(args.str("no-latent", std::string()));
   const auto shared = std::make_shared<const transgi::model::TransferModel>(std::move(model));

@@ -147,6 +147,9 @@ std::vector<OptionSpec> render_option_specs() {
       text("no-latent", "NODE,...", "none", "transgi: shade these nodes as if unbaked"),
       integer("frames", "F", 1, 100000, "32 (transgi), 400 (ddgi)", "frames run before the image is taken"),
       integer("timing-frames", "N", 1, 1000, "3", "last frames whose stage times are reported"),
+      integer("temporal-window", "N", 1, 1024, std::to_string(runtime::quality_preset().temporal_window),
+              "transgi quality path: a still view's GI is the mean of the last N jittered frames: higher = smoother "
+              "edges and less noise, at the cost of N frames to settle"),
       integer("direct-spp", "N", 1, 100000, "16", "direct-light samples per pixel (--direct stochastic, quality path)"),
       integer("probe-rays", "M", 1, 100000, "100 (transgi), 256 (ddgi)",
               "rays per probe a frame: higher = less probe noise, at the cost of probe time"),

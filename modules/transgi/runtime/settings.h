@@ -112,8 +112,11 @@ struct TransGISettings {
   // jittered G-buffer sample (engine/render/temporal_accumulation.h): a
   // still view antialiases at one sample per pixel per frame. 1 = off.
   // Higher = smoother edges and less noise, at the cost of that many frames
-  // before a still view settles.
-  int temporal_window = 1;
+  // before a still view settles. 16: one cycle of the jitter pattern; on
+  // Bitterli's rooms the GI pass's speckles 2.56 % -> 1.08 % and 0.98 % ->
+  // 0.41 % of pixels, RMSE 0.080 -> 0.072 and 0.076 -> 0.068
+  // (docs/image-quality.md). 1 = the paper's single frame.
+  int temporal_window = 16;
   // The probes keep their state and trace nothing (error decomposition
   // renders several variants of one probe state; debugging).
   bool freeze_probes = false;
