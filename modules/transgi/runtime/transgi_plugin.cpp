@@ -250,6 +250,8 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
   rs.mirror = settings->mirror;
   rs.ground_truth_rays = settings->ground_truth_rays;
   rs.seed = settings->seed + frame->probe_frames;
+  rs.pattern_seed = settings->seed;
+  rs.frame_index = frame->probe_frames;
   rs.has_transfer = [&](Entity e) {
     const LatentMesh* l = latents.try_read<LatentMesh>(e);
     return l && model && l->model == model;

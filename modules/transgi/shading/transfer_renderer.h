@@ -61,6 +61,14 @@ struct TransferRenderSettings {
   // rasterisers do. Off = point samples, which alias at one sample per pixel.
   bool texture_filtering = true;
   std::uint64_t seed = 0;
+  // The G-buffer's sub-pixel positions: frame `frame_index`'s spp points of
+  // one R2 sequence per pixel, shifted by a per-pixel offset drawn from
+  // `pattern_seed`. Consecutive frames take the sequence's next points, so
+  // a still view's temporal window (TransGISettings::temporal_window) is
+  // stratified over the pixel instead of independent random points (those
+  // left thin frames grainy after 16 frames).
+  std::uint64_t pattern_seed = 0;
+  std::uint64_t frame_index = 0;
   float filter_width = 1.5f;
   MirrorRay mirror{};
   const engine::render::LightSet* lights = nullptr;  // for the mirror ray's and near field's next-event samples (null: none)
@@ -100,6 +108,12 @@ struct TransferRenderResult {
   double light_ms = 0;  // fetching the SH light per shaded sample (probe interpolation)
 };
 
+
+// The G-buffer's sub-pixel position for a pixel's sample `sample` (frame
+// index x spp + the sample within the frame), in [0, 1)^2 before the pixel
+// filter: point `sample` of the R2 sequence shifted by a per-pixel offset
+// drawn from `pattern_seed`.
+glm::vec2 gbuffer_subpixel(std::uint64_t pattern_seed, std::size_t pixel, std::uint64_t sample);
 
 TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                                      const model::TransferModel& model, const engine::render::CameraRays& camera,
