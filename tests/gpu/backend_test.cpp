@@ -132,9 +132,7 @@ TEST(VulkanBackend, ACornellBoxGiFrameEqualsTheCpuBackends) {
   const eval::MethodRun gpu = cornell(runtime::Backend::Vulkan);
   ASSERT_EQ(gpu.backend.rfind("vulkan", 0), 0u) << "the plugin fell back: " << gpu.backend;
   EXPECT_EQ(gpu.backend.find("probe rays shaded on the CPU"), std::string::npos) << gpu.backend;
-  double mean = 0;
-  for (const auto& p : cpu.gi.pixels) mean += (p.r + p.g + p.b) / 3.0;
-  mean /= static_cast<double>(cpu.gi.pixels.size());
+  const double mean = gpu_test::mean_rgb(cpu.gi);
   ASSERT_GT(mean, 1e-3) << "the Cornell box's GI should not be black";
   const double rmse = engine::image::rmse_clamped(cpu.gi, gpu.gi);
   std::printf("Cornell box, 16 frames, 48x48: GI RMSE between backends %.3g, mean GI %.4f (%s)\n", rmse, mean, gpu.backend.c_str());
@@ -165,12 +163,6 @@ eval::MethodRun cornell_ddgi(bool gpu, const runtime::ProbePlacement& placement,
   return eval::run_ddgi(scene, width, 48, d);
 }
 
-double mean_of(const engine::image::ImageRGB& img) {
-  double mean = 0;
-  for (const auto& p : img.pixels) mean += (p.r + p.g + p.b) / 3.0;
-  return mean / static_cast<double>(img.pixels.size());
-}
-
 }  // namespace
 
 // DDGI on both backends (its probe rays traced through the GPU BVH, the blend
@@ -181,7 +173,7 @@ TEST(VulkanBackend, ACornellBoxDdgiFrameEqualsTheCpuBackends) {
   placement.mode = runtime::ProbeVolumeMode::Scene;
   placement.scene_dims = glm::ivec3(6);
   const eval::MethodRun cpu = cornell_ddgi(false, placement), gpu = cornell_ddgi(true, placement);
-  const double mean = mean_of(cpu.gi);
+  const double mean = gpu_test::mean_rgb(cpu.gi);
   ASSERT_GT(mean, 1e-3);
   const double rmse = engine::image::rmse_clamped(cpu.gi, gpu.gi);
   std::printf("Cornell box DDGI, 16 updates, 48x48: GI RMSE between backends %.3g, mean GI %.4f\n", rmse, mean);
@@ -205,7 +197,7 @@ TEST(VulkanBackend, ACornellBoxRealtimeDdgiFrameEqualsTheCpuBackends) {
                           gpu = cornell_ddgi(true, placement, true, 51, emitted);
     for (const auto& [name, a, b] : {std::tuple{"full", &cpu.full, &gpu.full}, std::tuple{"direct", &cpu.direct, &gpu.direct},
                                      std::tuple{"gi", &cpu.gi, &gpu.gi}}) {
-      const double mean = mean_of(*a);
+      const double mean = gpu_test::mean_rgb(*a);
       ASSERT_GT(mean, 1e-3) << name;
       const double rmse = engine::image::rmse_clamped(*a, *b);
       std::printf("Cornell box real-time DDGI, emitted maps %s, 16 updates, 51x48, %s: RMSE between backends %.3g, mean %.4f\n",
@@ -232,7 +224,7 @@ TEST(VulkanBackend, ACornellBoxDdgiFrameWithCascadesEqualsTheCpuBackends) {
   placement.cascades.look_ahead = 0.75f;  // the camera stands outside the box: reach into it
   placement.cascades.fit_scene_cell = 0.0f;  // cascades however small the scene
   const eval::MethodRun cpu = cornell_ddgi(false, placement), gpu = cornell_ddgi(true, placement);
-  const double mean = mean_of(cpu.gi);
+  const double mean = gpu_test::mean_rgb(cpu.gi);
   ASSERT_GT(mean, 1e-3);
   const double rmse = engine::image::rmse_clamped(cpu.gi, gpu.gi);
   std::printf("Cornell box DDGI, 3 cascades, 16 updates, 48x48: GI RMSE between backends %.3g, mean GI %.4f (%s)\n", rmse,

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "engine/gpu/vulkan_context.h"
+#include "engine/image/image.h"
 
 namespace gpu_test {
 
@@ -43,6 +44,18 @@ inline engine::gpu::VulkanContext* context(std::string* why) { return context_wi
 // A second context whose DeviceOnly buffers always go through staging
 // copies (GpuOptions::stage_device_only), as on a discrete GPU.
 inline engine::gpu::VulkanContext* staging_context(std::string* why) { return context_with(true, true, why); }
+
+}  // namespace gpu_test
+
+namespace gpu_test {
+
+// The mean of (r + g + b) / 3 over an image's pixels: the scale the GPU
+// tests' tolerances are stated against.
+inline double mean_rgb(const engine::image::ImageRGB& img) {
+  double mean = 0;
+  for (const auto& p : img.pixels) mean += (p.r + p.g + p.b) / 3.0;
+  return mean / static_cast<double>(img.pixels.size());
+}
 
 }  // namespace gpu_test
 

@@ -129,9 +129,7 @@ TEST(HostVulkanDevice, TheKernelsRunOnTheHostsDeviceAndLeaveItToTheHost) {
   EXPECT_NE(on_host.backend.find(host->name), std::string::npos) << on_host.backend;
   EXPECT_GT(ctx->traffic().submissions, 0u) << "nothing was submitted through the host's device";
   const eval::MethodRun on_own = cornell_on(nullptr);
-  double mean = 0;
-  for (const auto& p : on_own.gi.pixels) mean += (p.r + p.g + p.b) / 3.0;
-  mean /= static_cast<double>(on_own.gi.pixels.size());
+  const double mean = gpu_test::mean_rgb(on_own.gi);
   ASSERT_GT(mean, 1e-3) << "the Cornell box's GI should not be black";
   const double rmse = engine::image::rmse_clamped(on_host.gi, on_own.gi);
   std::printf("host's device against the plugin's own: GI RMSE %.3g, mean GI %.4f (%s)\n", rmse, mean, on_host.backend.c_str());
