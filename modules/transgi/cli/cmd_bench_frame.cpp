@@ -10,6 +10,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "cli/args.h"
+#include "cli/option_specs.h"
 #include "cli/commands.h"
 #include "cli/reference_view.h"
 #include "cli/runtime_options.h"
@@ -78,17 +79,13 @@ ecs::Entity pick_moving_object(ecs::World& world, const std::string& name) {
 }  // namespace
 
 int run_bench_frame(const std::vector<std::string>& argv) {
-  const Args args("bench-frame", argv,
-                  {"scene", "model", "width", "height", "frames", "warmup", "preset", "csv", "object", "threads", "camera",
-                   "direct-spp", "gi-scale", "gi-reuse", "taa", "probe-budget", "probe-settle", "backend", "device", "device-inference", "device-shading", "device-lights", "near-field-rays", "near-field-reach", "near-field-filter", "direct", "gi-out", "reference-out", "reference-spp", "map-width",
-                   "probe-volume", "probe-grid", "cascades", "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "cascade-map-width"},
-                  {"allow-unbaked"});
+  const Args args("bench-frame", argv, bench_frame_option_specs(), kBenchFrameSynopsis);
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const int width = static_cast<int>(args.integer("width", 16, 8192, 640));
   const int height = static_cast<int>(args.integer("height", 16, 8192, 360));
   const int frames = static_cast<int>(args.integer("frames", 1, 100000, 100));
   const int warmup = static_cast<int>(args.integer("warmup", 0, 100000, 64));
-  const std::string preset = args.choice("preset", {"realtime", "quality"}, "realtime");
+  const std::string preset = args.choice("preset", {"quality", "realtime"}, "realtime");
   const int threads = static_cast<int>(args.integer("threads", 0, 1024, 0));
   const std::string csv = args.str("csv", std::string());
   // Options first, so a typo is reported before seconds of loading.

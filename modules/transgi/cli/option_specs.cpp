@@ -50,11 +50,11 @@ void append(std::vector<OptionSpec>& to, std::vector<OptionSpec> from) {
 
 }  // namespace
 
-std::vector<OptionSpec> runtime_option_specs() {
+std::vector<OptionSpec> runtime_option_specs(const std::string& default_preset) {
   const runtime::TransGISettings q = runtime::quality_preset(), r = runtime::realtime_preset();
   const auto direct = [](runtime::DirectLight d) { return d == runtime::DirectLight::Deterministic ? "deterministic" : "stochastic"; };
   return {
-      choice("preset", {"quality", "realtime"}, "quality",
+      choice("preset", {"quality", "realtime"}, default_preset,
              "the settings the options below change: quality is the paper's path, realtime the game's"),
       number("gi-scale", "S", 0.05, 1.0, by_preset(q.realtime.resolution_scale, r.realtime.resolution_scale),
              "real-time GI resolution over the image's: higher = finer GI, at the cost of more decoded points"),
@@ -160,9 +160,38 @@ std::vector<OptionSpec> render_option_specs() {
       integer("warmup-frames", "W", 0, 100000, "64", "ddgi: first frames blended without hysteresis"),
       number("irradiance-gamma", "G", 0.1, 20.0, number_text(d.irradiance_gamma), "ddgi: the irradiance maps' encoding gamma"),
   };
-  append(o, runtime_option_specs());
+  append(o, runtime_option_specs("quality"));
   append(o, placement_option_specs(runtime::ProbeVolumeMode::Cascades));
   append(o, sun_option_specs());
+  return o;
+}
+
+const char* const kBenchFrameSynopsis =
+    "usage: transgi bench-frame --scene S.gltf --model M.tgm [options]\n"
+    "  The real-time frame's time, stage by stage, with an object moving.\n";
+
+std::vector<OptionSpec> bench_frame_option_specs() {
+  const runtime::TransGISettings r = runtime::realtime_preset();
+  std::vector<OptionSpec> o = {
+      text("scene", "PATH", "", "the glTF scene"),
+      text("model", "PATH", "", "the baked transfer model (.tgm)"),
+      flag("allow-unbaked", "shade meshes the model has no latents for diffusely instead of refusing"),
+      integer("width", "W", 16, 8192, "640", "frame width in pixels"),
+      integer("height", "H", 16, 8192, "360", "frame height in pixels"),
+      integer("frames", "N", 1, 100000, "100", "frames timed"),
+      integer("warmup", "N", 0, 100000, "64", "frames run before the timing starts"),
+      integer("threads", "T", 0, 1024, "0 (every core)", "worker threads"),
+      text("camera", "NAME", "the scene's first", "the camera node to render from"),
+      text("object", "NAME", "the smallest mesh node a tenth of the scene's size or more",
+           "the node moved on an orbit 0.15 of its size wide, a turn every 120 frames"),
+      text("csv", "PATH", "none", "every frame's stage times as CSV"),
+      integer("direct-spp", "N", 0, 100000, std::to_string(r.direct_spp), "direct-light samples per pixel (--direct stochastic)"),
+      text("gi-out", "PATH", "none", "the last frame's GI pass as EXR"),
+      text("reference-out", "PATH", "none", "the path tracer's GI pass of the moved scene as EXR"),
+      integer("reference-spp", "N", 1, 1 << 20, "1024", "samples per pixel of --reference-out"),
+  };
+  append(o, runtime_option_specs("realtime"));
+  append(o, placement_option_specs(runtime::ProbeVolumeMode::Cascades));
   return o;
 }
 

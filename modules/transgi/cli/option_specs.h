@@ -13,8 +13,9 @@ namespace transgi::cli {
 using engine::core::OptionSpec;
 
 // What runtime_settings_from and near_field_from read (--preset, --gi-scale,
-// --probe-budget, ..., --near-field-*); defaults from the presets.
-std::vector<OptionSpec> runtime_option_specs();
+// --probe-budget, ..., --near-field-*); defaults from the presets, the
+// preset itself `default_preset` (the command's).
+std::vector<OptionSpec> runtime_option_specs(const std::string& default_preset);
 // What probe_placement_from reads (--probe-volume, --probe-grid, --cascade-*).
 std::vector<OptionSpec> placement_option_specs(runtime::ProbeVolumeMode default_mode);
 // What apply_sun_options reads (--sun-elevation, --sun-azimuth).
@@ -23,5 +24,8 @@ std::vector<OptionSpec> sun_option_specs();
 // Every option `render` accepts, and the line --help prints above them.
 std::vector<OptionSpec> render_option_specs();
 extern const char* const kRenderSynopsis;
+// The same for `bench-frame`.
+std::vector<OptionSpec> bench_frame_option_specs();
+extern const char* const kBenchFrameSynopsis;
 
 }  // namespace transgi::cli
