@@ -61,3 +61,40 @@ foreach(component_package runtime:transgi dev:transgi-dev)
     COMPONENT ${component})
   install(FILES ${TRANSGI_CHANGELOG_GZ} DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/${package} COMPONENT ${component})
 endforeach()
+
+# Man pages (lintian: no-manual-page), written by help2man from the programs'
+# own --help when it is installed, so they say what --help says; gzip -9n as
+# Debian wants them.
+find_program(TRANSGI_HELP2MAN help2man)
+if(TRANSGI_HELP2MAN)
+  set(man_dir ${PROJECT_BINARY_DIR}/man)
+  set(man_pages)
+  foreach(entry "transgi:real-time dynamic global illumination: render, bake, compare and benchmark"
+                "transgi-game:the TransGI sample game and level editor")
+    string(FIND "${entry}" ":" colon)
+    string(SUBSTRING "${entry}" 0 ${colon} program)
+    math(EXPR after "${colon} + 1")
+    string(SUBSTRING "${entry}" ${after} -1 summary)
+    if(NOT TARGET ${program})
+      continue()
+    endif()
+    # transgi's page also holds render's and bench-frame's option tables.
+    set(include_sections)
+    set(include_option)
+    if(program STREQUAL "transgi")
+      set(include_sections COMMAND ${CMAKE_COMMAND} -DTOOL=$<TARGET_FILE:transgi> -DOUT=${man_dir}/transgi.h2m
+                                   -P ${PROJECT_SOURCE_DIR}/cmake/ManInclude.cmake)
+      set(include_option --include=${man_dir}/transgi.h2m)
+    endif()
+    add_custom_command(OUTPUT ${man_dir}/${program}.1.gz
+      COMMAND ${CMAKE_COMMAND} -E make_directory ${man_dir}
+      ${include_sections}
+      COMMAND ${TRANSGI_HELP2MAN} --no-info --section=1 --version-string=${PROJECT_VERSION} --name=${summary}
+              ${include_option} --output=${man_dir}/${program}.1 $<TARGET_FILE:${program}>
+      COMMAND gzip -9nf ${man_dir}/${program}.1
+      DEPENDS ${program} ${PROJECT_SOURCE_DIR}/cmake/ManInclude.cmake VERBATIM)
+    list(APPEND man_pages ${man_dir}/${program}.1.gz)
+  endforeach()
+  add_custom_target(transgi_man_pages ALL DEPENDS ${man_pages})
+  install(FILES ${man_pages} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1 COMPONENT runtime)
+endif()

@@ -14,7 +14,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   liblua5.4-dev libglfw3-dev libimgui-dev libgl-dev libgl1-mesa-dri
   libvulkan-dev glslang-dev glslang-tools spirv-tools vulkan-validationlayers
-  xvfb xauth ffmpeg
+  xvfb xauth ffmpeg help2man
 )
 # --fuzz: also the compiler of the `fuzz` preset (clang 14 with libFuzzer and
 # its sanitizer runtimes; tests/fuzz/README.md). The test suite does not need it.
