@@ -95,6 +95,11 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   ecs::World& world = scene.app->world();
   auto model = model::load_model(model_path);
   model::validate_model(model, world.resource<scene::SceneAssets>(), model_path, args.has("allow-unbaked"));
+  // The decoder's multiply-adds per point (2 FLOP each), for the inference's
+  // rate against the machine's peak; the dot with the light is left out.
+  double mlp_flop_per_point = 0;
+  for (int l = 0; l < model.decoder.layout().layer_count(); ++l)
+    mlp_flop_per_point += 2.0 * model.decoder.layout().in_of(l) * model.decoder.layout().out_of(l);
   settings.direct_spp = static_cast<int>(args.integer("direct-spp", 0, 100000, settings.direct_spp));
   scene.app->add_plugin<runtime::TransGIPlugin>(settings);
   runtime::attach_latent_meshes(world, std::make_shared<const model::TransferModel>(std::move(model)));
@@ -130,7 +135,7 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   std::ostringstream rows;
   rows << "frame,total_ms,gbuffer_ms,inference_ms,sh_light_ms,upsample_ms,probe_trace_ms,probe_raster_ms,probe_project_ms,"
           "direct_ms,antialiasing_ms,probes_traced,decoded_pixels,gpu_trace_ms,gpu_raster_ms,gpu_projection_ms,gpu_gbuffer_ms,gpu_inference_ms,gpu_shading_ms,gpu_accumulation_ms\n";
-  std::vector<double> totals;
+  std::vector<double> totals, inference_gflops;
   std::vector<std::vector<double>> stages;
   core::ProgressBar bar("bench-frame", static_cast<std::uint64_t>(warmup + frames), true);
   for (int f = 0; f < warmup + frames; ++f) {
@@ -149,6 +154,7 @@ int run_bench_frame(const std::vector<std::string>& argv) {
                                   s.collect_points, s.probe_raster, s.probe_projection, s.direct, s.antialiasing};
     totals.push_back(ms);
     stages.push_back(row);
+    if (s.inference > 0) inference_gflops.push_back(static_cast<double>(frame.realtime.inferred) * mlp_flop_per_point / (s.inference * 1e6));
     rows << f - warmup << ',' << ms;
     for (double v : row) rows << ',' << v;
     rows << ',' << frame.probe_stats.traced << ',' << frame.shaded_samples << ',' << frame.gpu_trace_ms << ','
@@ -172,6 +178,21 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   std::printf("last frame: %zu pixels decoded (%zu grid, %zu edge), %zu grid cells reused from the frame before, %zu rotations, %d probes traced\n",
               frame.realtime.grid_samples + frame.realtime.edge_samples, frame.realtime.grid_samples,
               frame.realtime.edge_samples, frame.realtime.reused_cells, frame.realtime.rotations, frame.probe_stats.traced);
+  if (!inference_gflops.empty()) {
+    const shading::FusedIsa isa = shading::best_fused_isa();
+    const double peak_gflops = isa == shading::FusedIsa::Amx          ? peak.amx_gflops
+                               : isa == shading::FusedIsa::Avx512Bf16 ? peak.bf16_gflops
+                               : isa == shading::FusedIsa::Avx2       ? peak.fp32_gflops
+                                                                      : 0.0;
+    const double rate = percentile(inference_gflops, 0.5);
+    std::printf("inference rate: %zu points last frame x %.1f kFLOP (the decoder's multiply-adds); median %.1f GFLOP/s", frame.realtime.inferred,
+                mlp_flop_per_point * 1e-3, rate);
+    if (peak_gflops > 0)
+      std::printf(", %.0f %% of the %s peak measured above (%.0f GFLOP/s)", 100.0 * rate / peak_gflops,
+                  isa == shading::FusedIsa::Avx2 ? "fp32 FMA" : isa == shading::FusedIsa::Amx ? "AMX bf16" : "AVX-512 bf16",
+                  peak_gflops);
+    std::printf("\n");
+  }
   world.view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& set) {
     if (set.state.fitted_to_scene) std::printf("cascades: the scene is small enough for one grid over its bounds (--cascade-fit-scene)\n");
     for (std::size_t k = 0; k < set.state.fields.size() && k < frame.cascade_stats.size(); ++k) {
