@@ -2,6 +2,7 @@
 // Warps from the unit square to directions and shapes, with their pdfs.
 // Conventions: local frames have +z as the normal; pdfs are per solid angle.
 #include <cmath>
+#include <cstdint>
 
 #include <glm/glm.hpp>
 #include <glm/gtc/constants.hpp>
@@ -24,6 +25,17 @@ struct Frame {
   [[nodiscard]] glm::vec3 to_local(const glm::vec3& v) const { return {glm::dot(v, t), glm::dot(v, b), glm::dot(v, n)}; }
   [[nodiscard]] glm::vec3 to_world(const glm::vec3& v) const { return v.x * t + v.y * b + v.z * n; }
 };
+
+// Point k of the R2 sequence (Roberts 2018: steps of 1 / the plastic
+// number and its square), shifted by `offset` modulo 1: any run of
+// consecutive points covers the unit square evenly. Double precision, so
+// k in the millions (a frame count) keeps its spacing.
+inline glm::vec2 r2_point(std::uint64_t k, glm::vec2 offset = glm::vec2(0.5f)) {
+  constexpr double a1 = 0.75487766624669276, a2 = 0.56984029099805327;
+  const double kk = static_cast<double>(k % (std::uint64_t{1} << 40));
+  const double x = static_cast<double>(offset.x) + kk * a1, y = static_cast<double>(offset.y) + kk * a2;
+  return {static_cast<float>(x - std::floor(x)), static_cast<float>(y - std::floor(y))};
+}
 
 inline glm::vec2 sample_concentric_disk(glm::vec2 u) {
   const glm::vec2 o = 2.0f * u - 1.0f;

@@ -29,30 +29,18 @@ struct Surface {
 // incoming_dir: the direction of the ray that found the hit.
 Surface make_surface(const rt::RtScene& scene, const rt::Hit& hit, const glm::vec3& incoming_dir);
 
-// The material at a point on a mesh (base colour, roughness, ... from
-// factors and textures). Shared by the renderer and the bake. uv_footprint:
-// the width of the area to average, in UV units (0 = a point sample, as
-// Monte Carlo renderers take); textures are then read at the mip level it
-// asks for (Texture::sample with lod).
-// Inline: a G-buffer builds one per pixel and reads fields of it back at
-// once; returned from another unit, each read waits on a store it cannot
-// forward.
-inline material::BrdfParams evaluate_material(const scene::SceneAssets& assets, std::uint32_t material, glm::vec2 uv,
-                                              float uv_footprint = 0);
-glm::vec3 evaluate_emission(const scene::SceneAssets& assets, std::uint32_t material, glm::vec2 uv, float uv_footprint = 0);
-
-// Ray cones (Akenine-Moller et al. 2019, "Texture Level of Detail Strategies
-// for Real-Time Ray Tracing"): a cone `cone_width` wide where it meets
-// triangle `triangle` of `mesh` (scaled by `scale` into the world) at an angle
-// whose cosine is cos_theta covers this width in UV units. 0 when the mesh
-// has no UVs or the triangle no area.
-float uv_footprint(const scene::MeshAsset& mesh, std::uint32_t triangle, float scale, float cone_width, float cos_theta);
-
 // A texture read at the mip level a footprint asks for (0: the finest).
 glm::vec4 sample_texture(const scene::Texture& t, glm::vec2 uv, bool srgb, float footprint);
 
+// The material at a point on a mesh (base colour, roughness, ... from
+// factors and textures). Shared by the renderer and the bake. footprint:
+// the width of the area to average, in UV units (0 = a point sample, as
+// Monte Carlo renderers take); textures are then read at the mip level it
+// asks for (Texture::sample with lod). Inline: a G-buffer builds one per
+// pixel and reads fields of it back at once; returned from another unit,
+// each read waits on a store it cannot forward.
 inline material::BrdfParams evaluate_material(const scene::SceneAssets& assets, std::uint32_t index, glm::vec2 uv,
-                                              float footprint) {
+                                              float footprint = 0) {
   const material::Material& m = assets.materials[index];
   material::BrdfParams p;
   glm::vec4 base = m.base_color_factor;
@@ -69,6 +57,15 @@ inline material::BrdfParams evaluate_material(const scene::SceneAssets& assets, 
   p.specular_color = m.specular_color_factor;
   return p;
 }
+glm::vec3 evaluate_emission(const scene::SceneAssets& assets, std::uint32_t material, glm::vec2 uv, float uv_footprint = 0);
+
+// Ray cones (Akenine-Moller et al. 2019, "Texture Level of Detail Strategies
+// for Real-Time Ray Tracing"): a cone `cone_width` wide where it meets
+// triangle `triangle` of `mesh` (scaled by `scale` into the world) at an angle
+// whose cosine is cos_theta covers this width in UV units. 0 when the mesh
+// has no UVs or the triangle no area.
+float uv_footprint(const scene::MeshAsset& mesh, std::uint32_t triangle, float scale, float cone_width, float cos_theta);
+
 // The mip level for a footprint on a texture of w x h texels.
 float texture_lod(float uv_footprint, int w, int h);
 

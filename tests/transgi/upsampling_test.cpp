@@ -78,7 +78,7 @@ TEST(Upsampling, VectorKernelEqualsTheReferenceBitForBit) {
   if (engine::cpu::isa_enabled(engine::cpu::Isa::Avx2)) kernels.push_back(UpsamplingIsa::Avx2);
   if (kernels.empty()) GTEST_SKIP() << "no AVX2 or AVX-512 on " << engine::cpu::isa_summary() << ": only the reference runs";
   for (const UpsamplingIsa isa : kernels) {
-    SCOPED_TRACE(isa == UpsamplingIsa::Avx512 ? "avx512" : "avx2");
+    SCOPED_TRACE(upsampling_isa_name(isa));
     engine::math::Pcg32 rng(21, 5);
     // Sizes that are and are not multiples of 16, scales that are not halves,
     // normal powers from 0, and guides with misses, depth steps and NaN.

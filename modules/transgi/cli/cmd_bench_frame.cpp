@@ -120,9 +120,7 @@ int run_bench_frame(const std::vector<std::string>& argv) {
               shading::fused_isa_name(shading::best_fused_isa()));
   std::printf("instruction sets: %s; fused inference %s, upsampling %s, probe kernels %s, GEMM (oneDNN) %s\n",
               engine::cpu::isa_summary().c_str(), shading::fused_isa_name(shading::best_fused_isa()),
-              shading::best_upsampling_isa() == shading::UpsamplingIsa::Avx512 ? "avx512"
-              : shading::best_upsampling_isa() == shading::UpsamplingIsa::Avx2 ? "avx2"
-                                                                                : "scalar",
+              shading::upsampling_isa_name(shading::best_upsampling_isa()),
               engine::cpu::isa_name(std::min(engine::cpu::effective_isa(), engine::cpu::Isa::Avx512)),
               model::onednn_isa_name().c_str());
   std::printf("moving '%s' on a %.3f m orbit, a full turn every 120 frames; preset %s, %dx%d\n",

@@ -23,9 +23,7 @@ glm::vec2 disk_pattern(int x, int y) {
   const unsigned i = static_cast<unsigned>((x & 7) | ((y & 7) << 3));
   unsigned r = 0;
   for (int b = 0; b < 6; ++b) r |= ((i >> b) & 1u) << (5 - b);
-  const float a1 = 0.7548776662f, a2 = 0.5698402910f;  // R2: 1 / plastic number, its square
-  const float k = static_cast<float>(r);
-  return {std::fmod(0.5f + a1 * k, 1.0f), std::fmod(0.5f + a2 * k, 1.0f)};
+  return engine::math::r2_point(r);
 }
 
 DirectTileShader::DirectTileShader(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,

@@ -102,23 +102,10 @@ glm::vec3 shade_glossy_gi(const engine::rt::RtScene& scene, const GSample& smp, 
   return weight * reflected_gi(scene, smp, glm::normalize(frame.to_world(wi)), light_at, lights, mirror.light_samples, rng);
 }
 
-namespace {
-
-// Point k of the R2 sequence (Roberts 2018: the plastic number's powers),
-// shifted by `offset` modulo 1.
-glm::vec2 r2_point(std::uint64_t k, glm::vec2 offset) {
-  constexpr double a1 = 0.75487766624669276, a2 = 0.56984029099805327;
-  const double kk = static_cast<double>(k % (1ull << 40));
-  const double x = offset.x + kk * a1, y = offset.y + kk * a2;
-  return {static_cast<float>(x - std::floor(x)), static_cast<float>(y - std::floor(y))};
-}
-
-}  // namespace
-
 glm::vec2 gbuffer_subpixel(std::uint64_t pattern_seed, std::size_t pixel, std::uint64_t sample) {
   engine::math::Pcg32 rng = engine::math::make_rng(pattern_seed, pixel, 0x5EEDull);
   const glm::vec2 offset{rng.next_float(), rng.next_float()};
-  return r2_point(sample, offset);
+  return engine::math::r2_point(sample, offset);
 }
 
 TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,

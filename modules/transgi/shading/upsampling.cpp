@@ -63,6 +63,15 @@ UpsamplingIsa best_upsampling_isa() {
   return isa;
 }
 
+const char* upsampling_isa_name(UpsamplingIsa isa) {
+  switch (isa) {
+    case UpsamplingIsa::Avx512: return "avx512";
+    case UpsamplingIsa::Avx2: return "avx2";
+    case UpsamplingIsa::Scalar: break;
+  }
+  return "scalar";
+}
+
 void plan_upsampling(const std::vector<glm::vec4>& guide, int width, int height, const RealtimeGiSettings& s, UpsamplingPlan& u,
                      UpsamplingIsa isa) {
   const float scale = std::clamp(s.resolution_scale, 1e-3f, 1.0f);

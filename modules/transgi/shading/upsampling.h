@@ -65,6 +65,7 @@ enum class UpsamplingIsa { Scalar, Avx2, Avx512 };
 // The fastest kernel the effective ISA allows (TRANSGI_MAX_ISA caps it;
 // TRANSGI_UPSAMPLING_ISA=scalar forces the reference).
 UpsamplingIsa best_upsampling_isa();
+const char* upsampling_isa_name(UpsamplingIsa isa);
 
 // guide: per output pixel, world normal (xyz) and depth (w; 0 = miss), row-major.
 void plan_upsampling(const std::vector<glm::vec4>& guide, int width, int height, const RealtimeGiSettings& s, UpsamplingPlan& u,
