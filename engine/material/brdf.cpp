@@ -12,7 +12,6 @@ using math::kInvPi;
 using math::kPi;
 
 namespace {
-constexpr float kDielectricF0 = 0.04f;
 
 float alpha_of(const BrdfParams& p) { return std::max(kMinAlpha, p.roughness * p.roughness); }
 float pow5(float x) {

@@ -36,6 +36,9 @@ struct BrdfParams {
 // Roughness below this is clamped: a perfect mirror is represented by a very
 // sharp GGX lobe (alpha = 1e-6 would overflow D in float).
 inline constexpr float kMinAlpha = 1e-3f;
+// A dielectric's Fresnel reflectance at normal incidence (index 1.5), times
+// specular_color.
+inline constexpr float kDielectricF0 = 0.04f;
 
 struct BrdfSample {
   glm::vec3 wi{0.0f};

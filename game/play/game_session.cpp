@@ -238,7 +238,7 @@ std::vector<GameSession::StageTime> GameSession::stage_times() const {
   }
   const auto& t = w.resource<transgi::runtime::GiFrame>().times;
   return {{"G-buffer", t.gbuffer + t.network_input}, {"inference", t.inference}, {"SH light", t.sh_multiplication},
-          {"upsample", t.upsample},           {"direct", t.direct},          {"antialiasing", t.antialiasing},
+          {"upsample", t.upsample},           {"reflections", t.reflections}, {"direct", t.direct},          {"antialiasing", t.antialiasing},
           {"probe rays", t.collect_points},   {"raster", t.probe_raster},    {"projection", t.probe_projection}};
 }
 

@@ -132,7 +132,7 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   frame.height = height;
   std::ostringstream rows;
   rows << "frame,total_ms,gbuffer_ms,inference_ms,sh_light_ms,upsample_ms,probe_trace_ms,probe_raster_ms,probe_project_ms,"
-          "direct_ms,antialiasing_ms,probes_traced,decoded_pixels,gpu_trace_ms,gpu_raster_ms,gpu_projection_ms,gpu_gbuffer_ms,gpu_inference_ms,gpu_shading_ms,gpu_accumulation_ms\n";
+          "direct_ms,antialiasing_ms,reflections_ms,probes_traced,decoded_pixels,gpu_trace_ms,gpu_raster_ms,gpu_projection_ms,gpu_gbuffer_ms,gpu_inference_ms,gpu_shading_ms,gpu_accumulation_ms\n";
   std::vector<double> totals, inference_gflops;
   std::vector<std::vector<double>> stages;
   core::ProgressBar bar("bench-frame", static_cast<std::uint64_t>(warmup + frames), true);
@@ -149,7 +149,7 @@ int run_bench_frame(const std::vector<std::string>& argv) {
     if (f < warmup) continue;
     const auto& s = frame.times;
     const std::vector<double> row{s.gbuffer + s.network_input, s.inference, s.sh_multiplication, s.upsample,
-                                  s.collect_points, s.probe_raster, s.probe_projection, s.direct, s.antialiasing};
+                                  s.collect_points, s.probe_raster, s.probe_projection, s.direct, s.antialiasing, s.reflections};
     totals.push_back(ms);
     stages.push_back(row);
     if (s.inference > 0) inference_gflops.push_back(static_cast<double>(frame.realtime.inferred) * mlp_flop_per_point / (s.inference * 1e6));
@@ -163,7 +163,7 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   if (!csv.empty()) eval::write_text(csv, rows.str());
 
   const char* names[] = {"G-buffer", "inference (fused)", "SH light", "upsampling", "probe rays + shading", "probe raster",
-                         "probe accumulation + projection", "direct light", "antialiasing"};
+                         "probe accumulation + projection", "direct light", "antialiasing", "reflections"};
   std::printf("frame time over %d frames after %d warm-up: median %.2f ms, p95 %.2f, max %.2f\n", frames, warmup,
               percentile(totals, 0.5), percentile(totals, 0.95), percentile(totals, 1.0));
   std::printf("stage medians (ms):");
@@ -173,9 +173,10 @@ int run_bench_frame(const std::vector<std::string>& argv) {
     std::printf(" %s %.2f;", names[k], percentile(v, 0.5));
   }
   std::printf("\n");
-  std::printf("last frame: %zu pixels decoded (%zu grid, %zu edge), %zu grid cells reused from the frame before, %zu rotations, %d probes traced\n",
+  std::printf("last frame: %zu pixels decoded (%zu grid, %zu edge), %zu grid cells reused from the frame before, %zu rotations, %zu reflection rays, %d probes traced\n",
               frame.realtime.grid_samples + frame.realtime.edge_samples, frame.realtime.grid_samples,
-              frame.realtime.edge_samples, frame.realtime.reused_cells, frame.realtime.rotations, frame.probe_stats.traced);
+              frame.realtime.edge_samples, frame.realtime.reused_cells, frame.realtime.rotations, frame.realtime.reflection_rays,
+              frame.probe_stats.traced);
   if (!inference_gflops.empty()) {
     const shading::FusedIsa isa = shading::best_fused_isa();
     const double peak_gflops = isa == shading::FusedIsa::Amx          ? peak.amx_gflops

@@ -124,7 +124,7 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
       [&] {
         const auto& t = frame.times;
         return std::vector<double>{t.gbuffer + t.network_input, t.inference, t.collect_points, t.probe_raster,
-                                   t.probe_projection, t.sh_multiplication, t.upsample, t.direct};
+                                   t.probe_projection, t.sh_multiplication, t.upsample, t.reflections, t.direct};
       },
       [&] { traced += frame.probe_stats.traced; });
   MethodRun r;
@@ -135,9 +135,9 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
   r.inferred_samples = frame.inferred_samples;
   r.backend = frame.backend + (frame.backend_fallback.empty() ? "" : "; " + frame.backend_fallback);
   r.stages = medians({"generate network input", "network inference", "collect shaded points", "probe raster",
-                      "probe accumulation + SH projection", "SH multiplication", "GI upsampling", "direct light"},
+                      "probe accumulation + SH projection", "SH multiplication", "GI upsampling", "reflections", "direct light"},
                      samples);
-  r.frame_ms = median_total(samples, 7);
+  r.frame_ms = median_total(samples, 8);
   world.view<const runtime::ProbeVolume>().each([&](const runtime::ProbeVolume& v) {
     if (v.field) r.probe_bytes += v.field->memory_bytes();
   });

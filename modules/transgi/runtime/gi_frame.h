@@ -24,6 +24,7 @@ struct GiStageTimes {
   double sh_multiplication = 0;  // probe interpolation, SH rotation and dot product
   double direct = 0;           // direct light (not TransGI's)
   double upsample = 0;         // real-time path: choosing decoded pixels and upsampling (0 on the quality path)
+  double reflections = 0;      // real-time path: metals' and glossy dielectrics' reflection rays and their filter
   double antialiasing = 0;     // real-time path: the temporal antialiasing's resolve (0 when off)
 };
 

@@ -185,6 +185,7 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   t.inference = st.inference_ms;
   t.sh_multiplication = st.rotate_ms + st.light_ms + st.near_ms;
   t.upsample = st.upsample_ms;
+  t.reflections = st.reflect_ms;
   frame.shaded_samples = st.grid_samples + st.edge_samples;
   frame.inferred_samples = st.inferred;
   frame.realtime = st;

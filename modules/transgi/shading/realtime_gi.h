@@ -86,6 +86,12 @@ struct GBuffer {
   // infinity (misses too), so the mirror pass finds its pixels in 4 bytes a
   // pixel rather than reading every GSample's material; written by trace_gbuffer.
   std::vector<float> metal_roughness;
+  // Per pixel: the roughness of a non-metal with a specular layer
+  // (specular > 0), else infinity: the glossy dielectrics of MirrorRay.
+  std::vector<float> dielectric_roughness;
+  // Per 4x4 tile ((width + 3) / 4 a row): the least dielectric_roughness in
+  // it, so a pass over the glossy dielectrics skips the tiles without one.
+  std::vector<float> tile_dielectric_roughness;
   // Per pixel: the entity hit (null for a miss), so routing samples by object
   // reads 8 bytes a pixel rather than a GSample; written by trace_gbuffer.
   std::vector<engine::ecs::Entity> entity;
@@ -136,6 +142,7 @@ struct RealtimeGiStats {
   double inference_ms = 0;  // latent gather, inputs, fused decoder + SH dot
   double inference_device_ms = 0;  // the batch decoder's own time (a GPU's timestamps), when one decoded
   double upsample_ms = 0;   // choosing samples, joint bilateral upsampling
+  double reflect_ms = 0;    // reflection rays of metals and glossy dielectrics, their filter
   double near_ms = 0;       // near-field rays on the decoded grid (off in the real-time preset)
   std::size_t grid_samples = 0, edge_samples = 0;  // decoded: on the grid, on their own
   std::size_t reused_cells = 0;                     // grid cells that took the previous frame's value
@@ -144,6 +151,7 @@ struct RealtimeGiStats {
   // Decoded samples whose GI came out non-finite (a NaN latent or weight, an
   // overflowing light) and were set to zero before upsampling.
   std::size_t nonfinite_samples = 0;
+  std::size_t reflection_rays = 0;                 // metals' (one a pixel) and glossy dielectrics' (one a 2x2 block at most)
 };
 
 // The GI image (output size = g's) from the probes of `fields` (a point
@@ -159,7 +167,11 @@ struct RealtimeGiStats {
 // contact light (near_field.h; mirror_lights light its hits), filtered over
 // the grid; edge pixels decoded on their own do not. With batch_decoder (a
 // GPU backend's kernel) the network samples are decoded by it in one batch
-// instead of by `decoder` tile by tile.
+// instead of by `decoder` tile by tile. Unless mirror.max_roughness < 0,
+// metals and glossy dielectrics reflect by rays (MirrorRay): a metal's GI is
+// its ray's, a glossy dielectric's is its diffuse light from the probes plus
+// its filtered rays'; the sky and emitters those rays see, and not the
+// probes' direct SH through their transfer, are their direct light.
 engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
                                           const engine::scene::SceneAssets& assets, const model::TransferModel* model,
                                           const FusedDecoder* decoder,

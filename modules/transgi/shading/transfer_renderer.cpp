@@ -34,72 +34,105 @@ bool is_mirror(const engine::material::BrdfParams& brdf, const MirrorRay& mirror
 
 namespace {
 
-// What a reflection ray from `smp` along wi finds, as GI: the hit's diffuse
-// albedo / pi x its irradiance (the probes' SH, plus light_samples
-// next-event samples of the lights); emitters and the sky are direct light.
-glm::vec3 reflected_gi(const engine::rt::RtScene& scene, const GSample& smp, const glm::vec3& wi, const LightAt& light_at,
-                       const engine::render::LightSet* lights, int light_samples, engine::math::Pcg32& rng) {
+// Irradiance at a reflection ray's hit from light_samples next-event
+// samples of the lights (sky, emitters and punctual lights alike).
+glm::vec3 sampled_irradiance(const engine::rt::RtScene& scene, const engine::render::Surface& s,
+                             const engine::render::LightSet* lights, int light_samples, engine::math::Pcg32& rng) {
   using namespace engine;
-  if (glm::dot(wi, smp.geometric_normal) <= 0) return glm::vec3(0.0f);
-  rt::Hit hit;
-  if (!scene.intersect(rt::Ray{rt::offset_ray_origin(smp.position, smp.geometric_normal, scene.offset_scale()), wi}, hit)) return glm::vec3(0.0f);
-  const render::Surface s = render::make_surface(scene, hit, wi);
-  if (s.emission.r > 0 || s.emission.g > 0 || s.emission.b > 0) return glm::vec3(0.0f);  // direct light
-  const glm::vec3 albedo = material::diffuse_albedo(s.brdf);
-  if (albedo == glm::vec3(0.0f)) return glm::vec3(0.0f);
-  float sh[75];
-  light_at(s.position, s.shading_normal, sh);
-  glm::vec3 irradiance = sh_irradiance(sh, s.shading_normal);
-  if (lights && light_samples > 0) {
-    const glm::vec3 origin = rt::offset_ray_origin(s.position, s.geometric_normal, scene.offset_scale());
-    glm::vec3 direct(0.0f);
-    for (int k = 0; k < light_samples; ++k) {
-      render::LightSample ls;
-      const float u_sel = rng.next_float();
-      const glm::vec2 u{rng.next_float(), rng.next_float()};
-      if (!lights->sample(s.position, u_sel, u, ls) || glm::dot(ls.direction, s.geometric_normal) <= 0) continue;
-      const float cos_i = glm::dot(ls.direction, s.shading_normal);
-      if (cos_i <= 0) continue;
-      const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
-      if (scene.occluded(rt::Ray{origin, ls.direction, 0.0f, tmax})) continue;
-      direct += ls.radiance * cos_i / (ls.delta ? 1.0f : ls.pdf);
-    }
-    irradiance += direct / static_cast<float>(light_samples);
+  if (!lights || light_samples <= 0) return glm::vec3(0.0f);
+  const glm::vec3 origin = rt::offset_ray_origin(s.position, s.geometric_normal, scene.offset_scale());
+  glm::vec3 direct(0.0f);
+  for (int k = 0; k < light_samples; ++k) {
+    render::LightSample ls;
+    const float u_sel = rng.next_float();
+    const glm::vec2 u{rng.next_float(), rng.next_float()};
+    if (!lights->sample(s.position, u_sel, u, ls) || glm::dot(ls.direction, s.geometric_normal) <= 0) continue;
+    const float cos_i = glm::dot(ls.direction, s.shading_normal);
+    if (cos_i <= 0) continue;
+    const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
+    if (scene.occluded(rt::Ray{origin, ls.direction, 0.0f, tmax})) continue;
+    direct += ls.radiance * cos_i / (ls.delta ? 1.0f : ls.pdf);
   }
-  return albedo * math::kInvPi * glm::max(irradiance, glm::vec3(0.0f));
+  return direct / static_cast<float>(light_samples);
+}
+
+// The probes' irradiance at a hit (light_at) plus light_samples next-event
+// samples of the lights: the mirror path's estimate.
+HitIrradiance probe_and_sampled_irradiance(const engine::rt::RtScene& scene, const LightAt& light_at,
+                                           const engine::render::LightSet* lights, int light_samples,
+                                           engine::math::Pcg32& rng) {
+  return [&scene, &light_at, lights, light_samples, &rng](const engine::render::Surface& s) {
+    float sh[75];
+    light_at(s.position, s.shading_normal, sh);
+    return sh_irradiance(sh, s.shading_normal) + sampled_irradiance(scene, s, lights, light_samples, rng);
+  };
 }
 
 }  // namespace
 
-glm::vec3 shade_mirror_gi(const engine::rt::RtScene& scene, const GSample& smp, const LightAt& light_at,
-                          const engine::render::LightSet* lights, const MirrorRay& mirror, engine::math::Pcg32& rng) {
-  const glm::vec3 n = smp.normal_world, wo = smp.wo_world;
-  const float cos_o = glm::dot(n, wo);
-  if (cos_o <= 0) return glm::vec3(0.0f);
-  const glm::vec3 wi = glm::normalize(2.0f * cos_o * n - wo);
-  return engine::material::schlick_fresnel(smp.brdf.base_color, cos_o) *
-         reflected_gi(scene, smp, wi, light_at, lights, mirror.light_samples, rng);
+ReflectedLight reflected_light(const engine::rt::RtScene& scene, const GSample& smp, const glm::vec3& wi,
+                               const engine::scene::Environment* sky, const HitIrradiance& irradiance) {
+  using namespace engine;
+  if (glm::dot(wi, smp.geometric_normal) <= 0) return {};
+  rt::Hit hit;
+  if (!scene.intersect(rt::Ray{rt::offset_ray_origin(smp.position, smp.geometric_normal, scene.offset_scale()), wi}, hit))
+    return {sky ? sky->radiance(wi) : glm::vec3(0.0f), glm::vec3(0.0f)};
+  const render::Surface s = render::make_surface(scene, hit, wi);
+  if (s.emission.r > 0 || s.emission.g > 0 || s.emission.b > 0) return {s.emission, glm::vec3(0.0f)};
+  const glm::vec3 albedo = material::diffuse_albedo(s.brdf);
+  if (albedo == glm::vec3(0.0f)) return {};
+  return {glm::vec3(0.0f), albedo * math::kInvPi * glm::max(irradiance(s), glm::vec3(0.0f))};
 }
 
-glm::vec3 shade_glossy_gi(const engine::rt::RtScene& scene, const GSample& smp, const LightAt& light_at,
-                          const engine::render::LightSet* lights, const MirrorRay& mirror, glm::vec2 u,
-                          engine::math::Pcg32& rng) {
+namespace {
+
+}  // namespace
+
+bool sample_reflection(const GSample& smp, bool mirror, glm::vec2 u, glm::vec3& wi_world, glm::vec3& weight) {
   using namespace engine;
+  const bool metal = smp.brdf.metallic >= 0.5f;
+  const glm::vec3 f0 = metal ? smp.brdf.base_color : glm::min(material::kDielectricF0 * smp.brdf.specular_color, glm::vec3(1.0f));
+  const float layer = metal ? 1.0f : smp.brdf.specular;
+  if (mirror) {
+    const glm::vec3 n = smp.normal_world, wo = smp.wo_world;
+    const float cos_o = glm::dot(n, wo);
+    if (cos_o <= 0) return false;
+    wi_world = glm::normalize(2.0f * cos_o * n - wo);
+    weight = layer * material::schlick_fresnel(f0, cos_o);
+    return true;
+  }
   const math::Frame frame = math::Frame::from_normal(smp.normal_world);
   const glm::vec3 wo = frame.to_local(smp.wo_world);
-  if (wo.z <= 0) return glm::vec3(0.0f);
+  if (wo.z <= 0) return false;
   const float alpha = std::max(smp.brdf.roughness * smp.brdf.roughness, material::kMinAlpha);
   const glm::vec3 h = material::sample_ggx_vndf(alpha, wo, u);
   const float wo_h = glm::dot(wo, h);
   const glm::vec3 wi = 2.0f * wo_h * h - wo;
-  if (wi.z <= 0 || wo_h <= 0) return glm::vec3(0.0f);
+  if (wi.z <= 0 || wo_h <= 0) return false;
   // Sampling the visible normals, f cos / pdf = F(wo.h) G2(wo, wi) / G1(wo),
   // which separable Smith makes G1(wi).
-  const glm::vec3 weight = material::schlick_fresnel(smp.brdf.base_color, wo_h) * material::smith_g1(alpha, wi.z);
+  weight = layer * material::schlick_fresnel(f0, wo_h) * material::smith_g1(alpha, wi.z);
+  wi_world = glm::normalize(frame.to_world(wi));
+  return true;
+}
+
+ReflectedLight shade_mirror(const engine::rt::RtScene& scene, const GSample& smp, const LightAt& light_at,
+                            const engine::render::LightSet* lights, const MirrorRay& mirror, engine::math::Pcg32& rng,
+                            const engine::scene::Environment* sky) {
+  return shade_glossy(scene, smp, light_at, lights, mirror, glm::vec2(0.0f), rng, sky, true);
+}
+
+ReflectedLight shade_glossy(const engine::rt::RtScene& scene, const GSample& smp, const LightAt& light_at,
+                            const engine::render::LightSet* lights, const MirrorRay& mirror, glm::vec2 u,
+                            engine::math::Pcg32& rng, const engine::scene::Environment* sky, bool mirror_direction) {
+  glm::vec3 wi, weight;
+  if (!sample_reflection(smp, mirror_direction, u, wi, weight)) return {};
   // The mirror's light samples: with one, the choice of light left the
   // reflections speckled after the antialiasing's 16-phase mean
   // (docs/image-quality.md, "Glossy metals").
-  return weight * reflected_gi(scene, smp, glm::normalize(frame.to_world(wi)), light_at, lights, mirror.light_samples, rng);
+  const ReflectedLight r =
+      reflected_light(scene, smp, wi, sky, probe_and_sampled_irradiance(scene, light_at, lights, mirror.light_samples, rng));
+  return {weight * r.direct, weight * r.gi};
 }
 
 glm::vec2 gbuffer_subpixel(std::uint64_t pattern_seed, std::size_t pixel, std::uint64_t sample) {
@@ -261,7 +294,7 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
   jobs::parallel_for<std::size_t>(0, mirrors.size(), 64, [&](std::size_t b, std::size_t e) {
     for (std::size_t j = b; j < e; ++j) {
       math::Pcg32 rng = math::make_rng(s.seed ^ 0x4D1Bull, mirrors[j], 0);
-      shaded[mirrors[j]] = shade_mirror_gi(scene, samples[mirrors[j]], light_at, s.lights, s.mirror, rng);
+      shaded[mirrors[j]] = shade_mirror(scene, samples[mirrors[j]], light_at, s.lights, s.mirror, rng).gi;
     }
   });
   result.light_ms = ms_since(t0);

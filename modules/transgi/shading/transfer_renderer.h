@@ -12,6 +12,7 @@
 #include "engine/render/camera_rays.h"
 #include "engine/math/rng.h"
 #include "engine/render/light_set.h"
+#include "engine/render/surface.h"
 #include "engine/rt/rt_scene.h"
 #include "model/transfer_model.h"
 #include "shading/gbuffer.h"
@@ -44,6 +45,17 @@ struct MirrorRay {
   // metals with real reflections, at the cost of a ray and its light samples
   // per such pixel, and noise in motion. Below max_roughness = off.
   float glossy_max_roughness = 0.5f;
+  // The real-time path only: non-metals with a specular layer (varnish,
+  // plastic, ceramic) up to this roughness take their specular reflection
+  // from GGX-sampled rays, one per 2x2 pixels, filtered, and their diffuse
+  // light from the probes' irradiance instead of the network's SH-4
+  // transfer, which blurs a varnished floor's reflection of a window into a
+  // grey haze over the whole floor. 0.4 is where Unreal's Lumen stops
+  // tracing reflections by default; rougher lobes are broad enough for the
+  // transfer. Higher = more surfaces with traced reflections, at the cost
+  // of a ray per four such pixels and the network's contact detail in their
+  // diffuse light. Below 0 = off.
+  float dielectric_max_roughness = 0.4f;
   bool operator==(const MirrorRay&) const = default;
 };
 
@@ -78,17 +90,41 @@ struct TransferRenderSettings {
   std::function<float(const glm::vec3&)> probe_spacing_at = nullptr;
 };
 
-// The light leaving a point of a near-mirror towards the viewer, as GI: its
-// Fresnel times what the reflection ray finds, shaded as above. Emitters and
-// the sky seen in the mirror are direct light (the reference's passes), not GI.
-glm::vec3 shade_mirror_gi(const engine::rt::RtScene& scene, const GSample& sample, const LightAt& light_at,
-                          const engine::render::LightSet* lights, const MirrorRay& mirror, engine::math::Pcg32& rng);
-// The same for a glossy metal (roughness alpha = roughness^2), by one ray
-// sampled from the GGX distribution of visible normals with u: its Fresnel
-// and shadowing (F(wo.h) G1(wi), the sample's weight) times what it finds.
-glm::vec3 shade_glossy_gi(const engine::rt::RtScene& scene, const GSample& sample, const LightAt& light_at,
-                          const engine::render::LightSet* lights, const MirrorRay& mirror, glm::vec2 u,
-                          engine::math::Pcg32& rng);
+// A reflection of the sample's specular lobe: its direction and weight
+// (f cos / pdf) with the lobe's Fresnel (a metal's base colour, else the
+// dielectric layer's 0.04 specular_color x specular). `mirror`: the mirror
+// direction (weight: Fresnel at the view angle); else one GGX visible-normal
+// sample drawn with u. False when there is none (a grazing view).
+bool sample_reflection(const GSample& sample, bool mirror, glm::vec2 u, glm::vec3& wi, glm::vec3& weight);
+// What one reflection ray brings back, split as the frame's passes are:
+// `direct` is the sky or emitter it sees (light reflected once), `gi` what
+// its hit reflects diffusely.
+struct ReflectedLight {
+  glm::vec3 direct{0.0f}, gi{0.0f};
+};
+// The irradiance at a reflection ray's hit.
+using HitIrradiance = std::function<glm::vec3(const engine::render::Surface& hit)>;
+// Traces from the sample along wi: a miss sees `sky` (the lighting
+// environment; null = black), an emitter its emission, a diffuse hit
+// reflects its diffuse albedo / pi x irradiance(hit). Not weighted.
+ReflectedLight reflected_light(const engine::rt::RtScene& scene, const GSample& sample, const glm::vec3& wi,
+                               const engine::scene::Environment* sky, const HitIrradiance& irradiance);
+// The light leaving a point of a near-mirror towards the viewer: its Fresnel
+// times what the reflection ray finds (reflected_light above), its hit lit by
+// the probes (light_at) and mirror.light_samples samples of `lights`. The sky
+// (`sky`, null = none) and emitters seen in the mirror are `direct`, as in the
+// reference's passes.
+ReflectedLight shade_mirror(const engine::rt::RtScene& scene, const GSample& sample, const LightAt& light_at,
+                            const engine::render::LightSet* lights, const MirrorRay& mirror, engine::math::Pcg32& rng,
+                            const engine::scene::Environment* sky = nullptr);
+// The same for a glossy surface (alpha = roughness^2), by one ray sampled
+// from the GGX distribution of visible normals with u (sample_reflection):
+// its Fresnel and shadowing, F(wo.h) G1(wi), times what it finds.
+// mirror_direction: the mirror's ray instead (shade_mirror).
+ReflectedLight shade_glossy(const engine::rt::RtScene& scene, const GSample& sample, const LightAt& light_at,
+                            const engine::render::LightSet* lights, const MirrorRay& mirror, glm::vec2 u,
+                            engine::math::Pcg32& rng, const engine::scene::Environment* sky = nullptr,
+                            bool mirror_direction = false);
 // Whether a sample takes the mirror path.
 bool is_mirror(const engine::material::BrdfParams& brdf, const MirrorRay& mirror);
 
