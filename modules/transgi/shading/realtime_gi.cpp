@@ -61,6 +61,12 @@ struct DielectricRays {
   std::vector<glm::vec3> direct, gi;         // per ray: the light it found, times its weight
   std::vector<glm::vec3> mean_direct, mean_gi;  // per ray: its neighbourhood's mean (gather_rays)
   std::vector<std::uint8_t> has_mean;
+  // choose_dielectric_rays' lists per row of 4x4 tiles, before they are joined.
+  struct Row {
+    std::vector<std::size_t> glossy, ray_pixel;
+    std::vector<glm::vec3> direction, weight;
+  };
+  std::vector<Row> rows;
 
   [[nodiscard]] std::size_t block_of(std::size_t p, std::size_t width) const {
     return p / width / 2 * static_cast<std::size_t>(bw) + p % width / 2;
@@ -340,21 +346,15 @@ float same_plane_weight(const GBuffer& g, std::size_t p, std::size_t q) {
   return (1.0f - plane * plane) * (cos_n - 0.9f) * 10.0f;
 }
 
-// One ray per 2x2 block from its pixel on the jitter's side of the centre,
-// so the antialiasing's phases visit the four in turn; none where that pixel
-// is no glossy dielectric or its sample falls below the surface. Each ray
-// keeps its weight (F G1) and its weighted light, both over its pixel's
-// specular albedo E: the filter divides the one sum by the other (a ratio
-// estimator), so a sky the same in every direction comes out exactly E L
-// while the Fresnel's correlation with where the light is, which a
-// split-sum mean of the light alone loses, is kept (Bitterli's Living Room:
-// full-image RMSE 0.132 against 0.137). The plain mean of the weighted light
-// left a uniform sky's reflection noisy by +-25 % a frame.
-void trace_dielectric_rays(const GBuffer& g, const engine::rt::RtScene& scene, const engine::scene::Environment* sky,
-                           const HitIrradiance& irradiance, DielectricRays& rays) {
+// The glossy dielectric pixels (the tiles whose least roughness says they
+// may hold one) and their rays' pixels, directions and weights: row of
+// tiles by row in parallel, then joined in row order, so the lists are the
+// same whatever the thread count. See trace_dielectric_rays for which
+// pixels trace.
+void choose_dielectric_rays(const GBuffer& g, float max_roughness, DielectricRays& rays) {
   using namespace engine;
   const std::uint64_t phase = jitter_phase(g);
-  const std::size_t ox = g.jitter.x >= 0 ? 1 : 0, oy = g.jitter.y >= 0 ? 1 : 0;
+  const int ox = g.jitter.x >= 0 ? 1 : 0, oy = g.jitter.y >= 0 ? 1 : 0;
   const std::size_t width = static_cast<std::size_t>(g.width);
   const int bw = (g.width + 1) / 2, bh = (g.height + 1) / 2;
   if (bw != rays.bw || bh != rays.bh) {
@@ -364,23 +364,63 @@ void trace_dielectric_rays(const GBuffer& g, const engine::rt::RtScene& scene, c
   } else {
     for (const std::size_t blk : rays.traced) rays.ray_of_block[blk] = kNoRay;  // the last frame's
   }
+  const int tiles_x = (g.width + 3) / 4, tiles_y = (g.height + 3) / 4;
+  rays.rows.resize(static_cast<std::size_t>(tiles_y));
+  jobs::parallel_for(0, tiles_y, 4, [&](int r0, int r1) {
+    for (int row = r0; row < r1; ++row) {
+      DielectricRays::Row& out = rays.rows[static_cast<std::size_t>(row)];
+      out.glossy.clear();
+      out.ray_pixel.clear();
+      out.direction.clear();
+      out.weight.clear();
+      for (int tile = 0; tile < tiles_x; ++tile) {
+        if (!(g.tile_dielectric_roughness[static_cast<std::size_t>(row) * tiles_x + tile] <= max_roughness)) continue;
+        for (int y = row * 4; y < std::min(row * 4 + 4, g.height); ++y)
+          for (int x = tile * 4; x < std::min(tile * 4 + 4, g.width); ++x) {
+            const std::size_t p = static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x);
+            if (!(g.dielectric_roughness[p] <= max_roughness)) continue;
+            out.glossy.push_back(p);
+            if (x % 2 != ox || y % 2 != oy) continue;
+            math::Pcg32 rng = math::make_rng(0xD1E1ull, p, phase);
+            glm::vec3 wi, weight;
+            if (!sample_reflection(g.samples[p], false, {rng.next_float(), rng.next_float()}, wi, weight)) continue;
+            out.ray_pixel.push_back(p);
+            out.direction.push_back(wi);
+            out.weight.push_back(weight);
+          }
+      }
+    }
+  });
+  rays.glossy.clear();
   rays.traced.clear();
   rays.ray_pixel.clear();
   rays.direction.clear();
   rays.weight.clear();
-  // The rays' directions first (cheap, serial: the rays keep the glossy
-  // list's order whatever the thread count), then their traces in parallel.
-  for (const std::size_t p : rays.glossy) {
-    if (p % width % 2 != ox || p / width % 2 != oy) continue;
-    math::Pcg32 rng = math::make_rng(0xD1E1ull, p, phase);
-    glm::vec3 wi, weight;
-    if (!sample_reflection(g.samples[p], false, {rng.next_float(), rng.next_float()}, wi, weight)) continue;
-    rays.ray_of_block[rays.block_of(p, width)] = static_cast<std::uint32_t>(rays.traced.size());
-    rays.traced.push_back(rays.block_of(p, width));
-    rays.ray_pixel.push_back(p);
-    rays.direction.push_back(wi);
-    rays.weight.push_back(weight);
+  for (const DielectricRays::Row& row : rays.rows) {
+    rays.glossy.insert(rays.glossy.end(), row.glossy.begin(), row.glossy.end());
+    for (const std::size_t p : row.ray_pixel) {
+      rays.ray_of_block[rays.block_of(p, width)] = static_cast<std::uint32_t>(rays.traced.size());
+      rays.traced.push_back(rays.block_of(p, width));
+    }
+    rays.ray_pixel.insert(rays.ray_pixel.end(), row.ray_pixel.begin(), row.ray_pixel.end());
+    rays.direction.insert(rays.direction.end(), row.direction.begin(), row.direction.end());
+    rays.weight.insert(rays.weight.end(), row.weight.begin(), row.weight.end());
   }
+}
+
+// Traces the rays choose_dielectric_rays picked: one per 2x2 block, from
+// its pixel on the jitter's side of the centre, so the antialiasing's phases
+// visit the four in turn; none where that pixel is no glossy dielectric or
+// its sample falls below the surface. Each ray keeps its weight (F G1) and
+// its weighted light, both over its pixel's specular albedo E: the filter
+// divides the one sum by the other (a ratio estimator), so light the same
+// in every direction comes out exactly E L, without the noise of the
+// Fresnel's spread between samples (a plain mean of the weighted light) and
+// keeping the Fresnel's correlation with where the light is (which a
+// split-sum mean of the light alone loses; docs/image-quality.md).
+void trace_dielectric_rays(const GBuffer& g, const engine::rt::RtScene& scene, const engine::scene::Environment* sky,
+                           const HitIrradiance& irradiance, DielectricRays& rays) {
+  using namespace engine;
   const std::size_t n = rays.traced.size();
   rays.direct.resize(n);
   rays.gi.resize(n);
@@ -446,17 +486,7 @@ std::size_t shade_dielectric_reflections(const GBuffer& g, const engine::rt::RtS
                                   float max_roughness, DielectricRays& rays, engine::image::ImageRGB& image,
                                   engine::image::ImageRGB* direct_out) {
   // The glossy pixels, tile by tile: most tiles have none.
-  rays.glossy.clear();
-  const int tiles_x = (g.width + 3) / 4;
-  for (std::size_t t = 0; t < g.tile_dielectric_roughness.size(); ++t) {
-    if (!(g.tile_dielectric_roughness[t] <= max_roughness)) continue;
-    const int tx = static_cast<int>(t) % tiles_x * 4, ty = static_cast<int>(t) / tiles_x * 4;
-    for (int y = ty; y < std::min(ty + 4, g.height); ++y)
-      for (int x = tx; x < std::min(tx + 4, g.width); ++x) {
-        const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
-        if (g.dielectric_roughness[p] <= max_roughness) rays.glossy.push_back(p);
-      }
-  }
+  choose_dielectric_rays(g, max_roughness, rays);
   if (rays.glossy.empty()) return 0;
   trace_dielectric_rays(g, scene, lights ? lights->environment() : nullptr, probe_hit_irradiance(scene, fields, lights), rays);
   gather_rays(g, rays);
