@@ -348,3 +348,84 @@ TEST(MirrorPath, AVarnishedFloorUnderAUniformSkyShowsItsSpecularAlbedoTimesTheSk
   render(off);
   for (std::size_t p = 0; p < direct.pixels.size(); ++p) EXPECT_EQ(direct.pixels[p], glm::vec3(0.0f)) << "pixel " << p;
 }
+
+// The glossy dielectrics' reflection history: a still floor under a sky
+// that varies with direction, seen at two jitter phases in turn. The second
+// frame's reflection is the mean of what each phase alone gives (each
+// frame's light over its specular albedo, the running mean over 2 frames,
+// times this frame's albedo), pixel for pixel: the history follows the
+// surface point to where the previous frame saw it. Tolerance 1e-4
+// relative (float rounding) plus 1e-6 absolute.
+TEST(MirrorPath, AStillGlossyFloorsReflectionIsTheMeanOfItsFramesRays) {
+  app::App app(app::AppOptions{.jobs = {.threads = 2}});
+  scene::SceneAssets a;
+  a.generation = scene::next_scene_generation();
+  a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({20, 20}, 0))};
+  material::Material varnish = lambert(glm::vec3(0.4f, 0.25f, 0.1f));
+  varnish.roughness_factor = 0.35f;
+  varnish.specular_factor = 1.0f;
+  a.materials = {varnish};
+  image::ImageRGB sky(16, 8);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 16; ++x) sky.at(x, y) = glm::vec3(0.2f + 0.3f * static_cast<float>(x % 5), 0.5f + 0.1f * static_cast<float>(y), 1.0f);
+  a.environment = scene::Environment(sky, 1.0f, glm::mat4(1.0f));
+  app.world().insert_resource<scene::SceneAssets>(std::move(a));
+  app.add_plugin<rt::RtPlugin>();
+  ecs::World& w = app.world();
+  const ecs::Entity floor = w.spawn();
+  w.emplace<transform::Transform>(floor);
+  w.emplace<scene::MeshInstance>(floor, scene::MeshInstance{0});
+  const ecs::Entity camera = w.spawn();
+  transform::Transform cam = transform::Transform::from_translation({0, 1, 3});
+  cam.rotation = glm::quatLookAt(glm::normalize(glm::vec3(0, -1, -3)), glm::vec3(0, 1, 0));
+  w.emplace<transform::Transform>(camera, cam);
+  w.emplace<scene::Camera>(camera, scene::Camera{.yfov_radians = 0.5f});
+  app.update();
+  const auto& rt = w.resource<rt::RtScene>();
+  const render::LightSet lights(rt, render::gather_punctual_lights(w), &*w.resource<scene::SceneAssets>().environment);
+  const render::CameraRays rays(w.get<scene::Camera>(camera), w.get<transform::WorldTransform>(camera), 40, 40);
+  probes::ProbeFieldSettings ps;
+  ps.grid = probes::ProbeGrid{{-1, 0.5f, -1}, {1, 1.5f, 1}, {2, 2, 2}};
+  ps.map = probes::MapLayout{8, 4};
+  const probes::ProbeField field(ps);  // never updated: no light
+  const probes::ProbeField* fields[] = {&field};
+  // Less than half a pixel apart: each pixel finds itself in the other frame.
+  const glm::vec2 phase_a{-0.125f, 0.125f}, phase_b{0.125f, -0.125f};
+  // The direct image of one frame at `jitter`, with `scratch` (its history),
+  // and each pixel's specular albedo.
+  const auto frame = [&](glm::vec2 jitter, shading::RealtimeGiScratch& scratch, std::vector<float>& albedo) {
+    shading::GBuffer g;
+    image::ImageRGB direct(40, 40);
+    app.jobs().run([&] {
+      shading::trace_gbuffer(rt, w.resource<scene::SceneAssets>(), rays, 40, 40, g, nullptr, nullptr, jitter);
+      shading::shade_gi_realtime(g, rt, w.resource<scene::SceneAssets>(), nullptr, nullptr, {}, fields,
+                                 shading::RealtimeGiSettings{}, nullptr, &direct, &scratch, &lights, shading::MirrorRay{});
+    });
+    albedo.assign(g.samples.size(), 0.0f);
+    for (std::size_t p = 0; p < g.samples.size(); ++p)
+      if (g.samples[p].hit)
+        albedo[p] = material::ggx_albedo(glm::dot(g.samples[p].normal_world, g.samples[p].wo_world), 0.35f * 0.35f)
+                        .with_f0(material::kDielectricF0);
+    return direct;
+  };
+  shading::RealtimeGiScratch alone_a, alone_b, together;
+  std::vector<float> albedo_a, albedo_b, albedo_2;
+  const image::ImageRGB a_only = frame(phase_a, alone_a, albedo_a);
+  const image::ImageRGB b_only = frame(phase_b, alone_b, albedo_b);
+  frame(phase_a, together, albedo_2);
+  const image::ImageRGB second = frame(phase_b, together, albedo_2);
+  int checked = 0, differ = 0;
+  for (int y = 22; y < 38; ++y)
+    for (int x = 6; x < 34; ++x) {
+      const std::size_t p = static_cast<std::size_t>(y) * 40 + x;
+      ASSERT_GT(albedo_a[p], 0.0f) << "pixel (" << x << ", " << y << ") must see the floor";
+      for (int c = 0; c < 3; ++c) {
+        const float mean = albedo_b[p] * 0.5f * (a_only.pixels[p][c] / albedo_a[p] + b_only.pixels[p][c] / albedo_b[p]);
+        EXPECT_NEAR(second.pixels[p][c], mean, 1e-4f * mean + 1e-6f) << "pixel (" << x << ", " << y << "), channel " << c;
+        differ += std::abs(a_only.pixels[p][c] - b_only.pixels[p][c]) > 1e-3f * mean;
+      }
+      ++checked;
+    }
+  EXPECT_GT(checked, 400);
+  EXPECT_GT(differ, checked) << "the two phases' rays must see different sky, or the test shows nothing";
+}

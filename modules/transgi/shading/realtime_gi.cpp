@@ -67,6 +67,21 @@ struct DielectricRays {
     std::vector<glm::vec3> direction, weight;
   };
   std::vector<Row> rows;
+  // Per pixel, the filtered light of the last two frames: the glossy pixels'
+  // running mean over up to kHistoryFrames frames, carried to the next frame
+  // through its camera (a reflection's own history, as engines keep one
+  // apart from the antialiasing's: a frame's rays alone leave the floor
+  // mottled in motion).
+  static constexpr int kHistoryFrames = 8;
+  struct History {
+    int width = 0, height = 0;
+    glm::vec2 jitter{0.0f};
+    std::optional<engine::render::CameraRays> camera;
+    std::vector<std::uint8_t> frames;  // 0 = not a glossy pixel
+    std::vector<glm::vec3> position, direct, gi;
+  };
+  History history[2];
+  int current = 0;
 
   [[nodiscard]] std::size_t block_of(std::size_t p, std::size_t width) const {
     return p / width / 2 * static_cast<std::size_t>(bw) + p % width / 2;
@@ -491,6 +506,18 @@ std::size_t shade_dielectric_reflections(const GBuffer& g, const engine::rt::RtS
   trace_dielectric_rays(g, scene, lights ? lights->environment() : nullptr, probe_hit_irradiance(scene, fields, lights), rays);
   gather_rays(g, rays);
   const std::size_t width = static_cast<std::size_t>(g.width);
+  DielectricRays::History& prev = rays.history[rays.current ^ 1];
+  DielectricRays::History& next = rays.history[rays.current];
+  const bool has_prev = prev.camera && g.camera && prev.width == g.width && prev.height == g.height;
+  next.width = g.width;
+  next.height = g.height;
+  next.jitter = g.jitter;
+  next.camera = g.camera;
+  next.frames.assign(g.samples.size(), 0);
+  next.position.resize(g.samples.size());
+  next.direct.resize(g.samples.size());
+  next.gi.resize(g.samples.size());
+  const float spread = g.camera ? g.camera->pixel_spread() : 0.0f;
   engine::jobs::parallel_for<std::size_t>(0, rays.glossy.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       const std::size_t p = rays.glossy[i];
@@ -513,11 +540,38 @@ std::size_t shade_dielectric_reflections(const GBuffer& g, const engine::rt::RtS
           sum_w += w;
         }
       if (!(sum_w > 0)) continue;
-      const glm::vec3 albedo = specular_layer_albedo(g.samples[p]) / sum_w;
-      image.pixels[p] += albedo * sum_gi;
-      if (direct_out) direct_out->pixels[p] += albedo * sum_direct;
+      glm::vec3 light_direct = sum_direct / sum_w, light_gi = sum_gi / sum_w;
+      // The same surface point's light in the previous frame, where it was
+      // seen (nearest pixel) and is still within a few pixels' footprint.
+      const glm::vec3& position = g.position[p];
+      std::uint8_t frames = 1;
+      if (has_prev) {
+        if (const std::optional<glm::vec2> film = prev.camera->project(position)) {
+          const int px = static_cast<int>(std::lround(film->x - 0.5f - prev.jitter.x));
+          const int py = static_cast<int>(std::lround(film->y - 0.5f - prev.jitter.y));
+          if (px >= 0 && py >= 0 && px < prev.width && py < prev.height) {
+            const std::size_t q = static_cast<std::size_t>(py) * static_cast<std::size_t>(prev.width) + static_cast<std::size_t>(px);
+            const float reach = 3.0f * spread * g.guide[p].w;
+            const glm::vec3 d = prev.position[q] - position;
+            if (prev.frames[q] > 0 && glm::dot(d, d) < reach * reach) {
+              frames = static_cast<std::uint8_t>(std::min<int>(prev.frames[q] + 1, DielectricRays::kHistoryFrames));
+              const float a = 1.0f / static_cast<float>(frames);
+              light_direct = prev.direct[q] + a * (light_direct - prev.direct[q]);
+              light_gi = prev.gi[q] + a * (light_gi - prev.gi[q]);
+            }
+          }
+        }
+      }
+      next.frames[p] = frames;
+      next.position[p] = position;
+      next.direct[p] = light_direct;
+      next.gi[p] = light_gi;
+      const glm::vec3 albedo = specular_layer_albedo(g.samples[p]);
+      image.pixels[p] += albedo * light_gi;
+      if (direct_out) direct_out->pixels[p] += albedo * light_direct;
     }
   });
+  rays.current ^= 1;
   return rays.traced.size();
 }
 
