@@ -355,7 +355,8 @@ TEST(MirrorPath, AVarnishedFloorUnderAUniformSkyShowsItsSpecularAlbedoTimesTheSk
 // frame's light over its specular albedo, the running mean over 2 frames,
 // times this frame's albedo), pixel for pixel: the history follows the
 // surface point to where the previous frame saw it. Tolerance 1e-4
-// relative (float rounding) plus 1e-6 absolute.
+// relative (float rounding) plus 1e-6 absolute. After forget_histories (a
+// camera cut) a frame is its own phase's alone, exactly.
 TEST(MirrorPath, AStillGlossyFloorsReflectionIsTheMeanOfItsFramesRays) {
   app::App app(app::AppOptions{.jobs = {.threads = 2}});
   scene::SceneAssets a;
@@ -428,4 +429,8 @@ TEST(MirrorPath, AStillGlossyFloorsReflectionIsTheMeanOfItsFramesRays) {
     }
   EXPECT_GT(checked, 400);
   EXPECT_GT(differ, checked) << "the two phases' rays must see different sky, or the test shows nothing";
+  // A camera cut forgets it: the next frame is its phase's alone.
+  together.forget_histories();
+  const image::ImageRGB after_cut = frame(phase_a, together, albedo_2);
+  for (std::size_t p = 0; p < a_only.pixels.size(); ++p) EXPECT_EQ(after_cut.pixels[p], a_only.pixels[p]) << "pixel " << p;
 }

@@ -148,6 +148,7 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   shading::RealtimeGiSettings realtime = settings.realtime;
   if (frame.camera_cut) {
     realtime.reuse_history = false;
+    packed.scratch.forget_histories();
     packed.taa.clear();
     frame.camera_cut = false;
   }

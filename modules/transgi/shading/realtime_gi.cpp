@@ -108,6 +108,10 @@ RealtimeGiScratch::RealtimeGiScratch() : impl(std::make_unique<Impl>()) {}
 RealtimeGiScratch::~RealtimeGiScratch() = default;
 RealtimeGiScratch::RealtimeGiScratch(RealtimeGiScratch&&) noexcept = default;
 RealtimeGiScratch& RealtimeGiScratch::operator=(RealtimeGiScratch&&) noexcept = default;
+void RealtimeGiScratch::forget_histories() {
+  impl->history.clear();
+  for (DielectricRays::History& h : impl->dielectric_rays.history) h.camera.reset();
+}
 
 namespace {
 

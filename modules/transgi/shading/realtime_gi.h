@@ -134,6 +134,9 @@ struct RealtimeGiScratch {
   ~RealtimeGiScratch();
   RealtimeGiScratch(RealtimeGiScratch&&) noexcept;
   RealtimeGiScratch& operator=(RealtimeGiScratch&&) noexcept;
+  // A camera cut: the next frame takes nothing from the frames before (the
+  // GI reuse's cells, the glossy reflections' history); storage is kept.
+  void forget_histories();
 };
 
 struct RealtimeGiStats {
