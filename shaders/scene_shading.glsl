@@ -58,7 +58,7 @@ vec3 offset_ray_origin(vec3 p, vec3 n, float scale) {
 #include "texture_wrap.glsl"
 
 vec4 texel_at(TextureGpu t, int x, int y, bool srgb) {
-  const int cx = texture_wrap(x, t.width, t.wrap & 0xffu), cy = texture_wrap(y, t.height, t.wrap >> 8);
+  const int cx = texture_wrap(x, t.width, t.wrap & 0xffu), cy = texture_wrap(y, t.height, (t.wrap >> 8) & 0xffu);
   const uint v = sh_texels[t.first + uint(cy * t.width + cx)];
   const uvec4 b = uvec4(v & 0xffu, (v >> 8) & 0xffu, (v >> 16) & 0xffu, v >> 24);
   if (srgb) return vec4(sh_tables[kShadingSrgbLut + b.r], sh_tables[kShadingSrgbLut + b.g], sh_tables[kShadingSrgbLut + b.b], float(b.a) / 255.0);
@@ -77,7 +77,11 @@ vec4 texture_sample(int index, vec2 uv, bool srgb) {
   const int x0 = int(fx), y0 = int(fy);
   const vec4 a = texel_at(t, x0, y0, srgb), b = texel_at(t, x0 + 1, y0, srgb);
   const vec4 c = texel_at(t, x0, y0 + 1, srgb), d = texel_at(t, x0 + 1, y0 + 1, srgb);
-  return (1.0 - ty) * ((1.0 - tx) * a + tx * b) + ty * ((1.0 - tx) * c + tx * d);
+  const vec4 mean = (1.0 - ty) * ((1.0 - tx) * a + tx * b) + ty * ((1.0 - tx) * c + tx * d);
+  if (((t.wrap >> 16) & 1u) == 0u || !(mean.a > 0.0)) return mean;
+  // A cut-out's colour weighted by alpha, as Texture::sample's.
+  const vec3 weighted = (1.0 - ty) * ((1.0 - tx) * a.a * a.rgb + tx * b.a * b.rgb) + ty * ((1.0 - tx) * c.a * c.rgb + tx * d.a * d.rgb);
+  return vec4(weighted / mean.a, mean.a);
 }
 
 // material::BrdfParams.

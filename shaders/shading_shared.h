@@ -61,7 +61,7 @@ struct MaterialGpu {
 struct TextureGpu {
   uint first;
   int width, height;
-  uint wrap;  // wrap_s | wrap_t << 8 (scene::Wrap: 0 repeat, 1 clamp, 2 mirrored)
+  uint wrap;  // wrap_s | wrap_t << 8 (scene::Wrap: 0 repeat, 1 clamp, 2 mirrored) | cut_out << 16
 };
 
 // LightSet's emissive triangle i in world space; pdf = its bin's density

@@ -131,7 +131,8 @@ void GpuShadingScene::sync_assets(const scene::SceneAssets& assets) {
   std::vector<std::uint32_t> texels;
   for (const scene::Texture& t : assets.textures) {
     const std::size_t n = t.width > 0 && t.height > 0 ? static_cast<std::size_t>(t.width) * static_cast<std::size_t>(t.height) : 0;
-    textures.push_back({static_cast<std::uint32_t>(texels.size()), n ? t.width : 0, n ? t.height : 0, wrap_bits(t)});
+    textures.push_back({static_cast<std::uint32_t>(texels.size()), n ? t.width : 0, n ? t.height : 0,
+                        wrap_bits(t) | (t.cut_out ? 1u << 16 : 0u)});
     for (std::size_t i = 0; i < n; ++i) {
       const std::uint8_t* p = &t.rgba[i * 4];
       texels.push_back(std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 | std::uint32_t{p[3]} << 24);

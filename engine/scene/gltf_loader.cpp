@@ -450,12 +450,16 @@ GltfLoadResult load_gltf(ecs::World& world, const fs::path& path, const GltfLoad
   sa.materials = load_materials(c);
   {
     // Mips for footprint-filtered lookups, averaged in the space each
-    // texture is read in (colour: linear light).
-    std::vector<std::uint8_t> colour(sa.textures.size(), 0);
-    for (const material::Material& m : sa.materials)
+    // texture is read in (colour: linear light), a cut-out's base colour
+    // weighted by its alpha.
+    std::vector<std::uint8_t> colour(sa.textures.size(), 0), cut_out(sa.textures.size(), 0);
+    for (const material::Material& m : sa.materials) {
       for (const auto t : {m.base_color_texture, m.emissive_texture})
         if (t >= 0) colour[static_cast<std::size_t>(t)] = 1;
-    for (std::size_t t = 0; t < sa.textures.size(); ++t) sa.textures[t].build_mips(colour[t] != 0);
+      if (m.base_color_texture >= 0 && m.alpha_mode != material::AlphaMode::Opaque)
+        cut_out[static_cast<std::size_t>(m.base_color_texture)] = 1;
+    }
+    for (std::size_t t = 0; t < sa.textures.size(); ++t) sa.textures[t].build_mips(colour[t] != 0, cut_out[t] != 0);
   }
   const auto default_material = static_cast<std::uint32_t>(sa.materials.size() - 1);
   const AccessorReader reader{model, c.file};

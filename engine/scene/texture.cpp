@@ -44,7 +44,8 @@ std::uint8_t encode_srgb(float v) {
   return static_cast<std::uint8_t>(std::lround(e * 255.0f));
 }
 
-glm::vec4 bilinear(const std::uint8_t* rgba, int width, int height, Wrap wrap_s, Wrap wrap_t, glm::vec2 uv, bool srgb);
+glm::vec4 bilinear(const std::uint8_t* rgba, int width, int height, Wrap wrap_s, Wrap wrap_t, glm::vec2 uv, bool srgb,
+                    bool cut_out);
 
 }  // namespace
 
@@ -52,7 +53,7 @@ const float* srgb_decode_table() { return srgb_lut().data(); }
 
 glm::vec4 Texture::sample(glm::vec2 uv, bool srgb) const {
   if (width <= 0 || height <= 0) return glm::vec4(1.0f);
-  return bilinear(rgba.data(), width, height, wrap_s, wrap_t, uv, srgb);
+  return bilinear(rgba.data(), width, height, wrap_s, wrap_t, uv, srgb, cut_out);
 }
 
 glm::vec4 Texture::sample(glm::vec2 uv, bool srgb, float lod) const {
@@ -62,16 +63,17 @@ glm::vec4 Texture::sample(glm::vec2 uv, bool srgb, float lod) const {
   const int lo = static_cast<int>(std::floor(lod));
   const float t = lod - static_cast<float>(lo);
   auto level = [&](int l) {
-    if (l == 0) return bilinear(rgba.data(), width, height, wrap_s, wrap_t, uv, srgb);
+    if (l == 0) return bilinear(rgba.data(), width, height, wrap_s, wrap_t, uv, srgb, cut_out);
     const MipLevel& m = mips[static_cast<std::size_t>(l - 1)];
-    return bilinear(m.rgba.data(), m.width, m.height, wrap_s, wrap_t, uv, srgb);
+    return bilinear(m.rgba.data(), m.width, m.height, wrap_s, wrap_t, uv, srgb, cut_out);
   };
   const glm::vec4 a = level(lo);
   if (t <= 0 || lo >= static_cast<int>(mips.size())) return a;
   return (1 - t) * a + t * level(lo + 1);
 }
 
-void Texture::build_mips(bool srgb) {
+void Texture::build_mips(bool srgb, bool cut_out_colour) {
+  cut_out = cut_out_colour;
   mips.clear();
   if (width <= 0 || height <= 0) return;
   const auto& lut = srgb_lut();
@@ -85,18 +87,34 @@ void Texture::build_mips(bool srgb) {
     for (int y = 0; y < m.height; ++y)
       for (int x = 0; x < m.width; ++x) {
         float sum[4] = {0, 0, 0, 0};
+        float colour_weight = 0;
         int n = 0;
         for (int dy = 0; dy < 2; ++dy)
           for (int dx = 0; dx < 2; ++dx) {
             const int sx = std::min(2 * x + dx, w - 1), sy = std::min(2 * y + dy, h - 1);
             const std::uint8_t* p = src + (static_cast<std::size_t>(sy) * w + sx) * 4;
-            for (int c = 0; c < 3; ++c) sum[c] += srgb ? lut[p[c]] : static_cast<float>(p[c]) / 255.0f;
-            sum[3] += static_cast<float>(p[3]) / 255.0f;
+            const float alpha = static_cast<float>(p[3]) / 255.0f;
+            const float weight = cut_out ? alpha : 1.0f;
+            for (int c = 0; c < 3; ++c) sum[c] += weight * (srgb ? lut[p[c]] : static_cast<float>(p[c]) / 255.0f);
+            sum[3] += alpha;
+            colour_weight += weight;
             ++n;
           }
+        // A block with no opaque texel keeps the plain mean of its colours.
+        if (!(colour_weight > 0)) {
+          colour_weight = 0;
+          for (int c = 0; c < 3; ++c) sum[c] = 0;
+          for (int dy = 0; dy < 2; ++dy)
+            for (int dx = 0; dx < 2; ++dx) {
+              const int sx = std::min(2 * x + dx, w - 1), sy = std::min(2 * y + dy, h - 1);
+              const std::uint8_t* p = src + (static_cast<std::size_t>(sy) * w + sx) * 4;
+              for (int c = 0; c < 3; ++c) sum[c] += srgb ? lut[p[c]] : static_cast<float>(p[c]) / 255.0f;
+              colour_weight += 1.0f;
+            }
+        }
         std::uint8_t* d = &m.rgba[(static_cast<std::size_t>(y) * m.width + x) * 4];
         for (int c = 0; c < 3; ++c) {
-          const float v = sum[c] / static_cast<float>(n);
+          const float v = sum[c] / colour_weight;
           d[c] = srgb ? encode_srgb(v) : static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
         }
         d[3] = static_cast<std::uint8_t>(std::lround(std::clamp(sum[3] / static_cast<float>(n), 0.0f, 1.0f) * 255.0f));
@@ -110,7 +128,8 @@ void Texture::build_mips(bool srgb) {
 
 namespace {
 
-glm::vec4 bilinear(const std::uint8_t* rgba, int width, int height, Wrap wrap_s, Wrap wrap_t, glm::vec2 uv, bool srgb) {
+glm::vec4 bilinear(const std::uint8_t* rgba, int width, int height, Wrap wrap_s, Wrap wrap_t, glm::vec2 uv, bool srgb,
+                    bool cut_out) {
   if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = glm::vec2(0.0f);
   // Keep the coordinate small before flooring so huge UVs stay exact enough.
   const float x = std::fmod(uv.x, 4096.0f) * static_cast<float>(width) - 0.5f;
@@ -126,7 +145,13 @@ glm::vec4 bilinear(const std::uint8_t* rgba, int width, int height, Wrap wrap_s,
     return glm::vec4(p[0], p[1], p[2], p[3]) / 255.0f;
   };
   const glm::vec4 a = texel(x0, y0), b = texel(x0 + 1, y0), c = texel(x0, y0 + 1), d = texel(x0 + 1, y0 + 1);
-  return (1 - ty) * ((1 - tx) * a + tx * b) + ty * ((1 - tx) * c + tx * d);
+  const glm::vec4 mean = (1 - ty) * ((1 - tx) * a + tx * b) + ty * ((1 - tx) * c + tx * d);
+  if (!cut_out || !(mean.a > 0)) return mean;
+  // A cut-out's colour weighted by alpha (as its mips are): a leaf's edge
+  // does not take the colour of the transparent texels beside it.
+  const glm::vec3 weighted = (1 - ty) * ((1 - tx) * a.a * glm::vec3(a) + tx * b.a * glm::vec3(b)) +
+                             ty * ((1 - tx) * c.a * glm::vec3(c) + tx * d.a * glm::vec3(d));
+  return glm::vec4(weighted / mean.a, mean.a);
 }
 
 }  // namespace

@@ -30,6 +30,9 @@ struct Texture {
   Wrap wrap_t = Wrap::Repeat;
   // Levels 1, 2, ... down to 1 x 1 (level 0 is rgba); empty until build_mips.
   std::vector<MipLevel> mips;
+  // The colour of an alpha-tested texture (build_mips' cut_out): lookups
+  // weight each texel's colour by its alpha.
+  bool cut_out = false;
 
   // Bilinear lookup; srgb = true converts each texel to linear first.
   [[nodiscard]] glm::vec4 sample(glm::vec2 uv, bool srgb) const;
@@ -38,8 +41,12 @@ struct Texture {
   [[nodiscard]] glm::vec4 sample(glm::vec2 uv, bool srgb, float lod) const;
   // 2 x 2 box-filtered levels. srgb = average in linear light and store
   // sRGB-encoded (a black and white checker averages to 0.5 linear, not to
-  // 0.5 encoded, which is 0.21 linear).
-  void build_mips(bool srgb);
+  // 0.5 encoded, which is 0.21 linear). cut_out_colour = the colour is averaged
+  // weighted by alpha (an alpha-tested leaf's colour, not the transparent
+  // texels' around it: their RGB, often white, turned plants pale at a
+  // distance), here and in every lookup after (sets cut_out); alpha itself
+  // is averaged plainly.
+  void build_mips(bool srgb, bool cut_out_colour = false);
   // Nearest-texel alpha (alpha testing must not blur the cut-out edge).
   [[nodiscard]] float alpha_nearest(glm::vec2 uv) const;
 };

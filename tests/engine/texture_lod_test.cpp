@@ -67,3 +67,54 @@ TEST(TextureLod, RayConeFootprintOnAQuadMatchesTheAnalyticLevel) {
   no_uvs.uvs.clear();
   EXPECT_EQ(render::uv_footprint(no_uvs, 0, 1.0f, 0.1f, 1.0f), 0.0f);
 }
+
+// An alpha-tested texture (a leaf): one opaque green texel among three
+// transparent white ones. Its mips average the colour weighted by alpha,
+// so the leaf stays green at a distance, while alpha is the plain mean
+// (a quarter covered). Without cut_out the white bleeds in: the plain
+// mean. A block with no opaque texel keeps its plain mean. Known answers
+// to the 8-bit sRGB encoding's rounding.
+TEST(TextureLod, ACutOutsMipsAverageTheColourOfItsOpaqueTexels) {
+  scene::Texture t;
+  t.width = t.height = 4;
+  t.rgba.assign(4 * 4 * 4, 255);  // white, opaque
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) {
+      std::uint8_t* p = &t.rgba[static_cast<std::size_t>(y * 4 + x) * 4];
+      const bool leaf = x == 0 && y == 0;
+      if (leaf) p[0] = p[2] = 0;  // (0, 255, 0)
+      if (!leaf) p[3] = 0;        // transparent white elsewhere
+    }
+  scene::Texture plain = t;
+  t.build_mips(true, true);
+  plain.build_mips(true, false);
+  const std::uint8_t* cut = t.mips[0].rgba.data();  // level 1, texel (0, 0): the leaf's block
+  EXPECT_EQ(cut[0], 0);
+  EXPECT_EQ(cut[1], 255);
+  EXPECT_EQ(cut[2], 0);
+  EXPECT_EQ(cut[3], 64);  // alpha 0.25
+  const std::uint8_t* bled = plain.mips[0].rgba.data();
+  EXPECT_GT(bled[0], 200) << "the plain mean takes three white texels in: 0.75 linear red";
+  const std::uint8_t* empty = t.mips[0].rgba.data() + 4;  // level 1, texel (1, 0): no opaque texel
+  EXPECT_EQ(empty[0], 255);
+  EXPECT_EQ(empty[3], 0);
+}
+
+// The same at level 0: a bilinear lookup halfway between an opaque green
+// texel and a transparent white one reads green (alpha 0.5) on a cut-out,
+// the plain mean on any other texture.
+TEST(TextureLod, ACutOutsBilinearLookupWeighsColourByAlpha) {
+  scene::Texture t;
+  t.width = 2;
+  t.height = 1;
+  t.wrap_s = t.wrap_t = scene::Wrap::ClampToEdge;
+  t.rgba = {0, 255, 0, 255, 255, 255, 255, 0};
+  scene::Texture plain = t;
+  t.build_mips(true, true);
+  plain.build_mips(true, false);
+  const glm::vec4 cut = t.sample({0.5f, 0.5f}, true);
+  EXPECT_NEAR(cut.r, 0.0f, 1e-6f);
+  EXPECT_NEAR(cut.g, 1.0f, 1e-6f);
+  EXPECT_NEAR(cut.a, 0.5f, 1e-6f);
+  EXPECT_NEAR(plain.sample({0.5f, 0.5f}, true).r, 0.5f, 1e-6f);
+}
