@@ -9,6 +9,8 @@
 // is exact, what is left is float rounding.
 #include <gtest/gtest.h>
 
+#include <optional>
+
 #include <glm/gtc/quaternion.hpp>
 
 #include "engine/app/app.h"
@@ -276,6 +278,73 @@ TEST(MirrorPath, ADielectricsReflectionWeightsAverageItsSpecularLayersAlbedo) {
   }
 }
 
+namespace {
+
+// A varnished floor (base colour 0.4, 0.25, 0.1; roughness 0.35; a full
+// specular layer) under `sky` alone, a camera 1 m above it looking down at
+// 18 degrees, and probes that hold no light (a field never updated): the
+// glossy dielectrics' reflections are all a real-time frame shows.
+struct VarnishedFloor {
+  static constexpr float kRoughness = 0.35f;
+  app::App app{app::AppOptions{.jobs = {.threads = 2}}};
+  ecs::Entity camera;
+  std::optional<render::LightSet> lights;
+  std::optional<probes::ProbeField> field;
+
+  explicit VarnishedFloor(scene::Environment sky) {
+    scene::SceneAssets a;
+    a.generation = scene::next_scene_generation();
+    a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({20, 20}, 0))};
+    material::Material varnish = lambert(glm::vec3(0.4f, 0.25f, 0.1f));
+    varnish.roughness_factor = kRoughness;
+    varnish.specular_factor = 1.0f;
+    a.materials = {varnish};
+    a.environment = std::move(sky);
+    app.world().insert_resource<scene::SceneAssets>(std::move(a));
+    app.add_plugin<rt::RtPlugin>();
+    ecs::World& w = app.world();
+    const ecs::Entity floor = w.spawn();
+    w.emplace<transform::Transform>(floor);
+    w.emplace<scene::MeshInstance>(floor, scene::MeshInstance{0});
+    camera = w.spawn();
+    transform::Transform cam = transform::Transform::from_translation({0, 1, 3});
+    cam.rotation = glm::quatLookAt(glm::normalize(glm::vec3(0, -1, -3)), glm::vec3(0, 1, 0));
+    w.emplace<transform::Transform>(camera, cam);
+    w.emplace<scene::Camera>(camera, scene::Camera{.yfov_radians = 0.5f});
+    app.update();
+    lights.emplace(w.resource<rt::RtScene>(), render::gather_punctual_lights(w), &*w.resource<scene::SceneAssets>().environment);
+    probes::ProbeFieldSettings ps;
+    ps.grid = probes::ProbeGrid{{-1, 0.5f, -1}, {1, 1.5f, 1}, {2, 2, 2}};
+    ps.map = probes::MapLayout{8, 4};
+    field.emplace(ps);
+  }
+
+  // One real-time frame of size x size traced at `jitter` into g, with
+  // `scratch` (null: no history); returns its GI, its direct light in direct.
+  image::ImageRGB frame(int size, shading::GBuffer& g, image::ImageRGB& direct, const shading::MirrorRay& mirror = {},
+                        glm::vec2 jitter = glm::vec2(0.0f), shading::RealtimeGiScratch* scratch = nullptr) {
+    ecs::World& w = app.world();
+    const auto& rt = w.resource<rt::RtScene>();
+    const render::CameraRays rays(w.get<scene::Camera>(camera), w.get<transform::WorldTransform>(camera), size, size);
+    const probes::ProbeField* fields[] = {&*field};
+    direct = image::ImageRGB(size, size);
+    image::ImageRGB gi;
+    app.jobs().run([&] {
+      shading::trace_gbuffer(rt, w.resource<scene::SceneAssets>(), rays, size, size, g, nullptr, nullptr, jitter);
+      gi = shading::shade_gi_realtime(g, rt, w.resource<scene::SceneAssets>(), nullptr, nullptr, {}, fields,
+                                      shading::RealtimeGiSettings{}, nullptr, &direct, scratch, &*lights, mirror);
+    });
+    return gi;
+  }
+
+  // The floor's specular albedo at a G-buffer sample's view angle.
+  static float specular_albedo(const shading::GSample& s) {
+    return material::ggx_albedo(glm::dot(s.normal_world, s.wo_world), kRoughness * kRoughness).with_f0(material::kDielectricF0);
+  }
+};
+
+}  // namespace
+
 // The real-time path's glossy dielectrics (MirrorRay::dielectric_max_
 // roughness): a varnished floor alone under a uniform sky of radiance L.
 // Every reflection ray escapes and finds L, so the floor's specular layer
@@ -286,55 +355,16 @@ TEST(MirrorPath, ADielectricsReflectionWeightsAverageItsSpecularLayersAlbedo) {
 // reflection at all.
 TEST(MirrorPath, AVarnishedFloorUnderAUniformSkyShowsItsSpecularAlbedoTimesTheSky) {
   const glm::vec3 sky(0.5f, 1.0f, 2.0f);
-  app::App app(app::AppOptions{.jobs = {.threads = 2}});
-  scene::SceneAssets a;
-  a.generation = scene::next_scene_generation();
-  a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({20, 20}, 0))};
-  material::Material varnish = lambert(glm::vec3(0.4f, 0.25f, 0.1f));
-  varnish.roughness_factor = 0.35f;
-  varnish.specular_factor = 1.0f;
-  a.materials = {varnish};
-  a.environment = scene::uniform_environment(sky);
-  app.world().insert_resource<scene::SceneAssets>(std::move(a));
-  app.add_plugin<rt::RtPlugin>();
-  ecs::World& w = app.world();
-  const ecs::Entity floor = w.spawn();
-  w.emplace<transform::Transform>(floor);
-  w.emplace<scene::MeshInstance>(floor, scene::MeshInstance{0});
-  const ecs::Entity camera = w.spawn();
-  transform::Transform cam = transform::Transform::from_translation({0, 1, 3});
-  cam.rotation = glm::quatLookAt(glm::normalize(glm::vec3(0, -1, -3)), glm::vec3(0, 1, 0));
-  w.emplace<transform::Transform>(camera, cam);
-  w.emplace<scene::Camera>(camera, scene::Camera{.yfov_radians = 0.5f});
-  app.update();
-  const auto& rt = w.resource<rt::RtScene>();
-  const scene::Environment* env = &*w.resource<scene::SceneAssets>().environment;
-  const render::LightSet lights(rt, render::gather_punctual_lights(w), env);
-  const render::CameraRays rays(w.get<scene::Camera>(camera), w.get<transform::WorldTransform>(camera), 48, 48);
-  probes::ProbeFieldSettings ps;
-  ps.grid = probes::ProbeGrid{{-1, 0.5f, -1}, {1, 1.5f, 1}, {2, 2, 2}};
-  ps.map = probes::MapLayout{8, 4};
-  const probes::ProbeField field(ps);  // never updated: no light
-  const probes::ProbeField* fields[] = {&field};
+  VarnishedFloor scene(scene::uniform_environment(sky));
   shading::GBuffer g;
-  image::ImageRGB gi, direct;
-  const auto render = [&](const shading::MirrorRay& mirror) {
-    direct = image::ImageRGB(48, 48);
-    app.jobs().run([&] {
-      shading::trace_gbuffer(rt, w.resource<scene::SceneAssets>(), rays, 48, 48, g);
-      gi = shading::shade_gi_realtime(g, rt, w.resource<scene::SceneAssets>(), nullptr, nullptr, {}, fields,
-                                      shading::RealtimeGiSettings{}, nullptr, &direct, nullptr, &lights, mirror);
-    });
-  };
-  render(shading::MirrorRay{});
+  image::ImageRGB direct;
+  const image::ImageRGB gi = scene.frame(48, g, direct);
   int checked = 0;
   for (int y = 20; y < 48; y += 3)
     for (int x = 8; x < 40; x += 3) {
       const std::size_t p = static_cast<std::size_t>(y) * 48 + x;
       ASSERT_TRUE(g.samples[p].hit) << "pixel (" << x << ", " << y << ") must see the floor";
-      const shading::GSample& s = g.samples[p];
-      const material::SpecularAlbedo e = material::ggx_albedo(glm::dot(s.normal_world, s.wo_world), 0.35f * 0.35f);
-      const float expected_albedo = e.with_f0(material::kDielectricF0);
+      const float expected_albedo = VarnishedFloor::specular_albedo(g.samples[p]);
       for (int c = 0; c < 3; ++c) {
         EXPECT_NEAR(direct.pixels[p][c], expected_albedo * sky[c], 1e-4f * expected_albedo * sky[c])
             << "pixel (" << x << ", " << y << "), channel " << c;
@@ -345,7 +375,7 @@ TEST(MirrorPath, AVarnishedFloorUnderAUniformSkyShowsItsSpecularAlbedoTimesTheSk
   EXPECT_GT(checked, 50);
   shading::MirrorRay off;
   off.dielectric_max_roughness = -1;
-  render(off);
+  scene.frame(48, g, direct, off);
   for (std::size_t p = 0; p < direct.pixels.size(); ++p) EXPECT_EQ(direct.pixels[p], glm::vec3(0.0f)) << "pixel " << p;
 }
 
@@ -358,55 +388,21 @@ TEST(MirrorPath, AVarnishedFloorUnderAUniformSkyShowsItsSpecularAlbedoTimesTheSk
 // relative (float rounding) plus 1e-6 absolute. After forget_histories (a
 // camera cut) a frame is its own phase's alone, exactly.
 TEST(MirrorPath, AStillGlossyFloorsReflectionIsTheMeanOfItsFramesRays) {
-  app::App app(app::AppOptions{.jobs = {.threads = 2}});
-  scene::SceneAssets a;
-  a.generation = scene::next_scene_generation();
-  a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({20, 20}, 0))};
-  material::Material varnish = lambert(glm::vec3(0.4f, 0.25f, 0.1f));
-  varnish.roughness_factor = 0.35f;
-  varnish.specular_factor = 1.0f;
-  a.materials = {varnish};
   image::ImageRGB sky(16, 8);
   for (int y = 0; y < 8; ++y)
     for (int x = 0; x < 16; ++x) sky.at(x, y) = glm::vec3(0.2f + 0.3f * static_cast<float>(x % 5), 0.5f + 0.1f * static_cast<float>(y), 1.0f);
-  a.environment = scene::Environment(sky, 1.0f, glm::mat4(1.0f));
-  app.world().insert_resource<scene::SceneAssets>(std::move(a));
-  app.add_plugin<rt::RtPlugin>();
-  ecs::World& w = app.world();
-  const ecs::Entity floor = w.spawn();
-  w.emplace<transform::Transform>(floor);
-  w.emplace<scene::MeshInstance>(floor, scene::MeshInstance{0});
-  const ecs::Entity camera = w.spawn();
-  transform::Transform cam = transform::Transform::from_translation({0, 1, 3});
-  cam.rotation = glm::quatLookAt(glm::normalize(glm::vec3(0, -1, -3)), glm::vec3(0, 1, 0));
-  w.emplace<transform::Transform>(camera, cam);
-  w.emplace<scene::Camera>(camera, scene::Camera{.yfov_radians = 0.5f});
-  app.update();
-  const auto& rt = w.resource<rt::RtScene>();
-  const render::LightSet lights(rt, render::gather_punctual_lights(w), &*w.resource<scene::SceneAssets>().environment);
-  const render::CameraRays rays(w.get<scene::Camera>(camera), w.get<transform::WorldTransform>(camera), 40, 40);
-  probes::ProbeFieldSettings ps;
-  ps.grid = probes::ProbeGrid{{-1, 0.5f, -1}, {1, 1.5f, 1}, {2, 2, 2}};
-  ps.map = probes::MapLayout{8, 4};
-  const probes::ProbeField field(ps);  // never updated: no light
-  const probes::ProbeField* fields[] = {&field};
+  VarnishedFloor scene(scene::Environment(sky, 1.0f, glm::mat4(1.0f)));
   // Less than half a pixel apart: each pixel finds itself in the other frame.
   const glm::vec2 phase_a{-0.125f, 0.125f}, phase_b{0.125f, -0.125f};
   // The direct image of one frame at `jitter`, with `scratch` (its history),
   // and each pixel's specular albedo.
   const auto frame = [&](glm::vec2 jitter, shading::RealtimeGiScratch& scratch, std::vector<float>& albedo) {
     shading::GBuffer g;
-    image::ImageRGB direct(40, 40);
-    app.jobs().run([&] {
-      shading::trace_gbuffer(rt, w.resource<scene::SceneAssets>(), rays, 40, 40, g, nullptr, nullptr, jitter);
-      shading::shade_gi_realtime(g, rt, w.resource<scene::SceneAssets>(), nullptr, nullptr, {}, fields,
-                                 shading::RealtimeGiSettings{}, nullptr, &direct, &scratch, &lights, shading::MirrorRay{});
-    });
+    image::ImageRGB direct;
+    scene.frame(40, g, direct, shading::MirrorRay{}, jitter, &scratch);
     albedo.assign(g.samples.size(), 0.0f);
     for (std::size_t p = 0; p < g.samples.size(); ++p)
-      if (g.samples[p].hit)
-        albedo[p] = material::ggx_albedo(glm::dot(g.samples[p].normal_world, g.samples[p].wo_world), 0.35f * 0.35f)
-                        .with_f0(material::kDielectricF0);
+      if (g.samples[p].hit) albedo[p] = VarnishedFloor::specular_albedo(g.samples[p]);
     return direct;
   };
   shading::RealtimeGiScratch alone_a, alone_b, together;
