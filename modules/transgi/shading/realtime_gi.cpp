@@ -46,6 +46,79 @@ glm::vec3 diffuse_layer_share(const GSample& s) {
 
 }  // namespace
 
+// Per pixel, a reflection's light over its last frames: a running mean over
+// up to kFrames frames, found where the previous camera saw the same surface
+// point (nearest pixel, within 3 pixels' footprint), as engines keep a
+// reflection history apart from the antialiasing's, which averages only
+// still views: one frame's rays alone leave a glossy surface mottled in
+// motion. A frame is begin(), blend() once per reflective pixel (from any
+// thread), end().
+class ReflectionHistory {
+ public:
+  static constexpr int kFrames = 8;
+
+  void begin(const GBuffer& g) {
+    const Frame& prev = frames_[current_ ^ 1];
+    has_prev_ = prev.camera && g.camera && prev.width == g.width && prev.height == g.height;
+    Frame& next = frames_[current_];
+    next.width = g.width;
+    next.height = g.height;
+    next.jitter = g.jitter;
+    next.camera = g.camera;
+    next.frames.assign(g.samples.size(), 0);
+    next.position.resize(g.samples.size());
+    next.direct.resize(g.samples.size());
+    next.gi.resize(g.samples.size());
+    spread_ = g.camera ? g.camera->pixel_spread() : 0.0f;
+  }
+  // Pixel p's light this frame in, its running mean out.
+  void blend(const GBuffer& g, std::size_t p, glm::vec3& direct, glm::vec3& gi) {
+    const Frame& prev = frames_[current_ ^ 1];
+    Frame& next = frames_[current_];
+    const glm::vec3& position = g.position[p];
+    std::uint8_t frames = 1;
+    if (has_prev_) {
+      if (const std::optional<glm::vec2> film = prev.camera->project(position)) {
+        const int px = static_cast<int>(std::lround(film->x - 0.5f - prev.jitter.x));
+        const int py = static_cast<int>(std::lround(film->y - 0.5f - prev.jitter.y));
+        if (px >= 0 && py >= 0 && px < prev.width && py < prev.height) {
+          const std::size_t q = static_cast<std::size_t>(py) * static_cast<std::size_t>(prev.width) + static_cast<std::size_t>(px);
+          const float reach = 3.0f * spread_ * g.guide[p].w;
+          const glm::vec3 d = prev.position[q] - position;
+          if (prev.frames[q] > 0 && glm::dot(d, d) < reach * reach) {
+            frames = static_cast<std::uint8_t>(std::min<int>(prev.frames[q] + 1, kFrames));
+            const float a = 1.0f / static_cast<float>(frames);
+            direct = prev.direct[q] + a * (direct - prev.direct[q]);
+            gi = prev.gi[q] + a * (gi - prev.gi[q]);
+          }
+        }
+      }
+    }
+    next.frames[p] = frames;
+    next.position[p] = position;
+    next.direct[p] = direct;
+    next.gi[p] = gi;
+  }
+  void end() { current_ ^= 1; }
+  // A camera cut: the next frame takes nothing from this one.
+  void forget() {
+    for (Frame& f : frames_) f.camera.reset();
+  }
+
+ private:
+  struct Frame {
+    int width = 0, height = 0;
+    glm::vec2 jitter{0.0f};
+    std::optional<engine::render::CameraRays> camera;
+    std::vector<std::uint8_t> frames;  // 0 = no reflection here
+    std::vector<glm::vec3> position, direct, gi;
+  };
+  Frame frames_[2];
+  int current_ = 0;
+  bool has_prev_ = false;
+  float spread_ = 0.0f;
+};
+
 // The glossy dielectrics' reflection rays of a frame, one per 2x2 block of
 // pixels at most (shade_dielectric_reflections), kept from frame to frame
 // for their storage.
@@ -67,21 +140,8 @@ struct DielectricRays {
     std::vector<glm::vec3> direction, weight;
   };
   std::vector<Row> rows;
-  // Per pixel, the filtered light of the last two frames: the glossy pixels'
-  // running mean over up to kHistoryFrames frames, carried to the next frame
-  // through its camera (a reflection's own history, as engines keep one
-  // apart from the antialiasing's: a frame's rays alone leave the floor
-  // mottled in motion).
-  static constexpr int kHistoryFrames = 8;
-  struct History {
-    int width = 0, height = 0;
-    glm::vec2 jitter{0.0f};
-    std::optional<engine::render::CameraRays> camera;
-    std::vector<std::uint8_t> frames;  // 0 = not a glossy pixel
-    std::vector<glm::vec3> position, direct, gi;
-  };
-  History history[2];
-  int current = 0;
+  // The glossy pixels' filtered light over their last frames.
+  ReflectionHistory history;
 
   [[nodiscard]] std::size_t block_of(std::size_t p, std::size_t width) const {
     return p / width / 2 * static_cast<std::size_t>(bw) + p % width / 2;
@@ -110,7 +170,7 @@ RealtimeGiScratch::RealtimeGiScratch(RealtimeGiScratch&&) noexcept = default;
 RealtimeGiScratch& RealtimeGiScratch::operator=(RealtimeGiScratch&&) noexcept = default;
 void RealtimeGiScratch::forget_histories() {
   impl->history.clear();
-  for (DielectricRays::History& h : impl->dielectric_rays.history) h.camera.reset();
+  impl->dielectric_rays.history.forget();
 }
 
 namespace {
@@ -336,6 +396,9 @@ std::size_t shade_metal_reflections(const GBuffer& g, const engine::rt::RtScene&
       glm::vec3 wi, weight;
       ReflectedLight r;
       if (sample_reflection(g.samples[p], mirror_direction, u, wi, weight)) r = reflected_light(scene, g.samples[p], wi, sky, irradiance);
+      // No history here, unlike the glossy dielectrics': on the sample
+      // level's gold sphere a running mean smeared its glints over
+      // neighbouring points while the camera walked (docs/image-quality.md).
       image.pixels[p] = weight * r.gi;
       if (direct_out) direct_out->pixels[p] += weight * r.direct;
     }
@@ -510,18 +573,7 @@ std::size_t shade_dielectric_reflections(const GBuffer& g, const engine::rt::RtS
   trace_dielectric_rays(g, scene, lights ? lights->environment() : nullptr, probe_hit_irradiance(scene, fields, lights), rays);
   gather_rays(g, rays);
   const std::size_t width = static_cast<std::size_t>(g.width);
-  DielectricRays::History& prev = rays.history[rays.current ^ 1];
-  DielectricRays::History& next = rays.history[rays.current];
-  const bool has_prev = prev.camera && g.camera && prev.width == g.width && prev.height == g.height;
-  next.width = g.width;
-  next.height = g.height;
-  next.jitter = g.jitter;
-  next.camera = g.camera;
-  next.frames.assign(g.samples.size(), 0);
-  next.position.resize(g.samples.size());
-  next.direct.resize(g.samples.size());
-  next.gi.resize(g.samples.size());
-  const float spread = g.camera ? g.camera->pixel_spread() : 0.0f;
+  rays.history.begin(g);
   engine::jobs::parallel_for<std::size_t>(0, rays.glossy.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       const std::size_t p = rays.glossy[i];
@@ -545,37 +597,13 @@ std::size_t shade_dielectric_reflections(const GBuffer& g, const engine::rt::RtS
         }
       if (!(sum_w > 0)) continue;
       glm::vec3 light_direct = sum_direct / sum_w, light_gi = sum_gi / sum_w;
-      // The same surface point's light in the previous frame, where it was
-      // seen (nearest pixel) and is still within a few pixels' footprint.
-      const glm::vec3& position = g.position[p];
-      std::uint8_t frames = 1;
-      if (has_prev) {
-        if (const std::optional<glm::vec2> film = prev.camera->project(position)) {
-          const int px = static_cast<int>(std::lround(film->x - 0.5f - prev.jitter.x));
-          const int py = static_cast<int>(std::lround(film->y - 0.5f - prev.jitter.y));
-          if (px >= 0 && py >= 0 && px < prev.width && py < prev.height) {
-            const std::size_t q = static_cast<std::size_t>(py) * static_cast<std::size_t>(prev.width) + static_cast<std::size_t>(px);
-            const float reach = 3.0f * spread * g.guide[p].w;
-            const glm::vec3 d = prev.position[q] - position;
-            if (prev.frames[q] > 0 && glm::dot(d, d) < reach * reach) {
-              frames = static_cast<std::uint8_t>(std::min<int>(prev.frames[q] + 1, DielectricRays::kHistoryFrames));
-              const float a = 1.0f / static_cast<float>(frames);
-              light_direct = prev.direct[q] + a * (light_direct - prev.direct[q]);
-              light_gi = prev.gi[q] + a * (light_gi - prev.gi[q]);
-            }
-          }
-        }
-      }
-      next.frames[p] = frames;
-      next.position[p] = position;
-      next.direct[p] = light_direct;
-      next.gi[p] = light_gi;
+      rays.history.blend(g, p, light_direct, light_gi);
       const glm::vec3 albedo = specular_layer_albedo(g.samples[p]);
       image.pixels[p] += albedo * light_gi;
       if (direct_out) direct_out->pixels[p] += albedo * light_direct;
     }
   });
-  rays.current ^= 1;
+  rays.history.end();
   return rays.traced.size();
 }
 
