@@ -82,6 +82,8 @@ std::vector<OptionSpec> runtime_option_specs(const std::string& default_preset) 
              "shade the probe rays' hits on the Vulkan device"),
       choice("device-lights", {"on", "off"}, on_off_by_preset(q.realtime.device_lights, r.realtime.device_lights),
              "interpolate the network samples' light on the device (32 bytes a sample cross the bus, not 600)"),
+      choice("reflections", {"on", "off"}, on_off_by_preset(q.mirror.max_roughness >= 0, r.mirror.max_roughness >= 0),
+             "trace the reflections of mirrors, glossy metals and glossy non-metals: off = the network's SH-4 transfer alone (the paper's)"),
       integer("near-field-rays", "N", 0, 1024, by_preset(q.near_field.rays, r.near_field.rays),
               "contact-light rays per GI cell (0 = off): higher = less noise, at the cost of ray time"),
       number("near-field-reach", "CELLS", 0.01, 16.0, by_preset(q.near_field.reach_cells, r.near_field.reach_cells),
