@@ -171,13 +171,14 @@ void EditorUi::gi_settings() {
   changed |= ImGui::SliderInt("probe budget / frame", &edit.probes.update_budget, 0, 512);
   // Traced reflections (shading::MirrorRay); off is the paper's SH-4 transfer alone.
   bool reflections = edit.mirror.max_roughness >= 0;
-  if (ImGui::Checkbox("traced reflections (mirrors, glossy metals, varnish)", &reflections)) {
+  if (ImGui::Checkbox("traced reflections", &reflections)) {
     edit.mirror.max_roughness = reflections ? transgi::shading::MirrorRay{}.max_roughness : -1.0f;
     changed = true;
   }
-  changed |= ImGui::SliderFloat("metals traced up to roughness", &edit.mirror.glossy_max_roughness, 0.0f, 1.0f, "%.2f");
-  changed |= ImGui::SliderFloat("non-metals traced up to roughness (<0 off)", &edit.mirror.dielectric_max_roughness, -0.05f,
-                                1.0f, "%.2f");
+  // Up to which roughness metals and non-metals (varnish, plastic) trace them.
+  changed |= ImGui::SliderFloat("metals traced to", &edit.mirror.glossy_max_roughness, 0.0f, 1.0f, "roughness %.2f");
+  changed |= ImGui::SliderFloat("others traced to", &edit.mirror.dielectric_max_roughness, -0.05f, 1.0f,
+                                "roughness %.2f (<0 off)");
   changed |= ImGui::Checkbox("decode transfer on the GPU (vulkan backend)", &edit.device_inference);
   changed |= ImGui::Checkbox("shade probe rays on the GPU (vulkan backend)", &edit.device_shading);
   changed |= ImGui::Checkbox("make the decoded samples' light on the GPU", &edit.realtime.device_lights);
