@@ -86,35 +86,27 @@ void Texture::build_mips(bool srgb, bool cut_out_colour) {
     m.rgba.resize(static_cast<std::size_t>(m.width) * m.height * 4);
     for (int y = 0; y < m.height; ++y)
       for (int x = 0; x < m.width; ++x) {
-        float sum[4] = {0, 0, 0, 0};
-        float colour_weight = 0;
+        // The plain sums, and for a cut-out the alpha-weighted colour.
+        float sum[4] = {0, 0, 0, 0}, weighted[3] = {0, 0, 0};
         int n = 0;
         for (int dy = 0; dy < 2; ++dy)
           for (int dx = 0; dx < 2; ++dx) {
             const int sx = std::min(2 * x + dx, w - 1), sy = std::min(2 * y + dy, h - 1);
             const std::uint8_t* p = src + (static_cast<std::size_t>(sy) * w + sx) * 4;
             const float alpha = static_cast<float>(p[3]) / 255.0f;
-            const float weight = cut_out ? alpha : 1.0f;
-            for (int c = 0; c < 3; ++c) sum[c] += weight * (srgb ? lut[p[c]] : static_cast<float>(p[c]) / 255.0f);
+            for (int c = 0; c < 3; ++c) {
+              const float v = srgb ? lut[p[c]] : static_cast<float>(p[c]) / 255.0f;
+              sum[c] += v;
+              weighted[c] += alpha * v;
+            }
             sum[3] += alpha;
-            colour_weight += weight;
             ++n;
           }
         // A block with no opaque texel keeps the plain mean of its colours.
-        if (!(colour_weight > 0)) {
-          colour_weight = 0;
-          for (int c = 0; c < 3; ++c) sum[c] = 0;
-          for (int dy = 0; dy < 2; ++dy)
-            for (int dx = 0; dx < 2; ++dx) {
-              const int sx = std::min(2 * x + dx, w - 1), sy = std::min(2 * y + dy, h - 1);
-              const std::uint8_t* p = src + (static_cast<std::size_t>(sy) * w + sx) * 4;
-              for (int c = 0; c < 3; ++c) sum[c] += srgb ? lut[p[c]] : static_cast<float>(p[c]) / 255.0f;
-              colour_weight += 1.0f;
-            }
-        }
+        const bool by_alpha = cut_out && sum[3] > 0;
         std::uint8_t* d = &m.rgba[(static_cast<std::size_t>(y) * m.width + x) * 4];
         for (int c = 0; c < 3; ++c) {
-          const float v = sum[c] / colour_weight;
+          const float v = by_alpha ? weighted[c] / sum[3] : sum[c] / static_cast<float>(n);
           d[c] = srgb ? encode_srgb(v) : static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
         }
         d[3] = static_cast<std::uint8_t>(std::lround(std::clamp(sum[3] / static_cast<float>(n), 0.0f, 1.0f) * 255.0f));

@@ -33,15 +33,14 @@ double ms_since(Clock::time_point t) { return std::chrono::duration<double, std:
 
 constexpr std::size_t kNone = SIZE_MAX;
 
-// The share of its irradiance a dielectric's diffuse lobe reflects towards
-// the viewer under light from every direction alike: 1 - s E(wo) per
-// channel, brdf.h's layer coupling averaged over the incoming directions.
-glm::vec3 diffuse_layer_share(const GSample& s) {
+// The directional albedo of a dielectric's specular layer towards the
+// viewer, per channel: the mean weight of its reflection rays.
+glm::vec3 specular_layer_albedo(const GSample& s) {
   using namespace engine::material;
   const float cos_o = std::clamp(glm::dot(s.normal_world, s.wo_world), 0.0f, 1.0f);
   const SpecularAlbedo e = ggx_albedo(cos_o, std::max(s.brdf.roughness * s.brdf.roughness, kMinAlpha));
   const glm::vec3 f0 = glm::min(kDielectricF0 * s.brdf.specular_color, glm::vec3(1.0f));
-  return glm::vec3(1.0f) - s.brdf.specular * glm::vec3(e.with_f0(f0.r), e.with_f0(f0.g), e.with_f0(f0.b));
+  return s.brdf.specular * glm::vec3(e.with_f0(f0.r), e.with_f0(f0.g), e.with_f0(f0.b));
 }
 
 }  // namespace
@@ -393,7 +392,7 @@ std::size_t shade_metal_reflections(const GBuffer& g, const engine::rt::RtScene&
       const bool mirror_direction = g.metal_roughness[p] <= mirror.max_roughness;
       math::Pcg32 rng = math::make_rng(0x6105ull, p, phase);
       const glm::vec2 u{rng.next_float(), rng.next_float()};
-      glm::vec3 wi, weight;
+      glm::vec3 wi, weight(0.0f);
       ReflectedLight r;
       if (sample_reflection(g.samples[p], mirror_direction, u, wi, weight)) r = reflected_light(scene, g.samples[p], wi, sky, irradiance);
       // No history here, unlike the glossy dielectrics': on the sample
@@ -405,16 +404,6 @@ std::size_t shade_metal_reflections(const GBuffer& g, const engine::rt::RtScene&
     traced.fetch_add(n, std::memory_order_relaxed);
   });
   return traced.load();
-}
-
-// The directional albedo of a dielectric's specular layer towards the
-// viewer, per channel: the mean weight of its reflection rays.
-glm::vec3 specular_layer_albedo(const GSample& s) {
-  using namespace engine::material;
-  const float cos_o = std::clamp(glm::dot(s.normal_world, s.wo_world), 0.0f, 1.0f);
-  const SpecularAlbedo e = ggx_albedo(cos_o, std::max(s.brdf.roughness * s.brdf.roughness, kMinAlpha));
-  const glm::vec3 f0 = glm::min(kDielectricF0 * s.brdf.specular_color, glm::vec3(1.0f));
-  return s.brdf.specular * glm::vec3(e.with_f0(f0.r), e.with_f0(f0.g), e.with_f0(f0.b));
 }
 
 // Where two G-buffer pixels lie on one surface, for the reflection filter:
@@ -506,9 +495,6 @@ void trace_dielectric_rays(const GBuffer& g, const engine::rt::RtScene& scene, c
   const std::size_t n = rays.traced.size();
   rays.direct.resize(n);
   rays.gi.resize(n);
-  rays.mean_direct.resize(n);
-  rays.mean_gi.resize(n);
-  rays.has_mean.resize(n);
   jobs::parallel_for<std::size_t>(0, n, 64, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       const GSample& s = g.samples[rays.ray_pixel[k]];
@@ -528,6 +514,9 @@ void gather_rays(const GBuffer& g, DielectricRays& rays) {
   constexpr int kReach = 3;
   constexpr float kSigma = 2.5f;  // pixels, at roughness 0.4 and above
   const std::size_t width = static_cast<std::size_t>(g.width);
+  rays.mean_direct.resize(rays.traced.size());
+  rays.mean_gi.resize(rays.traced.size());
+  rays.has_mean.resize(rays.traced.size());
   engine::jobs::parallel_for<std::size_t>(0, rays.traced.size(), 256, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       const std::size_t p = rays.ray_pixel[k];
@@ -630,7 +619,8 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   auto t0 = Clock::now();
   RealtimeGiScratch local;
   RealtimeGiScratch::Impl& sc = *(scratch ? scratch : &local)->impl;
-  if (g.guide.size() != g.samples.size() || g.entity.size() != g.samples.size() || g.metal_roughness.size() != g.samples.size())
+  if (g.guide.size() != g.samples.size() || g.entity.size() != g.samples.size() || g.metal_roughness.size() != g.samples.size() ||
+      g.dielectric_roughness.size() != g.samples.size())
     throw std::invalid_argument("shade_gi_realtime: the G-buffer lacks its per-pixel arrays; make it with trace_gbuffer");
   const std::vector<glm::vec4>& guide = g.guide;
   plan_upsampling(guide, g.width, g.height, settings, sc.up);
@@ -668,8 +658,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   // Glossy dielectrics (MirrorRay::dielectric_max_roughness) take their
   // diffuse light from the probes' irradiance and their specular from a ray.
   const bool reflections = mirror.max_roughness >= 0;
-  const bool glossy_dielectrics = reflections && mirror.dielectric_max_roughness >= 0 &&
-                                  g.dielectric_roughness.size() == g.samples.size();
+  const bool glossy_dielectrics = reflections && mirror.dielectric_max_roughness >= 0;
   const auto is_glossy_dielectric = [&](std::size_t p) {
     return glossy_dielectrics && g.dielectric_roughness[p] <= mirror.dielectric_max_roughness;
   };
@@ -741,7 +730,8 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
       // Over the base colour, as every sample is upsampled (below); a glossy
       // dielectric's diffuse lobe less what its specular layer reflects.
       glm::vec3 over = s.diffuse / model::demodulation(s.albedo) * engine::math::kInvPi;
-      if (is_glossy_dielectric(decode[diffuse[k]])) over *= diffuse_layer_share(s);
+      // (1 - s E(wo): brdf.h's layer coupling averaged over the incoming light).
+      if (is_glossy_dielectric(decode[diffuse[k]])) over *= glm::vec3(1.0f) - specular_layer_albedo(s);
       value[diffuse[k]] = over * sh_irradiance(world, s.normal_world);
       if (with_direct) value_direct[diffuse[k]] = over * sh_irradiance(world_direct, s.normal_world);
     }

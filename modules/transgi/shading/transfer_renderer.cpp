@@ -84,10 +84,6 @@ ReflectedLight reflected_light(const engine::rt::RtScene& scene, const GSample& 
   return {glm::vec3(0.0f), albedo * math::kInvPi * glm::max(irradiance(s), glm::vec3(0.0f))};
 }
 
-namespace {
-
-}  // namespace
-
 bool sample_reflection(const GSample& smp, bool mirror, glm::vec2 u, glm::vec3& wi_world, glm::vec3& weight) {
   using namespace engine;
   const bool metal = smp.brdf.metallic >= 0.5f;
@@ -117,21 +113,20 @@ bool sample_reflection(const GSample& smp, bool mirror, glm::vec2 u, glm::vec3& 
 }
 
 ReflectedLight shade_mirror(const engine::rt::RtScene& scene, const GSample& smp, const LightAt& light_at,
-                            const engine::render::LightSet* lights, const MirrorRay& mirror, engine::math::Pcg32& rng,
-                            const engine::scene::Environment* sky) {
-  return shade_glossy(scene, smp, light_at, lights, mirror, glm::vec2(0.0f), rng, sky, true);
+                            const engine::render::LightSet* lights, const MirrorRay& mirror, engine::math::Pcg32& rng) {
+  return shade_glossy(scene, smp, light_at, lights, mirror, glm::vec2(0.0f), rng, true);
 }
 
 ReflectedLight shade_glossy(const engine::rt::RtScene& scene, const GSample& smp, const LightAt& light_at,
                             const engine::render::LightSet* lights, const MirrorRay& mirror, glm::vec2 u,
-                            engine::math::Pcg32& rng, const engine::scene::Environment* sky, bool mirror_direction) {
+                            engine::math::Pcg32& rng, bool mirror_direction) {
   glm::vec3 wi, weight;
   if (!sample_reflection(smp, mirror_direction, u, wi, weight)) return {};
   // The mirror's light samples: with one, the choice of light left the
   // reflections speckled after the antialiasing's 16-phase mean
   // (docs/image-quality.md, "Glossy metals").
   const ReflectedLight r =
-      reflected_light(scene, smp, wi, sky, probe_and_sampled_irradiance(scene, light_at, lights, mirror.light_samples, rng));
+      reflected_light(scene, smp, wi, nullptr, probe_and_sampled_irradiance(scene, light_at, lights, mirror.light_samples, rng));
   return {weight * r.direct, weight * r.gi};
 }
 

@@ -109,22 +109,21 @@ using HitIrradiance = std::function<glm::vec3(const engine::render::Surface& hit
 // reflects its diffuse albedo / pi x irradiance(hit). Not weighted.
 ReflectedLight reflected_light(const engine::rt::RtScene& scene, const GSample& sample, const glm::vec3& wi,
                                const engine::scene::Environment* sky, const HitIrradiance& irradiance);
-// The light leaving a point of a near-mirror towards the viewer: its Fresnel
-// times what the reflection ray finds (reflected_light above), its hit lit by
-// the probes (light_at) and mirror.light_samples samples of `lights`. The sky
-// (`sky`, null = none) and emitters seen in the mirror are `direct`, as in the
-// reference's passes.
+// The quality path's mirror: the light leaving a point of a near-mirror
+// towards the viewer, its Fresnel times what the reflection ray finds
+// (reflected_light above, no sky), its hit lit by the probes (light_at) and
+// mirror.light_samples samples of `lights`. Emitters seen in the mirror are
+// `direct`, as in the reference's passes. (The real-time frame traces its
+// reflections in shading/realtime_gi.cpp, its hits lit by the probes alone.)
 ReflectedLight shade_mirror(const engine::rt::RtScene& scene, const GSample& sample, const LightAt& light_at,
-                            const engine::render::LightSet* lights, const MirrorRay& mirror, engine::math::Pcg32& rng,
-                            const engine::scene::Environment* sky = nullptr);
+                            const engine::render::LightSet* lights, const MirrorRay& mirror, engine::math::Pcg32& rng);
 // The same for a glossy surface (alpha = roughness^2), by one ray sampled
 // from the GGX distribution of visible normals with u (sample_reflection):
 // its Fresnel and shadowing, F(wo.h) G1(wi), times what it finds.
 // mirror_direction: the mirror's ray instead (shade_mirror).
 ReflectedLight shade_glossy(const engine::rt::RtScene& scene, const GSample& sample, const LightAt& light_at,
                             const engine::render::LightSet* lights, const MirrorRay& mirror, glm::vec2 u,
-                            engine::math::Pcg32& rng, const engine::scene::Environment* sky = nullptr,
-                            bool mirror_direction = false);
+                            engine::math::Pcg32& rng, bool mirror_direction = false);
 // Whether a sample takes the mirror path.
 bool is_mirror(const engine::material::BrdfParams& brdf, const MirrorRay& mirror);
 
