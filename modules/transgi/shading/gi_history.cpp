@@ -34,33 +34,53 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
   cur_.camera = g.camera;
   cur_.key.resize(cells);
   source.assign(cells, kDecode);
-  // The objects in view, numbered; a handful, so found by a linear search
-  // once per run of cells on one object.
+  // The objects in view, numbered in the order their first cells come; a
+  // handful, so found by a linear search once per run of cells on one object.
+  // Each chunk of cells lists its objects in parallel, the lists are merged in
+  // chunk order, then each cell is numbered in parallel.
   cur_.objects.clear();
   object_of_cell_.resize(cells);
-  {
+  constexpr std::size_t kChunk = 4096;
+  const std::size_t chunks = (cells + kChunk - 1) / kChunk;
+  std::vector<std::vector<Entity>> seen(chunks);
+  const auto entity_of = [&](std::size_t c) { return g.entity[up.cell_pixel[c]]; };
+  engine::jobs::parallel_for<std::size_t>(0, chunks, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      Entity last{};
+      bool any = false;
+      for (std::size_t c = k * kChunk; c < std::min(cells, (k + 1) * kChunk); ++c) {
+        if (!(up.cell_guide[c].w > 0)) continue;
+        const Entity en = entity_of(c);
+        if (any && en == last) continue;
+        any = true;
+        last = en;
+        if (std::find(seen[k].begin(), seen[k].end(), en) == seen[k].end()) seen[k].push_back(en);
+      }
+    }
+  });
+  for (const std::vector<Entity>& list : seen)
+    for (const Entity en : list)
+      if (std::none_of(cur_.objects.begin(), cur_.objects.end(), [&](const auto& o) { return o.first == en; })) {
+        const engine::rt::InstanceRecord* inst = scene.instance_of(en);
+        cur_.objects.emplace_back(en, inst ? inst->to_world : Similarity{});
+      }
+  engine::jobs::parallel_for<std::size_t>(0, cells, kChunk, [&](std::size_t b, std::size_t e) {
     Entity last{};
     std::uint32_t last_index = kNoObject;
-    for (std::size_t c = 0; c < cells; ++c) {
+    for (std::size_t c = b; c < e; ++c) {
       if (!(up.cell_guide[c].w > 0)) {
         object_of_cell_[c] = kNoObject;
         continue;
       }
-      const Entity e = g.entity[up.cell_pixel[c]];
-      if (!(e == last) || last_index == kNoObject) {
-        last = e;
-        last_index = kNoObject;
-        for (std::size_t k = 0; k < cur_.objects.size() && last_index == kNoObject; ++k)
-          if (cur_.objects[k].first == e) last_index = static_cast<std::uint32_t>(k);
-        if (last_index == kNoObject) {
-          const engine::rt::InstanceRecord* inst = scene.instance_of(e);
-          last_index = static_cast<std::uint32_t>(cur_.objects.size());
-          cur_.objects.emplace_back(e, inst ? inst->to_world : Similarity{});
-        }
+      const Entity en = entity_of(c);
+      if (!(en == last) || last_index == kNoObject) {
+        last = en;
+        last_index = 0;
+        while (!(cur_.objects[last_index].first == en)) ++last_index;  // listed above
       }
       object_of_cell_[c] = last_index;
     }
-  }
+  });
   // Per object in view, as matrices so a cell costs a few multiply-adds:
   // from a cell's camera-space direction (sx, sy, -1) and depth to the point
   // in the object's frame (c0 + depth / |dir| A dir); the world normal into

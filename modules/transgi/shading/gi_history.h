@@ -13,6 +13,7 @@
 // what decoding would give (tested against decoding every cell).
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "engine/render/camera_rays.h"
@@ -38,6 +39,9 @@ class GiHistory {
   // The previous frame's value of cell c, as plan() named it.
   [[nodiscard]] const glm::vec3& value(std::int32_t c) const { return prev_.value[static_cast<std::size_t>(c)]; }
   [[nodiscard]] const glm::vec3& value_direct(std::int32_t c) const { return prev_.value_direct[static_cast<std::size_t>(c)]; }
+  // Every cell's value (direct: zeros where none was stored), as value(c).
+  [[nodiscard]] std::span<const glm::vec3> values() const { return prev_.value; }
+  [[nodiscard]] std::span<const glm::vec3> values_direct() const { return prev_.value_direct; }
   void clear();
 
  private:
