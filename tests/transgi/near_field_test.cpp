@@ -162,6 +162,60 @@ TEST(NearField, TheFilterKeepsAConstantAndNeverCrossesADepthStep) {
   }
 }
 
+// The real-time filter (a horizontal then a vertical pass, one sample a
+// pixel) keeps a constant on each side of a depth step and of a crease, takes
+// values only from `valid` pixels, writes only `wanted` ones (zero elsewhere),
+// and averages noise on one surface as the full window does.
+TEST(NearField, TheSeparableFilterKeepsAConstantTakesOnlyValidPixelsAndNeverCrossesAnEdge) {
+  const int w = 12, h = 10;
+  const std::size_t n = static_cast<std::size_t>(w * h);
+  std::vector<shading::GSample> samples(n);
+  std::vector<glm::vec3> values(n);
+  std::vector<std::uint8_t> valid(n), wanted(n);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y * w + x);
+      samples[i].hit = !(x == 2 && y == 1);
+      samples[i].normal_world = y < 5 ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);  // a crease between rows 4 and 5
+      samples[i].depth = x < 6 ? 1.0f : 2.0f;                                        // a silhouette between columns 5 and 6
+      valid[i] = y % 3 == 0;  // one row in three traced rays
+      wanted[i] = (x + y) % 2;
+      // Invalid pixels hold garbage the filter must not read.
+      values[i] = !valid[i] ? glm::vec3(1e6f) : x < 6 ? (y < 5 ? glm::vec3(1, 2, 3) : glm::vec3(4.0f)) : glm::vec3(0.25f);
+    }
+  std::vector<glm::vec4> row;
+  std::vector<glm::vec3> out;
+  shading::filter_near_field_separable(guide_of(samples), w, h, values, valid, wanted, 3, row, out);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y * w + x);
+      const glm::vec3 expected = !wanted[i] || !samples[i].hit ? glm::vec3(0.0f)
+                                 : x < 6                       ? (y < 5 ? glm::vec3(1, 2, 3) : glm::vec3(4.0f))
+                                                               : glm::vec3(0.25f);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(out[i][c], expected[c], 1e-5f) << "pixel " << x << ", " << y << " channel " << c;
+    }
+  // Noise on one flat surface: alternating 0 and 2 on the valid pixels; the
+  // full 7 x 7 window averages it to 1 within 2/49 at the centre, the two
+  // passes within a few times that (each pass sees fewer values).
+  for (std::size_t i = 0; i < n; ++i) {
+    samples[i].hit = true;
+    samples[i].depth = 1.0f;
+    samples[i].normal_world = glm::vec3(0, 0, 1);
+    valid[i] = 1;
+    wanted[i] = 1;
+    values[i] = glm::vec3(static_cast<float>((i + i / w) % 2) * 2.0f);
+  }
+  shading::filter_near_field_separable(guide_of(samples), w, h, values, valid, wanted, 3, row, out);
+  const std::vector<glm::vec3> full = shading::filter_near_field(guide_of(samples), w, h, 1, values, 3);
+  const std::size_t centre = static_cast<std::size_t>(5 * w + 6);
+  EXPECT_NEAR(full[centre].r, 1.0f, 2.0f / 49.0f + 1e-5f);
+  EXPECT_NEAR(out[centre].r, 1.0f, 0.1f);
+  // Bad sizes are refused, not read past.
+  std::vector<std::uint8_t> short_mask(n - 1, 1);
+  EXPECT_THROW(shading::filter_near_field_separable(guide_of(samples), w, h, values, short_mask, wanted, 3, row, out),
+               std::invalid_argument);
+}
+
 // The real-time path's near field (on its half-resolution grid, filtered
 // there) against the quality path's (every pixel): a wall standing on a
 // sunlit floor, probes holding no light, so the wall's GI is its contact
@@ -221,16 +275,29 @@ TEST(NearField, TheRealTimePathAgreesWithTheQualityPath) {
   const model::TransferModel no_model;
   shading::TransferRenderResult quality;
   shading::GBuffer g;
-  image::ImageRGB realtime;
+  image::ImageRGB realtime, budgeted;
+  // The game's way: the GI reuse (each frame decodes every other cell; the
+  // rest keep the value, contact light included, they were given) and a cell
+  // budget that leaves rays on one decoded row in three, over four frames.
+  shading::NearFieldRays game_near = near;
+  game_near.cell_budget = 100;
+  shading::RealtimeGiSettings reuse;
+  reuse.reuse_history = true;
+  shading::RealtimeGiScratch scratch;
+  shading::RealtimeGiStats stats;
   app.jobs().run([&] {
     quality = shading::render_transfer(rt, assets, no_model, rays, size, size, no_light, nullptr,
                                        shading::TransferSource::Network, s);
     shading::trace_gbuffer(rt, assets, rays, size, size, g);
     realtime = shading::shade_gi_realtime(g, rt, assets, nullptr, nullptr, {}, fields, shading::RealtimeGiSettings{}, nullptr,
                                           nullptr, nullptr, &lights, shading::MirrorRay{.max_roughness = -1}, near);
+    for (int frame = 0; frame < 4; ++frame)
+      budgeted = shading::shade_gi_realtime(g, rt, assets, nullptr, nullptr, {}, fields, reuse, &stats, nullptr, &scratch, &lights,
+                                            shading::MirrorRay{.max_roughness = -1}, game_near);
   });
+  EXPECT_GT(stats.reused_cells, 0u) << "the last frame reused cells";
   // The wall's pixels: rows where the camera ray meets it, below its middle.
-  double sum_q = 0, sum_r = 0, low = 0, high = 0;
+  double sum_q = 0, sum_r = 0, sum_b = 0, low = 0, high = 0;
   int n = 0;
   for (int y = 0; y < size; ++y)
     for (int x = size / 4; x < 3 * size / 4; ++x) {
@@ -239,6 +306,7 @@ TEST(NearField, TheRealTimePathAgreesWithTheQualityPath) {
       if (smp.position.y < 0.5f) {
         sum_q += quality.image.at(x, y).g;
         sum_r += realtime.at(x, y).g;
+        sum_b += budgeted.at(x, y).g;
         ++n;
         if (smp.position.y < 0.25f) low += realtime.at(x, y).g;
       } else if (smp.position.y > 1.5f) {
@@ -246,9 +314,11 @@ TEST(NearField, TheRealTimePathAgreesWithTheQualityPath) {
       }
     }
   ASSERT_GT(n, 50) << "the camera must see the wall's lower half";
-  std::printf("wall below 0.5 m, %d pixels: mean GI quality %.5f, real-time %.5f\n", n, sum_q / n, sum_r / n);
+  std::printf("wall below 0.5 m, %d pixels: mean GI quality %.5f, real-time %.5f, budgeted with reuse %.5f\n", n, sum_q / n,
+              sum_r / n, sum_b / n);
   EXPECT_GT(sum_q / n, 0.01) << "contact light from the sunlit floor";
   EXPECT_NEAR(sum_r / n, sum_q / n, 0.10 * sum_q / n);
+  EXPECT_NEAR(sum_b / n, sum_q / n, 0.10 * sum_q / n);
   EXPECT_GT(low, 0.0);
   EXPECT_EQ(high, 0.0) << "above the reach (one 1 m cell) of the floor, nothing";
 }

@@ -90,6 +90,8 @@ std::vector<OptionSpec> runtime_option_specs(const std::string& default_preset) 
              "near-field ray length in probe cells: higher = more contact light found, at the cost of overlap with the probes"),
       integer("near-field-filter", "R", 0, 16, by_preset(q.near_field.filter_radius, r.near_field.filter_radius),
               "near-field filter radius in GI cells: higher = smoother, at the cost of detail"),
+      integer("near-field-budget", "N", 0, 1 << 24, by_preset(q.near_field.cell_budget, r.near_field.cell_budget),
+              "real-time path: GI cells that trace near-field rays a frame (0 = every decoded cell): higher = less noise at high resolutions, at the cost of ray time"),
   };
 }
 

@@ -37,6 +37,7 @@ void near_field_from(const Args& args, shading::NearFieldRays& n) {
   n.rays = static_cast<int>(args.integer("near-field-rays", 0, 1024, n.rays));
   n.reach_cells = static_cast<float>(args.number("near-field-reach", 0.01, 16.0, n.reach_cells));
   n.filter_radius = static_cast<int>(args.integer("near-field-filter", 0, 16, n.filter_radius));
+  n.cell_budget = static_cast<int>(args.integer("near-field-budget", 0, 1 << 24, n.cell_budget));
 }
 
 runtime::ProbePlacement probe_placement_from(const Args& args, runtime::ProbeVolumeMode default_mode) {

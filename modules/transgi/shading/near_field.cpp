@@ -1,6 +1,7 @@
 #include "shading/near_field.h"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "engine/jobs/parallel_for.h"
 #include "engine/math/sampling.h"
@@ -26,6 +27,8 @@ glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::
     light_at(p, n, sh);
     return sh_irradiance(sh, n);
   };
+  float own_sh[75];
+  const float* probes_sh = light_sh;
   glm::vec3 sum(0.0f);
   // Stratified over a sqrt(rays) x sqrt(rays) grid of the unit square where
   // it divides evenly, else plain random.
@@ -40,10 +43,14 @@ glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::
     if (!scene.intersect(rt::Ray{origin, dir, 0.0f, reach}, hit)) continue;
     if (skip_self && hit.entity == s.entity) continue;
     const probes::ProbeRayHit h = probes::shade_probe_ray(scene, light_set, dir, &hit, rng, feedback);
+    if (!probes_sh) {
+      light_at(s.position, s.normal_world, own_sh);
+      probes_sh = own_sh;
+    }
     const math::ShBasis y = math::sh_eval(dir);
     glm::vec3 probe_radiance(0.0f);
     for (int c = 0; c < 3; ++c)
-      for (int i = 0; i < math::kShCount; ++i) probe_radiance[c] += light_sh[c * math::kShCount + i] * y[static_cast<std::size_t>(i)];
+      for (int i = 0; i < math::kShCount; ++i) probe_radiance[c] += probes_sh[c * math::kShCount + i] * y[static_cast<std::size_t>(i)];
     sum += h.radiance - probe_radiance;
   }
   const glm::vec3 e = sum * (math::kPi / static_cast<float>(rays));
@@ -84,6 +91,61 @@ std::vector<glm::vec3> filter_near_field(std::span<const glm::vec4> guide, int w
         }
   });
   return out;
+}
+
+void filter_near_field_separable(std::span<const glm::vec4> guide, int width, int height, std::span<const glm::vec3> values,
+                                 std::span<const std::uint8_t> valid, std::span<const std::uint8_t> wanted, int radius,
+                                 std::vector<glm::vec4>& row, std::vector<glm::vec3>& out) {
+  const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  if (guide.size() != n || values.size() != n || valid.size() != n || wanted.size() != n)
+    throw std::invalid_argument("filter_near_field_separable: guide, values, valid and wanted must hold width x height entries");
+  // Rows with no valid pixel contribute nothing to the vertical pass.
+  std::vector<std::uint8_t> row_has(static_cast<std::size_t>(height), 0);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width && !row_has[static_cast<std::size_t>(y)]; ++x)
+      row_has[static_cast<std::size_t>(y)] = valid[static_cast<std::size_t>(y) * width + x];
+  // Pass 1 keeps, per pixel, the weighted sum and weight along its row; pass
+  // 2 sums those down the column, each tap weighted against the centre.
+  // Only rows with a valid pixel are written, and only they are read.
+  row.resize(n);
+  out.resize(n);
+  engine::jobs::parallel_for(0, height, 8, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      if (!row_has[static_cast<std::size_t>(y)]) continue;
+      for (int x = 0; x < width; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * width + x;
+        const glm::vec4& c = guide[p];
+        row[p] = glm::vec4(0.0f);
+        if (!(c.w > 0)) continue;
+        glm::vec4 acc(0.0f);
+        for (int nx = std::max(0, x - radius); nx <= std::min(width - 1, x + radius); ++nx) {
+          const std::size_t i = static_cast<std::size_t>(y) * width + nx;
+          if (!valid[i]) continue;
+          const float w = guide_similarity(c, guide[i], kDepthTolerance, kNormalPower);
+          if (w > 0) acc += glm::vec4(w * values[i], w);
+        }
+        row[p] = acc;
+      }
+    }
+  });
+  engine::jobs::parallel_for(0, height, 8, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < width; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * width + x;
+        const glm::vec4& c = guide[p];
+        out[p] = glm::vec3(0.0f);
+        if (!wanted[p] || !(c.w > 0)) continue;
+        glm::vec4 acc(0.0f);
+        for (int ny = std::max(0, y - radius); ny <= std::min(height - 1, y + radius); ++ny) {
+          if (!row_has[static_cast<std::size_t>(ny)]) continue;
+          const std::size_t i = static_cast<std::size_t>(ny) * width + x;
+          if (!(row[i].w > 0)) continue;
+          const float w = guide_similarity(c, guide[i], kDepthTolerance, kNormalPower);
+          if (w > 0) acc += w * row[i];
+        }
+        if (acc.w > 0) out[p] = glm::vec3(acc) / acc.w;
+      }
+  });
 }
 
 }  // namespace transgi::shading

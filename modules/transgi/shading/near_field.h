@@ -10,6 +10,7 @@
 // probes' SH said for those directions. Screen-space and short-range
 // world-space traces in front of a radiance cache are the same idea in
 // production engines (Lumen's near field).
+#include <cstdint>
 #include <functional>
 #include <span>
 #include <vector>
@@ -37,6 +38,14 @@ struct NearFieldRays {
   // depth and normal similarity (filter_near_field). Higher = less noise, at
   // the cost of contact light smeared along a surface. 0 = unfiltered.
   int filter_radius = 4;
+  // Real-time path: at most this many cells trace rays a frame (0 = every
+  // decoded cell). Past it, rays leave the decoded cells of one row in k,
+  // the smallest k that fits, and the filter spreads their estimate over the
+  // rows between, so the cost stays put as the resolution grows (k is at
+  // most the filter's 2 filter_radius + 1 rows, past which it would leave
+  // cells with no estimate in reach: the budget yields). Higher =
+  // less noisy contact light at high resolutions, at the cost of ray time.
+  int cell_budget = 0;
   bool operator==(const NearFieldRays&) const = default;
 };
 
@@ -49,7 +58,9 @@ using NearLightAt = std::function<void(const glm::vec3& position, const glm::vec
 // probes' SH radiance `light_sh` in that direction). Hits on the sample's
 // own entity are skipped where `skip_self` (its transfer already holds
 // them). Zero where nothing is near. May be negative per channel: the
-// caller clamps the shaded total.
+// caller clamps the shaded total. A null `light_sh` is interpolated with
+// `light_at` at s only once a ray hits: most rays from an open floor or wall
+// meet nothing within reach, and the interpolation costs more than the ray.
 glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::render::LightSet* lights,
                                 const GSample& s, const float* light_sh, float reach, bool skip_self, int rays,
                                 const NearLightAt& light_at, engine::math::Pcg32& rng);
@@ -63,5 +74,17 @@ glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::
 // surface stays that constant.
 std::vector<glm::vec3> filter_near_field(std::span<const glm::vec4> guide, int width, int height, int spp,
                                          std::span<const glm::vec3> values, int radius);
+
+// The same weights over one sample per pixel, as a horizontal then a
+// vertical pass (2 (2 radius + 1) taps a pixel instead of (2 radius + 1)^2:
+// the real-time frame's filter), taking only the pixels where `valid` is
+// nonzero (the cells that traced rays this frame), written only where
+// `wanted` is nonzero (the cells decoded this frame; elsewhere zero). Pixels
+// with no valid neighbour in reach get zero. A constant over one surface
+// stays that constant; a value crosses a silhouette or crease in neither pass.
+// `row` is the horizontal pass's buffer, `out` the result (both resized).
+void filter_near_field_separable(std::span<const glm::vec4> guide, int width, int height, std::span<const glm::vec3> values,
+                                 std::span<const std::uint8_t> valid, std::span<const std::uint8_t> wanted, int radius,
+                                 std::vector<glm::vec4>& row, std::vector<glm::vec3>& out);
 
 }  // namespace transgi::shading

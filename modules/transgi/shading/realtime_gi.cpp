@@ -147,11 +147,27 @@ struct DielectricRays {
   }
 };
 
+// The near field's per-cell buffers, kept across frames (add_contact_light).
+struct ContactScratch {
+  std::vector<glm::vec3> contact, filtered;
+  std::vector<glm::vec4> row;
+  std::vector<std::uint8_t> valid, wanted;
+};
+
 struct RealtimeGiScratch::Impl {
   DielectricRays dielectric_rays;
   UpsamplingPlan up;
-  std::vector<std::size_t> decode, slot_of_pixel, cell_slot;
+  std::vector<std::size_t> decode, slot_of_pixel;
   std::vector<glm::vec3> value, value_direct, shaded, shaded_direct;
+  // Per decoded sample: what its contact light is multiplied by (its
+  // diffuse reflectance over its base colour, over pi), taken while its
+  // GSample is in cache.
+  std::vector<glm::vec3> contact_gain;
+  std::vector<std::uint8_t> through_network;  // per decoded sample: its light comes from the network
+  std::vector<std::size_t> decoded_cells;      // the grid cells decoded this frame
+  std::vector<std::size_t> row_start;          // per row of cells: its first decoded cell's slot
+  std::vector<std::uint8_t> row_has_own;       // per pixel row: it holds a pixel decoded on its own
+  ContactScratch contact;
   std::vector<TransferQuery> queries;
   // Per network sample: where it is and its world normal, copied while its
   // GSample is in cache so the light fill does not miss on it a second time.
@@ -596,6 +612,52 @@ std::size_t shade_dielectric_reflections(const GBuffer& g, const engine::rt::RtS
   return rays.traced.size();
 }
 
+// Adds the near field's contact light (near_field.h) to the cells decoded
+// this frame (`cells`, their slots in `value` below decode.size()): `rays`
+// short rays from the cells of one row in k (NearFieldRays::cell_budget), filtered over them (a
+// horizontal then a vertical bilateral pass), times each sample's contact
+// gain. A network sample skips hits on its own object, whose transfer holds
+// them.
+void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::span<const probes::ProbeField* const> fields,
+                       const engine::render::LightSet* lights, const NearFieldRays& near_field, const UpsamplingPlan& up,
+                       std::span<const std::size_t> cells, std::span<const std::size_t> slot_of_pixel,
+                       std::span<const std::uint8_t> through_network, std::span<const glm::vec3> contact_gain,
+                       ContactScratch& scratch, std::vector<glm::vec3>& value) {
+  const NearLightAt light_at = [&](const glm::vec3& p, const glm::vec3& n, float* out) { probes::interpolate_fields(fields, p, n, out); };
+  const std::size_t grid = up.cell_pixel.size();
+  const std::size_t budget = static_cast<std::size_t>(std::max(0, near_field.cell_budget));
+  // No wider than the filter's window, so every cell has a row of rays in reach.
+  const std::size_t widest = 2 * static_cast<std::size_t>(std::max(0, near_field.filter_radius)) + 1;
+  const std::size_t stride = budget > 0 ? std::clamp<std::size_t>((cells.size() + budget - 1) / budget, 1, widest) : 1;
+  const std::size_t row = static_cast<std::size_t>(up.grid_w);
+  // Every entry read below is written first, except these masks.
+  scratch.contact.resize(grid);
+  scratch.valid.assign(grid, 0);
+  scratch.wanted.assign(grid, 0);
+  engine::jobs::parallel_for<std::size_t>(0, cells.size(), 64, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      const std::size_t c = cells[k];
+      scratch.wanted[c] = 1;
+      if ((c / row) % stride != 0) continue;
+      const std::size_t p = up.cell_pixel[c];
+      const GSample& s = g.samples[p];
+      engine::math::Pcg32 rng = engine::math::make_rng(0x4EA2F1ull, p, 0);  // fixed: the real-time image has no seed
+      const float reach = near_field.reach_cells * probes::fields_at(fields, s.position).field[0]->placement().min_spacing();
+      scratch.contact[c] = near_field_irradiance(scene, lights, s, nullptr, reach, through_network[slot_of_pixel[p]] != 0,
+                                                 near_field.rays, light_at, rng);
+      scratch.valid[c] = 1;
+    }
+  });
+  filter_near_field_separable(up.cell_guide, up.grid_w, up.grid_h, scratch.contact, scratch.valid, scratch.wanted,
+                              near_field.filter_radius, scratch.row, scratch.filtered);
+  engine::jobs::parallel_for<std::size_t>(0, cells.size(), 1024, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      const std::size_t c = cells[k], slot = slot_of_pixel[up.cell_pixel[c]];
+      value[slot] = glm::max(value[slot] + contact_gain[slot] * scratch.filtered[c], glm::vec3(0.0f));
+    }
+  });
+}
+
 }  // namespace
 
 engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
@@ -641,17 +703,53 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     decode.push_back(p);
   };
   // With reuse, the cells that take the previous frame's value are not decoded.
-  // (Not with the near field, whose contact light is estimated afresh on every cell.)
-  const bool reuse = settings.reuse_history && scratch != nullptr && g.camera.has_value() && near_field.rays <= 0;
+  const bool reuse = settings.reuse_history && scratch != nullptr && g.camera.has_value();
   if (reuse)
     sc.history.plan(up, g, scene, sc.source);
   else
     sc.history.clear();
-  for (std::size_t c = 0; c < up.cell_pixel.size(); ++c)
-    if (!reuse || sc.source[c] == GiHistory::kDecode) want(up.cell_pixel[c]);
+  // The cells in cell order, their slots by a prefix sum over rows of cells
+  // (cells decode distinct pixels, so the rows fill their slots in parallel).
+  const std::size_t grid_w = static_cast<std::size_t>(up.grid_w), grid_h = static_cast<std::size_t>(up.grid_h);
+  const auto decodes = [&](std::size_t c) { return (!reuse || sc.source[c] == GiHistory::kDecode) && up.cell_guide[c].w > 0; };
+  std::vector<std::size_t>& row_start = sc.row_start;
+  row_start.assign(grid_h + 1, 0);
+  engine::jobs::parallel_for<std::size_t>(0, grid_h, 8, [&](std::size_t b, std::size_t e) {
+    for (std::size_t j = b; j < e; ++j) {
+      std::size_t n = 0;
+      for (std::size_t c = j * grid_w; c < (j + 1) * grid_w; ++c) n += decodes(c) ? 1 : 0;
+      row_start[j + 1] = n;
+    }
+  });
+  for (std::size_t j = 0; j < grid_h; ++j) row_start[j + 1] += row_start[j];
+  decode.resize(row_start[grid_h]);
+  sc.decoded_cells.resize(row_start[grid_h]);
+  engine::jobs::parallel_for<std::size_t>(0, grid_h, 8, [&](std::size_t b, std::size_t e) {
+    for (std::size_t j = b; j < e; ++j) {
+      std::size_t slot = row_start[j];
+      for (std::size_t c = j * grid_w; c < (j + 1) * grid_w; ++c)
+        if (decodes(c)) {
+          slot_of_pixel[up.cell_pixel[c]] = slot;
+          decode[slot] = up.cell_pixel[c];
+          sc.decoded_cells[slot++] = c;
+        }
+    }
+  });
   stats.grid_samples = decode.size();
-  for (std::size_t p = 0; p < g.samples.size(); ++p)
-    if (up.kind[p] == UpsamplingPlan::kOwn) want(p);
+  // Pixels on their own: a few along silhouettes, found by rows in parallel.
+  std::vector<std::uint8_t>& row_has_own = sc.row_has_own;
+  row_has_own.assign(static_cast<std::size_t>(g.height), 0);
+  const std::size_t width = static_cast<std::size_t>(g.width);
+  engine::jobs::parallel_for<std::size_t>(0, row_has_own.size(), 8, [&](std::size_t b, std::size_t e) {
+    for (std::size_t y = b; y < e; ++y)
+      row_has_own[y] = std::find(up.kind.begin() + static_cast<std::ptrdiff_t>(y * width),
+                                 up.kind.begin() + static_cast<std::ptrdiff_t>((y + 1) * width), UpsamplingPlan::kOwn) !=
+                       up.kind.begin() + static_cast<std::ptrdiff_t>((y + 1) * width);
+  });
+  for (std::size_t y = 0; y < row_has_own.size(); ++y)
+    if (row_has_own[y])
+      for (std::size_t p = y * width; p < (y + 1) * width; ++p)
+        if (up.kind[p] == UpsamplingPlan::kOwn) want(p);
   stats.edge_samples = decode.size() - stats.grid_samples;
   double plan_ms = ms_since(t0);
 
@@ -712,12 +810,15 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   queries.resize(net.size());
   sc.net_position.resize(net.size());
   sc.net_normal.resize(net.size());
+  const bool with_contact = near_field.rays > 0;
+  sc.contact_gain.resize(with_contact ? decode.size() : 0);
   engine::jobs::parallel_for<std::size_t>(0, net.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       const GSample& s = g.samples[decode[net[k]]];
       queries[k] = {s.mesh, s.triangle, s.bary, s.albedo, s.normal_obj, s.wo_obj};
       sc.net_position[k] = s.position;
       sc.net_normal[k] = s.normal_world;
+      if (with_contact) sc.contact_gain[net[k]] = s.diffuse / model::demodulation(s.albedo) * engine::math::kInvPi;
     }
   });
   engine::jobs::parallel_for<std::size_t>(0, diffuse.size(), 256, [&](std::size_t b, std::size_t e) {
@@ -733,6 +834,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
       // (1 - s E(wo): brdf.h's layer coupling averaged over the incoming light).
       if (is_glossy_dielectric(decode[diffuse[k]])) over *= glm::vec3(1.0f) - specular_layer_albedo(s);
       value[diffuse[k]] = over * sh_irradiance(world, s.normal_world);
+      if (with_contact) sc.contact_gain[diffuse[k]] = over;
       if (with_direct) value_direct[diffuse[k]] = over * sh_irradiance(world_direct, s.normal_world);
     }
   });
@@ -801,6 +903,18 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     ++stats.nonfinite_samples;
   }
 
+  // The contact light, on the cells decoded this frame, before their values
+  // become the next frame's history: a reused cell keeps the contact light
+  // it was given when it was decoded, so the reuse still halves the work.
+  if (near_field.rays > 0) {
+    t0 = Clock::now();
+    sc.through_network.assign(decode.size(), 0);
+    for (const std::size_t i : net) sc.through_network[i] = 1;
+    add_contact_light(g, scene, fields, mirror_lights, near_field, up, sc.decoded_cells, slot_of_pixel, sc.through_network,
+                      sc.contact_gain, sc.contact, value);
+    stats.near_ms = ms_since(t0);
+  }
+
   if (reuse) {
     // The reused cells' values after the decoded ones, a reused cell's slot
     // at its cell index past them, so the cells are independent (no cell's
@@ -835,46 +949,32 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     sc.history.store(sc.cell_value, sc.cell_value_direct, sc.fresh);
   }
 
-  if (near_field.rays > 0) {
-    t0 = Clock::now();
-    std::vector<std::uint8_t> through_network(decode.size(), 0);
-    for (const std::size_t i : net) through_network[i] = 1;  // their transfer holds their own object
-    const NearLightAt light_at = [&](const glm::vec3& p, const glm::vec3& n, float* out) { probes::interpolate_fields(fields, p, n, out); };
-    std::vector<glm::vec3> contact(up.cell_pixel.size(), glm::vec3(0.0f));
-    engine::jobs::parallel_for<std::size_t>(0, contact.size(), 16, [&](std::size_t b, std::size_t e) {
-      float world[75];
-      for (std::size_t c = b; c < e; ++c) {
-        const std::size_t p = up.cell_pixel[c], slot = slot_of_pixel[p];
-        if (slot == kNone) continue;
-        const GSample& s = g.samples[p];
-        light_at(s.position, s.normal_world, world);
-        engine::math::Pcg32 rng = engine::math::make_rng(0x4EA2F1ull, p, 0);  // fixed: the real-time image has no seed
-        const float reach = near_field.reach_cells * probes::fields_at(fields, s.position).field[0]->placement().min_spacing();
-        contact[c] = near_field_irradiance(scene, mirror_lights, s, world, reach, through_network[slot] != 0, near_field.rays,
-                                           light_at, rng);
-      }
-    });
-    const std::vector<glm::vec3> filtered =
-        filter_near_field(up.cell_guide, up.grid_w, up.grid_h, 1, contact, near_field.filter_radius);
-    for (std::size_t c = 0; c < filtered.size(); ++c) {
-      const std::size_t p = up.cell_pixel[c], slot = slot_of_pixel[p];
-      if (slot == kNone) continue;
-      const GSample& s = g.samples[p];
-      value[slot] = glm::max(value[slot] + s.diffuse / model::demodulation(g.albedo[p]) * engine::math::kInvPi * filtered[c],
-                             glm::vec3(0.0f));
-    }
-    stats.near_ms = ms_since(t0);
-  }
 
   t0 = Clock::now();
   // The metals the reflection pass traces (below) take their direct light
   // from its ray, not from the probes' direct SH through their transfer.
   const float metal_ray_roughness = reflections ? std::max(mirror.max_roughness, mirror.glossy_max_roughness) : -1.0f;
-  // Each cell's slot in `value`, so the composite reads one index per tap
-  // (a miss cell has none; its taps have zero weight and are skipped).
-  std::vector<std::size_t>& cell_slot = sc.cell_slot;
-  cell_slot.resize(up.cell_pixel.size());
-  for (std::size_t c = 0; c < cell_slot.size(); ++c) cell_slot[c] = slot_of_pixel[up.cell_pixel[c]];
+  // Every cell's value in one dense array (zero for a miss cell, whose taps
+  // have zero weight), so a tap is one load: with the reuse, the history's
+  // (this frame's, stored above); else gathered here.
+  std::span<const glm::vec3> cell_values, cell_values_direct;
+  if (reuse) {
+    cell_values = sc.history.values();
+    cell_values_direct = sc.history.values_direct();
+  } else {
+    const std::size_t cells = up.cell_pixel.size();
+    sc.cell_value.resize(cells);
+    sc.cell_value_direct.resize(with_direct ? cells : 0);
+    engine::jobs::parallel_for<std::size_t>(0, cells, 4096, [&](std::size_t b, std::size_t e) {
+      for (std::size_t c = b; c < e; ++c) {
+        const std::size_t slot = slot_of_pixel[up.cell_pixel[c]];
+        sc.cell_value[c] = slot != kNone ? value[slot] : glm::vec3(0.0f);
+        if (with_direct) sc.cell_value_direct[c] = slot != kNone ? value_direct[slot] : glm::vec3(0.0f);
+      }
+    });
+    cell_values = sc.cell_value;
+    cell_values_direct = sc.cell_value_direct;
+  }
   engine::jobs::parallel_for(0, g.height, 8, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < g.width; ++x) {
@@ -891,9 +991,9 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
         for (int k = 0; k < 4; ++k) {
           const float w = up.weight[static_cast<std::size_t>(k)][p];
           if (!(w > 0)) continue;
-          const std::size_t slot = cell_slot[up.cell(k, x, y)];
-          sum += w * value[slot];
-          if (add_direct) sum_direct += w * value_direct[slot];
+          const std::size_t c = up.cell(k, x, y);
+          sum += w * cell_values[c];
+          if (add_direct) sum_direct += w * cell_values_direct[c];
         }
         image.pixels[p] = albedo * sum;
         if (add_direct) direct_out->pixels[p] += albedo * sum_direct;
