@@ -131,6 +131,24 @@ ColourMetrics compare_colour(const ImageRGB& a, const ImageRGB& b) {
   return m;
 }
 
+ImageRGB box_downsample(const ImageRGB& img, int n) {
+  if (n < 1) throw std::invalid_argument("box_downsample: the block size must be at least 1, got " + std::to_string(n));
+  const int w = (img.width + n - 1) / n, h = (img.height + n - 1) / n;
+  ImageRGB out(w, h);
+  for (int by = 0; by < h; ++by)
+    for (int bx = 0; bx < w; ++bx) {
+      glm::dvec3 sum(0.0);
+      int count = 0;
+      for (int y = by * n; y < std::min(img.height, (by + 1) * n); ++y)
+        for (int x = bx * n; x < std::min(img.width, (bx + 1) * n); ++x) {
+          sum += glm::dvec3(img.at(x, y));
+          ++count;
+        }
+      out.at(bx, by) = glm::vec3(sum / static_cast<double>(count));
+    }
+  return out;
+}
+
 double speckle_fraction(const ImageRGB& img, int threshold) {
   const Rgb8Image shown = to_srgb8(img);
   const int w = img.width, h = img.height;

@@ -55,6 +55,12 @@ struct ColourMetrics {
 };
 ColourMetrics compare_colour(const ImageRGB& a, const ImageRGB& b);
 
+// The image averaged over n x n pixel blocks (the last row and column of
+// blocks over what they hold): compared at a scale where a path-traced
+// reference's per-pixel noise has averaged out, so a metric measures the
+// image rather than that noise (docs/metrics.md). n = 1 returns a copy.
+ImageRGB box_downsample(const ImageRGB& img, int n);
+
 // The fraction of pixels, as displayed (to_srgb8 at exposure 0), that lie
 // more than `threshold` (8-bit levels) from the median of their 3x3
 // neighbourhood in some channel: isolated bright or dark pixels, speckles

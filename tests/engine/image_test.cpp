@@ -334,3 +334,26 @@ TEST(Metrics, SpeckleFractionCountsIsolatedPixelsNotEdgesOrGradients) {
   soft.at(2, 2) = glm::vec3(srgb_to_linear(0.5f + 70.0f / 255.0f));
   EXPECT_DOUBLE_EQ(speckle_fraction(soft), 1.0 / 25.0);
 }
+
+// Block means: a 5 x 3 image in 2 x 2 blocks gives 3 x 2 blocks, the right
+// column and bottom row averaging the pixels they hold; alternating noise of
+// +-1 around a level vanishes in every full block; n = 1 is a copy; n < 1 is
+// refused.
+TEST(Metrics, BoxDownsampleAveragesBlocksAndPartialEdges) {
+  ImageRGB img(5, 3);
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 5; ++x) img.at(x, y) = glm::vec3(static_cast<float>(y * 5 + x), 10.0f + ((x + y) % 2 ? 1.0f : -1.0f), 1.0f);
+  const ImageRGB d = box_downsample(img, 2);
+  ASSERT_EQ(d.width, 3);
+  ASSERT_EQ(d.height, 2);
+  EXPECT_FLOAT_EQ(d.at(0, 0).r, (0 + 1 + 5 + 6) / 4.0f);
+  EXPECT_FLOAT_EQ(d.at(2, 0).r, (4 + 9) / 2.0f);  // the right column: one pixel wide
+  EXPECT_FLOAT_EQ(d.at(1, 1).r, (12 + 13) / 2.0f);  // the bottom row: one pixel high
+  EXPECT_FLOAT_EQ(d.at(2, 1).r, 14.0f);
+  EXPECT_FLOAT_EQ(d.at(0, 0).g, 10.0f) << "the +-1 noise averages out in a full block";
+  EXPECT_FLOAT_EQ(d.at(1, 0).g, 10.0f);
+  EXPECT_FLOAT_EQ(d.at(2, 1).b, 1.0f);
+  const ImageRGB same = box_downsample(img, 1);
+  EXPECT_EQ(same.pixels, img.pixels);
+  EXPECT_THROW((void)box_downsample(img, 0), std::invalid_argument);
+}

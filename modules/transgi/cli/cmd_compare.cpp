@@ -17,10 +17,17 @@ void print_json(const nlohmann::ordered_json& j) { std::printf("%s\n", j.dump(-1
 }  // namespace
 
 int run_compare(const std::vector<std::string>& argv) {
-  const Args args("compare", argv, {"heatmap", "heatmap-max", "top-error", "edge-band-of", "band"}, {"colour"});
+  const Args args("compare", argv, {"heatmap", "heatmap-max", "top-error", "edge-band-of", "band", "downsample"}, {"colour"});
   if (args.positional().size() != 2) throw UsageError("compare: expected two EXR files: A.exr B.exr (B is the reference)");
-  const auto a = engine::image::read_exr(args.positional()[0]);
-  const auto b = engine::image::read_exr(args.positional()[1]);
+  // --downsample N: every metric over N x N block means of both images, where
+  // a path-traced reference's per-pixel noise has averaged out.
+  const int block = static_cast<int>(args.integer("downsample", 1, 64, 1));
+  const auto read = [&](const std::string& path) {
+    const auto img = engine::image::read_exr(path);
+    return block > 1 ? engine::image::box_downsample(img, block) : img;
+  };
+  const auto a = read(args.positional()[0]);
+  const auto b = read(args.positional()[1]);
   if (a.width != b.width || a.height != b.height)
     throw std::runtime_error("image sizes differ: " + args.positional()[0] + " is " + std::to_string(a.width) + "x" +
                              std::to_string(a.height) + ", " + args.positional()[1] + " is " + std::to_string(b.width) +
@@ -35,7 +42,7 @@ int run_compare(const std::vector<std::string>& argv) {
   if (args.has("edge-band-of")) {
     // The error near the edges of another image (a reference's direct pass:
     // its shadow edges), printed on a line of its own.
-    const auto guide = engine::image::read_exr(args.str("edge-band-of"));
+    const auto guide = read(args.str("edge-band-of"));
     if (guide.width != a.width || guide.height != a.height)
       throw std::runtime_error("--edge-band-of: " + args.str("edge-band-of") + " is not " + std::to_string(a.width) + "x" +
                                std::to_string(a.height));
