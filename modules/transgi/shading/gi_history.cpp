@@ -21,7 +21,8 @@ void GiHistory::clear() {
   frame_ = 0;
 }
 
-void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::rt::RtScene& scene, std::vector<std::int32_t>& source) {
+void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::rt::RtScene& scene, std::vector<std::int32_t>& source,
+                     std::vector<std::int32_t>* track) {
   using engine::ecs::Entity;
   using engine::transform::Similarity;
   const std::size_t cells = up.cell_pixel.size();
@@ -34,6 +35,7 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
   cur_.camera = g.camera;
   cur_.key.resize(cells);
   source.assign(cells, kDecode);
+  if (track) track->assign(cells, kDecode);
   // The objects in view, numbered in the order their first cells come; a
   // handful, so found by a linear search once per run of cells on one object.
   // Each chunk of cells lists its objects in parallel, the lists are merged in
@@ -148,7 +150,29 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
       for (int a = 0; a < 3; ++a) key.normal[a] = static_cast<std::int16_t>(std::clamp(n_obj[a], -1.0f, 1.0f) * kNormalScale);  // truncation: 3e-5 off at most
       key.fresh = 0;
       const int i = static_cast<int>(c % static_cast<std::size_t>(up.grid_w)), j = static_cast<int>(c / static_cast<std::size_t>(up.grid_w));
-      if (m.prev_object == kNoObject || ((static_cast<unsigned>(i + j) + parity) & 1) == 0) continue;  // this frame's colour: decoded
+      const bool reuse_colour = ((static_cast<unsigned>(i + j) + parity) & 1) != 0;  // else this frame's colour: decoded
+      if (m.prev_object == kNoObject || (!reuse_colour && !track)) continue;
+      // Within a cell's footprint at the point's depth, in object units.
+      const float reach = depth * spread * cell_pixels * m.to_object_scale;
+      const auto matches = [&](const Key& k, float& d2) {
+        if (k.object != m.prev_object) return false;
+        const float cos_normal =
+            (static_cast<float>(k.normal[0]) * n_obj.x + static_cast<float>(k.normal[1]) * n_obj.y + static_cast<float>(k.normal[2]) * n_obj.z) /
+            kNormalScale;
+        if (cos_normal < kMinNormalCos) return false;
+        const glm::vec3 d = k.object_position - p_obj;
+        d2 = glm::dot(d, d);
+        return true;
+      };
+      if (!reuse_colour) {
+        // Only the track is asked: the same cell, where nothing moved there
+        // (a still camera, a still object), is as good as the nearest.
+        float d2 = 0;
+        if (matches(prev_.key[c], d2) && d2 <= reach * reach) {
+          (*track)[c] = static_cast<std::int32_t>(c);
+          continue;
+        }
+      }
       const glm::vec3 local = m.prev_m * p_obj + m.prev_t;
       if (!(local.z < 0)) continue;  // behind last frame's camera
       // The previous cells around where the point was seen (cell centres at integers).
@@ -156,29 +180,28 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
       const float u = prev_u0 + prev_kx * local.x * inv, v = prev_v0 - prev_ky * local.y * inv;
       if (!(u > -1.0f && v > -1.0f && u < static_cast<float>(prev_.grid_w) && v < static_cast<float>(prev_.grid_h))) continue;
       const int i0 = static_cast<int>(u + 1.0f) - 1, j0 = static_cast<int>(v + 1.0f) - 1;  // floor, as u, v > -1
-      // Within a cell's footprint at the point's depth, in object units.
-      const float reach = depth * spread * cell_pixels * m.to_object_scale;
-      float best = reach * reach;
-      std::int32_t pick = kDecode;
+      // The nearest fresh cell (a value to reuse) and the nearest of any (the track).
+      float best = reach * reach, best_any = reach * reach;
+      std::int32_t pick = kDecode, pick_any = kDecode;
       for (int dj = 0; dj < 2; ++dj)
         for (int di = 0; di < 2; ++di) {
           const int pi = i0 + di, pj = j0 + dj;
           if (pi < 0 || pj < 0 || pi >= prev_.grid_w || pj >= prev_.grid_h) continue;
           const std::size_t q = static_cast<std::size_t>(pj) * static_cast<std::size_t>(prev_.grid_w) + static_cast<std::size_t>(pi);
           const Key& k = prev_.key[q];
-          if (!k.fresh || k.object != m.prev_object) continue;
-          const float cos_normal =
-              (static_cast<float>(k.normal[0]) * n_obj.x + static_cast<float>(k.normal[1]) * n_obj.y + static_cast<float>(k.normal[2]) * n_obj.z) /
-              kNormalScale;
-          if (cos_normal < kMinNormalCos) continue;
-          const glm::vec3 d = k.object_position - p_obj;
-          const float d2 = glm::dot(d, d);
-          if (d2 <= best) {
+          float d2 = 0;
+          if (!matches(k, d2)) continue;
+          if (k.fresh && d2 <= best) {
             best = d2;
             pick = static_cast<std::int32_t>(q);
           }
+          if (d2 <= best_any) {
+            best_any = d2;
+            pick_any = static_cast<std::int32_t>(q);
+          }
         }
-      source[c] = pick;
+      if (reuse_colour) source[c] = pick;
+      if (track) (*track)[c] = pick_any;
     }
   };
   engine::jobs::parallel_for<std::size_t>(0, cells, 1024, body);

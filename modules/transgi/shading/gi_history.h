@@ -30,8 +30,12 @@ class GiHistory {
 
   // For every cell of this frame's grid: the previous frame's cell whose
   // value it takes, or kDecode (cells that miss are kDecode too; the caller
-  // skips them). Remembers the cells' surface points for store().
-  void plan(const UpsamplingPlan& up, const GBuffer& g, const engine::rt::RtScene& scene, std::vector<std::int32_t>& source);
+  // skips them). Remembers the cells' surface points for store(). With
+  // `track`, also for every cell the previous frame's cell that saw the same
+  // surface point, fresh or not (kDecode where none did): what a per-cell
+  // running estimate follows from frame to frame.
+  void plan(const UpsamplingPlan& up, const GBuffer& g, const engine::rt::RtScene& scene, std::vector<std::int32_t>& source,
+            std::vector<std::int32_t>* track = nullptr);
   // This frame's value of every cell (zero where a cell misses) and whether
   // it was decoded afresh; becomes the previous frame for the next plan().
   // Takes the vectors' contents (swapped with spent storage).
