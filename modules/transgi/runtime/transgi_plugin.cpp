@@ -334,12 +334,15 @@ TransGISettings realtime_preset() {
   s.taa.enabled = true;
   s.direct_light = DirectLight::Deterministic;
   s.probes.fixed_pattern = true;  // with the deterministic direct light: no seed anywhere in the image
-  // One contact ray from at most 4096 decoded cells a frame (one row in 8 at
-  // 640x360): the probes alone leave a sunlit room's contact light out
-  // (a fifth of the Breakfast Room's GI on its ground plane), and every
-  // decoded cell's rays cost more than the frame's budget (docs/runtime.md).
-  s.near_field.rays = 1;
+  // Off by default (the paper's setting): one ray from about 4096 cells a
+  // frame, averaged over frames (`--near-field-rays 1`), gives the Breakfast
+  // Room on its ground plane its missing fifth of GI, but its running mean
+  // carries a moved object's old contact light for frames (a ghost the
+  // FrameHistory test catches), it can blacken a pixel where probes enter,
+  // and it costs about 1 ms at 640x360 (docs/image-quality.md, "Daylight").
+  s.near_field.rays = 0;
   s.near_field.cell_budget = 4096;
+  s.near_field.update_interval = 1;
   return s;
 }
 

@@ -1,6 +1,7 @@
 #include "shading/near_field.h"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "engine/jobs/parallel_for.h"
@@ -15,7 +16,7 @@ namespace transgi::shading {
 
 glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::render::LightSet* lights,
                                 const GSample& s, const float* light_sh, float reach, bool skip_self, int rays,
-                                const NearLightAt& light_at, engine::math::Pcg32& rng) {
+                                const NearLightAt& light_at, engine::math::Pcg32& rng, float clamp_ratio) {
   using namespace engine;
   if (!s.hit || rays <= 0 || !(reach > 0)) return glm::vec3(0.0f);
   static const render::LightSet kNoLights;
@@ -47,11 +48,14 @@ glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::
       light_at(s.position, s.normal_world, own_sh);
       probes_sh = own_sh;
     }
+    // The bound on one ray's term, pi x radiance, from the probes' irradiance.
+    const glm::vec3 bound = clamp_ratio > 0 ? clamp_ratio * glm::max(sh_irradiance(probes_sh, s.normal_world), glm::vec3(0.0f)) * math::kInvPi
+                                            : glm::vec3(std::numeric_limits<float>::infinity());
     const math::ShBasis y = math::sh_eval(dir);
     glm::vec3 probe_radiance(0.0f);
     for (int c = 0; c < 3; ++c)
       for (int i = 0; i < math::kShCount; ++i) probe_radiance[c] += probes_sh[c * math::kShCount + i] * y[static_cast<std::size_t>(i)];
-    sum += h.radiance - probe_radiance;
+    sum += glm::min(h.radiance - probe_radiance, bound);
   }
   const glm::vec3 e = sum * (math::kPi / static_cast<float>(rays));
   return std::isfinite(e.r + e.g + e.b) ? e : glm::vec3(0.0f);
@@ -95,7 +99,7 @@ std::vector<glm::vec3> filter_near_field(std::span<const glm::vec4> guide, int w
 
 void filter_near_field_separable(std::span<const glm::vec4> guide, int width, int height, std::span<const glm::vec3> values,
                                  std::span<const std::uint8_t> valid, std::span<const std::uint8_t> wanted, int radius,
-                                 std::vector<glm::vec4>& row, std::vector<glm::vec3>& out) {
+                                 std::vector<glm::vec4>& row, std::vector<glm::vec3>& out, std::vector<std::uint8_t>& estimated) {
   const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   if (guide.size() != n || values.size() != n || valid.size() != n || wanted.size() != n)
     throw std::invalid_argument("filter_near_field_separable: guide, values, valid and wanted must hold width x height entries");
@@ -109,6 +113,7 @@ void filter_near_field_separable(std::span<const glm::vec4> guide, int width, in
   // Only rows with a valid pixel are written, and only they are read.
   row.resize(n);
   out.resize(n);
+  estimated.resize(n);
   engine::jobs::parallel_for(0, height, 8, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y) {
       if (!row_has[static_cast<std::size_t>(y)]) continue;
@@ -134,6 +139,7 @@ void filter_near_field_separable(std::span<const glm::vec4> guide, int width, in
         const std::size_t p = static_cast<std::size_t>(y) * width + x;
         const glm::vec4& c = guide[p];
         out[p] = glm::vec3(0.0f);
+        estimated[p] = 0;
         if (!wanted[p] || !(c.w > 0)) continue;
         glm::vec4 acc(0.0f);
         for (int ny = std::max(0, y - radius); ny <= std::min(height - 1, y + radius); ++ny) {
@@ -143,7 +149,10 @@ void filter_near_field_separable(std::span<const glm::vec4> guide, int width, in
           const float w = guide_similarity(c, guide[i], kDepthTolerance, kNormalPower);
           if (w > 0) acc += w * row[i];
         }
-        if (acc.w > 0) out[p] = glm::vec3(acc) / acc.w;
+        if (acc.w > 0) {
+          out[p] = glm::vec3(acc) / acc.w;
+          estimated[p] = 1;
+        }
       }
   });
 }

@@ -38,14 +38,26 @@ struct NearFieldRays {
   // depth and normal similarity (filter_near_field). Higher = less noise, at
   // the cost of contact light smeared along a surface. 0 = unfiltered.
   int filter_radius = 4;
-  // Real-time path: at most this many cells trace rays a frame (0 = every
-  // decoded cell). Past it, rays leave the decoded cells of one row in k,
-  // the smallest k that fits, and the filter spreads their estimate over the
-  // rows between, so the cost stays put as the resolution grows (k is at
-  // most the filter's 2 filter_radius + 1 rows, past which it would leave
-  // cells with no estimate in reach: the budget yields). Higher =
-  // less noisy contact light at high resolutions, at the cost of ray time.
+  // Real-time path: at most this many cells trace rays a frame (0 = no
+  // limit). Rays leave every other cell of a row; past the budget, of one row
+  // in k, the smallest k that fits, and the filter spreads their estimate
+  // over the rows between, so the cost stays put as the resolution grows (k
+  // is at most the filter's 2 filter_radius + 1 rows, past which it would
+  // leave cells with no estimate in reach: the budget yields). Higher = less
+  // noisy contact light at high resolutions, at the cost of ray time.
   int cell_budget = 0;
+  // A ray's contribution is kept within this many times the probes'
+  // irradiance at the sample (0 = no bound). With one ray a cell, a ray that
+  // meets a small, very bright patch (a wall beside a lamp) spreads into a
+  // bright box the size of the filter's window; a bound on it is the usual
+  // firefly clamp. Higher = less of the contact light's energy lost, at the
+  // cost of brighter such boxes.
+  float clamp_ratio = 0.0f;
+  // Real-time path with the GI reuse: new estimates every this many frames;
+  // each surface point's running mean is carried between (over about the
+  // same number of frames, so fewer estimates). Higher = less ray and filter
+  // time a frame on average, at the cost of noisier contact light.
+  int update_interval = 1;
   bool operator==(const NearFieldRays&) const = default;
 };
 
@@ -61,9 +73,11 @@ using NearLightAt = std::function<void(const glm::vec3& position, const glm::vec
 // caller clamps the shaded total. A null `light_sh` is interpolated with
 // `light_at` at s only once a ray hits: most rays from an open floor or wall
 // meet nothing within reach, and the interpolation costs more than the ray.
+// `clamp_ratio` > 0 bounds each ray's irradiance term by that many times
+// the probes' irradiance at s (NearFieldRays::clamp_ratio).
 glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::render::LightSet* lights,
                                 const GSample& s, const float* light_sh, float reach, bool skip_self, int rays,
-                                const NearLightAt& light_at, engine::math::Pcg32& rng);
+                                const NearLightAt& light_at, engine::math::Pcg32& rng, float clamp_ratio = 0.0f);
 
 // Joint-bilateral average of per-sample values over the samples of the
 // (2 radius + 1)^2 pixels around each. guide[p * spp + k] is sample k of
@@ -82,9 +96,11 @@ std::vector<glm::vec3> filter_near_field(std::span<const glm::vec4> guide, int w
 // `wanted` is nonzero (the cells decoded this frame; elsewhere zero). Pixels
 // with no valid neighbour in reach get zero. A constant over one surface
 // stays that constant; a value crosses a silhouette or crease in neither pass.
-// `row` is the horizontal pass's buffer, `out` the result (both resized).
+// `row` is the horizontal pass's buffer, `out` the result, `estimated` per
+// pixel whether any valid pixel reached it (all resized): a zero in `out`
+// where none did is no estimate, not an estimate of zero.
 void filter_near_field_separable(std::span<const glm::vec4> guide, int width, int height, std::span<const glm::vec3> values,
                                  std::span<const std::uint8_t> valid, std::span<const std::uint8_t> wanted, int radius,
-                                 std::vector<glm::vec4>& row, std::vector<glm::vec3>& out);
+                                 std::vector<glm::vec4>& row, std::vector<glm::vec3>& out, std::vector<std::uint8_t>& estimated);
 
 }  // namespace transgi::shading

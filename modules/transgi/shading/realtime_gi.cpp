@@ -151,7 +151,13 @@ struct DielectricRays {
 struct ContactScratch {
   std::vector<glm::vec3> contact, filtered;
   std::vector<glm::vec4> row;
-  std::vector<std::uint8_t> valid, wanted;
+  std::vector<std::uint8_t> valid, wanted, estimated;
+  // Per cell of the last frame: the running mean of its filtered contact
+  // light and how many frames it holds; this frame's, then swapped.
+  std::vector<glm::vec3> mean, mean_next;
+  std::vector<std::uint8_t> count, count_next;
+  std::vector<std::int32_t> track;  // GiHistory::plan's
+  std::uint64_t frame = 0;
 };
 
 struct RealtimeGiScratch::Impl {
@@ -163,7 +169,6 @@ struct RealtimeGiScratch::Impl {
   // diffuse reflectance over its base colour, over pi), taken while its
   // GSample is in cache.
   std::vector<glm::vec3> contact_gain;
-  std::vector<std::uint8_t> through_network;  // per decoded sample: its light comes from the network
   std::vector<std::size_t> decoded_cells;      // the grid cells decoded this frame
   std::vector<std::size_t> row_start;          // per row of cells: its first decoded cell's slot
   std::vector<std::uint8_t> row_has_own;       // per pixel row: it holds a pixel decoded on its own
@@ -612,49 +617,116 @@ std::size_t shade_dielectric_reflections(const GBuffer& g, const engine::rt::RtS
   return rays.traced.size();
 }
 
+// Frames a cell's contact light is averaged over (ContactScratch::mean):
+// more = less noise, at the cost of contact light that lags a change as long.
+constexpr int kContactFrames = 8;
+
 // Adds the near field's contact light (near_field.h) to the cells decoded
-// this frame (`cells`, their slots in `value` below decode.size()): `rays`
-// short rays from the cells of one row in k (NearFieldRays::cell_budget), filtered over them (a
-// horizontal then a vertical bilateral pass), times each sample's contact
-// gain. A network sample skips hits on its own object, whose transfer holds
-// them.
+// this frame (`cells`: cells[k]'s value is value[k]), times each one's
+// contact gain. The rays leave a fixed lattice of cells, every
+// other cell of one row in k (NearFieldRays::cell_budget), whatever this
+// frame decodes: the GI reuse decodes a checkerboard, alternating, and rays
+// from its own colour's cells gave each colour its own noise, a frozen
+// checkerboard in a still view. The lattice's estimates are filtered (a
+// horizontal then a vertical bilateral pass) into every decoded cell, so
+// both colours read one field. `skips_own(p)`: the sample at pixel p is
+// shaded by the network, whose transfer holds its own object's light.
 void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::span<const probes::ProbeField* const> fields,
                        const engine::render::LightSet* lights, const NearFieldRays& near_field, const UpsamplingPlan& up,
-                       std::span<const std::size_t> cells, std::span<const std::size_t> slot_of_pixel,
-                       std::span<const std::uint8_t> through_network, std::span<const glm::vec3> contact_gain,
-                       ContactScratch& scratch, std::vector<glm::vec3>& value) {
+                       std::span<const std::size_t> cells, const std::function<bool(std::size_t)>& skips_own, std::span<const glm::vec3> contact_gain,
+                       std::span<const std::int32_t> track, ContactScratch& scratch, std::vector<glm::vec3>& value) {
   const NearLightAt light_at = [&](const glm::vec3& p, const glm::vec3& n, float* out) { probes::interpolate_fields(fields, p, n, out); };
-  const std::size_t grid = up.cell_pixel.size();
+  const std::size_t grid = up.cell_pixel.size(), grid_w = static_cast<std::size_t>(up.grid_w);
+  const std::size_t grid_h = static_cast<std::size_t>(up.grid_h);
+  // The lattice: one cell in cols_k of one row in rows_k (cols_k even, the
+  // rows offset by half of it), as dense as the budget allows, neither step
+  // wider than the filter's window so every cell has estimates in reach.
+  // Tracked, it shifts every frame, so over frames every cell traces.
   const std::size_t budget = static_cast<std::size_t>(std::max(0, near_field.cell_budget));
-  // No wider than the filter's window, so every cell has a row of rays in reach.
-  const std::size_t widest = 2 * static_cast<std::size_t>(std::max(0, near_field.filter_radius)) + 1;
-  const std::size_t stride = budget > 0 ? std::clamp<std::size_t>((cells.size() + budget - 1) / budget, 1, widest) : 1;
-  const std::size_t row = static_cast<std::size_t>(up.grid_w);
-  // Every entry read below is written first, except these masks.
-  scratch.contact.resize(grid);
-  scratch.valid.assign(grid, 0);
+  const std::size_t widest = std::max<std::size_t>(2, 2 * static_cast<std::size_t>(std::max(0, near_field.filter_radius)) + 1);
+  const std::size_t wanted_steps = budget > 0 ? (grid + budget - 1) / budget : 1;
+  std::size_t cols_k = 2, rows_k = std::max<std::size_t>(1, (wanted_steps + 1) / 2);
+  if (rows_k > widest) {
+    rows_k = widest;
+    cols_k = std::min(widest + 1, 2 * ((wanted_steps + 2 * rows_k - 1) / (2 * rows_k)));
+  }
+  const bool tracked = track.size() == grid;
+  // Tracked, new estimates come every update_interval frames; the frames
+  // between carry each point's mean along the track.
+  const std::uint64_t interval = tracked ? static_cast<std::uint64_t>(std::max(1, near_field.update_interval)) : 1;
+  const bool estimate = scratch.frame % interval == 0;
+  const std::uint64_t stream = tracked ? scratch.frame / interval : 0;  // new directions each estimate where a mean averages them
   scratch.wanted.assign(grid, 0);
-  engine::jobs::parallel_for<std::size_t>(0, cells.size(), 64, [&](std::size_t b, std::size_t e) {
-    for (std::size_t k = b; k < e; ++k) {
-      const std::size_t c = cells[k];
-      scratch.wanted[c] = 1;
-      if ((c / row) % stride != 0) continue;
-      const std::size_t p = up.cell_pixel[c];
-      const GSample& s = g.samples[p];
-      engine::math::Pcg32 rng = engine::math::make_rng(0x4EA2F1ull, p, 0);  // fixed: the real-time image has no seed
-      const float reach = near_field.reach_cells * probes::fields_at(fields, s.position).field[0]->placement().min_spacing();
-      scratch.contact[c] = near_field_irradiance(scene, lights, s, nullptr, reach, through_network[slot_of_pixel[p]] != 0,
-                                                 near_field.rays, light_at, rng);
-      scratch.valid[c] = 1;
-    }
-  });
-  filter_near_field_separable(up.cell_guide, up.grid_w, up.grid_h, scratch.contact, scratch.valid, scratch.wanted,
-                              near_field.filter_radius, scratch.row, scratch.filtered);
+  scratch.estimated.assign(grid, 0);
+  if (estimate) {
+    const std::size_t shift_j = static_cast<std::size_t>(stream % rows_k), shift_i = static_cast<std::size_t>((stream / rows_k) % cols_k);
+    scratch.contact.resize(grid);
+    scratch.valid.assign(grid, 0);
+    // Tracked, every cell's mean takes every frame's field, whichever colour
+    // the reuse decodes: a mean fed only on a cell's own decode frames would
+    // give the two colours their own noise, a checkerboard again.
+    if (tracked)
+      engine::jobs::parallel_for<std::size_t>(0, grid, 16384, [&](std::size_t b, std::size_t e) {
+        for (std::size_t c = b; c < e; ++c) scratch.wanted[c] = up.cell_guide[c].w > 0 ? 1 : 0;
+      });
+    else
+      for (const std::size_t c : cells) scratch.wanted[c] = 1;
+    const std::size_t lattice_rows = (grid_h + rows_k - 1) / rows_k, lattice_cols = (grid_w + cols_k - 1) / cols_k + 1;
+    engine::jobs::parallel_for<std::size_t>(0, lattice_rows * lattice_cols, 64, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        const std::size_t r = k / lattice_cols, j = r * rows_k + shift_j;
+        const std::size_t i = (k % lattice_cols) * cols_k + (r % 2) * (cols_k / 2) + shift_i;
+        if (j >= grid_h || i >= grid_w) continue;
+        const std::size_t c = j * grid_w + i;
+        if (!(up.cell_guide[c].w > 0)) continue;
+        const std::size_t p = up.cell_pixel[c];
+        const GSample& s = g.samples[p];
+        engine::math::Pcg32 rng = engine::math::make_rng(0x4EA2F1ull, p, stream);  // no seed: by frame, not by run
+        const float reach = near_field.reach_cells * probes::fields_at(fields, s.position).field[0]->placement().min_spacing();
+        scratch.contact[c] =
+            near_field_irradiance(scene, lights, s, nullptr, reach, skips_own(p), near_field.rays, light_at, rng, near_field.clamp_ratio);
+        scratch.valid[c] = 1;
+      }
+    });
+    filter_near_field_separable(up.cell_guide, up.grid_w, up.grid_h, scratch.contact, scratch.valid, scratch.wanted,
+                                near_field.filter_radius, scratch.row, scratch.filtered, scratch.estimated);
+  }
+  if (tracked) {
+    // The running mean over the last kContactFrames frames of each surface
+    // point, followed through the GI history's track (a point seen anew
+    // starts from this frame's estimate).
+    scratch.mean_next.resize(grid);
+    scratch.count_next.assign(grid, 0);
+    const int estimates = std::max(1, kContactFrames / static_cast<int>(interval));  // so the lag stays kContactFrames frames
+    // A cell that no estimate reached carries its point's mean unchanged.
+    engine::jobs::parallel_for<std::size_t>(0, grid, 4096, [&](std::size_t b, std::size_t e) {
+      for (std::size_t c = b; c < e; ++c) {
+        const std::int32_t q = track[c];
+        const bool known = q >= 0 && static_cast<std::size_t>(q) < scratch.count.size() && scratch.count[static_cast<std::size_t>(q)] > 0;
+        if (!scratch.wanted[c] || !scratch.estimated[c]) {
+          if (known) {
+            scratch.mean_next[c] = scratch.mean[static_cast<std::size_t>(q)];
+            scratch.count_next[c] = scratch.count[static_cast<std::size_t>(q)];
+          }
+          continue;
+        }
+        const int n = known ? std::min<int>(scratch.count[static_cast<std::size_t>(q)], estimates - 1) : 0;
+        scratch.mean_next[c] = n > 0 ? (scratch.mean[static_cast<std::size_t>(q)] * static_cast<float>(n) + scratch.filtered[c]) /
+                                           static_cast<float>(n + 1)
+                                     : scratch.filtered[c];
+        scratch.count_next[c] = static_cast<std::uint8_t>(n + 1);
+      }
+    });
+    std::swap(scratch.mean, scratch.mean_next);
+    std::swap(scratch.count, scratch.count_next);
+    ++scratch.frame;
+  }
+  // (A cell with no estimate yet, tracked or not, holds a zero mean or filtered value.)
+  const auto contact = [&](std::size_t c) {
+    return tracked ? (scratch.count[c] > 0 ? scratch.mean[c] : glm::vec3(0.0f)) : scratch.filtered[c];
+  };
   engine::jobs::parallel_for<std::size_t>(0, cells.size(), 1024, [&](std::size_t b, std::size_t e) {
-    for (std::size_t k = b; k < e; ++k) {
-      const std::size_t c = cells[k], slot = slot_of_pixel[up.cell_pixel[c]];
-      value[slot] = glm::max(value[slot] + contact_gain[slot] * scratch.filtered[c], glm::vec3(0.0f));
-    }
+    for (std::size_t k = b; k < e; ++k) value[k] = glm::max(value[k] + contact_gain[k] * contact(cells[k]), glm::vec3(0.0f));
   });
 }
 
@@ -705,11 +777,12 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   // With reuse, the cells that take the previous frame's value are not decoded.
   const bool reuse = settings.reuse_history && scratch != nullptr && g.camera.has_value();
   if (reuse)
-    sc.history.plan(up, g, scene, sc.source);
+    sc.history.plan(up, g, scene, sc.source, near_field.rays > 0 ? &sc.contact.track : nullptr);
   else
     sc.history.clear();
   // The cells in cell order, their slots by a prefix sum over rows of cells
-  // (cells decode distinct pixels, so the rows fill their slots in parallel).
+  // (cells decode distinct pixels, so the rows fill their slots in parallel):
+  // decoded_cells[k] is the cell whose value is value[k].
   const std::size_t grid_w = static_cast<std::size_t>(up.grid_w), grid_h = static_cast<std::size_t>(up.grid_h);
   const auto decodes = [&](std::size_t c) { return (!reuse || sc.source[c] == GiHistory::kDecode) && up.cell_guide[c].w > 0; };
   std::vector<std::size_t>& row_start = sc.row_start;
@@ -908,10 +981,13 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   // it was given when it was decoded, so the reuse still halves the work.
   if (near_field.rays > 0) {
     t0 = Clock::now();
-    sc.through_network.assign(decode.size(), 0);
-    for (const std::size_t i : net) sc.through_network[i] = 1;
-    add_contact_light(g, scene, fields, mirror_lights, near_field, up, sc.decoded_cells, slot_of_pixel, sc.through_network,
-                      sc.contact_gain, sc.contact, value);
+    // The lattice's cells need not be decoded this frame: their route as the split above decides it.
+    const std::function<bool(std::size_t)> skips_own = [&](std::size_t p) {
+      return model && decoder && (!has_transfer || has_transfer(g.entity[p])) && !is_glossy_dielectric(p);
+    };
+    add_contact_light(g, scene, fields, mirror_lights, near_field, up, sc.decoded_cells, skips_own,
+                      sc.contact_gain, reuse ? std::span<const std::int32_t>(sc.contact.track) : std::span<const std::int32_t>(),
+                      sc.contact, value);
     stats.near_ms = ms_since(t0);
   }
 
