@@ -336,10 +336,9 @@ TransGISettings realtime_preset() {
   s.probes.fixed_pattern = true;  // with the deterministic direct light: no seed anywhere in the image
   // Off by default (the paper's setting): one ray from about 4096 cells a
   // frame, averaged over frames (`--near-field-rays 1`), gives the Breakfast
-  // Room on its ground plane its missing fifth of GI, but its running mean
-  // carries a moved object's old contact light for frames (a ghost the
-  // FrameHistory test catches), it can blacken a pixel where probes enter,
-  // and it costs about 1 ms at 640x360 (docs/image-quality.md, "Daylight").
+  // Room on its ground plane its missing fifth of GI and passes the suite,
+  // but costs about 1 ms at 640x360, past issue 37's frame budget
+  // (docs/image-quality.md, "Daylight on the real-time path").
   s.near_field.rays = 0;
   s.near_field.cell_budget = 4096;
   s.near_field.update_interval = 1;

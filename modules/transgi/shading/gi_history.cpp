@@ -22,7 +22,7 @@ void GiHistory::clear() {
 }
 
 void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::rt::RtScene& scene, std::vector<std::int32_t>& source,
-                     std::vector<std::int32_t>* track) {
+                     std::vector<std::int32_t>* track, std::vector<std::uint8_t>* moved) {
   using engine::ecs::Entity;
   using engine::transform::Similarity;
   const std::size_t cells = up.cell_pixel.size();
@@ -36,6 +36,7 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
   cur_.key.resize(cells);
   source.assign(cells, kDecode);
   if (track) track->assign(cells, kDecode);
+  if (moved) moved->assign(cells, 0);
   // The objects in view, numbered in the order their first cells come; a
   // handful, so found by a linear search once per run of cells on one object.
   // Each chunk of cells lists its objects in parallel, the lists are merged in
@@ -93,6 +94,7 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
     glm::vec3 c0{0.0f}, prev_t{0.0f};
     float to_object_scale = 1.0f;
     std::uint32_t prev_object = kNoObject;
+    bool moved = false;  // its transform changed since the previous frame
   };
   const bool comparable = g.camera && prev_.camera && prev_.grid_w == up.grid_w && prev_.grid_h == up.grid_h &&
                           prev_.width == up.width && prev_.height == up.height && prev_.key.size() == cells;
@@ -114,7 +116,21 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
         m.prev_object = static_cast<std::uint32_t>(q);
         m.prev_m = prev_to_world.scale * (prev_camera_from_world * glm::mat3_cast(prev_to_world.rotation));
         m.prev_t = prev_camera_from_world * (prev_to_world.translation - prev_.camera->position());
+        m.moved = !(prev_to_world == to_world);
       }
+  }
+  if (moved && comparable) {
+    // Where a moved object is now, and where it was (the previous frame's
+    // cell at the same place on screen).
+    std::vector<std::uint8_t> prev_moved(prev_.objects.size(), 0);
+    for (const Motion& m : motion)
+      if (m.prev_object != kNoObject && m.moved) prev_moved[m.prev_object] = 1;
+    engine::jobs::parallel_for<std::size_t>(0, cells, 4096, [&](std::size_t b, std::size_t e) {
+      for (std::size_t c = b; c < e; ++c) {
+        const std::uint32_t now = object_of_cell_[c], was = prev_.key[c].object;
+        (*moved)[c] = (now != kNoObject && motion[now].moved) || (was < prev_moved.size() && prev_moved[was]);
+      }
+    });
   }
   const float spread = cam.pixel_spread();
   const float cell_pixels = std::max(up.sx, up.sy);

@@ -33,9 +33,11 @@ class GiHistory {
   // skips them). Remembers the cells' surface points for store(). With
   // `track`, also for every cell the previous frame's cell that saw the same
   // surface point, fresh or not (kDecode where none did): what a per-cell
-  // running estimate follows from frame to frame.
+  // running estimate follows from frame to frame. With `moved`, per cell
+  // whether an object whose transform changed since the previous frame is
+  // there now or was there then (the previous frame's cell at that index).
   void plan(const UpsamplingPlan& up, const GBuffer& g, const engine::rt::RtScene& scene, std::vector<std::int32_t>& source,
-            std::vector<std::int32_t>* track = nullptr);
+            std::vector<std::int32_t>* track = nullptr, std::vector<std::uint8_t>* moved = nullptr);
   // This frame's value of every cell (zero where a cell misses) and whether
   // it was decoded afresh; becomes the previous frame for the next plan().
   // Takes the vectors' contents (swapped with spent storage).

@@ -157,6 +157,7 @@ struct ContactScratch {
   std::vector<glm::vec3> mean, mean_next;
   std::vector<std::uint8_t> count, count_next;
   std::vector<std::int32_t> track;  // GiHistory::plan's
+  std::vector<std::uint8_t> moved, near_moved, near_moved_row;  // GiHistory::plan's, and it dilated
   std::uint64_t frame = 0;
 };
 
@@ -621,6 +622,16 @@ std::size_t shade_dielectric_reflections(const GBuffer& g, const engine::rt::RtS
 // more = less noise, at the cost of contact light that lags a change as long.
 constexpr int kContactFrames = 8;
 
+// Contact light may darken a cell to this fraction of its probe light, no
+// further: it replaces what the probes hold for the near directions, and a
+// noisy estimate against an over-bright probe (one entering a cascade) had
+// taken cells to black.
+constexpr float kContactFloor = 0.25f;
+
+// How far, in GI cells, from where a moved object is or was a cell's contact
+// light restarts: about twice the filter's reach.
+constexpr int kContactResetCells = 8;
+
 // Adds the near field's contact light (near_field.h) to the cells decoded
 // this frame (`cells`: cells[k]'s value is value[k]), times each one's
 // contact gain. The rays leave a fixed lattice of cells, every
@@ -634,7 +645,8 @@ constexpr int kContactFrames = 8;
 void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::span<const probes::ProbeField* const> fields,
                        const engine::render::LightSet* lights, const NearFieldRays& near_field, const UpsamplingPlan& up,
                        std::span<const std::size_t> cells, const std::function<bool(std::size_t)>& skips_own, std::span<const glm::vec3> contact_gain,
-                       std::span<const std::int32_t> track, ContactScratch& scratch, std::vector<glm::vec3>& value) {
+                       std::span<const std::int32_t> track, std::span<const std::uint8_t> moved, ContactScratch& scratch,
+                       std::vector<glm::vec3>& value) {
   const NearLightAt light_at = [&](const glm::vec3& p, const glm::vec3& n, float* out) { probes::interpolate_fields(fields, p, n, out); };
   const std::size_t grid = up.cell_pixel.size(), grid_w = static_cast<std::size_t>(up.grid_w);
   const std::size_t grid_h = static_cast<std::size_t>(up.grid_h);
@@ -691,10 +703,33 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
     filter_near_field_separable(up.cell_guide, up.grid_w, up.grid_h, scratch.contact, scratch.valid, scratch.wanted,
                                 near_field.filter_radius, scratch.row, scratch.filtered, scratch.estimated);
   }
+  // Cells within kContactResetCells of where a moved object is or was: the
+  // contact light there changed with the move, so their means restart (else
+  // the floor beside a moved object keeps its old light for frames: a ghost).
+  const bool reset_near_moved = tracked && moved.size() == grid;
+  if (reset_near_moved) {
+    const int radius = kContactResetCells;
+    scratch.near_moved_row.assign(grid, 0);
+    scratch.near_moved.assign(grid, 0);
+    engine::jobs::parallel_for<std::size_t>(0, grid_h, 8, [&](std::size_t b, std::size_t e) {
+      for (std::size_t j = b; j < e; ++j)
+        for (std::size_t i = 0; i < grid_w; ++i)
+          if (moved[j * grid_w + i])
+            for (std::size_t x = i > static_cast<std::size_t>(radius) ? i - radius : 0; x <= std::min(grid_w - 1, i + radius); ++x)
+              scratch.near_moved_row[j * grid_w + x] = 1;
+    });
+    engine::jobs::parallel_for<std::size_t>(0, grid_w, 64, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i)
+        for (std::size_t j = 0; j < grid_h; ++j)
+          if (scratch.near_moved_row[j * grid_w + i])
+            for (std::size_t y = j > static_cast<std::size_t>(radius) ? j - radius : 0; y <= std::min(grid_h - 1, j + radius); ++y)
+              scratch.near_moved[y * grid_w + i] = 1;
+    });
+  }
   if (tracked) {
     // The running mean over the last kContactFrames frames of each surface
-    // point, followed through the GI history's track (a point seen anew
-    // starts from this frame's estimate).
+    // point, followed through the GI history's track (a point seen anew, or
+    // one near a moved object, starts from this frame's estimate).
     scratch.mean_next.resize(grid);
     scratch.count_next.assign(grid, 0);
     const int estimates = std::max(1, kContactFrames / static_cast<int>(interval));  // so the lag stays kContactFrames frames
@@ -702,7 +737,8 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
     engine::jobs::parallel_for<std::size_t>(0, grid, 4096, [&](std::size_t b, std::size_t e) {
       for (std::size_t c = b; c < e; ++c) {
         const std::int32_t q = track[c];
-        const bool known = q >= 0 && static_cast<std::size_t>(q) < scratch.count.size() && scratch.count[static_cast<std::size_t>(q)] > 0;
+        const bool known = q >= 0 && static_cast<std::size_t>(q) < scratch.count.size() && scratch.count[static_cast<std::size_t>(q)] > 0 &&
+                           !(reset_near_moved && scratch.near_moved[c]);
         if (!scratch.wanted[c] || !scratch.estimated[c]) {
           if (known) {
             scratch.mean_next[c] = scratch.mean[static_cast<std::size_t>(q)];
@@ -726,7 +762,8 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
     return tracked ? (scratch.count[c] > 0 ? scratch.mean[c] : glm::vec3(0.0f)) : scratch.filtered[c];
   };
   engine::jobs::parallel_for<std::size_t>(0, cells.size(), 1024, [&](std::size_t b, std::size_t e) {
-    for (std::size_t k = b; k < e; ++k) value[k] = glm::max(value[k] + contact_gain[k] * contact(cells[k]), glm::vec3(0.0f));
+    for (std::size_t k = b; k < e; ++k)
+      value[k] = glm::max(value[k] + contact_gain[k] * contact(cells[k]), kContactFloor * value[k]);
   });
 }
 
@@ -777,7 +814,8 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   // With reuse, the cells that take the previous frame's value are not decoded.
   const bool reuse = settings.reuse_history && scratch != nullptr && g.camera.has_value();
   if (reuse)
-    sc.history.plan(up, g, scene, sc.source, near_field.rays > 0 ? &sc.contact.track : nullptr);
+    sc.history.plan(up, g, scene, sc.source, near_field.rays > 0 ? &sc.contact.track : nullptr,
+                    near_field.rays > 0 ? &sc.contact.moved : nullptr);
   else
     sc.history.clear();
   // The cells in cell order, their slots by a prefix sum over rows of cells
@@ -987,7 +1025,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     };
     add_contact_light(g, scene, fields, mirror_lights, near_field, up, sc.decoded_cells, skips_own,
                       sc.contact_gain, reuse ? std::span<const std::int32_t>(sc.contact.track) : std::span<const std::int32_t>(),
-                      sc.contact, value);
+                      reuse ? std::span<const std::uint8_t>(sc.contact.moved) : std::span<const std::uint8_t>(), sc.contact, value);
     stats.near_ms = ms_since(t0);
   }
 
