@@ -92,10 +92,6 @@ std::vector<OptionSpec> runtime_option_specs(const std::string& default_preset) 
               "near-field filter radius in GI cells: higher = smoother, at the cost of detail"),
       integer("near-field-budget", "N", 0, 1 << 24, by_preset(q.near_field.cell_budget, r.near_field.cell_budget),
               "real-time path: GI cells that trace near-field rays a frame (0 = no limit): higher = less noise at high resolutions, at the cost of ray time"),
-      integer("near-field-interval", "F", 1, 64, by_preset(q.near_field.update_interval, r.near_field.update_interval),
-              "real-time path with the GI reuse: new near-field estimates every F frames, each point's mean carried between: higher = less ray time a frame, at the cost of noisier contact light"),
-      number("near-field-clamp", "K", 0.0, 1e6, by_preset(q.near_field.clamp_ratio, r.near_field.clamp_ratio),
-             "bound on a near-field ray's light, in times the probes' irradiance at the sample (0 = none): higher = less contact light lost, at the cost of bright boxes where a ray meets a small, very bright patch"),
   };
 }
 

@@ -38,8 +38,6 @@ void near_field_from(const Args& args, shading::NearFieldRays& n) {
   n.reach_cells = static_cast<float>(args.number("near-field-reach", 0.01, 16.0, n.reach_cells));
   n.filter_radius = static_cast<int>(args.integer("near-field-filter", 0, 16, n.filter_radius));
   n.cell_budget = static_cast<int>(args.integer("near-field-budget", 0, 1 << 24, n.cell_budget));
-  n.clamp_ratio = static_cast<float>(args.number("near-field-clamp", 0.0, 1e6, n.clamp_ratio));
-  n.update_interval = static_cast<int>(args.integer("near-field-interval", 1, 64, n.update_interval));
 }
 
 runtime::ProbePlacement probe_placement_from(const Args& args, runtime::ProbeVolumeMode default_mode) {

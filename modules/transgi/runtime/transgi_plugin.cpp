@@ -341,7 +341,6 @@ TransGISettings realtime_preset() {
   // (docs/image-quality.md, "Daylight on the real-time path").
   s.near_field.rays = 0;
   s.near_field.cell_budget = 4096;
-  s.near_field.update_interval = 1;
   return s;
 }
 

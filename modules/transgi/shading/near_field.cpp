@@ -1,7 +1,6 @@
 #include "shading/near_field.h"
 
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 
 #include "engine/jobs/parallel_for.h"
@@ -16,7 +15,7 @@ namespace transgi::shading {
 
 glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::render::LightSet* lights,
                                 const GSample& s, const float* light_sh, float reach, bool skip_self, int rays,
-                                const NearLightAt& light_at, engine::math::Pcg32& rng, float clamp_ratio) {
+                                const NearLightAt& light_at, engine::math::Pcg32& rng) {
   using namespace engine;
   if (!s.hit || rays <= 0 || !(reach > 0)) return glm::vec3(0.0f);
   static const render::LightSet kNoLights;
@@ -48,14 +47,11 @@ glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::
       light_at(s.position, s.normal_world, own_sh);
       probes_sh = own_sh;
     }
-    // The bound on one ray's term, pi x radiance, from the probes' irradiance.
-    const glm::vec3 bound = clamp_ratio > 0 ? clamp_ratio * glm::max(sh_irradiance(probes_sh, s.normal_world), glm::vec3(0.0f)) * math::kInvPi
-                                            : glm::vec3(std::numeric_limits<float>::infinity());
     const math::ShBasis y = math::sh_eval(dir);
     glm::vec3 probe_radiance(0.0f);
     for (int c = 0; c < 3; ++c)
       for (int i = 0; i < math::kShCount; ++i) probe_radiance[c] += probes_sh[c * math::kShCount + i] * y[static_cast<std::size_t>(i)];
-    sum += glm::min(h.radiance - probe_radiance, bound);
+    sum += h.radiance - probe_radiance;
   }
   const glm::vec3 e = sum * (math::kPi / static_cast<float>(rays));
   return std::isfinite(e.r + e.g + e.b) ? e : glm::vec3(0.0f);

@@ -46,18 +46,6 @@ struct NearFieldRays {
   // leave cells with no estimate in reach: the budget yields). Higher = less
   // noisy contact light at high resolutions, at the cost of ray time.
   int cell_budget = 0;
-  // A ray's contribution is kept within this many times the probes'
-  // irradiance at the sample (0 = no bound). With one ray a cell, a ray that
-  // meets a small, very bright patch (a wall beside a lamp) spreads into a
-  // bright box the size of the filter's window; a bound on it is the usual
-  // firefly clamp. Higher = less of the contact light's energy lost, at the
-  // cost of brighter such boxes.
-  float clamp_ratio = 0.0f;
-  // Real-time path with the GI reuse: new estimates every this many frames;
-  // each surface point's running mean is carried between (over about the
-  // same number of frames, so fewer estimates). Higher = less ray and filter
-  // time a frame on average, at the cost of noisier contact light.
-  int update_interval = 1;
   bool operator==(const NearFieldRays&) const = default;
 };
 
@@ -73,11 +61,9 @@ using NearLightAt = std::function<void(const glm::vec3& position, const glm::vec
 // caller clamps the shaded total. A null `light_sh` is interpolated with
 // `light_at` at s only once a ray hits: most rays from an open floor or wall
 // meet nothing within reach, and the interpolation costs more than the ray.
-// `clamp_ratio` > 0 bounds each ray's irradiance term by that many times
-// the probes' irradiance at s (NearFieldRays::clamp_ratio).
 glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::render::LightSet* lights,
                                 const GSample& s, const float* light_sh, float reach, bool skip_self, int rays,
-                                const NearLightAt& light_at, engine::math::Pcg32& rng, float clamp_ratio = 0.0f);
+                                const NearLightAt& light_at, engine::math::Pcg32& rng);
 
 // Joint-bilateral average of per-sample values over the samples of the
 // (2 radius + 1)^2 pixels around each. guide[p * spp + k] is sample k of

@@ -634,13 +634,12 @@ constexpr int kContactResetCells = 8;
 
 // Adds the near field's contact light (near_field.h) to the cells decoded
 // this frame (`cells`: cells[k]'s value is value[k]), times each one's
-// contact gain. The rays leave a fixed lattice of cells, every
-// other cell of one row in k (NearFieldRays::cell_budget), whatever this
-// frame decodes: the GI reuse decodes a checkerboard, alternating, and rays
-// from its own colour's cells gave each colour its own noise, a frozen
-// checkerboard in a still view. The lattice's estimates are filtered (a
-// horizontal then a vertical bilateral pass) into every decoded cell, so
-// both colours read one field. `skips_own(p)`: the sample at pixel p is
+// contact gain. The rays leave a lattice of cells (NearFieldRays::
+// cell_budget) whatever this frame decodes: the GI reuse decodes a
+// checkerboard, alternating, and rays from its own colour's cells gave each
+// colour its own noise, a frozen checkerboard in a still view. The
+// lattice's estimates are filtered (a horizontal then a vertical bilateral
+// pass) into every cell, so both colours read one field. `skips_own(p)`: the sample at pixel p is
 // shaded by the network, whose transfer holds its own object's light.
 void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::span<const probes::ProbeField* const> fields,
                        const engine::render::LightSet* lights, const NearFieldRays& near_field, const UpsamplingPlan& up,
@@ -663,50 +662,43 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
     cols_k = std::min(widest + 1, 2 * ((wanted_steps + 2 * rows_k - 1) / (2 * rows_k)));
   }
   const bool tracked = track.size() == grid;
-  // Tracked, new estimates come every update_interval frames; the frames
-  // between carry each point's mean along the track.
-  const std::uint64_t interval = tracked ? static_cast<std::uint64_t>(std::max(1, near_field.update_interval)) : 1;
-  const bool estimate = scratch.frame % interval == 0;
-  const std::uint64_t stream = tracked ? scratch.frame / interval : 0;  // new directions each estimate where a mean averages them
+  const std::uint64_t stream = tracked ? scratch.frame : 0;  // new directions every frame where a mean averages them
   scratch.wanted.assign(grid, 0);
-  scratch.estimated.assign(grid, 0);
-  if (estimate) {
-    const std::size_t shift_j = static_cast<std::size_t>(stream % rows_k), shift_i = static_cast<std::size_t>((stream / rows_k) % cols_k);
-    scratch.contact.resize(grid);
-    scratch.valid.assign(grid, 0);
-    // Tracked, every cell's mean takes every frame's field, whichever colour
-    // the reuse decodes: a mean fed only on a cell's own decode frames would
-    // give the two colours their own noise, a checkerboard again.
-    if (tracked)
-      engine::jobs::parallel_for<std::size_t>(0, grid, 16384, [&](std::size_t b, std::size_t e) {
-        for (std::size_t c = b; c < e; ++c) scratch.wanted[c] = up.cell_guide[c].w > 0 ? 1 : 0;
-      });
-    else
-      for (const std::size_t c : cells) scratch.wanted[c] = 1;
-    const std::size_t lattice_rows = (grid_h + rows_k - 1) / rows_k, lattice_cols = (grid_w + cols_k - 1) / cols_k + 1;
-    engine::jobs::parallel_for<std::size_t>(0, lattice_rows * lattice_cols, 64, [&](std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k) {
-        const std::size_t r = k / lattice_cols, j = r * rows_k + shift_j;
-        const std::size_t i = (k % lattice_cols) * cols_k + (r % 2) * (cols_k / 2) + shift_i;
-        if (j >= grid_h || i >= grid_w) continue;
-        const std::size_t c = j * grid_w + i;
-        if (!(up.cell_guide[c].w > 0)) continue;
-        const std::size_t p = up.cell_pixel[c];
-        const GSample& s = g.samples[p];
-        engine::math::Pcg32 rng = engine::math::make_rng(0x4EA2F1ull, p, stream);  // no seed: by frame, not by run
-        const float reach = near_field.reach_cells * probes::fields_at(fields, s.position).field[0]->placement().min_spacing();
-        scratch.contact[c] =
-            near_field_irradiance(scene, lights, s, nullptr, reach, skips_own(p), near_field.rays, light_at, rng, near_field.clamp_ratio);
-        scratch.valid[c] = 1;
-      }
+  const std::size_t shift_j = static_cast<std::size_t>(stream % rows_k), shift_i = static_cast<std::size_t>((stream / rows_k) % cols_k);
+  scratch.contact.resize(grid);
+  scratch.valid.assign(grid, 0);
+  // Tracked, every cell's mean takes every frame's field, whichever colour
+  // the reuse decodes: a mean fed only on a cell's own decode frames would
+  // give the two colours their own noise, a checkerboard again.
+  if (tracked)
+    engine::jobs::parallel_for<std::size_t>(0, grid, 16384, [&](std::size_t b, std::size_t e) {
+      for (std::size_t c = b; c < e; ++c) scratch.wanted[c] = up.cell_guide[c].w > 0 ? 1 : 0;
     });
-    filter_near_field_separable(up.cell_guide, up.grid_w, up.grid_h, scratch.contact, scratch.valid, scratch.wanted,
-                                near_field.filter_radius, scratch.row, scratch.filtered, scratch.estimated);
-  }
+  else
+    for (const std::size_t c : cells) scratch.wanted[c] = 1;
+  const std::size_t lattice_rows = (grid_h + rows_k - 1) / rows_k, lattice_cols = (grid_w + cols_k - 1) / cols_k + 1;
+  engine::jobs::parallel_for<std::size_t>(0, lattice_rows * lattice_cols, 64, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      const std::size_t r = k / lattice_cols, j = r * rows_k + shift_j;
+      const std::size_t i = (k % lattice_cols) * cols_k + (r % 2) * (cols_k / 2) + shift_i;
+      if (j >= grid_h || i >= grid_w) continue;
+      const std::size_t c = j * grid_w + i;
+      if (!(up.cell_guide[c].w > 0)) continue;
+      const std::size_t p = up.cell_pixel[c];
+      const GSample& s = g.samples[p];
+      engine::math::Pcg32 rng = engine::math::make_rng(0x4EA2F1ull, p, stream);  // no seed: by frame, not by run
+      const float reach = near_field.reach_cells * probes::fields_at(fields, s.position).field[0]->placement().min_spacing();
+      scratch.contact[c] =
+          near_field_irradiance(scene, lights, s, nullptr, reach, skips_own(p), near_field.rays, light_at, rng);
+      scratch.valid[c] = 1;
+    }
+  });
+  filter_near_field_separable(up.cell_guide, up.grid_w, up.grid_h, scratch.contact, scratch.valid, scratch.wanted,
+                              near_field.filter_radius, scratch.row, scratch.filtered, scratch.estimated);
   // Cells within kContactResetCells of where a moved object is or was: the
   // contact light there changed with the move, so their means restart (else
   // the floor beside a moved object keeps its old light for frames: a ghost).
-  const bool reset_near_moved = tracked && moved.size() == grid;
+  const bool reset_near_moved = tracked && moved.size() == grid && std::find(moved.begin(), moved.end(), 1) != moved.end();
   if (reset_near_moved) {
     const int radius = kContactResetCells;
     scratch.near_moved_row.assign(grid, 0);
@@ -732,21 +724,20 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
     // one near a moved object, starts from this frame's estimate).
     scratch.mean_next.resize(grid);
     scratch.count_next.assign(grid, 0);
-    const int estimates = std::max(1, kContactFrames / static_cast<int>(interval));  // so the lag stays kContactFrames frames
     // A cell that no estimate reached carries its point's mean unchanged.
     engine::jobs::parallel_for<std::size_t>(0, grid, 4096, [&](std::size_t b, std::size_t e) {
       for (std::size_t c = b; c < e; ++c) {
         const std::int32_t q = track[c];
         const bool known = q >= 0 && static_cast<std::size_t>(q) < scratch.count.size() && scratch.count[static_cast<std::size_t>(q)] > 0 &&
                            !(reset_near_moved && scratch.near_moved[c]);
-        if (!scratch.wanted[c] || !scratch.estimated[c]) {
+        if (!scratch.estimated[c]) {
           if (known) {
             scratch.mean_next[c] = scratch.mean[static_cast<std::size_t>(q)];
             scratch.count_next[c] = scratch.count[static_cast<std::size_t>(q)];
           }
           continue;
         }
-        const int n = known ? std::min<int>(scratch.count[static_cast<std::size_t>(q)], estimates - 1) : 0;
+        const int n = known ? std::min<int>(scratch.count[static_cast<std::size_t>(q)], kContactFrames - 1) : 0;
         scratch.mean_next[c] = n > 0 ? (scratch.mean[static_cast<std::size_t>(q)] * static_cast<float>(n) + scratch.filtered[c]) /
                                            static_cast<float>(n + 1)
                                      : scratch.filtered[c];
