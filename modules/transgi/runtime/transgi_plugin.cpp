@@ -159,7 +159,10 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   std::optional<shading::DirectTileShader> direct;
   // With a backend's tracer the shadow rays go to it in one batch after the
   // G-buffer, not tile by tile inside it.
-  if (deterministic && !tracer) direct.emplace(rt, lights, rays, frame.width, frame.height);
+  // Last frame's images lend their storage to this frame's (nothing reads
+  // them once a new frame starts).
+  if (deterministic && !tracer) direct.emplace(rt, lights, rays, frame.width, frame.height, std::move(frame.direct));
+  packed.scratch.recycle(std::move(frame.gi));
   const glm::vec2 jitter = settings.taa.enabled ? packed.taa.next_jitter(settings.taa) : glm::vec2(0.0f);
   shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, packed.gbuffer, direct ? &*direct : nullptr, tracer,
                          jitter);

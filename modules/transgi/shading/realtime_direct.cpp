@@ -5,6 +5,9 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <span>
+#include <stdexcept>
 #include <vector>
 
 #include "engine/jobs/parallel_for.h"
@@ -27,11 +30,12 @@ glm::vec2 disk_pattern(int x, int y) {
 }
 
 DirectTileShader::DirectTileShader(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
-                                   const engine::render::CameraRays& camera, int width, int height)
+                                   const engine::render::CameraRays& camera, int width, int height,
+                                   engine::image::ImageRGB recycled)
     : scene_(scene),
       lights_(lights),
       camera_(camera),
-      out_(width, height),
+      out_(recycled.width == width && recycled.height == height ? std::move(recycled) : engine::image::ImageRGB(width, height)),
       n_lights_(lights.punctual_count()),
       rays_per_tile_(static_cast<std::size_t>((width + 3) / 4) * static_cast<std::size_t>((height + 3) / 4), 0) {
   using namespace engine;
@@ -52,7 +56,8 @@ DirectTileShader::DirectTileShader(const engine::rt::RtScene& scene, const engin
     soft.tan_radius = std::tan(std::min(light.angular_radius, 1.5f));
     soft.centre = directional_[l][0];
     soft.centre.direction = -light.direction;
-    soft.blocker.assign(pixels, kNotReceiver);
+    // Not cleared here: each tile writes its own pixels (shade_tile).
+    soft.blocker = std::make_unique_for_overwrite<float[]>(pixels);
     soft_of_[l] = static_cast<int>(soft_.size());
     soft_.push_back(std::move(soft));
   }
@@ -73,7 +78,8 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty, Scratch& scr
   const std::size_t tile = static_cast<std::size_t>(ty / 4) * static_cast<std::size_t>((g.width + 3) / 4) + static_cast<std::size_t>(tx / 4);
   const bool collecting = batch_.collect != nullptr;
   std::size_t answer = batch_.distances ? (*batch_.first)[tile] : 0;
-  // Emission and background first.
+  // Emission and background first. Every pixel of the tile is written here
+  // (the image and the soft lights' visibility are not cleared beforehand).
   for (int y = ty; y < std::min(ty + 4, g.height); ++y)
     for (int x = tx; x < std::min(tx + 4, g.width); ++x) {
       const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
@@ -83,6 +89,9 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty, Scratch& scr
         out_.pixels[p] = s.emission;
       else if (background)
         out_.pixels[p] = background->radiance(camera_.generate({static_cast<float>(x) + 0.5f + g.jitter.x, static_cast<float>(y) + 0.5f + g.jitter.y}).direction);
+      else
+        out_.pixels[p] = glm::vec3(0.0f);
+      for (SoftLight& soft : soft_) soft.blocker[p] = kNotReceiver;
     }
   for (std::size_t l = 0; l < n_lights_; ++l) {
     SoftLight* soft = soft_of_[l] >= 0 ? &soft_[static_cast<std::size_t>(soft_of_[l])] : nullptr;
@@ -178,9 +187,11 @@ namespace {
 constexpr int kCell = 2;
 constexpr int kWindowCells = 8;  // 16 pixels
 
+// No member initialisers: the per-cell arrays are written cell by cell, not
+// cleared first (WindowSums{} is zero).
 struct WindowSums {
-  std::int32_t blocked = 0, traced = 0, lit = 0;
-  float inverse_distance = 0;
+  std::int32_t blocked, traced, lit;
+  float inverse_distance;
   void add(const WindowSums& o, int sign) {
     blocked += sign * o.blocked;
     traced += sign * o.traced;
@@ -192,14 +203,14 @@ struct WindowSums {
 // Per pixel: the penumbra's half-width in pixels, 1 to 8 (0: not in or near
 // a penumbra, or not a receiver). A mean over a sliding window, it changes
 // smoothly from pixel to pixel.
-std::vector<std::uint8_t> penumbra_radius(const GBuffer& g, const std::vector<float>& blocker, float tan_radius,
-                                          float pixel_spread) {
+void penumbra_radius(const GBuffer& g, std::span<const float> blocker, float tan_radius, float pixel_spread,
+                     std::span<std::uint8_t> radius) {
   const int w = g.width, h = g.height;
   const int cw = (w + kCell - 1) / kCell, ch = (h + kCell - 1) / kCell;
   const auto cell_at = [cw](int cx, int cy) { return static_cast<std::size_t>(cy) * static_cast<std::size_t>(cw) + static_cast<std::size_t>(cx); };
   constexpr int kBandCells = 8 / kCell;
   const int bands = (ch + kBandCells - 1) / kBandCells;
-  std::vector<WindowSums> cells(static_cast<std::size_t>(cw) * ch);  // each written once below
+  const auto cells = std::make_unique_for_overwrite<WindowSums[]>(static_cast<std::size_t>(cw) * ch);  // each written once below
   std::vector<std::uint8_t> band_blocked(static_cast<std::size_t>(bands), 0), band_lit(static_cast<std::size_t>(bands), 0);
   engine::jobs::parallel_for(0, bands, 1, [&](int b0, int b1) {
     for (int b = b0; b < b1; ++b) {
@@ -207,7 +218,7 @@ std::vector<std::uint8_t> penumbra_radius(const GBuffer& g, const std::vector<fl
       // non-receiver, fails every comparison).
       for (int cy = b * kBandCells; cy < std::min(ch, (b + 1) * kBandCells); ++cy)
         for (int cx = 0; cx < cw; ++cx) {
-          WindowSums cell;
+          WindowSums cell{};
           for (int y = cy * kCell; y < std::min(h, cy * kCell + kCell); ++y)
             for (int x = cx * kCell; x < std::min(w, cx * kCell + kCell); ++x) {
               const float d = blocker[static_cast<std::size_t>(y) * w + x];
@@ -243,15 +254,17 @@ std::vector<std::uint8_t> penumbra_radius(const GBuffer& g, const std::vector<fl
   }
   for (int b = 0; b < bands; ++b)
     for (int k = std::max(0, b - 1); k <= std::min(bands - 1, b + 1); ++k) summed[static_cast<std::size_t>(b)] |= active[static_cast<std::size_t>(k)];
-  std::vector<std::uint8_t> radius(blocker.size(), 0);
-  if (std::find(active.begin(), active.end(), 1) == active.end()) return radius;
-  // Along the cell rows: cells [cx - 4, cx + 3].
-  std::vector<WindowSums> rows(cells.size());
+  engine::jobs::parallel_for<std::size_t>(0, radius.size(), 16384, [&](std::size_t b, std::size_t e) {
+    std::fill(radius.begin() + static_cast<std::ptrdiff_t>(b), radius.begin() + static_cast<std::ptrdiff_t>(e), std::uint8_t{0});
+  });
+  if (std::find(active.begin(), active.end(), 1) == active.end()) return;
+  // Along the cell rows: cells [cx - 4, cx + 3]; only the summed bands' rows are written and read.
+  const auto rows = std::make_unique_for_overwrite<WindowSums[]>(static_cast<std::size_t>(cw) * ch);
   engine::jobs::parallel_for(0, ch, 8, [&](int y0, int y1) {
     for (int cy = y0; cy < y1; ++cy) {
       if (!summed[static_cast<std::size_t>(cy / kBandCells)]) continue;
       const WindowSums* row = &cells[cell_at(0, cy)];
-      WindowSums sum;
+      WindowSums sum{};
       for (int cx = 0; cx < std::min(cw, kWindowCells / 2 - 1); ++cx) sum.add(row[cx], 1);
       for (int cx = 0; cx < cw; ++cx) {
         if (cx + kWindowCells / 2 - 1 < cw) sum.add(row[cx + kWindowCells / 2 - 1], 1);
@@ -264,7 +277,7 @@ std::vector<std::uint8_t> penumbra_radius(const GBuffer& g, const std::vector<fl
   // afresh, so rounding does not drift down the image), then each pixel's
   // radius from its cell's window and its own depth.
   engine::jobs::parallel_for(0, bands, 1, [&](int b0, int b1) {
-    std::vector<WindowSums> column(static_cast<std::size_t>(cw));
+    std::vector<WindowSums> column(static_cast<std::size_t>(cw), WindowSums{});
     for (int b = b0; b < b1; ++b) {
       if (!active[static_cast<std::size_t>(b)]) continue;
       // Each band sums its windows afresh: bands are independent, so any
@@ -296,7 +309,6 @@ std::vector<std::uint8_t> penumbra_radius(const GBuffer& g, const std::vector<fl
       }
     }
   });
-  return radius;
 }
 
 // Whether pixel q lies on pixel p's surface: normals within ~25 degrees, q
@@ -312,16 +324,18 @@ struct SurfaceTest {
 
 }  // namespace
 
-std::vector<float> penumbra_filter(const GBuffer& g, const std::vector<float>& blocker, float tan_radius,
-                                   float pixel_spread) {
+void penumbra_filter(const GBuffer& g, std::span<const float> blocker, float tan_radius, float pixel_spread,
+                     std::span<float> out) {
   const int w = g.width, h = g.height;
   const std::size_t n = blocker.size();
-  std::vector<float> out(n);
+  if (out.size() != n) throw std::invalid_argument("penumbra_filter: out must have one value per pixel of blocker");
   engine::jobs::parallel_for<std::size_t>(0, n, 16384, [&](std::size_t b, std::size_t e) {
     for (std::size_t p = b; p < e; ++p) out[p] = std::isnan(blocker[p]) ? kNotReceiver : std::isinf(blocker[p]) ? 1.0f : 0.0f;
   });
-  if (!(tan_radius > 0)) return out;
-  const std::vector<std::uint8_t> radius = penumbra_radius(g, blocker, tan_radius, pixel_spread);
+  if (!(tan_radius > 0)) return;
+  const auto radius_storage = std::make_unique_for_overwrite<std::uint8_t[]>(n);
+  const std::span<std::uint8_t> radius(radius_storage.get(), n);
+  penumbra_radius(g, blocker, tan_radius, pixel_spread, radius);
   const auto each_pixel = [&](auto&& fn) {
     engine::jobs::parallel_for(0, h, 4, [&](int y0, int y1) {
       for (int y = y0; y < y1; ++y)
@@ -343,7 +357,9 @@ std::vector<float> penumbra_filter(const GBuffer& g, const std::vector<float>& b
   // about their own width.
   // The rows read the pattern's visibility (`out` as it stands) and the
   // columns write `out` only where they read `rows`: one copy, not two.
-  std::vector<float> rows(out);
+  const auto rows_storage = std::make_unique_for_overwrite<float[]>(n);
+  float* const rows = rows_storage.get();
+  engine::jobs::parallel_for<std::size_t>(0, n, 16384, [&](std::size_t b, std::size_t e) { std::copy(out.begin() + static_cast<std::ptrdiff_t>(b), out.begin() + static_cast<std::ptrdiff_t>(e), rows + b); });
   each_pixel([&](int x, int, std::size_t p) {
     float sum = 0, count = 0;
     for (int dx = -radius[p]; dx <= last(radius[p]); ++dx) {
@@ -368,12 +384,14 @@ std::vector<float> penumbra_filter(const GBuffer& g, const std::vector<float>& b
     }
     out[p] = sum / count;
   });
-  return out;
 }
 
 engine::image::ImageRGB DirectTileShader::take(const GBuffer& g, RealtimeDirectStats* stats) {
   for (const SoftLight& soft : soft_) {
-    const std::vector<float> lit = penumbra_filter(g, soft.blocker, soft.tan_radius, camera_.pixel_spread());
+    const std::size_t pixels = static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height);
+    const auto lit_storage = std::make_unique_for_overwrite<float[]>(pixels);
+    const std::span<float> lit(lit_storage.get(), pixels);
+    penumbra_filter(g, std::span<const float>(soft.blocker.get(), pixels), soft.tan_radius, camera_.pixel_spread(), lit);
     std::atomic<std::size_t> bad{0};
     engine::jobs::parallel_for<std::size_t>(0, lit.size(), 16384, [&](std::size_t b, std::size_t e) {
       std::size_t local_bad = 0;

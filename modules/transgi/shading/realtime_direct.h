@@ -19,6 +19,8 @@
 // The reference is the path tracer's direct pass.
 #include <array>
 #include <atomic>
+#include <memory>
+#include <span>
 #include <vector>
 
 #include "engine/image/image.h"
@@ -44,7 +46,11 @@ struct RealtimeDirectStats {
 class DirectTileShader {
  public:
   DirectTileShader(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
-                   const engine::render::CameraRays& camera, int width, int height);
+                   const engine::render::CameraRays& camera, int width, int height,
+                   engine::image::ImageRGB recycled = {});
+  // `recycled`: last frame's image, whose storage this one reuses where the
+  // size matches (tiles write every pixel, so nothing is cleared: clearing
+  // a 640x360 image was serial time in the frame).
   // A tile's rays, hits and per-pixel terms. Built once per loop over tiles,
   // not per tile: constructing 16 rays and hits every tile cost a fifth of
   // the pass.
@@ -96,7 +102,7 @@ class DirectTileShader {
     std::size_t light = 0;
     float tan_radius = 0.0f;
     engine::render::LightSample centre;
-    std::vector<float> blocker;
+    std::unique_ptr<float[]> blocker;  // width x height, written by the tiles
   };
   std::vector<SoftLight> soft_;
   std::vector<int> soft_of_;  // per punctual light: its index in soft_, or -1
@@ -131,7 +137,8 @@ glm::vec2 disk_pattern(int x, int y);
 // the pixel's footprint): a box of 8 or 16 pixels, which holds every point
 // of the 8x8 pattern, where the penumbra is 4 pixels wide or more, one no
 // wider than it where narrower.
-std::vector<float> penumbra_filter(const GBuffer& g, const std::vector<float>& blocker, float tan_radius,
-                                   float pixel_spread);
+// `out` has one value per pixel of `blocker`; every one is written.
+void penumbra_filter(const GBuffer& g, std::span<const float> blocker, float tan_radius, float pixel_spread,
+                     std::span<float> out);
 
 }  // namespace transgi::shading

@@ -184,11 +184,13 @@ struct RealtimeGiScratch::Impl {
   std::vector<std::int32_t> source;
   std::vector<std::uint8_t> fresh;
   std::vector<glm::vec3> cell_value, cell_value_direct;
+  engine::image::ImageRGB recycled;  // RealtimeGiScratch::recycle
 };
 RealtimeGiScratch::RealtimeGiScratch() : impl(std::make_unique<Impl>()) {}
 RealtimeGiScratch::~RealtimeGiScratch() = default;
 RealtimeGiScratch::RealtimeGiScratch(RealtimeGiScratch&&) noexcept = default;
 RealtimeGiScratch& RealtimeGiScratch::operator=(RealtimeGiScratch&&) noexcept = default;
+void RealtimeGiScratch::recycle(engine::image::ImageRGB&& image) { impl->recycled = std::move(image); }
 void RealtimeGiScratch::forget_histories() {
   impl->history.clear();
   impl->dielectric_rays.history.forget();
@@ -770,11 +772,18 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
                                           const engine::render::LightSet* mirror_lights, const MirrorRay& mirror,
                                           const NearFieldRays& near_field, TransferBatchDecoder* batch_decoder) {
   RealtimeGiStats stats;
-  engine::image::ImageRGB image(g.width, g.height);
+  // A recycled image of the right size is not cleared: the upsampling below
+  // writes every pixel.
+  engine::image::ImageRGB image;
+  const bool writes_every_pixel = !fields.empty() && !g.samples.empty();
+  if (scratch && writes_every_pixel && scratch->impl->recycled.width == g.width && scratch->impl->recycled.height == g.height)
+    image = std::move(scratch->impl->recycled);
+  else
+    image = engine::image::ImageRGB(g.width, g.height);
   // The probes' direct light is added to what direct_out holds (the rest of
   // the frame's direct light): one pass over it, not an image and a sum.
   if (direct_out && (direct_out->width != g.width || direct_out->height != g.height)) *direct_out = engine::image::ImageRGB(g.width, g.height);
-  if (fields.empty() || g.samples.empty()) {
+  if (!writes_every_pixel) {
     if (stats_out) *stats_out = stats;
     return image;
   }
@@ -1084,7 +1093,10 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < g.width; ++x) {
         const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
-        if (up.kind[p] == UpsamplingPlan::kMiss) continue;
+        if (up.kind[p] == UpsamplingPlan::kMiss) {
+          image.pixels[p] = glm::vec3(0.0f);
+          continue;
+        }
         const glm::vec3 albedo = model::demodulation(g.albedo[p]);
         const bool add_direct = with_direct && !(g.metal_roughness[p] <= metal_ray_roughness);
         if (up.kind[p] == UpsamplingPlan::kOwn) {

@@ -137,6 +137,10 @@ struct RealtimeGiScratch {
   // A camera cut: the next frame takes nothing from the frames before (the
   // GI reuse's cells, the glossy reflections' history); storage is kept.
   void forget_histories();
+  // Last frame's GI image, handed back so the next one reuses its storage:
+  // the upsampling writes every pixel, so nothing is cleared (clearing a
+  // 640x360 image was serial time in the frame).
+  void recycle(engine::image::ImageRGB&& image);
 };
 
 struct RealtimeGiStats {

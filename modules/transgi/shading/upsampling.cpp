@@ -82,14 +82,19 @@ void plan_upsampling(const std::vector<glm::vec4>& guide, int width, int height,
   u.sx = static_cast<float>(width) / static_cast<float>(u.grid_w);
   u.sy = static_cast<float>(height) / static_cast<float>(u.grid_h);
   u.cell_pixel.resize(static_cast<std::size_t>(u.grid_w) * u.grid_h);
-  for (int j = 0; j < u.grid_h; ++j)
-    for (int i = 0; i < u.grid_w; ++i) {
-      const int x = std::min(width - 1, static_cast<int>((static_cast<float>(i) + 0.5f) * u.sx));
-      const int y = std::min(height - 1, static_cast<int>((static_cast<float>(j) + 0.5f) * u.sy));
-      u.cell_pixel[static_cast<std::size_t>(j) * u.grid_w + i] = static_cast<std::size_t>(y) * width + x;
-    }
   u.cell_guide.resize(u.cell_pixel.size());
-  for (std::size_t c = 0; c < u.cell_pixel.size(); ++c) u.cell_guide[c] = guide[u.cell_pixel[c]];
+  // By rows of cells in parallel: gathering the cells' guides misses cache
+  // on every other pixel row.
+  engine::jobs::parallel_for(0, u.grid_h, 16, [&](int j0, int j1) {
+    for (int j = j0; j < j1; ++j)
+      for (int i = 0; i < u.grid_w; ++i) {
+        const int x = std::min(width - 1, static_cast<int>((static_cast<float>(i) + 0.5f) * u.sx));
+        const int y = std::min(height - 1, static_cast<int>((static_cast<float>(j) + 0.5f) * u.sy));
+        const std::size_t c = static_cast<std::size_t>(j) * u.grid_w + i;
+        u.cell_pixel[c] = static_cast<std::size_t>(y) * width + x;
+        u.cell_guide[c] = guide[u.cell_pixel[c]];
+      }
+  });
   // Output position in cell coordinates, cell centres at integers: the two
   // cells either side and the bilinear weight of the second.
   const auto axis = [](int n, float per_cell, int cells, std::vector<std::int32_t>& c0, std::vector<std::int32_t>& c1,
