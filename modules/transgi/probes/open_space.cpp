@@ -143,21 +143,37 @@ OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& gri
   // links[q] bit k: the segment from q to q + forward_offset(k) is clear.
   // Segment s is (probe, k) = (segment_of[s] / kForward, % kForward).
   std::vector<std::uint16_t> links(static_cast<std::size_t>(probes), 0);
+  // Every (probe, k) slot in parallel, then the segments that exist in
+  // slot order (built serially, this was serial time every frame an
+  // object moved).
+  const std::size_t slots = static_cast<std::size_t>(probes) * kForward;
+  std::vector<rt::Ray> candidate(slots);
+  std::vector<std::uint8_t> exists(slots, 0);
+  jobs::parallel_for(0, probes, 64, [&](int q0, int q1) {
+    for (int q = q0; q < q1; ++q) {
+      const glm::ivec3 c = grid.coords(q);
+      const glm::vec3 from = grid.grid_point(q);
+      for (int k = 0; k < kForward; ++k) {
+        const glm::ivec3 n = c + forward_offset(k);
+        if (!inside_grid(grid, n)) continue;
+        const glm::vec3 d = grid.grid_point(grid.index(n)) - from;
+        const float len = glm::length(d);
+        if (!(len > 0)) continue;
+        const std::size_t slot = static_cast<std::size_t>(q) * kForward + static_cast<std::size_t>(k);
+        candidate[slot] = rt::Ray{from, d / len, 0.0f, len};
+        exists[slot] = 1;
+      }
+    }
+  });
   std::vector<rt::Ray> segments;
   std::vector<int> segment_of;
-  for (int q = 0; q < probes; ++q) {
-    const glm::ivec3 c = grid.coords(q);
-    const glm::vec3 from = grid.grid_point(q);
-    for (int k = 0; k < kForward; ++k) {
-      const glm::ivec3 n = c + forward_offset(k);
-      if (!inside_grid(grid, n)) continue;
-      const glm::vec3 d = grid.grid_point(grid.index(n)) - from;
-      const float len = glm::length(d);
-      if (!(len > 0)) continue;
-      segments.push_back(rt::Ray{from, d / len, 0.0f, len});
-      segment_of.push_back(q * kForward + k);
+  segments.reserve(slots);
+  segment_of.reserve(slots);
+  for (std::size_t slot = 0; slot < slots; ++slot)
+    if (exists[slot]) {
+      segments.push_back(candidate[slot]);
+      segment_of.push_back(static_cast<int>(slot));
     }
-  }
   std::vector<std::uint8_t> blocked(segments.size(), 0);
   if (!tracer || !tracer->occluded(scene, segments, blocked))
     jobs::parallel_for<std::size_t>(0, segments.size(), 64, [&](std::size_t b, std::size_t e) {

@@ -227,7 +227,9 @@ void GiHistory::store(std::vector<glm::vec3>& value, std::vector<glm::vec3>& val
   std::swap(cur_.value, value);
   std::swap(cur_.value_direct, value_direct);
   if (cur_.value_direct.size() != cur_.value.size()) cur_.value_direct.assign(cur_.value.size(), glm::vec3(0.0f));
-  for (std::size_t c = 0; c < cur_.key.size() && c < fresh.size(); ++c) cur_.key[c].fresh = fresh[c];
+  engine::jobs::parallel_for<std::size_t>(0, std::min(cur_.key.size(), fresh.size()), 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t c = b; c < e; ++c) cur_.key[c].fresh = fresh[c];
+  });
   std::swap(prev_, cur_);
   ++frame_;
 }

@@ -185,6 +185,11 @@ struct RealtimeGiScratch::Impl {
   std::vector<std::uint8_t> fresh;
   std::vector<glm::vec3> cell_value, cell_value_direct;
   engine::image::ImageRGB recycled;  // RealtimeGiScratch::recycle
+  // The split of decoded samples into network and diffuse ones.
+  std::vector<engine::ecs::Entity> sample_entity;
+  std::vector<std::uint8_t> sample_glossy;
+  std::vector<std::size_t> net, diffuse;
+  std::vector<int> rotation_of;
 };
 RealtimeGiScratch::RealtimeGiScratch() : impl(std::make_unique<Impl>()) {}
 RealtimeGiScratch::~RealtimeGiScratch() = default;
@@ -874,16 +879,30 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
 
   // Split into network and diffuse samples; one rotation per moved object.
   t0 = Clock::now();
-  std::vector<std::size_t> net, diffuse;  // indices into decode
-  std::vector<int> rotation_of;           // per net sample
+  std::vector<std::size_t>& net = sc.net;            // indices into decode
+  std::vector<std::size_t>& diffuse = sc.diffuse;
+  std::vector<int>& rotation_of = sc.rotation_of;  // per net sample
+  net.clear();
+  diffuse.clear();
+  rotation_of.clear();
   RotatedProbes rotated(fields);
   {
+    // Each sample's entity and glossiness gathered in parallel (the reads
+    // miss cache: the G-buffer was written long before), then routed in order.
+    sc.sample_entity.resize(decode.size());
+    sc.sample_glossy.resize(decode.size());
+    engine::jobs::parallel_for<std::size_t>(0, decode.size(), 2048, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        sc.sample_entity[i] = g.entity[decode[i]];
+        sc.sample_glossy[i] = is_glossy_dielectric(decode[i]) ? 1 : 0;
+      }
+    });
     std::unordered_map<engine::ecs::Entity, std::pair<bool, int>> per_entity;
     // Neighbouring samples mostly lie on one entity: look it up only when it changes.
     engine::ecs::Entity last{};
     std::pair<bool, int> last_route{false, -1};
     for (std::size_t i = 0; i < decode.size(); ++i) {
-      const engine::ecs::Entity e = g.entity[decode[i]];
+      const engine::ecs::Entity e = sc.sample_entity[i];
       if (i == 0 || !(e == last)) {
         auto [it, inserted] = per_entity.try_emplace(e, false, -1);
         if (inserted) {
@@ -893,7 +912,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
         last = e;
         last_route = it->second;
       }
-      if (last_route.first && !is_glossy_dielectric(decode[i])) {
+      if (last_route.first && !sc.sample_glossy[i]) {
         net.push_back(i);
         rotation_of.push_back(last_route.second);
       } else {
@@ -916,8 +935,12 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   std::vector<glm::vec3>& value = sc.value;
   std::vector<glm::vec3>& value_direct = sc.value_direct;
   std::vector<TransferQuery>& queries = sc.queries;
-  value.resize(decode.size());
-  value_direct.resize(with_direct ? decode.size() : 0);
+  // With the reuse, the reused cells' values follow the decoded ones (below):
+  // sized once, so no frame shrinks and regrows (and clears) them.
+  const std::size_t decoded = decode.size();
+  const std::size_t value_slots = decoded + (reuse ? up.cell_pixel.size() : 0);
+  value.resize(value_slots);
+  value_direct.resize(with_direct ? value_slots : 0);
   queries.resize(net.size());
   sc.net_position.resize(net.size());
   sc.net_normal.resize(net.size());
@@ -1006,7 +1029,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   stats.diffuse = diffuse.size();
   // The decoded values' boundary: nothing non-finite reaches the upsampling.
   const auto finite = [](const glm::vec3& v) { return std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b); };
-  for (std::size_t i = 0; i < value.size(); ++i) {
+  for (std::size_t i = 0; i < decoded; ++i) {
     const bool ok = finite(value[i]) && (!with_direct || finite(value_direct[i]));
     if (ok) continue;
     value[i] = glm::vec3(0.0f);
@@ -1033,9 +1056,7 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     // The reused cells' values after the decoded ones, a reused cell's slot
     // at its cell index past them, so the cells are independent (no cell's
     // pixel is another's); then every cell's value is the next frame's history.
-    const std::size_t cells = up.cell_pixel.size(), base = value.size();
-    value.resize(base + cells);
-    if (with_direct) value_direct.resize(base + cells);
+    const std::size_t cells = up.cell_pixel.size(), base = decoded;
     sc.cell_value.resize(cells);
     sc.cell_value_direct.resize(with_direct ? cells : 0);
     sc.fresh.resize(cells);
