@@ -337,12 +337,12 @@ TransGISettings realtime_preset() {
   s.taa.enabled = true;
   s.direct_light = DirectLight::Deterministic;
   s.probes.fixed_pattern = true;  // with the deterministic direct light: no seed anywhere in the image
-  // Off by default (the paper's setting): one ray from about 4096 cells a
-  // frame, averaged over frames (`--near-field-rays 1`), gives the Breakfast
-  // Room on its ground plane its missing fifth of GI and passes the suite,
-  // but costs about 1 ms at 640x360, past issue 37's frame budget
-  // (docs/image-quality.md, "Daylight on the real-time path").
-  s.near_field.rays = 0;
+  // One ray from about 4096 cells a frame, averaged over frames: gives a
+  // daylit room the contact light the metre-spaced probes miss (the
+  // Breakfast Room on its ground plane lost a fifth of its GI without it),
+  // for about 1 ms at 640x360 (docs/image-quality.md, "Daylight on the
+  // real-time path"). `--near-field-rays 0` is the paper's probes alone.
+  s.near_field.rays = 1;
   s.near_field.cell_budget = 4096;
   return s;
 }
