@@ -129,9 +129,13 @@ int render_transgi(const Args& args, eval::LoadedScene& scene, int width, int he
   t.settings.probes.sharing.mode = args.choice("sharing", {"depth-guard", "paper"}, "depth-guard") == "paper"
                                        ? transgi::probes::SharingMode::PaperFaithful
                                        : transgi::probes::SharingMode::DepthGuard;
-  t.frames = static_cast<int>(args.integer("frames", 1, 100000, 32));
-  t.timing_frames = static_cast<int>(args.integer("timing-frames", 1, 1000, 3));
   t.settings.temporal_window = static_cast<int>(args.integer("temporal-window", 1, 1024, t.settings.temporal_window));
+  // By default the still image's window starts once the probes' cold start
+  // is over: a mean over warm-up frames is an image of the warm-up (on a
+  // daylit room, 32 frames averaged frames 17-32 and came out 8-10 % bright).
+  t.frames = static_cast<int>(
+      args.integer("frames", 1, 100000, t.settings.probes.accumulation.warmup_frames + t.settings.temporal_window));
+  t.timing_frames = static_cast<int>(args.integer("timing-frames", 1, 1000, 3));
   t.placement = probe_placement_from(args, runtime::ProbeVolumeMode::Cascades);
   t.no_latent = split_names(args.str("no-latent", std::string()));
   const auto shared = std::make_shared<const transgi::model::TransferModel>(std::move(model));

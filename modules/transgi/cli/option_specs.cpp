@@ -149,7 +149,10 @@ std::vector<OptionSpec> render_option_specs() {
       text("coefficient-maps", "PREFIX", "none", "transgi --lighting environment: write three SH coefficient images"),
       flag("allow-unbaked", "transgi: shade meshes the model has no latents for diffusely instead of refusing"),
       text("no-latent", "NODE,...", "none", "transgi: shade these nodes as if unbaked"),
-      integer("frames", "F", 1, 100000, "32 (transgi), 400 (ddgi)", "frames run before the image is taken"),
+      integer("frames", "F", 1, 100000,
+              std::to_string(runtime::quality_preset().probes.accumulation.warmup_frames + runtime::quality_preset().temporal_window) +
+                  " (transgi: the probes' warm-up, then the temporal window), 400 (ddgi)",
+              "frames run before the image is taken"),
       integer("timing-frames", "N", 1, 1000, "3", "last frames whose stage times are reported"),
       integer("temporal-window", "N", 1, 1024, std::to_string(runtime::quality_preset().temporal_window),
               "transgi quality path: a still view's GI is the mean of the last N jittered frames: higher = smoother "
