@@ -1,6 +1,9 @@
 // AVX2 + FMA fused decoder, every layer fp32: the path for CPUs without
-// AVX-512 BF16. Outputs across the 8 lanes, 2 rows x 4 vectors = 8
-// accumulators per register block (16 ymm registers in all).
+// AVX-512 BF16. Outputs across the 8 lanes, 6 rows x 2 vectors = 12
+// accumulators per register block, 2 weight vectors and a broadcast (15 of
+// the 16 ymm registers). Each weight vector loaded serves 6 FMAs: a hidden
+// layer's 64 KB of fp32 weights does not fit L1, and with 2 rows x 4
+// vectors (4 FMAs a weight load) the kernel waited on L2.
 #include <immintrin.h>
 
 #include <algorithm>
@@ -14,13 +17,16 @@ namespace transgi::shading::detail {
 namespace {
 
 constexpr int kLanes = 8;
-constexpr int kRows = 2;
+constexpr int kRows = 6;
+static_assert(kGroupAvx2 == 2 * kLanes, "the register block is 2 vectors of outputs wide");
+// A tile's rows rounded up to whole blocks of kRows.
+constexpr int kTileRows = (kFusedTile + kRows - 1) / kRows * kRows;
 
 struct Tile {
-  alignas(32) float act[2][kFusedTile * kMaxWidth];  // act[0] also holds the inputs
-  alignas(32) float light[kFusedTile * kLightPadded];
-  alignas(32) float light2[kFusedTile * kLightPadded];
-  float rgb[kFusedTile * 3], rgb2[kFusedTile * 3];
+  alignas(32) float act[2][kTileRows * kMaxWidth];  // act[0] also holds the inputs
+  alignas(32) float light[kTileRows * kLightPadded];
+  alignas(32) float light2[kTileRows * kLightPadded];
+  float rgb[kTileRows * 3], rgb2[kTileRows * 3];
   bool two_lights = false;
 };
 
@@ -72,12 +78,10 @@ TRANSGI_AVX2 void layer_group(const PackedLayer& L, int o0, Tile& t, int src, in
 
 TRANSGI_AVX2 void run_layer(const PackedLayer& L, Tile& t, int src, int rows, bool output) {
   for (int o0 = 0; o0 < L.out_padded; o0 += kGroupAvx2) {
-    switch (std::min(kGroupAvx2, L.out_padded - o0) / kLanes) {
-      case 4: layer_group<4>(L, o0, t, src, rows, output); break;
-      case 3: layer_group<3>(L, o0, t, src, rows, output); break;
-      case 2: layer_group<2>(L, o0, t, src, rows, output); break;
-      default: layer_group<1>(L, o0, t, src, rows, output); break;
-    }
+    if (std::min(kGroupAvx2, L.out_padded - o0) / kLanes == 2)
+      layer_group<2>(L, o0, t, src, rows, output);
+    else
+      layer_group<1>(L, o0, t, src, rows, output);
   }
 }
 

@@ -13,9 +13,10 @@ inline constexpr int kMaxWidth = 256;
 inline constexpr int kLightPadded = 80;  // 75 SH values, padded to whole vectors
 // The AMX output layer: 3 channels x 25 values, each channel padded to 32.
 inline constexpr int kAmxOutputs = 96;
-// Outputs per register block: 4 vectors of 16 (AVX-512) or of 8 (AVX2).
+// Outputs per register block: 4 vectors of 16 (AVX-512) or 2 of 8 (AVX2,
+// whose 16 registers hold 6 rows of them).
 inline constexpr int kGroupAvx512 = 64;
-inline constexpr int kGroupAvx2 = 32;
+inline constexpr int kGroupAvx2 = 16;
 
 // The fp32 first layer on AVX-512 FMA, shared by the bf16 and AMX backends:
 // act[r * act_stride + o] = bf16(relu(W input_r + b)) for rows r < rows (a
