@@ -5,6 +5,8 @@
 // previous frame did not see must be decoded.
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <cmath>
 #include <cstdio>
 
@@ -97,6 +99,32 @@ Diff diff_on(const Lit::Frame& f, ecs::Entity entity) {
 }
 
 }  // namespace
+
+// The real-time frame hands last frame's GI image back (RealtimeGiScratch::
+// recycle), and the upsampling clears nothing: every pixel, a miss
+// included, must be written. Garbage in the recycled image must not show.
+TEST(GiHistory, ARecycledImageFullOfGarbageGivesTheSameFrame) {
+  EdgeScene s;
+  Lit lit(s);
+  shading::RealtimeGiScratch plain, recycling;
+  // Looking up past the wall's top edge: the sky fills the top rows.
+  const transform::Similarity view{.translation = {0.3f, 1.2f, 3.5f}, .rotation = glm::angleAxis(0.25f, glm::vec3(1, 0, 0))};
+  lit.frame(view, plain);
+  lit.frame(view, recycling);
+  image::ImageRGB garbage(kW, kH);
+  for (std::size_t i = 0; i < garbage.pixels.size(); ++i)
+    garbage.pixels[i] = i % 2 ? glm::vec3(std::numeric_limits<float>::quiet_NaN()) : glm::vec3(1e30f, -7.0f, 3.0f);
+  recycling.recycle(std::move(garbage));
+  const Lit::Frame want = lit.frame(view, plain), got = lit.frame(view, recycling);
+  int misses = 0;
+  for (const auto& smp : want.g.samples) misses += smp.hit ? 0 : 1;
+  EXPECT_GT(misses, 0) << "the view must hold pixels that miss (the upsampling writes them too)";
+  ASSERT_EQ(got.reused.pixels.size(), want.reused.pixels.size());
+  for (std::size_t i = 0; i < want.reused.pixels.size(); ++i)
+    ASSERT_EQ(got.reused.pixels[i], want.reused.pixels[i]) << "pixel " << i << ": with a recycled image " << got.reused.pixels[i].r
+                                                         << ", without " << want.reused.pixels[i].r;
+  EXPECT_GT(mean_of(want.reused), 0.0) << "the image must not be trivially black";
+}
 
 // A still camera on a still scene: after the first frame, half the cells
 // take last frame's values, and the image is the decoded one bit for bit.

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <glm/gtc/quaternion.hpp>
@@ -94,6 +95,44 @@ TEST(RealtimeDirect, ShadedInsideTheGBufferLoopEqualsTheStandalonePass) {
   for (std::size_t i = 0; i < got.pixels.size(); ++i)
     ASSERT_EQ(got.pixels[i], want.pixels[i]) << "pixel " << i << ": inside the G-buffer loop " << got.pixels[i].r << ", standalone "
                                              << want.pixels[i].r;
+}
+
+TEST(RealtimeDirect, RecycledStorageFullOfGarbageGivesTheSameImage) {
+  // The real-time frame hands last frame's image to the next shader, which
+  // clears nothing: every tile must write each of its pixels (emission or
+  // sky, then the lights added). Garbage (NaN, huge values) in the recycled
+  // image must not reach the result. (The soft sun's visibility is fresh
+  // storage each frame, so garbage cannot be planted there from here.)
+  SunLevel level(small_realtime(0, 1), 2);
+  const int w = 37, h = 29;  // tiles cut by both edges
+  level.run(2, w, h);
+  auto& world = level.app.world();
+  const auto& lights = world.resource<render::SceneLights>();
+  ASSERT_GE(lights.set.split_sun_index(), 0) << "the scene must have a sun whose light is added to the tiles' pixels";
+  const auto& rt = world.resource<rt::RtScene>();
+  const auto& assets = world.resource<scene::SceneAssets>();
+  const render::CameraRays rays(world.get<scene::Camera>(level.camera), world.get<transform::WorldTransform>(level.camera), w, h);
+  shading::GBuffer g;
+  image::ImageRGB fresh, recycled;
+  level.app.jobs().run([&] {
+    shading::DirectTileShader clean(rt, lights.set, rays, w, h);
+    shading::trace_gbuffer(rt, assets, rays, w, h, g, &clean);
+    fresh = clean.take(g);
+    image::ImageRGB garbage(w, h);
+    for (std::size_t i = 0; i < garbage.pixels.size(); ++i)
+      garbage.pixels[i] = i % 2 ? glm::vec3(std::numeric_limits<float>::quiet_NaN()) : glm::vec3(1e30f, -7.0f, 3.0f);
+    shading::DirectTileShader reused(rt, lights.set, rays, w, h, std::move(garbage));
+    shading::trace_gbuffer(rt, assets, rays, w, h, g, &reused);
+    recycled = reused.take(g);
+  });
+  ASSERT_EQ(recycled.pixels.size(), fresh.pixels.size());
+  double sum = 0;
+  for (std::size_t i = 0; i < fresh.pixels.size(); ++i) {
+    sum += fresh.pixels[i].g;
+    ASSERT_EQ(recycled.pixels[i], fresh.pixels[i]) << "pixel " << i << ": recycled storage " << recycled.pixels[i].r << ", fresh "
+                                                   << fresh.pixels[i].r;
+  }
+  EXPECT_GT(sum, 0.0) << "the image must not be trivially black";
 }
 
 namespace {
