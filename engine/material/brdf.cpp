@@ -89,6 +89,20 @@ float spec_probability(const BrdfParams& p, float cos_o) {
   return std::clamp(spec / (spec + diffuse), 0.1f, 0.9f);
 }
 
+namespace {
+glm::vec3 dielectric_f0(const BrdfParams& p) { return glm::min(kDielectricF0 * p.specular_color, glm::vec3(1.0f)); }
+// The non-metal part's diffuse lobe, before the (1 - metallic) weight.
+glm::vec3 diffuse_lobe(const BrdfParams& p, const glm::vec3& f0, float alpha, float cos_o, float cos_i) {
+  return kInvPi * p.base_color * diffuse_coupling(p, f0, alpha, cos_o, cos_i);
+}
+}  // namespace
+
+glm::vec3 brdf_eval_diffuse(const BrdfParams& p, const glm::vec3& wo, const glm::vec3& wi) {
+  const float cos_o = wo.z, cos_i = wi.z;
+  if (cos_o <= 0 || cos_i <= 0 || !(p.metallic < 1.0f)) return glm::vec3(0.0f);
+  return (1.0f - p.metallic) * diffuse_lobe(p, dielectric_f0(p), alpha_of(p), cos_o, cos_i);
+}
+
 glm::vec3 brdf_eval(const BrdfParams& p, const glm::vec3& wo, const glm::vec3& wi) {
   const float cos_o = wo.z, cos_i = wi.z;
   if (cos_o <= 0 || cos_i <= 0) return glm::vec3(0.0f);
@@ -99,8 +113,8 @@ glm::vec3 brdf_eval(const BrdfParams& p, const glm::vec3& wo, const glm::vec3& w
 
   glm::vec3 dielectric(0.0f);
   if (p.metallic < 1.0f) {
-    const glm::vec3 f0 = glm::min(kDielectricF0 * p.specular_color, glm::vec3(1.0f));
-    dielectric = kInvPi * p.base_color * diffuse_coupling(p, f0, alpha, cos_o, cos_i);
+    const glm::vec3 f0 = dielectric_f0(p);
+    dielectric = diffuse_lobe(p, f0, alpha, cos_o, cos_i);
     if (p.specular > 0) dielectric += p.specular * ggx * schlick_fresnel(f0, cos_oh);
   }
   glm::vec3 metal(0.0f);

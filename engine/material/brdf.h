@@ -54,6 +54,10 @@ inline glm::vec3 diffuse_albedo(const BrdfParams& p) { return p.base_color * (1.
 
 // f(wo, wi). Zero when either direction is below the surface.
 glm::vec3 brdf_eval(const BrdfParams& p, const glm::vec3& wo, const glm::vec3& wi);
+// The diffuse lobe of f alone (the non-metal part, its layer coupling
+// included): brdf_eval less the glossy lobes. For estimators that must not
+// see glints (a sparse ray that meets the sun's highlight on a metal).
+glm::vec3 brdf_eval_diffuse(const BrdfParams& p, const glm::vec3& wo, const glm::vec3& wi);
 // Density with which brdf_sample() produces wi.
 float brdf_pdf(const BrdfParams& p, const glm::vec3& wo, const glm::vec3& wi);
 // Picks the GGX lobe (visible-normal sampling, Heitz 2018) or the cosine lobe

@@ -14,6 +14,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "engine/app/app.h"
+#include "engine/material/brdf.h"
 #include "engine/math/rng.h"
 #include "engine/math/sh.h"
 #include "engine/render/light_set.h"
@@ -35,11 +36,11 @@ struct SunlitFloor {
   static constexpr float kAlbedo = 0.5f, kLux = 2.0f;
   app::App app{app::AppOptions{.jobs = {.threads = 2}}};
   ecs::Entity floor;
-  SunlitFloor() {
+  explicit SunlitFloor(material::Material floor_material = lambert(glm::vec3(kAlbedo))) {
     scene::SceneAssets a;
     a.generation = scene::next_scene_generation();
     a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({100, 100}, 0))};
-    a.materials = {lambert(glm::vec3(kAlbedo))};
+    a.materials = {floor_material};
     app.world().insert_resource<scene::SceneAssets>(std::move(a));
     app.add_plugin<rt::RtPlugin>();
     ecs::World& w = app.world();
@@ -107,6 +108,31 @@ TEST(NearField, APointOverASunlitFloorGetsTheFloorsLightInsideItsReach) {
     // each off by at most its own share (1/4096): under 2 % of the cone.
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], expected, 0.02f * std::abs(expected) + 1e-6f) << "channel " << k;
   }
+}
+
+// The near field carries diffuse contact light only. A polished metal floor
+// under the sun reflects it straight up into the point above (a glint its few
+// rays a frame would meet now and then, and the filter spread into a bright
+// box); it reflects nothing diffusely, so with probes holding no light the
+// estimate is exactly zero. A Lambertian floor's, the same scene otherwise,
+// is not (the case above).
+TEST(NearField, AGlintOnAMetalIsNotContactLight) {
+  material::Material gold = lambert(glm::vec3(1.0f, 0.8f, 0.3f));
+  gold.metallic_factor = 1.0f;
+  gold.roughness_factor = 0.2f;
+  gold.specular_factor = 1.0f;
+  SunlitFloor metal(gold);
+  EXPECT_EQ(estimate(metal, facing_down(0.3f), 0.0f, 1.0f, false, 256), glm::vec3(0.0f));
+  SunlitFloor matte;
+  EXPECT_GT(estimate(matte, facing_down(0.3f), 0.0f, 1.0f, false, 256).g, 0.1f);
+  // The BRDF's diffuse lobe alone: all of a metal's f is glossy, all of a
+  // Lambertian's diffuse.
+  material::BrdfParams metal_brdf{.base_color = glm::vec3(1.0f, 0.8f, 0.3f), .metallic = 1.0f, .roughness = 0.2f};
+  material::BrdfParams matte_brdf{.base_color = glm::vec3(0.5f), .metallic = 0.0f, .roughness = 1.0f, .specular = 0.0f};
+  const glm::vec3 up(0, 0, 1);
+  EXPECT_EQ(material::brdf_eval_diffuse(metal_brdf, up, up), glm::vec3(0.0f));
+  EXPECT_GT(material::brdf_eval(metal_brdf, up, up).r, 1.0f) << "the glint the near field leaves out";
+  EXPECT_EQ(material::brdf_eval_diffuse(matte_brdf, up, up), material::brdf_eval(matte_brdf, up, up));
 }
 
 TEST(NearField, TheSamplesOwnObjectAndWhatLiesBeyondReachAddNothing) {

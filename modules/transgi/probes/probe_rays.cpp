@@ -48,7 +48,7 @@ glm::quat low_discrepancy_rotation(std::uint64_t index) {
 namespace transgi::probes {
 
 PendingProbeRay begin_probe_ray(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
-                                const glm::vec3& dir, const engine::rt::Hit* traced, engine::math::Pcg32& rng) {
+                                const glm::vec3& dir, const engine::rt::Hit* traced, engine::math::Pcg32& rng, HitLobes lobes) {
   using namespace engine;
   PendingProbeRay p;
   ProbeRayHit& r = p.r;
@@ -86,7 +86,9 @@ PendingProbeRay begin_probe_ray(const engine::rt::RtScene& scene, const engine::
   const glm::vec2 u{rng.next_float(), rng.next_float()};
   if (lights.sample(s.position, u_sel, u, ls) && glm::dot(ls.direction, s.geometric_normal) > 0) {
     const glm::vec3 wi = s.frame.to_local(ls.direction);
-    const glm::vec3 f = wi.z > 0 ? material::brdf_eval(s.brdf, wo, wi) : glm::vec3(0.0f);
+    const glm::vec3 f = !(wi.z > 0)                ? glm::vec3(0.0f)
+                        : lobes == HitLobes::Diffuse ? material::brdf_eval_diffuse(s.brdf, wo, wi)
+                                                     : material::brdf_eval(s.brdf, wo, wi);
     if (f != glm::vec3(0.0f)) {
       const glm::vec3 o = rt::offset_ray_origin(s.position, s.geometric_normal, scene.offset_scale());
       const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);

@@ -62,11 +62,17 @@ struct PendingProbeRay {
   glm::vec3 to_probe{0.0f};         // -dir
 };
 
+// Which lobes of the hit's BRDF reflect its next-event sample: all of them
+// (the probes), or the diffuse lobe only (the near field, whose few rays a
+// frame, spread by its filter, made a sun glint on a metal a bright box).
+enum class HitLobes { All, Diffuse };
+
 // Everything up to the shadow ray: the surface, its emission, and one
 // next-event-estimation sample (MIS-free: delta and area lights alike are
 // sampled, never hit). `traced` null: the ray escaped.
 PendingProbeRay begin_probe_ray(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
-                                const glm::vec3& dir, const engine::rt::Hit* traced, engine::math::Pcg32& rng);
+                                const glm::vec3& dir, const engine::rt::Hit* traced, engine::math::Pcg32& rng,
+                                HitLobes lobes = HitLobes::All);
 
 // The rest, given whether the shadow ray was blocked: the sample's light if
 // not, plus the diffuse albedo / pi times `feedback(position, normal,
@@ -92,8 +98,9 @@ ProbeRayHit finish_probe_ray(const PendingProbeRay& p, bool blocked, Feedback&& 
 // light is added at the pixel; what they saw is in `emitted`.
 template <class Feedback>
 ProbeRayHit shade_probe_ray(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, const glm::vec3& dir,
-                            const engine::rt::Hit* traced, engine::math::Pcg32& rng, Feedback&& feedback) {
-  const PendingProbeRay p = begin_probe_ray(scene, lights, dir, traced, rng);
+                            const engine::rt::Hit* traced, engine::math::Pcg32& rng, Feedback&& feedback,
+                            HitLobes lobes = HitLobes::All) {
+  const PendingProbeRay p = begin_probe_ray(scene, lights, dir, traced, rng, lobes);
   const bool blocked = p.needs_shadow && scene.occluded(p.shadow);
   return finish_probe_ray(p, blocked, std::forward<Feedback>(feedback));
 }

@@ -42,7 +42,10 @@ glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::
     rt::Hit hit;
     if (!scene.intersect(rt::Ray{origin, dir, 0.0f, reach}, hit)) continue;
     if (skip_self && hit.entity == s.entity) continue;
-    const probes::ProbeRayHit h = probes::shade_probe_ray(scene, light_set, dir, &hit, rng, feedback);
+    // The hit's diffuse lobe only: the near field carries contact light, and
+    // a glint (the sun in a metal) met by one ray would be spread into a
+    // bright box by the filter; the probes keep what the glossy lobes reflect.
+    const probes::ProbeRayHit h = probes::shade_probe_ray(scene, light_set, dir, &hit, rng, feedback, probes::HitLobes::Diffuse);
     if (!probes_sh) {
       light_at(s.position, s.normal_world, own_sh);
       probes_sh = own_sh;
