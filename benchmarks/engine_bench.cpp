@@ -4,10 +4,13 @@
 //   BM_Schedule50Empty_*  vs BM_Baseline_50FunctionCalls (50 std::function calls)
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <functional>
 #include <vector>
 
 #include "engine/jobs/job_system.h"
+#include "engine/math/distribution.h"
+#include "engine/math/rng.h"
 #include "engine/schedule/schedule.h"
 
 using namespace engine::schedule;
@@ -136,7 +139,41 @@ void BM_Schedule50Empty_Serial(benchmark::State& state) {
 
 }  // namespace
 
+// Sampling an environment-sized distribution (2048 x 1024, the Living
+// Room's sky) with random u: the guided search of Distribution1D against a
+// binary search over each whole CDF (the baseline, as it was before the guide
+// table), same tables, same u.
+const engine::math::Distribution2D& sky_distribution() {
+  static const engine::math::Distribution2D d = [] {
+    std::vector<float> f(2048 * 1024);
+    engine::math::Pcg32 rng(5, 6);
+    for (float& v : f) v = rng.next_float() * rng.next_float();
+    return engine::math::Distribution2D(f, 2048, 1024);
+  }();
+  return d;
+}
+std::size_t full_search(const engine::math::Distribution1D& d, float u) {
+  const std::vector<double>& cdf = d.cdf();
+  const auto it = std::upper_bound(cdf.begin(), cdf.end(), static_cast<double>(u));
+  return std::min(d.size() - 1, static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (it - cdf.begin()) - 1)));
+}
+void BM_Baseline_SkySampleFullBinarySearch(benchmark::State& state) {
+  const auto& d = sky_distribution();
+  engine::math::Pcg32 rng(7, 8);
+  for (auto _ : state) {
+    const std::size_t row = full_search(d.marginal(), rng.next_float());
+    benchmark::DoNotOptimize(full_search(d.rows()[row], rng.next_float()));
+  }
+}
+void BM_SkySampleGuided(benchmark::State& state) {
+  const auto& d = sky_distribution();
+  engine::math::Pcg32 rng(7, 8);
+  for (auto _ : state) benchmark::DoNotOptimize(d.sample({rng.next_float(), rng.next_float()}, nullptr));
+}
+
 BENCHMARK(BM_Baseline_PlainVectorIterate)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Baseline_SkySampleFullBinarySearch)->Unit(benchmark::kNanosecond);
+BENCHMARK(BM_SkySampleGuided)->Unit(benchmark::kNanosecond);
 BENCHMARK(BM_ViewIterate_WritePos_ReadVel)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ViewIterate_ReadOnly)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ViewIterate_ParallelWrite)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);

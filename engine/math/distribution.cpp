@@ -16,12 +16,36 @@ Distribution1D::Distribution1D(std::span<const float> f) : func_(f.begin(), f.en
   } else {
     for (std::size_t i = 0; i <= n; ++i) cdf_[i] /= integral_;
   }
+  if (n == 0) return;
+  // G + 1 thresholds k / G, k = 0..G, about one per 8 bins.
+  const std::size_t g = std::max<std::size_t>(1, (n + 7) / 8);
+  guide_.resize(g + 1);
+  std::size_t i = 0;
+  for (std::size_t k = 0; k <= g; ++k) {
+    const double t = guide_threshold(k);
+    while (i < n && cdf_[i + 1] <= t) ++i;
+    guide_[k] = static_cast<std::uint32_t>(i);
+  }
 }
 
 float Distribution1D::sample_continuous(float u, float* pdf, std::size_t* index) const {
   const std::size_t n = func_.size();
-  // Largest i with cdf[i] <= u.
-  const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), static_cast<double>(u));
+  if (guide_.empty()) {  // no bins: nothing to sample
+    if (index) *index = 0;
+    if (pdf) *pdf = 0.0f;
+    return 0.0f;
+  }
+  // Largest i with cdf[i] <= u, searched between the guide entries of the
+  // thresholds either side of u: cdf[guide_[k]] <= k / G <= u < (k + 1) / G
+  // < cdf[guide_[k + 1] + 1], so the first entry past u lies in the bracket.
+  const double ud = static_cast<double>(u);
+  const std::size_t g = guide_.size() - 1;
+  const double scaled = ud * static_cast<double>(g);
+  std::size_t k = scaled >= 0.0 ? static_cast<std::size_t>(std::min(scaled, static_cast<double>(g - 1))) : 0;
+  while (k > 0 && guide_threshold(k) > ud) --k;  // the product's rounding, either way
+  while (k + 1 < g && guide_threshold(k + 1) <= ud) ++k;
+  const std::size_t lo = guide_[k], hi = std::min<std::size_t>(static_cast<std::size_t>(guide_[k + 1]) + 2, cdf_.size());
+  const auto it = std::upper_bound(cdf_.begin() + static_cast<std::ptrdiff_t>(lo), cdf_.begin() + static_cast<std::ptrdiff_t>(hi), ud);
   std::size_t i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (it - cdf_.begin()) - 1));
   i = std::min(i, n - 1);
   if (index) *index = i;

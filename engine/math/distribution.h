@@ -2,6 +2,7 @@
 // Piecewise-constant 1D and 2D distributions (pbrt-v4 style) for importance
 // sampling tabulated functions such as environment maps.
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -29,6 +30,14 @@ class Distribution1D {
   std::vector<float> func_;
   std::vector<double> cdf_;
   double integral_ = 0;
+  // A guide table (the cutpoint method): guide_[k] is the largest i with
+  // cdf[i] <= k / G, so a sample's search starts in a bracket of about 8
+  // entries instead of over the whole table (a 2048-wide environment row
+  // was a dozen cache misses a sample). The same index as the full search.
+  std::vector<std::uint32_t> guide_;
+  [[nodiscard]] double guide_threshold(std::size_t k) const {
+    return static_cast<double>(k) / static_cast<double>(guide_.size() - 1);
+  }
 };
 
 class Distribution2D {

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "engine/math/distribution.h"
@@ -29,6 +31,45 @@ TEST(Distribution1D, SamplesFollowTheFunction) {
   EXPECT_NEAR(counts[0] / double(n), 1.0 / 8, 0.005);
   EXPECT_NEAR(counts[2] / double(n), 3.0 / 8, 0.005);
   EXPECT_NEAR(counts[3] / double(n), 4.0 / 8, 0.005);
+}
+
+// The guide table only narrows the search: every u must land on the bin a
+// binary search over the whole CDF finds (the largest i with cdf[i] <= u),
+// with the same offset, for tables with runs of zero bins, one bin, sizes
+// either side of a multiple of the guide's 8 bins, and u on and beside the
+// guide's thresholds k / G and the CDF's own entries.
+TEST(Distribution1D, TheGuidedSearchFindsTheBinOfAFullBinarySearch) {
+  Pcg32 rng(3, 4);
+  for (const std::size_t n : {std::size_t{1}, std::size_t{2}, std::size_t{7}, std::size_t{8}, std::size_t{9},
+                              std::size_t{1000}, std::size_t{2048}}) {
+    std::vector<float> f(n);
+    for (std::size_t i = 0; i < n; ++i) f[i] = (i % 5 == 1 || (i > n / 3 && i < n / 2)) ? 0.0f : rng.next_float() * 10.0f;
+    const Distribution1D d(f);
+    const std::vector<double>& cdf = d.cdf();
+    std::vector<float> us;
+    for (int k = 0; k < 4000; ++k) us.push_back(rng.next_float());
+    const std::size_t g = std::max<std::size_t>(1, (n + 7) / 8);
+    for (std::size_t k = 0; k <= g; ++k) {
+      const float t = static_cast<float>(static_cast<double>(k) / static_cast<double>(g));
+      for (const float v : {t, std::nextafter(t, 0.0f), std::nextafter(t, 1.0f)}) us.push_back(v);
+    }
+    for (const double c : cdf) {
+      const float v = static_cast<float>(c);
+      for (const float w : {v, std::nextafter(v, 0.0f), std::nextafter(v, 1.0f)}) us.push_back(w);
+    }
+    for (float u : us) {
+      u = std::clamp(u, 0.0f, 1.0f - 0x1p-24f);
+      const auto it = std::upper_bound(cdf.begin(), cdf.end(), static_cast<double>(u));
+      const std::size_t want = std::min(n - 1, static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (it - cdf.begin()) - 1)));
+      std::size_t got = 0;
+      float pdf = 0;
+      const float x = d.sample_continuous(u, &pdf, &got);
+      ASSERT_EQ(got, want) << "n " << n << ", u " << u;
+      double du = static_cast<double>(u) - cdf[want];
+      if (cdf[want + 1] > cdf[want]) du /= cdf[want + 1] - cdf[want];
+      ASSERT_EQ(x, std::min(static_cast<float>((static_cast<double>(want) + du) / static_cast<double>(n)), 1.0f - 0x1p-24f));
+    }
+  }
 }
 
 TEST(Distribution2D, PdfIntegratesToOneAndMatchesSampling) {
