@@ -393,7 +393,7 @@ engine::image::ImageRGB DirectTileShader::take(const GBuffer& g, RealtimeDirectS
     const std::span<float> lit(lit_storage.get(), pixels);
     penumbra_filter(g, std::span<const float>(soft.blocker.get(), pixels), soft.tan_radius, camera_.pixel_spread(), lit);
     std::atomic<std::size_t> bad{0};
-    engine::jobs::parallel_for<std::size_t>(0, lit.size(), 16384, [&](std::size_t b, std::size_t e) {
+    engine::jobs::parallel_for<std::size_t>(0, lit.size(), 2048, [&](std::size_t b, std::size_t e) {
       std::size_t local_bad = 0;
       for (std::size_t p = b; p < e; ++p) {
         // The BRDF along the disk's centre, only where some of it arrives:
