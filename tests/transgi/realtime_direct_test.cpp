@@ -70,19 +70,36 @@ TEST(RealtimeDirect, FullImageIsIdenticalAcrossSeedsAndThreadCounts) {
   EXPECT_GT(mean, 0.0) << "the image must not be trivially black";
 }
 
+namespace {
+
+// The sunlit level two frames in, at a size whose 4x4 tiles both image
+// edges cut, and what shading one of its frames reads.
+struct CutTiles {
+  static constexpr int w = 37, h = 29;
+  SunLevel level{small_realtime(0, 1), 2};
+  CutTiles() { level.run(2, w, h); }
+  ecs::World& world() { return level.app.world(); }
+  const render::SceneLights& lights() { return world().resource<render::SceneLights>(); }
+  const rt::RtScene& rt() { return world().resource<rt::RtScene>(); }
+  const scene::SceneAssets& assets() { return world().resource<scene::SceneAssets>(); }
+  render::CameraRays rays() {
+    return render::CameraRays(world().get<scene::Camera>(level.camera), world().get<transform::WorldTransform>(level.camera), w, h);
+  }
+};
+
+}  // namespace
+
 TEST(RealtimeDirect, ShadedInsideTheGBufferLoopEqualsTheStandalonePass) {
-  SunLevel level(small_realtime(0, 1), 2);
-  const int w = 37, h = 29;  // tiles cut by both edges
-  level.run(2, w, h);
-  auto& world = level.app.world();
-  const auto& lights = world.resource<render::SceneLights>();
-  const auto& rt = world.resource<rt::RtScene>();
-  const auto& assets = world.resource<scene::SceneAssets>();
-  const render::CameraRays rays(world.get<scene::Camera>(level.camera), world.get<transform::WorldTransform>(level.camera), w, h);
+  CutTiles scene;
+  const int w = CutTiles::w, h = CutTiles::h;
+  const auto& lights = scene.lights();
+  const auto& rt = scene.rt();
+  const auto& assets = scene.assets();
+  const render::CameraRays rays = scene.rays();
   shading::GBuffer separate, fused;
   shading::RealtimeDirectStats separate_stats, fused_stats;
   image::ImageRGB want, got;
-  level.app.jobs().run([&] {
+  scene.level.app.jobs().run([&] {
     shading::trace_gbuffer(rt, assets, rays, w, h, separate);
     want = shading::shade_direct_realtime(separate, rt, lights.set, rays, &separate_stats);
     shading::DirectTileShader shader(rt, lights.set, rays, w, h);
@@ -103,18 +120,16 @@ TEST(RealtimeDirect, RecycledStorageFullOfGarbageGivesTheSameImage) {
   // sky, then the lights added). Garbage (NaN, huge values) in the recycled
   // image must not reach the result. (The soft sun's visibility is fresh
   // storage each frame, so garbage cannot be planted there from here.)
-  SunLevel level(small_realtime(0, 1), 2);
-  const int w = 37, h = 29;  // tiles cut by both edges
-  level.run(2, w, h);
-  auto& world = level.app.world();
-  const auto& lights = world.resource<render::SceneLights>();
+  CutTiles scene;
+  const int w = CutTiles::w, h = CutTiles::h;
+  const auto& lights = scene.lights();
   ASSERT_GE(lights.set.split_sun_index(), 0) << "the scene must have a sun whose light is added to the tiles' pixels";
-  const auto& rt = world.resource<rt::RtScene>();
-  const auto& assets = world.resource<scene::SceneAssets>();
-  const render::CameraRays rays(world.get<scene::Camera>(level.camera), world.get<transform::WorldTransform>(level.camera), w, h);
+  const auto& rt = scene.rt();
+  const auto& assets = scene.assets();
+  const render::CameraRays rays = scene.rays();
   shading::GBuffer g;
   image::ImageRGB fresh, recycled;
-  level.app.jobs().run([&] {
+  scene.level.app.jobs().run([&] {
     shading::DirectTileShader clean(rt, lights.set, rays, w, h);
     shading::trace_gbuffer(rt, assets, rays, w, h, g, &clean);
     fresh = clean.take(g);
