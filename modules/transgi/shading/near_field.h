@@ -38,13 +38,13 @@ struct NearFieldRays {
   // depth and normal similarity (filter_near_field). Higher = less noise, at
   // the cost of contact light smeared along a surface. 0 = unfiltered.
   int filter_radius = 4;
-  // Real-time path: at most this many cells trace rays a frame (0 = no
-  // limit). Rays leave every other cell of a row; past the budget, of one row
-  // in k, the smallest k that fits, and the filter spreads their estimate
-  // over the rows between, so the cost stays put as the resolution grows (k
-  // is at most the filter's 2 filter_radius + 1 rows, past which it would
-  // leave cells with no estimate in reach: the budget yields). Higher = less
-  // noisy contact light at high resolutions, at the cost of ray time.
+  // Real-time path: about this many cells trace rays a frame (0 = every
+  // other cell). They form a lattice, one cell in cols_k of one row in
+  // rows_k, shifted every frame, and the filter spreads their estimates over
+  // the cells between, so the cost stays put as the resolution grows; neither
+  // step is wider than the filter's window (2 filter_radius + 1 cells), past
+  // which cells would have no estimate in reach: there the budget yields.
+  // Higher = less noisy contact light, at the cost of ray time.
   int cell_budget = 0;
   bool operator==(const NearFieldRays&) const = default;
 };
