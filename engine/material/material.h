@@ -1,6 +1,7 @@
 #pragma once
 // glTF 2.0 metallic-roughness material, with KHR_materials_emissive_strength
 // and KHR_materials_specular (factor and colour).
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -36,6 +37,18 @@ struct Material {
   // Whether any texture is read; if not, a texture footprint changes nothing.
   [[nodiscard]] bool is_textured() const {
     return base_color_texture != kNoTexture || metallic_roughness_texture != kNoTexture || emissive_texture != kNoTexture;
+  }
+  // Whether its colour is a texture or a hue rather than a grey: the surfaces
+  // where GI must keep a texture's detail and colour (issue 37's colour
+  // measure). A hue: the base colour's chromaticity rgb / (r + g + b) lies
+  // more than 0.1 (L1) from grey's (1/3, 1/3, 1/3); a cream wall (0.8, 0.75,
+  // 0.6) is just past it (0.109), an orange desk (0.6, 0.3, 0.1) far past it (0.53).
+  [[nodiscard]] bool is_textured_or_coloured() const {
+    if (base_color_texture != kNoTexture) return true;
+    const float sum = base_color_factor.r + base_color_factor.g + base_color_factor.b;
+    if (!(sum > 0)) return false;
+    const glm::vec3 c = glm::vec3(base_color_factor) / sum;
+    return std::abs(c.r - 1.0f / 3) + std::abs(c.g - 1.0f / 3) + std::abs(c.b - 1.0f / 3) > 0.1f;
   }
 };
 

@@ -20,6 +20,8 @@ const char* pass_name(Pass p) {
   switch (p) {
     case Pass::Direct: return "direct";
     case Pass::Gi: return "gi";
+    case Pass::Albedo: return "albedo";
+    case Pass::Textured: return "textured";
     default: return "full";
   }
 }
@@ -35,6 +37,8 @@ PathTracer::PathTracer(const rt::RtScene& scene, const LightSet& lights, CameraR
       sum_full_(static_cast<std::size_t>(width) * height, glm::dvec3(0.0)),
       sum_direct_(sum_full_.size(), glm::dvec3(0.0)),
       sum_gi_(sum_full_.size(), glm::dvec3(0.0)),
+      sum_albedo_(sum_full_.size(), glm::dvec3(0.0)),
+      sum_textured_(sum_full_.size(), 0.0),
       sum_sq_full_(sum_full_.size(), 0.0),
       sum_sq_direct_(sum_full_.size(), 0.0),
       sum_sq_gi_(sum_full_.size(), 0.0),
@@ -66,6 +70,10 @@ PathRadiance PathTracer::trace(rt::Ray ray, math::Pcg32& rng) const {
       break;
     }
     const Surface s = make_surface(scene_, hit, ray.direction);
+    if (depth == 0) {
+      L.albedo = s.brdf.base_color;
+      L.textured = scene_.assets()->materials[s.material].is_textured_or_coloured() ? 1.0f : 0.0f;
+    }
     if (!black(s.emission)) {
       float w = 1.0f;
       if (depth > 0) {
@@ -138,6 +146,8 @@ void PathTracer::add_samples(int n, const std::vector<std::uint8_t>& want) {
           sum_full_[pixel] += glm::dvec3(L.full);
           sum_direct_[pixel] += glm::dvec3(L.direct);
           sum_gi_[pixel] += glm::dvec3(L.gi);
+          sum_albedo_[pixel] += glm::dvec3(L.albedo);
+          sum_textured_[pixel] += L.textured;
           const double lf = math::luminance(L.full), ld = math::luminance(L.direct), lg = math::luminance(L.gi);
           sum_sq_full_[pixel] += lf * lf;
           sum_sq_direct_[pixel] += ld * ld;
@@ -199,7 +209,13 @@ double PathTracer::mean_samples_per_pixel() const {
 }
 
 image::ImageRGB PathTracer::image(Pass pass) const {
-  const auto& sums = pass == Pass::Direct ? sum_direct_ : pass == Pass::Gi ? sum_gi_ : sum_full_;
+  if (pass == Pass::Textured) {
+    image::ImageRGB out(width_, height_);
+    for (std::size_t i = 0; i < sum_textured_.size(); ++i)
+      out.pixels[i] = glm::vec3(count_[i] > 0 ? static_cast<float>(sum_textured_[i] / count_[i]) : 0.0f);
+    return out;
+  }
+  const auto& sums = pass == Pass::Direct ? sum_direct_ : pass == Pass::Gi ? sum_gi_ : pass == Pass::Albedo ? sum_albedo_ : sum_full_;
   image::ImageRGB out(width_, height_);
   for (std::size_t i = 0; i < sums.size(); ++i) out.pixels[i] = count_[i] > 0 ? glm::vec3(sums[i] / static_cast<double>(count_[i])) : glm::vec3(0.0f);
   return out;

@@ -7,7 +7,12 @@
 //   direct = light reaching the camera-visible point straight from an emitter
 //            (plus emitters and environment seen directly),
 //   gi     = everything else (light that bounced at least once more),
-//   full   = direct + gi (accumulated on its own, so a bucketing slip shows).
+//   full   = direct + gi (accumulated on its own, so a bucketing slip shows),
+// and an albedo pass: the base colour (texture included) of the first surface a
+// camera ray meets, black where it sees the background, antialiased by the same
+// pixel filter (Cycles' "diffuse colour"), and a textured pass: the fraction of
+// a pixel's camera rays whose first surface is textured or coloured
+// (Material::is_textured_or_coloured), where colour metrics are taken.
 //
 // Every sample's random numbers depend only on (seed, pixel, sample index),
 // so images are identical for any thread count and any progressive batch size.
@@ -36,7 +41,7 @@ struct PathTracerSettings {
   int batch_spp = 4;
 };
 
-enum class Pass { Full, Direct, Gi };
+enum class Pass { Full, Direct, Gi, Albedo, Textured };
 
 // Adaptive sampling (as production renderers do): after `min_spp`, rounds of
 // `round_spp` more samples go only to the pixels whose estimated relative
@@ -57,6 +62,8 @@ struct AdaptiveSampling {
 
 struct PathRadiance {
   glm::vec3 full{0.0f}, direct{0.0f}, gi{0.0f};
+  glm::vec3 albedo{0.0f};  // the first surface's base colour
+  float textured = 0.0f;   // 1: the first surface is textured or coloured
 };
 
 struct PathTracerStats {
@@ -101,7 +108,8 @@ class PathTracer {
   // Adds samples [count_[p], count_[p] + n) to each pixel p with want[p] (all if empty).
   void add_samples(int n, const std::vector<std::uint8_t>& want);
 
-  std::vector<glm::dvec3> sum_full_, sum_direct_, sum_gi_;
+  std::vector<glm::dvec3> sum_full_, sum_direct_, sum_gi_, sum_albedo_;
+  std::vector<double> sum_textured_;
   std::vector<double> sum_sq_full_, sum_sq_direct_, sum_sq_gi_;  // of luminance, for adaptive sampling
   std::vector<std::uint32_t> count_;                              // samples per pixel
   int spp_ = 0;

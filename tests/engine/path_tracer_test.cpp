@@ -108,6 +108,49 @@ TEST(PathTracer, DiffuseSphereUnderUniformSkyHasRadianceAlbedoTimesSky) {
   EXPECT_NEAR(mean_luminance(full, 0, 0, 3, 3), sky, 1e-5) << "corner pixels see the sky directly";
 }
 
+TEST(PathTracer, AlbedoAndTexturedPassesShowTheFirstSurface) {
+  // An orange sphere and a grey one before the sky: the albedo pass is the
+  // base colour where the camera sees a sphere and black on the sky; the
+  // textured pass is 1 on the coloured sphere (its chromaticity lies 0.53
+  // from grey's) and 0 on the grey one and the sky. Antialiased like the
+  // other passes: the silhouette's pixels hold fractions.
+  const glm::vec3 orange(0.6f, 0.3f, 0.1f);
+  for (const glm::vec3 colour : {orange, glm::vec3(0.5f)}) {
+    Scene s({scene::make_uv_sphere(1.0f, 64, 32)}, {lambert(colour)}, {0, 0, 6}, glm::quat(1, 0, 0, 0),
+            scene::uniform_environment(glm::vec3(1.0f)));
+    s.app.update();
+    auto& world = s.app.world();
+    const auto& rt_scene = world.resource<rt::RtScene>();
+    const LightSet lights(rt_scene, gather_punctual_lights(world), &*world.resource<scene::SceneAssets>().environment);
+    const CameraRays cam(world.get<scene::Camera>(s.camera), world.get<transform::WorldTransform>(s.camera), 32, 32);
+    PathTracer pt(rt_scene, lights, cam, 32, 32, PathTracerSettings{.max_depth = 0, .seed = 3});
+    jobs::JobSystem jobs({.threads = 2});
+    jobs.run([&] { pt.render(16); });
+    const image::ImageRGB albedo = pt.image(Pass::Albedo), textured = pt.image(Pass::Textured);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(albedo.at(16, 16)[c], colour[c], 1e-6f);
+    EXPECT_EQ(albedo.at(0, 0), glm::vec3(0.0f)) << "the sky has no albedo";
+    EXPECT_EQ(textured.at(16, 16).r, colour == orange ? 1.0f : 0.0f);
+    EXPECT_EQ(textured.at(0, 0).r, 0.0f);
+    bool fraction = false;
+    for (int x = 16; x < 32; ++x) fraction |= albedo.at(x, 16).g > 0.01f && albedo.at(x, 16).g < 0.99f * colour.g;
+    EXPECT_TRUE(fraction) << "the silhouette is antialiased";
+  }
+}
+
+TEST(Material, TexturedOrColouredIsATextureOrAHueNotAGrey) {
+  material::Material m;
+  m.base_color_factor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
+  EXPECT_FALSE(m.is_textured_or_coloured());
+  m.base_color_factor = glm::vec4(0.8f, 0.75f, 0.6f, 1.0f);  // cream: 0.109 from grey
+  EXPECT_TRUE(m.is_textured_or_coloured());
+  m.base_color_factor = glm::vec4(0.8f, 0.78f, 0.7f, 1.0f);  // off-white: 0.053
+  EXPECT_FALSE(m.is_textured_or_coloured());
+  m.base_color_factor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  EXPECT_FALSE(m.is_textured_or_coloured()) << "black has no hue";
+  m.base_color_texture = 0;
+  EXPECT_TRUE(m.is_textured_or_coloured());
+}
+
 TEST(PathTracer, FurnaceWithGiConvergesToEmissionOverOneMinusAlbedo) {
   // Inside a closed room whose walls all emit Le and reflect with albedo a,
   // L = Le + a L, so L = Le / (1 - a); direct = Le (1 + a) (the emitter seen

@@ -46,18 +46,32 @@ struct Outputs {
   std::string pass;
 };
 
-void write_passes(const Outputs& o, const image::ImageRGB& full, const image::ImageRGB& direct, const image::ImageRGB& gi) {
-  const image::ImageRGB& main = o.pass == "gi" ? gi : o.pass == "direct" ? direct : full;
+// The path tracer's surface passes (the real-time methods have none): the
+// albedo (--pass albedo, and with --pass all) and where the surfaces are
+// textured or coloured (with --pass all: compare --colour-mask takes it).
+struct SurfacePasses {
+  image::ImageRGB albedo, textured;
+};
+
+void write_passes(const Outputs& o, const image::ImageRGB& full, const image::ImageRGB& direct, const image::ImageRGB& gi,
+                  const SurfacePasses* surfaces = nullptr) {
+  const image::ImageRGB* albedo = surfaces ? &surfaces->albedo : nullptr;
+  const image::ImageRGB& main = o.pass == "gi" ? gi : o.pass == "direct" ? direct : o.pass == "albedo" ? *albedo : full;
   image::write_exr(o.out, main);
   if (o.pass == "all") {
     image::write_exr(sibling(o.out, "_direct"), direct);
     image::write_exr(sibling(o.out, "_gi"), gi);
+    if (surfaces) {
+      image::write_exr(sibling(o.out, "_albedo"), surfaces->albedo);
+      image::write_exr(sibling(o.out, "_textured"), surfaces->textured);
+    }
   }
   if (o.png.empty()) return;
   image::write_png_srgb(o.png, main, static_cast<float>(o.exposure));
   if (o.pass == "all") {
     image::write_png_srgb(sibling(o.png, "_direct"), direct, static_cast<float>(o.exposure));
     image::write_png_srgb(sibling(o.png, "_gi"), gi, static_cast<float>(o.exposure));
+    if (albedo) image::write_png_srgb(sibling(o.png, "_albedo"), *albedo, static_cast<float>(o.exposure));
   }
 }
 
@@ -186,14 +200,17 @@ int render_reference(const Args& args, eval::LoadedScene& scene, int width, int 
   if (lights.empty()) std::fprintf(stderr, "warning: the scene has no lights; the image will be black\n");
   const engine::render::CameraRays camera(world.get<scene::Camera>(scene.camera), world.get<transform::WorldTransform>(scene.camera),
                                           width, height);
-  engine::render::PathTracer tracer(rt_scene, lights, camera, width, height, engine::render::PathTracerSettings{.seed = seed});
+  // The albedo alone needs only the first hit.
+  engine::render::PathTracer tracer(rt_scene, lights, camera, width, height,
+                                    engine::render::PathTracerSettings{.max_depth = o.pass == "albedo" ? 0 : 64, .seed = seed});
   std::fprintf(stderr, "%zu emissive triangles, %zu punctual lights, environment %s\n", lights.emissive_triangle_count(),
                lights.punctual_count(), lights.environment() ? "yes" : "no");
   core::ProgressBar bar("render " + std::to_string(width) + "x" + std::to_string(height) + " " + o.pass, static_cast<std::uint64_t>(spp));
   scene.app->jobs().run([&] { tracer.render(spp, [&](int done, int) { bar.update(static_cast<std::uint64_t>(done)); }); });
   bar.finish();
+  const SurfacePasses surfaces{tracer.image(engine::render::Pass::Albedo), tracer.image(engine::render::Pass::Textured)};
   write_passes(o, tracer.image(engine::render::Pass::Full), tracer.image(engine::render::Pass::Direct),
-               tracer.image(engine::render::Pass::Gi));
+               tracer.image(engine::render::Pass::Gi), &surfaces);
   const double seconds = tracer.stats().seconds;
   std::printf("rendered %s (reference, %s pass) %dx%d at %d spp in %.2f s (%.2f Mpaths/s, %d threads)%s\n", o.out.c_str(),
               o.pass.c_str(), width, height, spp, seconds, static_cast<double>(tracer.stats().samples) / seconds * 1e-6,
@@ -211,7 +228,7 @@ int run_render(const std::vector<std::string>& argv) {
   const std::string scene_path = args.str("scene");
   const std::string method = args.choice("method", {"reference", "transgi", "ddgi"}, "reference");
   Outputs o;
-  o.pass = args.choice("pass", {"full", "direct", "gi", "all"}, "full");
+  o.pass = args.choice("pass", {"full", "direct", "gi", "albedo", "all"}, "full");
   o.out = args.str("out");
   o.png = args.str("png", std::string());
   o.exposure = args.number("exposure", -30, 30, 0.0);
@@ -220,6 +237,7 @@ int run_render(const std::vector<std::string>& argv) {
   const int threads = static_cast<int>(args.integer("threads", 0, 1024, 0));
   eval::LoadedScene scene = eval::load_scene(scene_path, args.str("camera", std::string()), threads);
   apply_sun_options(args, scene);
+  if (o.pass == "albedo" && method != "reference") throw std::runtime_error("--pass albedo: only --method reference writes an albedo pass");
   if (method == "transgi") return render_transgi(args, scene, width, height, o);
   if (method == "ddgi") return render_ddgi(args, scene, width, height, o);
   return render_reference(args, scene, width, height, o);
