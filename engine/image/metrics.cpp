@@ -100,29 +100,52 @@ double rmse_clamped_in(const ImageRGB& a, const ImageRGB& b, const std::vector<s
   return n ? std::sqrt(sum / (3.0 * static_cast<double>(n))) : 0.0;
 }
 
-ColourMetrics compare_colour(const ImageRGB& a, const ImageRGB& b) {
+ColourMetrics compare_colour(const ImageRGB& a, const ImageRGB& b, const ImageRGB* surface_mask, const ImageRGB* albedo) {
   check_sizes(a, b);
+  if (surface_mask) check_sizes(a, *surface_mask);
+  if (albedo) check_sizes(a, *albedo);
   const int w = a.width, h = a.height;
   const auto at = [w](int x, int y) { return static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x); };
+  const auto on_surfaces = [&](int x, int y) {
+    if (!surface_mask) return true;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int xx = std::clamp(x + dx, 0, w - 1), yy = std::clamp(y + dy, 0, h - 1);
+        const glm::vec3 m = surface_mask->pixels[at(xx, yy)];
+        if (!((m.r + m.g + m.b) / 3 >= 0.99f)) return false;
+      }
+    return true;
+  };
   double mean_b = 0;
   for (const glm::vec3& p : b.pixels) mean_b += math::luminance(p);
   mean_b /= static_cast<double>(std::max<std::size_t>(1, b.size()));
-  const auto detail = [&](const ImageRGB& img, int x, int y) {
+  const auto signed_detail = [&](const ImageRGB& img, int x, int y) {
     const double local = box3_luminance(img, x, y);
-    return local > 0 ? std::abs(math::luminance(img.pixels[at(x, y)]) - local) / local : 0.0;
+    return local > 0 ? (math::luminance(img.pixels[at(x, y)]) - local) / local : 0.0;
   };
+  const auto detail = [&](const ImageRGB& img, int x, int y) { return std::abs(signed_detail(img, x, y)); };
+  double a_with_albedo = 0, b_with_albedo = 0, b_squared = 0, albedo_squared = 0;
   ColourMetrics m;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const glm::vec3 pa = glm::max(a.pixels[at(x, y)], glm::vec3(0.0f)), pb = glm::max(b.pixels[at(x, y)], glm::vec3(0.0f));
-      if (!(math::luminance(pb) > 0.05 * mean_b)) continue;
+      if (!(math::luminance(pb) > 0.05 * mean_b) || !on_surfaces(x, y)) continue;
       const float sa = pa.r + pa.g + pa.b, sb = pb.r + pb.g + pb.b;
       const glm::vec3 ca = sa > 0 ? pa / sa : glm::vec3(1.0f / 3), cb = pb / sb;
       m.chroma_error += std::abs(ca.r - cb.r) + std::abs(ca.g - cb.g) + std::abs(ca.b - cb.b);
       m.detail_a += detail(a, x, y);
       m.detail_b += detail(b, x, y);
+      if (albedo) {
+        const double dl = signed_detail(*albedo, x, y), db = signed_detail(b, x, y);
+        a_with_albedo += signed_detail(a, x, y) * dl;
+        b_with_albedo += db * dl;
+        b_squared += db * db;
+        albedo_squared += dl * dl;
+      }
       ++m.pixels;
     }
+  if (b_with_albedo != 0) m.texture_gain = a_with_albedo / b_with_albedo;
+  if (b_squared > 0 && albedo_squared > 0) m.texture_correlation = b_with_albedo / std::sqrt(b_squared * albedo_squared);
   if (m.pixels) {
     m.chroma_error /= static_cast<double>(m.pixels);
     m.detail_a /= static_cast<double>(m.pixels);

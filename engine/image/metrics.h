@@ -47,13 +47,26 @@ double rmse_clamped_in(const ImageRGB& a, const ImageRGB& b, const std::vector<s
 // (r + g + b) (a shift of hue, whatever the brightness); detail, the mean
 // of |Y - (3x3 box mean of Y)| / (3x3 box mean of Y), how much the image
 // varies from pixel to pixel relative to its local level (a texture's
-// contrast; a reference's noise adds to it).
+// contrast; a reference's noise adds to it). With a surface mask (the path
+// tracer's textured pass), only pixels whose 3x3 neighbourhood lies wholly
+// (mask >= 0.99) on textured or coloured surfaces count: their detail is
+// the texture's, not a silhouette's.
+//
+// With the surfaces' albedo (the path tracer's albedo pass), texture_gain:
+// how much of the albedo's own pattern A carries, relative to B:
+// sum d(A) d(L) / sum d(B) d(L), d the signed detail (Y - box3) / box3 and
+// L the albedo. B's noise is independent of the albedo, so it averages out of
+// both sums where it inflates `detail`; 1 = the texture's contrast exactly.
+// texture_correlation: the correlation of d(B) with d(L), how much of B's
+// detail is the texture (near 0, the gain is itself noise).
 struct ColourMetrics {
   double chroma_error = 0;
   double detail_a = 0, detail_b = 0;
+  double texture_gain = 0, texture_correlation = 0;
   std::size_t pixels = 0;
 };
-ColourMetrics compare_colour(const ImageRGB& a, const ImageRGB& b);
+ColourMetrics compare_colour(const ImageRGB& a, const ImageRGB& b, const ImageRGB* surface_mask = nullptr,
+                             const ImageRGB* albedo = nullptr);
 
 // The image averaged over n x n pixel blocks (the last row and column of
 // blocks over what they hold): compared at a scale where a path-traced

@@ -15,6 +15,7 @@
 #include "engine/image/exr.h"
 #include "engine/image/metrics.h"
 #include "engine/image/tonemap.h"
+#include "engine/math/rng.h"
 
 namespace fs = std::filesystem;
 using namespace engine::image;
@@ -315,6 +316,40 @@ TEST(Metrics, ColourMetricsMeasureHueShiftAndDetail) {
   // Orange c = (0.6, 0.3, 0.1), blue c = (0.1, 0.2, 0.7): |c - 1/3| sums 0.533 and 0.733.
   EXPECT_NEAR(grey.chroma_error, 0.5 * (0.5333333 + 0.7333333), 1e-5);
   EXPECT_DOUBLE_EQ(grey.detail_a, 0.0) << "flat grey has no detail";
+}
+
+TEST(Metrics, TextureGainSeesTheAlbedosContrastThroughTheReferencesNoise) {
+  // A 64 x 64 texture L (albedo 0.3-0.7, seeded), lit by 1: the reference B
+  // is L plus independent noise of 0.1, as a path tracer's; A carries the
+  // texture exactly, H at half its contrast around the mean. The gain must
+  // find 1 and about 0.5 (H's relative detail is half of L's only to first
+  // order: tolerance 0.05), where the noise-biased detail ratio says A has
+  // too little texture.
+  const int n = 64;
+  ImageRGB l(n, n), a(n, n), b(n, n), h(n, n), mask(n, n);
+  engine::math::Pcg32 rng = engine::math::make_rng(11, 0, 0);
+  double mean = 0;
+  for (auto& p : l.pixels) {
+    p = glm::vec3(0.3f + 0.4f * rng.next_float());
+    mean += p.g / (n * n);
+  }
+  for (std::size_t i = 0; i < l.size(); ++i) {
+    a.pixels[i] = l.pixels[i];
+    b.pixels[i] = l.pixels[i] + glm::vec3(0.2f * (rng.next_float() - 0.5f) * std::sqrt(3.0f));
+    h.pixels[i] = glm::vec3(static_cast<float>(mean)) + 0.5f * (l.pixels[i] - glm::vec3(static_cast<float>(mean)));
+    mask.pixels[i] = glm::vec3(i % n < n / 2 ? 1.0f : 0.0f);  // the left half is "textured"
+  }
+  const ColourMetrics exact = compare_colour(a, b, nullptr, &l), halved = compare_colour(h, b, nullptr, &l);
+  EXPECT_NEAR(exact.texture_gain, 1.0, 0.05);
+  EXPECT_NEAR(halved.texture_gain, 0.5, 0.05);
+  EXPECT_GT(exact.texture_correlation, 0.5);
+  EXPECT_LT(exact.detail_a / exact.detail_b, 0.9) << "the reference's noise inflates its detail, or this test shows nothing";
+  EXPECT_DOUBLE_EQ(compare_colour(b, b, nullptr, &l).texture_gain, 1.0);
+  // The mask: only pixels whose 3 x 3 neighbourhood lies in the left half
+  // (columns 0-30) count, all rows.
+  const ColourMetrics left = compare_colour(a, b, &mask, &l);
+  EXPECT_EQ(left.pixels, static_cast<std::size_t>(31 * n));
+  EXPECT_EQ(compare_colour(a, b).texture_gain, 0.0) << "no albedo, no gain";
 }
 
 TEST(Metrics, SpeckleFractionCountsIsolatedPixelsNotEdgesOrGradients) {

@@ -1,4 +1,5 @@
 #include <cstdio>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -17,7 +18,7 @@ void print_json(const nlohmann::ordered_json& j) { std::printf("%s\n", j.dump(-1
 }  // namespace
 
 int run_compare(const std::vector<std::string>& argv) {
-  const Args args("compare", argv, {"heatmap", "heatmap-max", "top-error", "edge-band-of", "band", "downsample"}, {"colour"});
+  const Args args("compare", argv, {"heatmap", "heatmap-max", "top-error", "edge-band-of", "band", "downsample", "colour-mask", "albedo"}, {"colour"});
   if (args.positional().size() != 2) throw UsageError("compare: expected two EXR files: A.exr B.exr (B is the reference)");
   // --downsample N: every metric over N x N block means of both images, where
   // a path-traced reference's per-pixel noise has averaged out.
@@ -53,14 +54,34 @@ int run_compare(const std::vector<std::string>& argv) {
   }
   if (args.has("colour")) {
     // Hue and texture against the reference (engine/image/metrics.h), a line of their own.
-    const auto c = engine::image::compare_colour(a, b);
-    print_json({{"chroma_error", c.chroma_error},
-                {"detail", c.detail_a},
-                {"detail_reference", c.detail_b},
-                {"detail_ratio", c.detail_b > 0 ? c.detail_a / c.detail_b : 0.0},
-                {"colour_pixels", c.pixels},
-                {"speckles", engine::image::speckle_fraction(a)},
-                {"speckles_reference", engine::image::speckle_fraction(b)}});
+    // --colour-mask M: only where M (the reference's textured pass) says the
+    // surfaces are textured or coloured, downsampled as the images are.
+    std::optional<engine::image::ImageRGB> mask;
+    if (args.has("colour-mask")) {
+      mask = read(args.str("colour-mask"));
+      if (mask->width != a.width || mask->height != a.height)
+        throw std::runtime_error("--colour-mask: " + args.str("colour-mask") + " is not the images' size");
+    }
+    // --albedo L: the texture's gain against the reference (metrics.h).
+    std::optional<engine::image::ImageRGB> albedo;
+    if (args.has("albedo")) {
+      albedo = read(args.str("albedo"));
+      if (albedo->width != a.width || albedo->height != a.height)
+        throw std::runtime_error("--albedo: " + args.str("albedo") + " is not the images' size");
+    }
+    const auto c = engine::image::compare_colour(a, b, mask ? &*mask : nullptr, albedo ? &*albedo : nullptr);
+    nlohmann::ordered_json colour{{"chroma_error", c.chroma_error},
+                                  {"detail", c.detail_a},
+                                  {"detail_reference", c.detail_b},
+                                  {"detail_ratio", c.detail_b > 0 ? c.detail_a / c.detail_b : 0.0},
+                                  {"colour_pixels", c.pixels},
+                                  {"speckles", engine::image::speckle_fraction(a)},
+                                  {"speckles_reference", engine::image::speckle_fraction(b)}};
+    if (albedo) {
+      colour["texture_gain"] = c.texture_gain;
+      colour["texture_correlation"] = c.texture_correlation;
+    }
+    print_json(colour);
   }
   nlohmann::ordered_json line{{"rmse", m.rmse}, {"l1", m.l1}, {"ssim", m.ssim}, {"relmse", m.relmse}, {"mean_ratio", m.mean_ratio}};
   if (args.has("top-error"))

@@ -13,7 +13,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: transgi <command> [options]\n"
     "  render   --scene S.gltf --out F.exr [--method reference|transgi|ddgi] [options]: transgi render --help\n"
-    "  compare  A.exr B.exr [--heatmap out.png] [--heatmap-max E] [--colour] [--edge-band-of R_direct.exr [--band PX]]\n"
+    "  compare  A.exr B.exr [--heatmap out.png] [--heatmap-max E] [--colour [--colour-mask R_textured.exr] [--albedo R_albedo.exr]] [--edge-band-of R_direct.exr [--band PX]]\n"
     "           [--top-error PERCENT] [--downsample N (every metric over N x N block means)]\n"
     "  tonemap  IN.exr OUT.png [--exposure EV] [--signed SCALE] [--minus B.exr]\n"
     "  bake     --scene S.gltf --out M.tgm [--points N] [--dirs D] [--outgoing K] [--iters I] [--batch B]\n"
