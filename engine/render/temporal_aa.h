@@ -62,6 +62,13 @@ struct TemporalAaSettings {
   // are blended a row at a time, vectorised. false = every pixel by the
   // per-pixel path: the reference the fast path is tested against.
   bool vectorised_rows = true;
+  // Textures are read this many mip levels finer than a pixel's footprint
+  // asks: the jitter cycle already averages each pixel's area, and the mip's
+  // own filter on top of it blurred textures (a grazing floor most, where
+  // the isotropic footprint is the long side). -1 leaves about the
+  // reference's 1.5-pixel filter (engines bias their mips under TAA the same
+  // way). Lower = sharper textures, at the cost of shimmer in motion.
+  float texture_lod_bias = -1.0f;
 };
 
 // What the resolve needs to know of each pixel's surface, this frame. The

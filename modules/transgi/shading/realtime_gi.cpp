@@ -259,7 +259,7 @@ GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::Sce
 
 void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                    const engine::render::CameraRays& camera, int width, int height, GBuffer& g, DirectTileShader* direct,
-                   engine::rt::RayBatchTracer* tracer, glm::vec2 jitter) {
+                   engine::rt::RayBatchTracer* tracer, glm::vec2 jitter, float texture_lod_bias) {
   g.width = width;
   g.jitter = jitter;
   g.height = height;
@@ -275,7 +275,8 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
   // their traversal.
   const int tiles_x = (width + 3) / 4, tiles_y = (height + 3) / 4;
   g.tile_dielectric_roughness.resize(static_cast<std::size_t>(tiles_x) * tiles_y);
-  const float spread = camera.pixel_spread();
+  // The cone that picks the textures' mip level (a level finer = half as wide).
+  const float spread = camera.pixel_spread() * std::exp2(texture_lod_bias);
   // A backend traces every camera ray in one batch, in the tiles' order.
   std::vector<engine::rt::Ray>& batch_rays = g.batch.rays;
   std::vector<engine::rt::Hit>& batch_hits = g.batch.hits;

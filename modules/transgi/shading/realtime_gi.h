@@ -120,10 +120,12 @@ GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::Sce
 // backend), every camera ray is traced by it in one batch first; Embree's
 // packets trace them where it declines. `jitter` moves every ray off the
 // pixel centre by that many pixels (temporal antialiasing, [-0.5, 0.5)).
+// Textures are read `texture_lod_bias` mip levels off the pixel's footprint
+// (TemporalAaSettings::texture_lod_bias under antialiasing, else 0).
 void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                    const engine::render::CameraRays& camera, int width, int height, GBuffer& g,
                    DirectTileShader* direct = nullptr, engine::rt::RayBatchTracer* tracer = nullptr,
-                   glm::vec2 jitter = glm::vec2(0.0f));
+                   glm::vec2 jitter = glm::vec2(0.0f), float texture_lod_bias = 0.0f);
 
 // Buffers the real-time path keeps from frame to frame: at 640x360 they are
 // tens of MB that would otherwise be faulted in and zeroed every frame.

@@ -149,7 +149,7 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
   // 1. G-buffer: one filtered primary ray per sample.
   auto t0 = Clock::now();
   std::vector<Sample> samples(n);
-  const float spread = s.texture_filtering ? camera.pixel_spread() : 0.0f;
+  const float spread = s.texture_filtering ? camera.pixel_spread() * std::exp2(s.texture_lod_bias) : 0.0f;
   jobs::parallel_for(0, height, 1, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < width; ++x)

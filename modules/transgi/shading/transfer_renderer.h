@@ -72,6 +72,12 @@ struct TransferRenderSettings {
   // Textures read at the mip level of each primary ray's cone (ray cones), as
   // rasterisers do. Off = point samples, which alias at one sample per pixel.
   bool texture_filtering = true;
+  // ... that many mip levels finer: a pixel's samples and the still view's
+  // temporal window already average its area under the pixel filter, and
+  // the mip's own filter on top of that blurred textures (as under TAA:
+  // TemporalAaSettings::texture_lod_bias). Lower = sharper, at the cost of
+  // aliasing where few samples average a pixel.
+  float texture_lod_bias = -1.0f;
   std::uint64_t seed = 0;
   // The G-buffer's sub-pixel positions: frame `frame_index`'s spp points of
   // one R2 sequence per pixel, shifted by a per-pixel offset drawn from
