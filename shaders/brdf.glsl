@@ -95,3 +95,24 @@ vec3 brdf_eval(Brdf p, vec3 wo, vec3 wi) {
 
 // material::diffuse_albedo.
 vec3 diffuse_albedo(Brdf p) { return p.base_color * (1.0 - p.metallic); }
+
+// material::directional_albedo: the whole BRDF's reflectance of light
+// arriving evenly, towards cos_o.
+vec3 directional_albedo(Brdf p, float cos_o) {
+  if (!(cos_o > 0.0)) return vec3(0.0);
+  const float alpha = alpha_of(p);
+  const vec2 e = ggx_albedo(cos_o, alpha);
+  vec3 dielectric = vec3(0.0), metal = vec3(0.0);
+  if (p.metallic < 1.0) {
+    const vec3 f0 = min(kDielectricF0 * p.specular_color, vec3(1.0));
+    const vec2 avg = ggx_average_albedo(alpha);
+    for (int k = 0; k < 3; ++k) {
+      const float spec = p.specular > 0.0 ? min(1.0, p.specular * (f0[k] * e.x + e.y)) : 0.0;
+      const float e_avg = p.specular > 0.0 ? min(1.0, p.specular * (f0[k] * avg.x + avg.y)) : 0.0;
+      dielectric[k] = (e_avg < 1.0 ? p.base_color[k] * (1.0 - spec) : 0.0) + spec;
+    }
+  }
+  if (p.metallic > 0.0)
+    for (int k = 0; k < 3; ++k) metal[k] = p.base_color[k] * e.x + e.y;
+  return (1.0 - p.metallic) * dielectric + p.metallic * metal;
+}

@@ -75,7 +75,8 @@ void main() {
   const vec3 wo = to_local(s.frame, -dir);
   if (!emitter && wo.z > 0.0) {
     o.flags |= kProbeRayTakesFeedback;
-    const vec3 albedo = diffuse_albedo(s.brdf) * kShadingInvPi;
+    // probe_rays.cpp's begin_probe_ray: the feedback is reflected by every lobe.
+    const vec3 albedo = directional_albedo(s.brdf, wo.z) * kShadingInvPi;
     o.ar = albedo.r;
     o.ag = albedo.g;
     o.ab = albedo.b;

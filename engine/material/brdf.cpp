@@ -103,6 +103,26 @@ glm::vec3 brdf_eval_diffuse(const BrdfParams& p, const glm::vec3& wo, const glm:
   return (1.0f - p.metallic) * diffuse_lobe(p, dielectric_f0(p), alpha_of(p), cos_o, cos_i);
 }
 
+glm::vec3 directional_albedo(const BrdfParams& p, float cos_o) {
+  if (!(cos_o > 0)) return glm::vec3(0.0f);
+  const float alpha = alpha_of(p);
+  const SpecularAlbedo e = ggx_albedo(cos_o, alpha);
+  glm::vec3 dielectric(0.0f), metal(0.0f);
+  if (p.metallic < 1.0f) {
+    // The diffuse lobe's coupling (1 - E_o)(1 - E_i) / (1 - E_avg) integrates
+    // over wi to 1 - E_o: what the specular layer does not reflect.
+    const glm::vec3 f0 = dielectric_f0(p);
+    for (int k = 0; k < 3; ++k) {
+      const float spec = p.specular > 0 ? std::min(1.0f, p.specular * e.with_f0(f0[k])) : 0.0f;
+      const float e_avg = p.specular > 0 ? std::min(1.0f, p.specular * ggx_average_albedo(alpha).with_f0(f0[k])) : 0.0f;
+      dielectric[k] = (e_avg < 1.0f ? p.base_color[k] * (1.0f - spec) : 0.0f) + spec;
+    }
+  }
+  if (p.metallic > 0.0f)
+    for (int k = 0; k < 3; ++k) metal[k] = e.with_f0(p.base_color[k]);
+  return (1.0f - p.metallic) * dielectric + p.metallic * metal;
+}
+
 glm::vec3 brdf_eval(const BrdfParams& p, const glm::vec3& wo, const glm::vec3& wi) {
   const float cos_o = wo.z, cos_i = wi.z;
   if (cos_o <= 0 || cos_i <= 0) return glm::vec3(0.0f);

@@ -51,6 +51,13 @@ struct BrdfSample {
 // What irradiance-only lighting can reflect: probe feedback bounces, DDGI, and
 // TransGI's fallback for objects without latents.
 inline glm::vec3 diffuse_albedo(const BrdfParams& p) { return p.base_color * (1.0f - p.metallic); }
+// The whole BRDF's directional albedo towards wo (cos_o = wo.z): the
+// fraction of light arriving evenly from the hemisphere that it reflects
+// towards wo, integral f(wo, wi) cos_i dwi, diffuse and specular lobes both.
+// What a surface reflects of light known only as an average (irradiance /
+// pi): a varnished floor's specular layer and a metal reflect the room's
+// light too, where diffuse_albedo leaves them black.
+glm::vec3 directional_albedo(const BrdfParams& p, float cos_o);
 
 // f(wo, wi). Zero when either direction is below the surface.
 glm::vec3 brdf_eval(const BrdfParams& p, const glm::vec3& wo, const glm::vec3& wi);

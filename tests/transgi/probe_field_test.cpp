@@ -12,7 +12,9 @@
 #include "engine/app/app.h"
 #include "engine/rt/rt_plugin.h"
 #include "engine/scene/procedural.h"
+#include "engine/render/surface.h"
 #include "probes/probe_field.h"
+#include "probes/probe_rays.h"
 #include "floor_under_sky.h"
 
 using namespace transgi::probes;
@@ -178,4 +180,54 @@ TEST(ProbeField, OracleProbesAboveALitFloorHoldTheAnalyticSh) {
     field.replace_with_oracle(s.app.world().resource<rt::RtScene>(), lights, 16, 9);
   });
   expect_floor_sh(field, a, 0.02);
+}
+
+// ---- the bounce a probe ray's hit reflects --------------------------------------------
+//
+// A floor lit evenly by radiance L = E / pi from its whole hemisphere (the
+// feedback's irradiance E, no lights) reflects towards any wo exactly its
+// BRDF's directional albedo times L (tests/engine/brdf_test.cpp checks that
+// albedo against the BRDF's integral). With the diffuse albedo alone, as
+// before, a gold floor reflected nothing of the room's light and a
+// varnished one too little; the near field (HitLobes::Diffuse) keeps the
+// diffuse lobe.
+TEST(ProbeRays, AHitReflectsTheFeedbackByItsWholeDirectionalAlbedo) {
+  const float irradiance = 2.0f, cos_o = 0.5f;
+  const glm::vec3 dir = glm::normalize(glm::vec3(std::sqrt(1.0f - cos_o * cos_o), -cos_o, 0.0f));
+  material::Material gold, varnish;
+  gold.base_color_factor = glm::vec4(1.0f, 0.78f, 0.34f, 1);
+  gold.metallic_factor = 1;
+  gold.roughness_factor = 0.4f;
+  varnish.base_color_factor = glm::vec4(0.30f, 0.15f, 0.08f, 1);
+  varnish.metallic_factor = 0;
+  varnish.roughness_factor = 0.3f;
+  for (const material::Material& m : {gold, varnish}) {
+    app::App app(app::AppOptions{.jobs = {.threads = 1}});
+    scene::SceneAssets a;
+    a.generation = scene::next_scene_generation();
+    a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({100, 100}))};
+    a.materials = {m};
+    app.world().insert_resource<scene::SceneAssets>(std::move(a));
+    app.add_plugin<rt::RtPlugin>();
+    const ecs::Entity floor = app.world().spawn();
+    app.world().emplace<transform::Transform>(floor);
+    app.world().emplace<scene::MeshInstance>(floor, scene::MeshInstance{0});
+    app.update();
+    const auto& rt = app.world().resource<rt::RtScene>();
+    const render::LightSet none(rt, {}, nullptr);
+    const auto feedback = [&](const glm::vec3&, const glm::vec3&, const glm::vec3&) { return glm::vec3(irradiance); };
+    math::Pcg32 rng(1, 2);
+    const ProbeRayHit all = trace_probe_ray(rt, none, {0, 1, 0}, dir, rng, feedback);
+    rt::Hit hit;
+    ASSERT_TRUE(rt.intersect(rt::Ray{{0, 1, 0}, dir}, hit));
+    const PendingProbeRay diffuse_only = begin_probe_ray(rt, none, dir, &hit, rng, HitLobes::Diffuse);
+    const ProbeRayHit diffuse = finish_probe_ray(diffuse_only, false, feedback);
+    const render::Surface s = render::make_surface(rt, hit, dir);
+    const glm::vec3 expected = material::directional_albedo(s.brdf, cos_o) * irradiance / 3.14159265f;
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(all.radiance[k], expected[k], 1e-5f * expected[k] + 1e-7f) << "metallic " << m.metallic_factor << " channel " << k;
+      EXPECT_NEAR(diffuse.radiance[k], material::diffuse_albedo(s.brdf)[k] * irradiance / 3.14159265f, 1e-6f);
+    }
+    EXPECT_GT(all.radiance.b, diffuse.radiance.b + 0.01f) << "the specular layer reflects the room's light too";
+  }
 }

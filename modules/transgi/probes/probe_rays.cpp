@@ -78,7 +78,10 @@ PendingProbeRay begin_probe_ray(const engine::rt::RtScene& scene, const engine::
   const glm::vec3 wo = s.frame.to_local(-dir);
   if (emitter || wo.z <= 0) return p;
   p.takes_feedback = true;
-  p.diffuse_over_pi = material::diffuse_albedo(s.brdf) * math::kInvPi;
+  // The bounce: the previous frame's irradiance there, reflected as light
+  // arriving evenly, by every lobe that reflects the next-event sample.
+  p.reflectance_over_pi = (lobes == HitLobes::Diffuse ? material::diffuse_albedo(s.brdf) : material::directional_albedo(s.brdf, wo.z)) *
+                          math::kInvPi;
   p.shading_normal = s.shading_normal;
   p.to_probe = -dir;
   render::LightSample ls;

@@ -57,7 +57,7 @@ struct PendingProbeRay {
   engine::rt::Ray shadow;           // the next-event sample's shadow ray
   glm::vec3 unoccluded{0.0f};       // what that sample adds if the shadow ray is clear
   bool takes_feedback = false;      // a lit-side hit of a non-emitter: gets the bounce
-  glm::vec3 diffuse_over_pi{0.0f};  // diffuse albedo / pi
+  glm::vec3 reflectance_over_pi{0.0f};  // what the feedback's irradiance is reflected by, over pi
   glm::vec3 shading_normal{0.0f};
   glm::vec3 to_probe{0.0f};         // -dir
 };
@@ -75,7 +75,9 @@ PendingProbeRay begin_probe_ray(const engine::rt::RtScene& scene, const engine::
                                 HitLobes lobes = HitLobes::All);
 
 // The rest, given whether the shadow ray was blocked: the sample's light if
-// not, plus the diffuse albedo / pi times `feedback(position, normal,
+// not, plus the directional albedo / pi (material::directional_albedo: the
+// specular layer and metals reflect the room's light too; the diffuse
+// albedo for HitLobes::Diffuse) times `feedback(position, normal,
 // to_probe)`, the previous frame's irradiance.
 template <class Feedback>
 ProbeRayHit finish_probe_ray(const PendingProbeRay& p, bool blocked, Feedback&& feedback) {
@@ -85,7 +87,7 @@ ProbeRayHit finish_probe_ray(const PendingProbeRay& p, bool blocked, Feedback&& 
     r.radiance += p.unoccluded;
     r.saw_light = true;
   }
-  r.radiance += p.diffuse_over_pi * feedback(r.position, p.shading_normal, p.to_probe);
+  r.radiance += p.reflectance_over_pi * feedback(r.position, p.shading_normal, p.to_probe);
   if (!std::isfinite(r.radiance.r + r.radiance.g + r.radiance.b)) {
     r.radiance = glm::vec3(0.0f);
     r.replaced_non_finite = true;
