@@ -76,23 +76,29 @@ TEST(ProbeField, ProbesAboveALitFloorConvergeToTheAnalyticSh) {
 // must be much faster.
 
 namespace {
+// A square floor of half width `half` and material m, at the origin, the
+// world's only mesh.
+void add_floor(app::App& app, const material::Material& m, float half) {
+  scene::SceneAssets a;
+  a.generation = scene::next_scene_generation();
+  a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({half, half}))};
+  a.materials = {m};
+  app.world().insert_resource<scene::SceneAssets>(std::move(a));
+  app.add_plugin<rt::RtPlugin>();
+  const ecs::Entity floor = app.world().spawn();
+  app.world().emplace<transform::Transform>(floor);
+  app.world().emplace<scene::MeshInstance>(floor, scene::MeshInstance{0});
+}
+
 struct TwoLights {
   app::App app{app::AppOptions{.jobs = {.threads = 2}}};
   ecs::Entity light_a, light_b;
   TwoLights() {
-    scene::SceneAssets a;
-    a.generation = scene::next_scene_generation();
-    a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({4, 4}))};
     material::Material m;
     m.base_color_factor = glm::vec4(0.6f, 0.6f, 0.6f, 1);
     m.metallic_factor = 0;
     m.specular_factor = 0;
-    a.materials = {m};
-    app.world().insert_resource<scene::SceneAssets>(std::move(a));
-    app.add_plugin<rt::RtPlugin>();
-    const ecs::Entity floor = app.world().spawn();
-    app.world().emplace<transform::Transform>(floor);
-    app.world().emplace<scene::MeshInstance>(floor, scene::MeshInstance{0});
+    add_floor(app, m, 4);
     light_a = spawn_light({-1.5f, 2.0f, 0.0f}, 20.0f);
     light_b = spawn_light({1.5f, 2.0f, 0.0f}, 10.0f);
     app.update();
@@ -203,15 +209,7 @@ TEST(ProbeRays, AHitReflectsTheFeedbackByItsWholeDirectionalAlbedo) {
   varnish.roughness_factor = 0.3f;
   for (const material::Material& m : {gold, varnish}) {
     app::App app(app::AppOptions{.jobs = {.threads = 1}});
-    scene::SceneAssets a;
-    a.generation = scene::next_scene_generation();
-    a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({100, 100}))};
-    a.materials = {m};
-    app.world().insert_resource<scene::SceneAssets>(std::move(a));
-    app.add_plugin<rt::RtPlugin>();
-    const ecs::Entity floor = app.world().spawn();
-    app.world().emplace<transform::Transform>(floor);
-    app.world().emplace<scene::MeshInstance>(floor, scene::MeshInstance{0});
+    add_floor(app, m, 100);
     app.update();
     const auto& rt = app.world().resource<rt::RtScene>();
     const render::LightSet none(rt, {}, nullptr);
