@@ -112,31 +112,39 @@ GameSession::GameSession(const GameOptions& options) : options_(options), refere
 
   auto& frame = world.resource<transgi::runtime::GiFrame>();
   frame.camera = camera_;
-  warm_up_probes();
+  warm_up();
   frame.width = options_.width;
   frame.height = options_.height;
   frame.antialias_passes = options_.view != "full";  // as set_view says
   set_method(options_.method);
 }
 
-void GameSession::warm_up_probes() {
+void GameSession::warm_up() {
   engine::ecs::World& w = world();
-  const int frames = options_.probe_warmup_frames >= 0 ? options_.probe_warmup_frames
-                                                       : w.resource<transgi::runtime::TransGISettings>().probes.settle_frames;
+  auto& settings = w.resource<transgi::runtime::TransGISettings>();
+  const int frames = options_.probe_warmup_frames >= 0 ? options_.probe_warmup_frames : settings.probes.settle_frames;
   if (frames <= 0) return;
   auto& gi = w.resource<transgi::runtime::GiFrame>();
   auto& time = w.resource<engine::app::Time>();
-  const int width = gi.width, height = gi.height;
   const bool paused = time.paused;
-  gi.width = gi.height = 0;  // the probes update; no image is made
-  time.paused = true;        // scripts start, but no game time passes
+  time.paused = true;  // scripts start, but no game time passes
   const auto t0 = std::chrono::steady_clock::now();
+  gi.width = gi.height = 0;  // the probes update; no image is made
   for (int f = 0; f < frames; ++f) app_->jobs().run([&] { app_->update(); });
+  int image_frames = 0;
+  if (options_.method == GameMethod::TransGI) {
+    // Images made at the game's size and thrown away, every GI cell tracing
+    // its contact ray (no budget): loading time, not frame time.
+    gi.width = options_.width;
+    gi.height = options_.height;
+    const int budget = settings.near_field.cell_budget;
+    settings.near_field.cell_budget = 0;
+    for (; image_frames < options_.image_warmup_frames; ++image_frames) app_->jobs().run([&] { app_->update(); });
+    settings.near_field.cell_budget = budget;
+  }
   time.paused = paused;
-  gi.width = width;
-  gi.height = height;
   w.resource<engine::core::Log>().info(
-      "game", "probes warmed up over " + std::to_string(frames) + " updates in " +
+      "game", "warmed up over " + std::to_string(frames) + " probe updates and " + std::to_string(image_frames) + " frames in " +
                   std::to_string(static_cast<int>(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count())) +
                   " ms, before the first frame");
 }

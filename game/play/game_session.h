@@ -35,6 +35,11 @@ struct GameOptions {
   // real-time preset's settle_frames; 0 = none. Higher = a better-settled
   // first frame, at the cost of that many probe updates of load time.
   int probe_warmup_frames = -1;
+  // Then (unless the probes' warm-up is 0) frames made and thrown away, the
+  // near field tracing every GI cell (GameSession::warm_up): 8 = its
+  // per-cell mean's span. Higher = a steadier first frame, at the cost of
+  // about 60 ms of load time each at 640x360.
+  int image_warmup_frames = 8;
   // (entity name, Lua file): each named entity runs that script instead of
   // its own (--script ENTITY=FILE), for quick tries; a relative file is
   // taken from the working directory.
@@ -80,8 +85,13 @@ class GameSession {
   [[nodiscard]] const std::string& view_name() const { return options_.view; }
   // Reference samples per pixel accumulated since the last change.
   [[nodiscard]] int reference_spp() const;
-  // The level's first probe updates, before the first frame (GameOptions::probe_warmup_frames).
-  void warm_up_probes();
+  // The level's first probe updates, before the first frame
+  // (GameOptions::probe_warmup_frames), then a few frames made and thrown
+  // away (GameOptions::image_warmup_frames): the near field's per-cell
+  // means and the antialiasing's
+  // history start full, where one frame's sparse lattice of contact rays
+  // left blocks on shaded faces for the first dozen frames.
+  void warm_up();
   // The last frame's stage times of the method shown (TransGI's, DDGI's, or
   // the path tracer's), named as the stats overlay shows them.
   struct StageTime {
