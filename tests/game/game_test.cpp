@@ -623,6 +623,24 @@ TEST(GameSession, TheStatsShowTheShownMethodsOwnStagesOnAScaleThatFits) {
   EXPECT_EQ(names(s.stage_times()), "path tracing,");
 }
 
+// A session's frame 0 against its frame 30: mean |difference| / mean over
+// every channel. paused: game time held (the sun still).
+double first_frame_against_frame_30(const game::GameOptions& o, bool paused) {
+  game::GameSession s(o);
+  if (paused) s.world().resource<engine::app::Time>().paused = true;
+  idle(s, 1);
+  const engine::image::ImageRGB first = s.image();
+  idle(s, 30);
+  const engine::image::ImageRGB& later = s.image();
+  double diff = 0, level = 0;
+  for (std::size_t i = 0; i < first.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      diff += std::abs(first.pixels[i][c] - later.pixels[i][c]);
+      level += std::abs(later.pixels[i][c]);
+    }
+  return diff / level;
+}
+
 TEST(GameSession, TheFirstFrameIsSettled) {
   // The first frames showed probe-sized bright squares while the probes
   // settled (issue 37). With the warm-up, frame 0's GI is already close to
@@ -631,18 +649,7 @@ TEST(GameSession, TheFirstFrameIsSettled) {
     game::GameOptions o = level_options(64, 36);
     o.view = "gi";
     o.probe_warmup_frames = warmup;
-    game::GameSession s(o);
-    idle(s, 1);
-    const engine::image::ImageRGB first = s.image();
-    idle(s, 30);
-    const engine::image::ImageRGB& later = s.image();
-    double diff = 0, level = 0;
-    for (std::size_t i = 0; i < first.pixels.size(); ++i)
-      for (int c = 0; c < 3; ++c) {
-        diff += std::abs(first.pixels[i][c] - later.pixels[i][c]);
-        level += std::abs(later.pixels[i][c]);
-      }
-    return diff / level;
+    return first_frame_against_frame_30(o, false);
   };
   const double warm = first_vs_later(-1), cold = first_vs_later(0);
   std::printf("[ measured ] frame 0 against frame 30, mean |difference| / mean: %.3f warmed, %.3f cold\n", warm, cold);
@@ -834,19 +841,7 @@ TEST(GameSession, TheFirstFrameHasTheNearFieldsWholeLight) {
     o.view = "gi";
     o.probe_warmup_frames = -1;  // level_options turns the warm-up off
     o.image_warmup_frames = image_warmup;
-    game::GameSession s(o);
-    s.world().resource<engine::app::Time>().paused = true;  // the sun held: only the warm-up differs
-    idle(s, 1);
-    const engine::image::ImageRGB first = s.image();
-    idle(s, 30);
-    const engine::image::ImageRGB& later = s.image();
-    double diff = 0, level = 0;
-    for (std::size_t i = 0; i < first.pixels.size(); ++i)
-      for (int c = 0; c < 3; ++c) {
-        diff += std::abs(first.pixels[i][c] - later.pixels[i][c]);
-        level += std::abs(later.pixels[i][c]);
-      }
-    return diff / level;
+    return first_frame_against_frame_30(o, true);  // the sun held: only the warm-up differs
   };
   const double with_images = first_vs_later(8), probes_only = first_vs_later(0);
   std::printf("[ measured ] frame 0 against frame 30, mean |difference| / mean: %.4f with the image warm-up, %.4f probes only\n",
