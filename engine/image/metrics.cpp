@@ -123,7 +123,6 @@ ColourMetrics compare_colour(const ImageRGB& a, const ImageRGB& b, const ImageRG
     const double local = box3_luminance(img, x, y);
     return local > 0 ? (math::luminance(img.pixels[at(x, y)]) - local) / local : 0.0;
   };
-  const auto detail = [&](const ImageRGB& img, int x, int y) { return std::abs(signed_detail(img, x, y)); };
   double a_with_albedo = 0, b_with_albedo = 0, b_squared = 0, albedo_squared = 0;
   ColourMetrics m;
   for (int y = 0; y < h; ++y)
@@ -133,11 +132,12 @@ ColourMetrics compare_colour(const ImageRGB& a, const ImageRGB& b, const ImageRG
       const float sa = pa.r + pa.g + pa.b, sb = pb.r + pb.g + pb.b;
       const glm::vec3 ca = sa > 0 ? pa / sa : glm::vec3(1.0f / 3), cb = pb / sb;
       m.chroma_error += std::abs(ca.r - cb.r) + std::abs(ca.g - cb.g) + std::abs(ca.b - cb.b);
-      m.detail_a += detail(a, x, y);
-      m.detail_b += detail(b, x, y);
+      const double da = signed_detail(a, x, y), db = signed_detail(b, x, y);
+      m.detail_a += std::abs(da);
+      m.detail_b += std::abs(db);
       if (albedo) {
-        const double dl = signed_detail(*albedo, x, y), db = signed_detail(b, x, y);
-        a_with_albedo += signed_detail(a, x, y) * dl;
+        const double dl = signed_detail(*albedo, x, y);
+        a_with_albedo += da * dl;
         b_with_albedo += db * dl;
         b_squared += db * db;
         albedo_squared += dl * dl;

@@ -20,15 +20,18 @@ float pow5(float x) {
 }
 }  // namespace
 
+namespace {
+// The specular layer's albedo in one channel (F0 = f0), at most 1.
+float layer_albedo(const BrdfParams& p, const SpecularAlbedo& e, float f0) { return std::min(1.0f, p.specular * e.with_f0(f0)); }
+}  // namespace
+
 glm::vec3 diffuse_coupling(const BrdfParams& p, const glm::vec3& f0, float alpha, float cos_o, float cos_i) {
   if (p.specular <= 0) return glm::vec3(1.0f);
   const SpecularAlbedo eo = ggx_albedo(cos_o, alpha), ei = ggx_albedo(cos_i, alpha);
   const SpecularAlbedo avg = ggx_average_albedo(alpha);
   glm::vec3 c;
   for (int k = 0; k < 3; ++k) {
-    const float e_o = std::min(1.0f, p.specular * eo.with_f0(f0[k]));
-    const float e_i = std::min(1.0f, p.specular * ei.with_f0(f0[k]));
-    const float e_avg = std::min(1.0f, p.specular * avg.with_f0(f0[k]));
+    const float e_o = layer_albedo(p, eo, f0[k]), e_i = layer_albedo(p, ei, f0[k]), e_avg = layer_albedo(p, avg, f0[k]);
     c[k] = e_avg < 1.0f ? (1.0f - e_o) * (1.0f - e_i) / (1.0f - e_avg) : 0.0f;
   }
   return c;
@@ -108,14 +111,16 @@ glm::vec3 directional_albedo(const BrdfParams& p, float cos_o) {
   const float alpha = alpha_of(p);
   const SpecularAlbedo e = ggx_albedo(cos_o, alpha);
   glm::vec3 dielectric(0.0f), metal(0.0f);
-  if (p.metallic < 1.0f) {
+  if (p.metallic < 1.0f && p.specular <= 0) {
+    dielectric = p.base_color;  // no layer: the coupling is 1
+  } else if (p.metallic < 1.0f) {
     // The diffuse lobe's coupling (1 - E_o)(1 - E_i) / (1 - E_avg) integrates
     // over wi to 1 - E_o: what the specular layer does not reflect.
     const glm::vec3 f0 = dielectric_f0(p);
+    const SpecularAlbedo avg = ggx_average_albedo(alpha);
     for (int k = 0; k < 3; ++k) {
-      const float spec = p.specular > 0 ? std::min(1.0f, p.specular * e.with_f0(f0[k])) : 0.0f;
-      const float e_avg = p.specular > 0 ? std::min(1.0f, p.specular * ggx_average_albedo(alpha).with_f0(f0[k])) : 0.0f;
-      dielectric[k] = (e_avg < 1.0f ? p.base_color[k] * (1.0f - spec) : 0.0f) + spec;
+      const float e_o = layer_albedo(p, e, f0[k]);
+      dielectric[k] = (layer_albedo(p, avg, f0[k]) < 1.0f ? p.base_color[k] * (1.0f - e_o) : 0.0f) + e_o;
     }
   }
   if (p.metallic > 0.0f)

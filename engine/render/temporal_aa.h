@@ -69,6 +69,9 @@ struct TemporalAaSettings {
   // reference's 1.5-pixel filter (engines bias their mips under TAA the same
   // way). Lower = sharper textures, at the cost of shimmer in motion.
   float texture_lod_bias = -1.0f;
+  // The bias a G-buffer reads textures with: none without antialiasing,
+  // whose single sample per pixel must then be the pixel's own average.
+  [[nodiscard]] float texture_lod_bias_in_use() const { return enabled ? texture_lod_bias : 0.0f; }
 };
 
 // What the resolve needs to know of each pixel's surface, this frame. The

@@ -88,9 +88,9 @@ class GameSession {
   // The level's first probe updates, before the first frame
   // (GameOptions::probe_warmup_frames), then a few frames made and thrown
   // away (GameOptions::image_warmup_frames): the near field's per-cell
-  // means and the antialiasing's
-  // history start full, where one frame's sparse lattice of contact rays
-  // left blocks on shaded faces for the first dozen frames.
+  // means and the antialiasing's history start full, where one frame's
+  // sparse lattice of contact rays left blocks on shaded faces for the first
+  // dozen frames.
   void warm_up();
   // The last frame's stage times of the method shown (TransGI's, DDGI's, or
   // the path tracer's), named as the stats overlay shows them.

@@ -33,6 +33,14 @@ int run_compare(const std::vector<std::string>& argv) {
     throw std::runtime_error("image sizes differ: " + args.positional()[0] + " is " + std::to_string(a.width) + "x" +
                              std::to_string(a.height) + ", " + args.positional()[1] + " is " + std::to_string(b.width) +
                              "x" + std::to_string(b.height));
+  // An image an option names, read as A and B are; it must be A's size.
+  const auto read_option = [&](const std::string& option) {
+    auto img = read(args.str(option));
+    if (img.width != a.width || img.height != a.height)
+      throw std::runtime_error("--" + option + ": " + args.str(option) + " is not " + std::to_string(a.width) + "x" +
+                               std::to_string(a.height));
+    return img;
+  };
   const auto m = engine::image::compare_images(a, b);
   if (args.has("heatmap")) {
     double used = 0;
@@ -43,10 +51,7 @@ int run_compare(const std::vector<std::string>& argv) {
   if (args.has("edge-band-of")) {
     // The error near the edges of another image (a reference's direct pass:
     // its shadow edges), printed on a line of its own.
-    const auto guide = read(args.str("edge-band-of"));
-    if (guide.width != a.width || guide.height != a.height)
-      throw std::runtime_error("--edge-band-of: " + args.str("edge-band-of") + " is not " + std::to_string(a.width) + "x" +
-                               std::to_string(a.height));
+    const auto guide = read_option("edge-band-of");
     const auto band = engine::image::edge_band(guide, static_cast<int>(args.integer("band", 0, 64, 3)));
     std::size_t n = 0;
     for (auto v : band) n += v;
@@ -56,19 +61,10 @@ int run_compare(const std::vector<std::string>& argv) {
     // Hue and texture against the reference (engine/image/metrics.h), a line of their own.
     // --colour-mask M: only where M (the reference's textured pass) says the
     // surfaces are textured or coloured, downsampled as the images are.
-    std::optional<engine::image::ImageRGB> mask;
-    if (args.has("colour-mask")) {
-      mask = read(args.str("colour-mask"));
-      if (mask->width != a.width || mask->height != a.height)
-        throw std::runtime_error("--colour-mask: " + args.str("colour-mask") + " is not the images' size");
-    }
+    std::optional<engine::image::ImageRGB> mask, albedo;
+    if (args.has("colour-mask")) mask = read_option("colour-mask");
     // --albedo L: the texture's gain against the reference (metrics.h).
-    std::optional<engine::image::ImageRGB> albedo;
-    if (args.has("albedo")) {
-      albedo = read(args.str("albedo"));
-      if (albedo->width != a.width || albedo->height != a.height)
-        throw std::runtime_error("--albedo: " + args.str("albedo") + " is not the images' size");
-    }
+    if (args.has("albedo")) albedo = read_option("albedo");
     const auto c = engine::image::compare_colour(a, b, mask ? &*mask : nullptr, albedo ? &*albedo : nullptr);
     nlohmann::ordered_json colour{{"chroma_error", c.chroma_error},
                                   {"detail", c.detail_a},

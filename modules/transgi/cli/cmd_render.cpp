@@ -55,8 +55,7 @@ struct SurfacePasses {
 
 void write_passes(const Outputs& o, const image::ImageRGB& full, const image::ImageRGB& direct, const image::ImageRGB& gi,
                   const SurfacePasses* surfaces = nullptr) {
-  const image::ImageRGB* albedo = surfaces ? &surfaces->albedo : nullptr;
-  const image::ImageRGB& main = o.pass == "gi" ? gi : o.pass == "direct" ? direct : o.pass == "albedo" ? *albedo : full;
+  const image::ImageRGB& main = o.pass == "gi" ? gi : o.pass == "direct" ? direct : o.pass == "albedo" ? surfaces->albedo : full;
   image::write_exr(o.out, main);
   if (o.pass == "all") {
     image::write_exr(sibling(o.out, "_direct"), direct);
@@ -71,7 +70,10 @@ void write_passes(const Outputs& o, const image::ImageRGB& full, const image::Im
   if (o.pass == "all") {
     image::write_png_srgb(sibling(o.png, "_direct"), direct, static_cast<float>(o.exposure));
     image::write_png_srgb(sibling(o.png, "_gi"), gi, static_cast<float>(o.exposure));
-    if (albedo) image::write_png_srgb(sibling(o.png, "_albedo"), *albedo, static_cast<float>(o.exposure));
+    if (surfaces) {
+      image::write_png_srgb(sibling(o.png, "_albedo"), surfaces->albedo, static_cast<float>(o.exposure));
+      image::write_png_srgb(sibling(o.png, "_textured"), surfaces->textured, static_cast<float>(o.exposure));
+    }
   }
 }
 

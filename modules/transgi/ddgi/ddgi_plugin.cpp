@@ -134,7 +134,7 @@ void render_realtime(const rt::RtScene& rt, const scene::SceneAssets& assets, co
   shading::DirectTileShader direct(rt, lights, rays, frame.width, frame.height);
   const glm::vec2 jitter = options.taa.enabled ? scratch.taa.next_jitter(options.taa) : glm::vec2(0.0f);
   shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, g, &direct, kernels ? kernels->tracer() : nullptr,
-                         jitter, options.taa.enabled ? options.taa.texture_lod_bias : 0.0f);
+                         jitter, options.taa.texture_lod_bias_in_use());
   frame.direct = direct.take(g);
   frame.times.direct = ms_since(t0);
   t0 = Clock::now();

@@ -165,7 +165,7 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   packed.scratch.recycle(std::move(frame.gi));
   const glm::vec2 jitter = settings.taa.enabled ? packed.taa.next_jitter(settings.taa) : glm::vec2(0.0f);
   shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, packed.gbuffer, direct ? &*direct : nullptr, tracer,
-                         jitter, settings.taa.enabled ? settings.taa.texture_lod_bias : 0.0f);
+                         jitter, settings.taa.texture_lod_bias_in_use());
   std::optional<engine::image::ImageRGB> batched_direct;
   if (deterministic && tracer)
     batched_direct = shading::shade_direct_realtime(packed.gbuffer, rt, lights, rays, &frame.direct_stats, tracer);

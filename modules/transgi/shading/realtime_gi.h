@@ -121,7 +121,7 @@ GBuffer trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::Sce
 // packets trace them where it declines. `jitter` moves every ray off the
 // pixel centre by that many pixels (temporal antialiasing, [-0.5, 0.5)).
 // Textures are read `texture_lod_bias` mip levels off the pixel's footprint
-// (TemporalAaSettings::texture_lod_bias under antialiasing, else 0).
+// (TemporalAaSettings::texture_lod_bias_in_use()).
 void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets,
                    const engine::render::CameraRays& camera, int width, int height, GBuffer& g,
                    DirectTileShader* direct = nullptr, engine::rt::RayBatchTracer* tracer = nullptr,
