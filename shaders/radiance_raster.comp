@@ -83,7 +83,9 @@ void main() {
                   const vec2 moments = unpackHalf2x16(depth[base + uint(texel)]);
                   const float unit = probes[target].depth_unit;
                   const float own = moments.x * unit, spread = sqrt(moments.y * unit * unit);
-                  if (!isnan(own) && !isinf(own) &&
+                  // No own hit in the texel (NaN): nothing says the point is
+                  // visible from the target (radiance_sharing.cpp).
+                  if (isnan(own) || isinf(own) ||
                       dist > own * (1.0 + p.relative_tolerance) + p.absolute_tolerance * unit + p.spread_tolerance * spread)
                     texel = kRejected;
                 }

@@ -207,9 +207,53 @@ TEST(RadianceSharing, DepthGuardStopsALeakThroughAWall) {
   std::vector<FrameSamples> guarded, faithful;
   const auto gs = rasterize_shared(g, m, pts, depth, {.mode = SharingMode::DepthGuard}, guarded);
   rasterize_shared(g, m, pts, depth, {.mode = SharingMode::PaperFaithful}, faithful);
-  EXPECT_EQ(gs.rejected_by_guard, 1u);
+  // Probe 1's point beyond the wall for probe 0, and probe 0's point on the
+  // wall for probe 1, whose own rays towards -x found nothing.
+  EXPECT_EQ(gs.rejected_by_guard, 2u);
   EXPECT_EQ(guarded[0].sum[static_cast<std::size_t>(t)], glm::vec3(0.1f)) << "only the wall's own radiance";
   EXPECT_EQ(faithful[0].sum[static_cast<std::size_t>(t)], glm::vec3(50.1f)) << "the paper-faithful mode leaks";
+}
+
+TEST(RadianceSharing, ATexelWithoutOwnHitsTakesNoNeighbourPoint) {
+  // Probe 0 stands under a table top (y = 0.3, wide): its rays up meet the
+  // table's underside, except in the texel straight up (a polar texel of
+  // the lat-long map, which its rays may not reach for frames). Probe 1,
+  // beside the table, sees the bright ceiling (y = 2.5) right above probe 0.
+  // Without an own hit there the guard cannot compare distances: sharing
+  // the ceiling's point would light probe 0's zenith through the table.
+  const ProbeGrid g{{0, 0, 0}, {1, 0, 0}, {2, 1, 1}};
+  const MapLayout m{32, 16};
+  const glm::vec3 ceiling{0.0f, 2.5f, 0.0f};
+  const glm::vec3 from_1 = glm::normalize(ceiling - g.position(1));
+  const int zenith = m.texel_of({0, 1, 0});
+  ASSERT_EQ(m.texel_of(glm::normalize(ceiling - g.position(0))), zenith);
+  std::vector<std::vector<ShadedPoint>> pts(2);
+  pts[1].push_back({ceiling, glm::vec3(20.0f), from_1, glm::length(ceiling - g.position(1)), -from_1});
+  std::vector<ProbeMapState> states(2);
+  for (auto& st : states) st.reset(m.texel_count());
+  const std::vector<const DepthMap*> depth = {&states[0].depth, &states[1].depth};
+  std::vector<FrameSamples> out;
+
+  ASSERT_TRUE(std::isnan(states[0].depth.mean(static_cast<std::size_t>(zenith))));
+  auto stats = rasterize_shared(g, m, pts, depth, {}, out);
+  EXPECT_EQ(out[0].count[static_cast<std::size_t>(zenith)], 0.0f) << "no own hit: the ceiling's point is not taken";
+  EXPECT_EQ(stats.rejected_by_guard, 1u);
+
+  // An escaped own ray leaves the texel without a hit too: still rejected.
+  pts[0] = {{glm::vec3(0.0f), glm::vec3(0.0f), {0, 1, 0}, std::numeric_limits<float>::infinity()}};
+  update_own_depth(states[0], m, pts[0], {});
+  rasterize_shared(g, m, pts, depth, {}, out);
+  EXPECT_EQ(out[0].count[static_cast<std::size_t>(zenith)], 1.0f) << "only the escaped ray's zero sample";
+  EXPECT_EQ(out[0].sum[static_cast<std::size_t>(zenith)], glm::vec3(0.0f));
+
+  // Once probe 0's own ray there hits the ceiling (no table this time), the
+  // point is taken.
+  states[0].reset(m.texel_count());
+  pts[0] = {{ceiling, glm::vec3(20.0f), {0, 1, 0}, 2.5f, {0, -1, 0}}};
+  update_own_depth(states[0], m, pts[0], {});
+  stats = rasterize_shared(g, m, pts, depth, {}, out);
+  EXPECT_EQ(out[0].count[static_cast<std::size_t>(zenith)], 2.0f) << "its own hit and the neighbour's point";
+  EXPECT_EQ(out[0].sum[static_cast<std::size_t>(zenith)], glm::vec3(40.0f));
 }
 
 TEST(RadianceSharing, ACoarseTexelOverTwoDepthsKeepsTheFarSurfacesPoints) {

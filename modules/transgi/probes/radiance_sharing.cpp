@@ -131,7 +131,12 @@ SharingStats rasterize(const ProbeGrid& grid, const MapLayout& layout, const std
           }
           if (q != p && s.mode == SharingMode::DepthGuard && depth) {
             const float own = depth->mean(t);
-            if (std::isfinite(own) && dist[i] > own * (1.0f + s.relative_tolerance) + s.absolute_tolerance * depth->unit +
+            // No own hit in the texel (NaN): the target's rays there escaped
+            // to the sky or have not arrived (a polar texel of the lat-long
+            // map, a few rays a frame). Nothing says the point is visible
+            // from the target, and where it is not (past a window's jamb,
+            // above a table the target is under) it is a leak.
+            if (!std::isfinite(own) || dist[i] > own * (1.0f + s.relative_tolerance) + s.absolute_tolerance * depth->unit +
                                                     s.spread_tolerance * std::sqrt(depth->variance(t))) {
               ++rej;
               continue;

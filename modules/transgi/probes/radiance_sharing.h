@@ -12,8 +12,9 @@
 // A neighbour's point can lie behind a wall that the target probe's own rays
 // hit first. With the depth guard on, such a point is rejected when its
 // distance exceeds the target's own mean hit distance in that texel by more
-// than the tolerance, or (same_side) when the target stands behind the
-// surface the point lies on. SharingMode::PaperFaithful keeps every point
+// than the tolerance, when the target has no own hit in that texel (its rays
+// there escaped, or none has arrived yet), or (same_side) when the target
+// stands behind the surface the point lies on. SharingMode::PaperFaithful keeps every point
 // (ablation).
 #include <cstdint>
 #include <span>
