@@ -768,42 +768,48 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
 
 }  // namespace
 
-engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
-                                          const engine::scene::SceneAssets& assets, const model::TransferModel* model,
-                                          const FusedDecoder* decoder,
-                                          const std::function<bool(engine::ecs::Entity)>& has_transfer,
-                                          std::span<const probes::ProbeField* const> fields,
-                                          const RealtimeGiSettings& settings, RealtimeGiStats* stats_out,
-                                          engine::image::ImageRGB* direct_out, RealtimeGiScratch* scratch,
-                                          const engine::render::LightSet* mirror_lights, const MirrorRay& mirror,
-                                          const NearFieldRays& near_field, TransferBatchDecoder* batch_decoder) {
-  RealtimeGiStats stats;
-  // A recycled image of the right size is not cleared: the upsampling below
-  // writes every pixel.
-  engine::image::ImageRGB image;
-  const bool writes_every_pixel = !fields.empty() && !g.samples.empty();
-  if (scratch && writes_every_pixel && scratch->impl->recycled.width == g.width && scratch->impl->recycled.height == g.height)
-    image = std::move(scratch->impl->recycled);
-  else
-    image = engine::image::ImageRGB(g.width, g.height);
-  // The probes' direct light is added to what direct_out holds (the rest of
-  // the frame's direct light): one pass over it, not an image and a sum.
-  if (direct_out && (direct_out->width != g.width || direct_out->height != g.height)) *direct_out = engine::image::ImageRGB(g.width, g.height);
-  if (!writes_every_pixel) {
-    if (stats_out) *stats_out = stats;
-    return image;
-  }
-  auto t0 = Clock::now();
-  RealtimeGiScratch local;
-  RealtimeGiScratch::Impl& sc = *(scratch ? scratch : &local)->impl;
-  if (g.guide.size() != g.samples.size() || g.entity.size() != g.samples.size() || g.metal_roughness.size() != g.samples.size() ||
-      g.dielectric_roughness.size() != g.samples.size())
-    throw std::invalid_argument("shade_gi_realtime: the G-buffer lacks its per-pixel arrays; make it with trace_gbuffer");
-  const std::vector<glm::vec4>& guide = g.guide;
-  plan_upsampling(guide, g.width, g.height, settings, sc.up);
-  const UpsamplingPlan& up = sc.up;
+namespace {
 
-  // The pixels to decode: grid cells that hit, then pixels on their own.
+// What every stage of one real-time GI frame reads (shade_gi_realtime's
+// arguments), and the choices made once from them.
+struct GiFrameInputs {
+  const GBuffer& g;
+  const engine::rt::RtScene& scene;
+  const engine::scene::SceneAssets& assets;
+  const model::TransferModel* model;
+  const FusedDecoder* decoder;
+  const std::function<bool(engine::ecs::Entity)>& has_transfer;
+  std::span<const probes::ProbeField* const> fields;
+  const RealtimeGiSettings& settings;
+  const engine::render::LightSet* mirror_lights;
+  const MirrorRay& mirror;
+  const NearFieldRays& near_field;
+  TransferBatchDecoder* batch_decoder;
+  bool reuse = false;        // cells may take the previous frame's value (GiHistory)
+  bool with_direct = false;  // the probes' direct SH goes to direct_out too
+  // Glossy dielectrics (MirrorRay::dielectric_max_roughness) take their
+  // diffuse light from the probes' irradiance and their specular from a ray.
+  bool reflections = false, glossy_dielectrics = false;
+
+  [[nodiscard]] bool is_glossy_dielectric(std::size_t p) const {
+    return glossy_dielectrics && g.dielectric_roughness[p] <= mirror.dielectric_max_roughness;
+  }
+  // Whether pixel p's sample is decoded by the network (else lit diffusely).
+  [[nodiscard]] bool network_decodes(engine::ecs::Entity e) const {
+    return model && decoder && (!has_transfer || has_transfer(e));
+  }
+};
+
+// Stage 1, plan. After it: sc.up is the upsampling plan; sc.decode lists the
+// pixels to decode (the grid cells that hit and are not reused, in cell
+// order, then the pixels decoded on their own), sc.decoded_cells the cell of
+// each of the first ones, sc.slot_of_pixel each listed pixel's slot (kNone
+// elsewhere); with the reuse, sc.source says where each cell's value comes from.
+void plan_decode(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc, RealtimeGiStats& stats) {
+  const GBuffer& g = in.g;
+  const std::vector<glm::vec4>& guide = g.guide;
+  plan_upsampling(guide, g.width, g.height, in.settings, sc.up);
+  const UpsamplingPlan& up = sc.up;
   std::vector<std::size_t>& decode = sc.decode;
   decode.clear();
   std::vector<std::size_t>& slot_of_pixel = sc.slot_of_pixel;
@@ -811,24 +817,17 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   engine::jobs::parallel_for<std::size_t>(0, slot_of_pixel.size(), 16384, [&](std::size_t b, std::size_t e) {
     std::fill(slot_of_pixel.begin() + static_cast<std::ptrdiff_t>(b), slot_of_pixel.begin() + static_cast<std::ptrdiff_t>(e), kNone);
   });
-  // guide[p].w > 0 is samples[p].hit, read from 16 bytes a pixel instead of a GSample.
-  auto want = [&](std::size_t p) {
-    if (slot_of_pixel[p] != kNone || !(guide[p].w > 0)) return;
-    slot_of_pixel[p] = decode.size();
-    decode.push_back(p);
-  };
   // With reuse, the cells that take the previous frame's value are not decoded.
-  const bool reuse = settings.reuse_history && scratch != nullptr && g.camera.has_value();
-  if (reuse)
-    sc.history.plan(up, g, scene, sc.source, near_field.rays > 0 ? &sc.contact.track : nullptr,
-                    near_field.rays > 0 ? &sc.contact.moved : nullptr);
+  if (in.reuse)
+    sc.history.plan(up, g, in.scene, sc.source, in.near_field.rays > 0 ? &sc.contact.track : nullptr,
+                    in.near_field.rays > 0 ? &sc.contact.moved : nullptr);
   else
     sc.history.clear();
   // The cells in cell order, their slots by a prefix sum over rows of cells
   // (cells decode distinct pixels, so the rows fill their slots in parallel):
   // decoded_cells[k] is the cell whose value is value[k].
   const std::size_t grid_w = static_cast<std::size_t>(up.grid_w), grid_h = static_cast<std::size_t>(up.grid_h);
-  const auto decodes = [&](std::size_t c) { return (!reuse || sc.source[c] == GiHistory::kDecode) && up.cell_guide[c].w > 0; };
+  const auto decodes = [&](std::size_t c) { return (!in.reuse || sc.source[c] == GiHistory::kDecode) && up.cell_guide[c].w > 0; };
   std::vector<std::size_t>& row_start = sc.row_start;
   row_start.assign(grid_h + 1, 0);
   engine::jobs::parallel_for<std::size_t>(0, grid_h, 8, [&](std::size_t b, std::size_t e) {
@@ -863,94 +862,86 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
                                  up.kind.begin() + static_cast<std::ptrdiff_t>((y + 1) * width), UpsamplingPlan::kOwn) !=
                        up.kind.begin() + static_cast<std::ptrdiff_t>((y + 1) * width);
   });
+  // guide[p].w > 0 is samples[p].hit, read from 16 bytes a pixel instead of a GSample.
   for (std::size_t y = 0; y < row_has_own.size(); ++y)
     if (row_has_own[y])
       for (std::size_t p = y * width; p < (y + 1) * width; ++p)
-        if (up.kind[p] == UpsamplingPlan::kOwn) want(p);
-  stats.edge_samples = decode.size() - stats.grid_samples;
-  double plan_ms = ms_since(t0);
-
-  // Glossy dielectrics (MirrorRay::dielectric_max_roughness) take their
-  // diffuse light from the probes' irradiance and their specular from a ray.
-  const bool reflections = mirror.max_roughness >= 0;
-  const bool glossy_dielectrics = reflections && mirror.dielectric_max_roughness >= 0;
-  const auto is_glossy_dielectric = [&](std::size_t p) {
-    return glossy_dielectrics && g.dielectric_roughness[p] <= mirror.dielectric_max_roughness;
-  };
-
-  // Split into network and diffuse samples; one rotation per moved object.
-  t0 = Clock::now();
-  std::vector<std::size_t>& net = sc.net;            // indices into decode
-  std::vector<std::size_t>& diffuse = sc.diffuse;
-  std::vector<int>& rotation_of = sc.rotation_of;  // per net sample
-  net.clear();
-  diffuse.clear();
-  rotation_of.clear();
-  RotatedProbes rotated(fields);
-  {
-    // Each sample's entity and glossiness gathered in parallel (the reads
-    // miss cache: the G-buffer was written long before), then routed in order.
-    sc.sample_entity.resize(decode.size());
-    sc.sample_glossy.resize(decode.size());
-    engine::jobs::parallel_for<std::size_t>(0, decode.size(), 2048, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) {
-        sc.sample_entity[i] = g.entity[decode[i]];
-        sc.sample_glossy[i] = is_glossy_dielectric(decode[i]) ? 1 : 0;
-      }
-    });
-    std::unordered_map<engine::ecs::Entity, std::pair<bool, int>> per_entity;
-    // Neighbouring samples mostly lie on one entity: look it up only when it changes.
-    engine::ecs::Entity last{};
-    std::pair<bool, int> last_route{false, -1};
-    for (std::size_t i = 0; i < decode.size(); ++i) {
-      const engine::ecs::Entity e = sc.sample_entity[i];
-      if (i == 0 || !(e == last)) {
-        auto [it, inserted] = per_entity.try_emplace(e, false, -1);
-        if (inserted) {
-          it->second.first = model && decoder && (!has_transfer || has_transfer(e));
-          if (it->second.first) it->second.second = rotated.add(scene.instance_of(e)->to_world.rotation);
+        if (up.kind[p] == UpsamplingPlan::kOwn && slot_of_pixel[p] == kNone && guide[p].w > 0) {
+          slot_of_pixel[p] = decode.size();
+          decode.push_back(p);
         }
-        last = e;
-        last_route = it->second;
+  stats.edge_samples = decode.size() - stats.grid_samples;
+}
+
+// Stage 2, route. After it: sc.net (with sc.rotation_of) and sc.diffuse
+// split the decoded samples (indices into sc.decode) into those the network
+// decodes and those lit diffusely (glossy dielectrics, objects without
+// transfer), and `rotated` holds the probes' SH in each moved object's frame.
+void route_samples(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc, RotatedProbes& rotated) {
+  const std::vector<std::size_t>& decode = sc.decode;
+  sc.net.clear();
+  sc.diffuse.clear();
+  sc.rotation_of.clear();
+  // Each sample's entity and glossiness gathered in parallel (the reads
+  // miss cache: the G-buffer was written long before), then routed in order.
+  sc.sample_entity.resize(decode.size());
+  sc.sample_glossy.resize(decode.size());
+  engine::jobs::parallel_for<std::size_t>(0, decode.size(), 2048, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      sc.sample_entity[i] = in.g.entity[decode[i]];
+      sc.sample_glossy[i] = in.is_glossy_dielectric(decode[i]) ? 1 : 0;
+    }
+  });
+  std::unordered_map<engine::ecs::Entity, std::pair<bool, int>> per_entity;
+  // Neighbouring samples mostly lie on one entity: look it up only when it changes.
+  engine::ecs::Entity last{};
+  std::pair<bool, int> last_route{false, -1};
+  for (std::size_t i = 0; i < decode.size(); ++i) {
+    const engine::ecs::Entity e = sc.sample_entity[i];
+    if (i == 0 || !(e == last)) {
+      auto [it, inserted] = per_entity.try_emplace(e, false, -1);
+      if (inserted) {
+        it->second.first = in.network_decodes(e);
+        if (it->second.first) it->second.second = rotated.add(in.scene.instance_of(e)->to_world.rotation);
       }
-      if (last_route.first && !sc.sample_glossy[i]) {
-        net.push_back(i);
-        rotation_of.push_back(last_route.second);
-      } else {
-        diffuse.push_back(i);
-      }
+      last = e;
+      last_route = it->second;
+    }
+    if (last_route.first && !sc.sample_glossy[i]) {
+      sc.net.push_back(i);
+      sc.rotation_of.push_back(last_route.second);
+    } else {
+      sc.diffuse.push_back(i);
     }
   }
   rotated.rotate_all();
-  stats.rotations = rotated.count();
-  stats.rotate_ms = ms_since(t0);
+}
 
-  // Light per decoded sample: object-space SH for the network, irradiance
-  // for the diffuse fallback; the probes' indirect light and, if asked, their
-  // direct sky and emitter light, with one set of interpolation weights. The
-  // network samples' SH is interpolated tile by tile inside the fused
-  // decoder, so it stays in cache instead of going through memory.
-  t0 = Clock::now();
-  const bool with_direct = direct_out != nullptr;
+// Stage 3, light the diffuse samples. After it: sc.value (and
+// sc.value_direct) hold each diffuse sample's light over its base colour,
+// sc.queries and sc.net_position / net_normal each network sample's input,
+// sc.contact_gain every decoded sample's.
+void light_diffuse_samples(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc) {
+  const GBuffer& g = in.g;
+  const std::vector<std::size_t>& decode = sc.decode;
+  const std::vector<std::size_t>& net = sc.net;
+  const std::vector<std::size_t>& diffuse = sc.diffuse;
   // Every entry below is written before it is read: resize, never refill.
-  std::vector<glm::vec3>& value = sc.value;
-  std::vector<glm::vec3>& value_direct = sc.value_direct;
-  std::vector<TransferQuery>& queries = sc.queries;
-  // With the reuse, the reused cells' values follow the decoded ones (below):
-  // sized once, so no frame shrinks and regrows (and clears) them.
-  const std::size_t decoded = decode.size();
-  const std::size_t value_slots = decoded + (reuse ? up.cell_pixel.size() : 0);
-  value.resize(value_slots);
-  value_direct.resize(with_direct ? value_slots : 0);
-  queries.resize(net.size());
+  // With the reuse, the reused cells' values follow the decoded ones
+  // (merge_reused_cells): sized once, so no frame shrinks and regrows (and
+  // clears) them.
+  const std::size_t value_slots = decode.size() + (in.reuse ? sc.up.cell_pixel.size() : 0);
+  sc.value.resize(value_slots);
+  sc.value_direct.resize(in.with_direct ? value_slots : 0);
+  sc.queries.resize(net.size());
   sc.net_position.resize(net.size());
   sc.net_normal.resize(net.size());
-  const bool with_contact = near_field.rays > 0;
+  const bool with_contact = in.near_field.rays > 0;
   sc.contact_gain.resize(with_contact ? decode.size() : 0);
   engine::jobs::parallel_for<std::size_t>(0, net.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       const GSample& s = g.samples[decode[net[k]]];
-      queries[k] = {s.mesh, s.triangle, s.bary, s.albedo, s.normal_obj, s.wo_obj};
+      sc.queries[k] = {s.mesh, s.triangle, s.bary, s.albedo, s.normal_obj, s.wo_obj};
       sc.net_position[k] = s.position;
       sc.net_normal[k] = s.normal_world;
       if (with_contact) sc.contact_gain[net[k]] = s.diffuse / model::demodulation(s.albedo) * engine::math::kInvPi;
@@ -961,151 +952,144 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     for (std::size_t k = b; k < e; ++k) {
       const GSample& s = g.samples[decode[diffuse[k]]];
       probes::interpolate_fields_with(
-          fields, s.position, s.normal_world, [](const probes::ProbeField* f) { return f->light_sh_all().data(); },
-          [](const probes::ProbeField* f) { return f->direct_sh_all().data(); }, world, with_direct ? world_direct : nullptr);
+          in.fields, s.position, s.normal_world, [](const probes::ProbeField* f) { return f->light_sh_all().data(); },
+          [](const probes::ProbeField* f) { return f->direct_sh_all().data(); }, world, in.with_direct ? world_direct : nullptr);
       // Over the base colour, as every sample is upsampled (below); a glossy
       // dielectric's diffuse lobe less what its specular layer reflects.
       glm::vec3 over = s.diffuse / model::demodulation(s.albedo) * engine::math::kInvPi;
       // (1 - s E(wo): brdf.h's layer coupling averaged over the incoming light).
-      if (is_glossy_dielectric(decode[diffuse[k]])) over *= glm::vec3(1.0f) - specular_layer_albedo(s);
-      value[diffuse[k]] = over * sh_irradiance(world, s.normal_world);
+      if (in.is_glossy_dielectric(decode[diffuse[k]])) over *= glm::vec3(1.0f) - specular_layer_albedo(s);
+      sc.value[diffuse[k]] = over * sh_irradiance(world, s.normal_world);
       if (with_contact) sc.contact_gain[diffuse[k]] = over;
-      if (with_direct) value_direct[diffuse[k]] = over * sh_irradiance(world_direct, s.normal_world);
+      if (in.with_direct) sc.value_direct[diffuse[k]] = over * sh_irradiance(world_direct, s.normal_world);
     }
   });
-  const double diffuse_light_ms = ms_since(t0);
+}
 
-  t0 = Clock::now();
+// Stage 4, decode. After it: sc.value (and sc.value_direct) hold each
+// network sample's light over its base colour. Returns the seconds the
+// decoder's threads spent interpolating light (for the stage times).
+double decode_network_samples(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc, const RotatedProbes& rotated,
+                              RealtimeGiStats& stats) {
+  const std::vector<std::size_t>& net = sc.net;
+  if (net.empty()) return 0.0;
+  std::vector<glm::vec3>& shaded = sc.shaded;
+  std::vector<glm::vec3>& shaded_direct = sc.shaded_direct;
+  shaded.resize(net.size());
+  shaded_direct.resize(in.with_direct ? net.size() : 0);
+  const auto fill = [&](std::size_t b, std::size_t e, float* light, float* light_direct) {
+    for (std::size_t k = b; k < e; ++k) {
+      const int r = sc.rotation_of[k];
+      probes::interpolate_fields_with(
+          in.fields, sc.net_position[k], sc.net_normal[k], [&](const probes::ProbeField* f) { return rotated.sh(r, f); },
+          [&](const probes::ProbeField* f) { return rotated.sh(r, f, true); }, light + (k - b) * 75,
+          light_direct ? light_direct + (k - b) * 75 : nullptr);
+    }
+  };
   double fill_seconds = 0;
-  if (!net.empty()) {
-    std::vector<glm::vec3>& shaded = sc.shaded;
-    std::vector<glm::vec3>& shaded_direct = sc.shaded_direct;
-    shaded.resize(net.size());
-    shaded_direct.resize(with_direct ? net.size() : 0);
-    const auto fill = [&](std::size_t b, std::size_t e, float* light, float* light_direct) {
-      for (std::size_t k = b; k < e; ++k) {
-        const glm::vec3& position = sc.net_position[k];
-        const glm::vec3& normal = sc.net_normal[k];
-        const int r = rotation_of[k];
-        probes::interpolate_fields_with(
-            fields, position, normal, [&](const probes::ProbeField* f) { return rotated.sh(r, f); },
-            [&](const probes::ProbeField* f) { return rotated.sh(r, f, true); }, light + (k - b) * 75,
-            light_direct ? light_direct + (k - b) * 75 : nullptr);
-      }
-    };
-    ProbeLightMaker* maker = batch_decoder && settings.device_lights ? batch_decoder->probe_lights() : nullptr;
-    if (maker && !maker->set_probes(fields, static_cast<int>(rotated.count()),
-                                    [&](int r, const probes::ProbeField* f, bool direct) { return rotated.sh(r, f, direct); }))
-      maker = nullptr;  // more fields than the device takes: the CPU makes the lights
-    if (maker)
-      shade_transfer_device_lights(
-          *batch_decoder, *maker, *model, assets, queries,
-          [&](std::size_t k) { return ProbeLightMaker::Point{sc.net_position[k], rotation_of[k], sc.net_normal[k], 0.0f}; },
-          shaded.data(), with_direct ? shaded_direct.data() : nullptr, &stats.inference_device_ms);
-    else if (batch_decoder)
-      fill_seconds = shade_transfer_batched(*batch_decoder, *model, assets, queries, fill, shaded.data(),
-                                            with_direct ? shaded_direct.data() : nullptr, &stats.inference_device_ms);
-    else
-      fill_seconds = shade_transfer_fused(*decoder, *model, assets, queries, fill, shaded.data(),
-                                          with_direct ? shaded_direct.data() : nullptr);
-    // Every sample's light is upsampled over its base colour (issue 37): a
-    // demodulated model's already is; a format-1 model's is divided here.
-    const bool demodulated = model->demodulated;
-    engine::jobs::parallel_for<std::size_t>(0, net.size(), 1024, [&](std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k) {
-        const glm::vec3 inv = demodulated ? glm::vec3(1.0f) : 1.0f / model::demodulation(g.albedo[decode[net[k]]]);
-        value[net[k]] = inv * shaded[k];
-        if (with_direct) value_direct[net[k]] = inv * shaded_direct[k];
-      }
-    });
-  }
-  // The fused call's wall time, split by the share its threads spent
-  // interpolating light (reported as SH light) and decoding (inference).
-  const double fused_ms = ms_since(t0);
-  const double fill_ms = std::min(fused_ms, 1e3 * fill_seconds / std::max(1, engine::jobs::current_thread_count()));
-  stats.light_ms = diffuse_light_ms + fill_ms;
-  stats.inference_ms = fused_ms - fill_ms;
+  ProbeLightMaker* maker = in.batch_decoder && in.settings.device_lights ? in.batch_decoder->probe_lights() : nullptr;
+  if (maker && !maker->set_probes(in.fields, static_cast<int>(rotated.count()),
+                                  [&](int r, const probes::ProbeField* f, bool direct) { return rotated.sh(r, f, direct); }))
+    maker = nullptr;  // more fields than the device takes: the CPU makes the lights
+  if (maker)
+    shade_transfer_device_lights(
+        *in.batch_decoder, *maker, *in.model, in.assets, sc.queries,
+        [&](std::size_t k) { return ProbeLightMaker::Point{sc.net_position[k], sc.rotation_of[k], sc.net_normal[k], 0.0f}; },
+        shaded.data(), in.with_direct ? shaded_direct.data() : nullptr, &stats.inference_device_ms);
+  else if (in.batch_decoder)
+    fill_seconds = shade_transfer_batched(*in.batch_decoder, *in.model, in.assets, sc.queries, fill, shaded.data(),
+                                          in.with_direct ? shaded_direct.data() : nullptr, &stats.inference_device_ms);
+  else
+    fill_seconds = shade_transfer_fused(*in.decoder, *in.model, in.assets, sc.queries, fill, shaded.data(),
+                                        in.with_direct ? shaded_direct.data() : nullptr);
+  // Every sample's light is upsampled over its base colour (issue 37): a
+  // demodulated model's already is; a format-1 model's is divided here.
+  const bool demodulated = in.model->demodulated;
+  engine::jobs::parallel_for<std::size_t>(0, net.size(), 1024, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      const glm::vec3 inv = demodulated ? glm::vec3(1.0f) : 1.0f / model::demodulation(in.g.albedo[sc.decode[net[k]]]);
+      sc.value[net[k]] = inv * shaded[k];
+      if (in.with_direct) sc.value_direct[net[k]] = inv * shaded_direct[k];
+    }
+  });
+  return fill_seconds;
+}
 
-  stats.inferred = net.size();
-  stats.diffuse = diffuse.size();
-  // The decoded values' boundary: nothing non-finite reaches the upsampling.
+// The decoded values' boundary: nothing non-finite reaches the upsampling.
+// Returns how many samples it zeroed.
+std::size_t zero_nonfinite_values(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc) {
   const auto finite = [](const glm::vec3& v) { return std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b); };
-  for (std::size_t i = 0; i < decoded; ++i) {
-    const bool ok = finite(value[i]) && (!with_direct || finite(value_direct[i]));
+  std::size_t zeroed = 0;
+  for (std::size_t i = 0; i < sc.decode.size(); ++i) {
+    const bool ok = finite(sc.value[i]) && (!in.with_direct || finite(sc.value_direct[i]));
     if (ok) continue;
-    value[i] = glm::vec3(0.0f);
-    if (with_direct) value_direct[i] = glm::vec3(0.0f);
-    ++stats.nonfinite_samples;
+    sc.value[i] = glm::vec3(0.0f);
+    if (in.with_direct) sc.value_direct[i] = glm::vec3(0.0f);
+    ++zeroed;
   }
+  return zeroed;
+}
 
-  // The contact light, on the cells decoded this frame, before their values
-  // become the next frame's history: a reused cell keeps the contact light
-  // it was given when it was decoded, so the reuse still halves the work.
-  if (near_field.rays > 0) {
-    t0 = Clock::now();
-    // The lattice's cells need not be decoded this frame: their route as the split above decides it.
-    const std::function<bool(std::size_t)> skips_own = [&](std::size_t p) {
-      return model && decoder && (!has_transfer || has_transfer(g.entity[p])) && !is_glossy_dielectric(p);
-    };
-    add_contact_light(g, scene, fields, mirror_lights, near_field, up, sc.decoded_cells, skips_own,
-                      sc.contact_gain, reuse ? std::span<const std::int32_t>(sc.contact.track) : std::span<const std::int32_t>(),
-                      reuse ? std::span<const std::uint8_t>(sc.contact.moved) : std::span<const std::uint8_t>(), sc.contact, value);
-    stats.near_ms = ms_since(t0);
-  }
-
-  if (reuse) {
-    // The reused cells' values after the decoded ones, a reused cell's slot
-    // at its cell index past them, so the cells are independent (no cell's
-    // pixel is another's); then every cell's value is the next frame's history.
-    const std::size_t cells = up.cell_pixel.size(), base = decoded;
-    sc.cell_value.resize(cells);
-    sc.cell_value_direct.resize(with_direct ? cells : 0);
-    sc.fresh.resize(cells);
-    std::atomic<std::size_t> reused{0};
-    engine::jobs::parallel_for<std::size_t>(0, cells, 4096, [&](std::size_t b, std::size_t e) {
-      std::size_t n = 0;
-      for (std::size_t c = b; c < e; ++c) {
-        const std::int32_t src = sc.source[c];
-        const std::size_t p = up.cell_pixel[c];
-        std::size_t slot = slot_of_pixel[p];
-        if (src != GiHistory::kDecode && slot == kNone) {
-          slot = slot_of_pixel[p] = base + c;
-          value[slot] = sc.history.value(src);
-          if (with_direct) value_direct[slot] = sc.history.value_direct(src);
-          ++n;
-        }
-        const bool hit = slot != kNone;
-        sc.cell_value[c] = hit ? value[slot] : glm::vec3(0.0f);
-        if (with_direct) sc.cell_value_direct[c] = hit ? value_direct[slot] : glm::vec3(0.0f);
-        sc.fresh[c] = hit && src == GiHistory::kDecode;
+// Stage 5, with the reuse: the reused cells' values go after the decoded
+// ones, a reused cell's slot at its cell index past them, so the cells are
+// independent (no cell's pixel is another's). After it: every cell's value
+// is in sc.cell_value and stored as the next frame's history. Returns the
+// number of cells reused.
+std::size_t merge_reused_cells(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc) {
+  const UpsamplingPlan& up = sc.up;
+  const std::size_t cells = up.cell_pixel.size(), base = sc.decode.size();
+  sc.cell_value.resize(cells);
+  sc.cell_value_direct.resize(in.with_direct ? cells : 0);
+  sc.fresh.resize(cells);
+  std::atomic<std::size_t> reused{0};
+  engine::jobs::parallel_for<std::size_t>(0, cells, 4096, [&](std::size_t b, std::size_t e) {
+    std::size_t n = 0;
+    for (std::size_t c = b; c < e; ++c) {
+      const std::int32_t src = sc.source[c];
+      const std::size_t p = up.cell_pixel[c];
+      std::size_t slot = sc.slot_of_pixel[p];
+      if (src != GiHistory::kDecode && slot == kNone) {
+        slot = sc.slot_of_pixel[p] = base + c;
+        sc.value[slot] = sc.history.value(src);
+        if (in.with_direct) sc.value_direct[slot] = sc.history.value_direct(src);
+        ++n;
       }
-      reused.fetch_add(n, std::memory_order_relaxed);
-    });
-    stats.reused_cells = reused.load();
-    sc.history.store(sc.cell_value, sc.cell_value_direct, sc.fresh);
-  }
+      const bool hit = slot != kNone;
+      sc.cell_value[c] = hit ? sc.value[slot] : glm::vec3(0.0f);
+      if (in.with_direct) sc.cell_value_direct[c] = hit ? sc.value_direct[slot] : glm::vec3(0.0f);
+      sc.fresh[c] = hit && src == GiHistory::kDecode;
+    }
+    reused.fetch_add(n, std::memory_order_relaxed);
+  });
+  sc.history.store(sc.cell_value, sc.cell_value_direct, sc.fresh);
+  return reused.load();
+}
 
-
-  t0 = Clock::now();
-  // The metals the reflection pass traces (below) take their direct light
-  // from its ray, not from the probes' direct SH through their transfer.
-  const float metal_ray_roughness = reflections ? std::max(mirror.max_roughness, mirror.glossy_max_roughness) : -1.0f;
+// Stage 6, upsample and composite. After it: every pixel of `image` holds
+// its GI (zero where the camera missed), times its base colour, and
+// direct_out has the probes' direct light added, except on the metals the
+// reflection pass traces (their direct light comes from its ray).
+void upsample_and_composite(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc, engine::image::ImageRGB& image,
+                            engine::image::ImageRGB* direct_out) {
+  const GBuffer& g = in.g;
+  const UpsamplingPlan& up = sc.up;
+  const float metal_ray_roughness = in.reflections ? std::max(in.mirror.max_roughness, in.mirror.glossy_max_roughness) : -1.0f;
   // Every cell's value in one dense array (zero for a miss cell, whose taps
   // have zero weight), so a tap is one load: with the reuse, the history's
-  // (this frame's, stored above); else gathered here.
+  // (this frame's, stored by merge_reused_cells); else gathered here.
   std::span<const glm::vec3> cell_values, cell_values_direct;
-  if (reuse) {
+  if (in.reuse) {
     cell_values = sc.history.values();
     cell_values_direct = sc.history.values_direct();
   } else {
     const std::size_t cells = up.cell_pixel.size();
     sc.cell_value.resize(cells);
-    sc.cell_value_direct.resize(with_direct ? cells : 0);
+    sc.cell_value_direct.resize(in.with_direct ? cells : 0);
     engine::jobs::parallel_for<std::size_t>(0, cells, 4096, [&](std::size_t b, std::size_t e) {
       for (std::size_t c = b; c < e; ++c) {
-        const std::size_t slot = slot_of_pixel[up.cell_pixel[c]];
-        sc.cell_value[c] = slot != kNone ? value[slot] : glm::vec3(0.0f);
-        if (with_direct) sc.cell_value_direct[c] = slot != kNone ? value_direct[slot] : glm::vec3(0.0f);
+        const std::size_t slot = sc.slot_of_pixel[up.cell_pixel[c]];
+        sc.cell_value[c] = slot != kNone ? sc.value[slot] : glm::vec3(0.0f);
+        if (in.with_direct) sc.cell_value_direct[c] = slot != kNone ? sc.value_direct[slot] : glm::vec3(0.0f);
       }
     });
     cell_values = sc.cell_value;
@@ -1120,10 +1104,10 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
           continue;
         }
         const glm::vec3 albedo = model::demodulation(g.albedo[p]);
-        const bool add_direct = with_direct && !(g.metal_roughness[p] <= metal_ray_roughness);
+        const bool add_direct = in.with_direct && !(g.metal_roughness[p] <= metal_ray_roughness);
         if (up.kind[p] == UpsamplingPlan::kOwn) {
-          image.pixels[p] = albedo * value[slot_of_pixel[p]];
-          if (add_direct) direct_out->pixels[p] += albedo * value_direct[slot_of_pixel[p]];
+          image.pixels[p] = albedo * sc.value[sc.slot_of_pixel[p]];
+          if (add_direct) direct_out->pixels[p] += albedo * sc.value_direct[sc.slot_of_pixel[p]];
           continue;
         }
         glm::vec3 sum(0.0f), sum_direct(0.0f);
@@ -1138,14 +1122,101 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
         if (add_direct) direct_out->pixels[p] += albedo * sum_direct;
       }
   });
+}
+
+}  // namespace
+
+engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
+                                          const engine::scene::SceneAssets& assets, const model::TransferModel* model,
+                                          const FusedDecoder* decoder,
+                                          const std::function<bool(engine::ecs::Entity)>& has_transfer,
+                                          std::span<const probes::ProbeField* const> fields,
+                                          const RealtimeGiSettings& settings, RealtimeGiStats* stats_out,
+                                          engine::image::ImageRGB* direct_out, RealtimeGiScratch* scratch,
+                                          const engine::render::LightSet* mirror_lights, const MirrorRay& mirror,
+                                          const NearFieldRays& near_field, TransferBatchDecoder* batch_decoder) {
+  RealtimeGiStats stats;
+  // A recycled image of the right size is not cleared: the upsampling below
+  // writes every pixel.
+  engine::image::ImageRGB image;
+  const bool writes_every_pixel = !fields.empty() && !g.samples.empty();
+  if (scratch && writes_every_pixel && scratch->impl->recycled.width == g.width && scratch->impl->recycled.height == g.height)
+    image = std::move(scratch->impl->recycled);
+  else
+    image = engine::image::ImageRGB(g.width, g.height);
+  // The probes' direct light is added to what direct_out holds (the rest of
+  // the frame's direct light): one pass over it, not an image and a sum.
+  if (direct_out && (direct_out->width != g.width || direct_out->height != g.height)) *direct_out = engine::image::ImageRGB(g.width, g.height);
+  if (!writes_every_pixel) {
+    if (stats_out) *stats_out = stats;
+    return image;
+  }
+  if (g.guide.size() != g.samples.size() || g.entity.size() != g.samples.size() || g.metal_roughness.size() != g.samples.size() ||
+      g.dielectric_roughness.size() != g.samples.size())
+    throw std::invalid_argument("shade_gi_realtime: the G-buffer lacks its per-pixel arrays; make it with trace_gbuffer");
+  RealtimeGiScratch local;
+  RealtimeGiScratch::Impl& sc = *(scratch ? scratch : &local)->impl;
+  GiFrameInputs in{g, scene, assets, model, decoder, has_transfer, fields, settings, mirror_lights, mirror, near_field, batch_decoder};
+  in.reuse = settings.reuse_history && scratch != nullptr && g.camera.has_value();
+  in.with_direct = direct_out != nullptr;
+  in.reflections = mirror.max_roughness >= 0;
+  in.glossy_dielectrics = in.reflections && mirror.dielectric_max_roughness >= 0;
+
+  auto t0 = Clock::now();
+  plan_decode(in, sc, stats);
+  const double plan_ms = ms_since(t0);
+
+  t0 = Clock::now();
+  RotatedProbes rotated(fields);
+  route_samples(in, sc, rotated);
+  stats.rotations = rotated.count();
+  stats.rotate_ms = ms_since(t0);
+
+  // Light per decoded sample: irradiance for the diffuse samples, object-
+  // space SH for the network, whose SH is interpolated tile by tile inside
+  // the fused decoder, so it stays in cache instead of going through memory.
+  t0 = Clock::now();
+  light_diffuse_samples(in, sc);
+  const double diffuse_light_ms = ms_since(t0);
+  t0 = Clock::now();
+  const double fill_seconds = decode_network_samples(in, sc, rotated, stats);
+  // The decoder's wall time, split by the share its threads spent
+  // interpolating light (reported as SH light) and decoding (inference).
+  const double fused_ms = ms_since(t0);
+  const double fill_ms = std::min(fused_ms, 1e3 * fill_seconds / std::max(1, engine::jobs::current_thread_count()));
+  stats.light_ms = diffuse_light_ms + fill_ms;
+  stats.inference_ms = fused_ms - fill_ms;
+  stats.inferred = sc.net.size();
+  stats.diffuse = sc.diffuse.size();
+  stats.nonfinite_samples = zero_nonfinite_values(in, sc);
+
+  // The contact light, on the cells decoded this frame, before their values
+  // become the next frame's history: a reused cell keeps the contact light
+  // it was given when it was decoded, so the reuse still halves the work.
+  if (near_field.rays > 0) {
+    t0 = Clock::now();
+    // The lattice's cells need not be decoded this frame: their route as route_samples decides it.
+    const std::function<bool(std::size_t)> skips_own = [&](std::size_t p) {
+      return in.network_decodes(g.entity[p]) && !in.is_glossy_dielectric(p);
+    };
+    add_contact_light(g, scene, fields, mirror_lights, near_field, sc.up, sc.decoded_cells, skips_own, sc.contact_gain,
+                      in.reuse ? std::span<const std::int32_t>(sc.contact.track) : std::span<const std::int32_t>(),
+                      in.reuse ? std::span<const std::uint8_t>(sc.contact.moved) : std::span<const std::uint8_t>(), sc.contact,
+                      sc.value);
+    stats.near_ms = ms_since(t0);
+  }
+  if (in.reuse) stats.reused_cells = merge_reused_cells(in, sc);
+
+  t0 = Clock::now();
+  upsample_and_composite(in, sc, image, direct_out);
   stats.upsample_ms = plan_ms + ms_since(t0);
 
-  if (reflections) {
+  if (in.reflections) {
     t0 = Clock::now();
     stats.reflection_rays = shade_metal_reflections(g, scene, fields, mirror, mirror_lights, image, direct_out);
-    if (glossy_dielectrics)
-      stats.reflection_rays += shade_dielectric_reflections(g, scene, fields, mirror_lights, mirror.dielectric_max_roughness, sc.dielectric_rays, image,
-                                   direct_out);
+    if (in.glossy_dielectrics)
+      stats.reflection_rays += shade_dielectric_reflections(g, scene, fields, mirror_lights, mirror.dielectric_max_roughness,
+                                                            sc.dielectric_rays, image, direct_out);
     stats.reflect_ms = ms_since(t0);
   }
   if (stats_out) *stats_out = stats;
