@@ -60,9 +60,10 @@ struct Lit {
     s.app.jobs().run([&] {
       f.g = shading::trace_gbuffer(rt, assets, rays, kW, kH);
       shading::RealtimeGiSettings rs;
-      f.decoded = shading::shade_gi_realtime(f.g, rt, assets, nullptr, nullptr, {}, fields, rs);
+      f.decoded = shading::shade_gi_realtime({.gbuffer = f.g, .scene = rt, .assets = assets, .fields = fields, .settings = rs});
       rs.reuse_history = true;
-      f.reused = shading::shade_gi_realtime(f.g, rt, assets, nullptr, nullptr, {}, fields, rs, &f.stats, nullptr, &scratch);
+      f.reused = shading::shade_gi_realtime({.gbuffer = f.g, .scene = rt, .assets = assets, .fields = fields, .settings = rs},
+                                            {.stats = &f.stats, .scratch = &scratch});
     });
     return f;
   }

@@ -109,8 +109,8 @@ TEST(MirrorPath, AFlatMirrorUnderALitCeilingShowsTheCeilingsRadiance) {
   engine::image::ImageRGB realtime;
   app.jobs().run([&] {
     shading::trace_gbuffer(rt, w.resource<scene::SceneAssets>(), rays, 32, 32, g);
-    realtime = shading::shade_gi_realtime(g, rt, w.resource<scene::SceneAssets>(), nullptr, nullptr, {}, fields,
-                                          shading::RealtimeGiSettings{}, nullptr, nullptr, nullptr, &lights);
+    realtime = shading::shade_gi_realtime(
+        {.gbuffer = g, .scene = rt, .assets = w.resource<scene::SceneAssets>(), .fields = fields, .mirror_lights = &lights});
   });
   for (int y = 14; y < 18; ++y)
     for (int x = 14; x < 18; ++x)
@@ -331,8 +331,13 @@ struct VarnishedFloor {
     image::ImageRGB gi;
     app.jobs().run([&] {
       shading::trace_gbuffer(rt, w.resource<scene::SceneAssets>(), rays, size, size, g, nullptr, nullptr, jitter);
-      gi = shading::shade_gi_realtime(g, rt, w.resource<scene::SceneAssets>(), nullptr, nullptr, {}, fields,
-                                      shading::RealtimeGiSettings{}, nullptr, &direct, scratch, &*lights, mirror);
+      gi = shading::shade_gi_realtime({.gbuffer = g,
+                                       .scene = rt,
+                                       .assets = w.resource<scene::SceneAssets>(),
+                                       .fields = fields,
+                                       .mirror_lights = &*lights,
+                                       .mirror = mirror},
+                                      {.direct = &direct, .scratch = scratch});
     });
     return gi;
   }

@@ -322,11 +322,23 @@ TEST(NearField, TheRealTimePathAgreesWithTheQualityPath) {
     quality = shading::render_transfer(rt, assets, no_model, rays, size, size, no_light, nullptr,
                                        shading::TransferSource::Network, s);
     shading::trace_gbuffer(rt, assets, rays, size, size, g);
-    realtime = shading::shade_gi_realtime(g, rt, assets, nullptr, nullptr, {}, fields, shading::RealtimeGiSettings{}, nullptr,
-                                          nullptr, nullptr, &lights, shading::MirrorRay{.max_roughness = -1}, near);
+    realtime = shading::shade_gi_realtime({.gbuffer = g,
+                                           .scene = rt,
+                                           .assets = assets,
+                                           .fields = fields,
+                                           .mirror_lights = &lights,
+                                           .mirror = shading::MirrorRay{.max_roughness = -1},
+                                           .near_field = near});
     for (int frame = 0; frame < 32; ++frame)
-      budgeted = shading::shade_gi_realtime(g, rt, assets, nullptr, nullptr, {}, fields, reuse, &stats, nullptr, &scratch, &lights,
-                                            shading::MirrorRay{.max_roughness = -1}, game_near);
+      budgeted = shading::shade_gi_realtime({.gbuffer = g,
+                                             .scene = rt,
+                                             .assets = assets,
+                                             .fields = fields,
+                                             .settings = reuse,
+                                             .mirror_lights = &lights,
+                                             .mirror = shading::MirrorRay{.max_roughness = -1},
+                                             .near_field = game_near},
+                                            {.stats = &stats, .scratch = &scratch});
   });
   EXPECT_GT(stats.reused_cells, 0u) << "the last frame reused cells";
   // The wall's pixels: rows where the camera ray meets it, below its middle.

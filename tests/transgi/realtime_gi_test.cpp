@@ -79,11 +79,12 @@ TEST(RealtimeGi, HalfResolutionUpsamplingDoesNotBleedAcrossSilhouettes) {
     g = shading::trace_gbuffer(rt, assets, camera, 96, 64);
     shading::RealtimeGiSettings rs;
     rs.resolution_scale = 1.0f;
-    full = shading::shade_gi_realtime(g, rt, assets, nullptr, nullptr, {}, fields, rs);
+    full = shading::shade_gi_realtime({.gbuffer = g, .scene = rt, .assets = assets, .fields = fields, .settings = rs});
     rs.resolution_scale = 0.5f;
-    half = shading::shade_gi_realtime(g, rt, assets, nullptr, nullptr, {}, fields, rs, &half_stats);
+    half = shading::shade_gi_realtime({.gbuffer = g, .scene = rt, .assets = assets, .fields = fields, .settings = rs},
+                                      {.stats = &half_stats});
     rs.edge_aware = false;
-    bilinear = shading::shade_gi_realtime(g, rt, assets, nullptr, nullptr, {}, fields, rs);
+    bilinear = shading::shade_gi_realtime({.gbuffer = g, .scene = rt, .assets = assets, .fields = fields, .settings = rs});
   });
   double mean = 0;
   for (const auto& p : full.pixels) mean += (p.r + p.g + p.b) / 3.0;

@@ -180,9 +180,19 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   if (deterministic) frame.direct = direct ? direct->take(packed.gbuffer, &frame.direct_stats) : std::move(*batched_direct);
   const double take_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   shading::RealtimeGiStats st;
-  frame.gi = shading::shade_gi_realtime(g, rt, assets, model.get(), model ? packed.decoder.get() : nullptr, has_transfer, fields,
-                                        realtime, &st, deterministic ? &frame.direct : nullptr, &packed.scratch, &lights, settings.mirror,
-                                        settings.near_field, batch_decoder);
+  frame.gi = shading::shade_gi_realtime({.gbuffer = g,
+                                         .scene = rt,
+                                         .assets = assets,
+                                         .fields = fields,
+                                         .settings = realtime,
+                                         .model = model.get(),
+                                         .decoder = model ? packed.decoder.get() : nullptr,
+                                         .has_transfer = has_transfer,
+                                         .batch_decoder = batch_decoder,
+                                         .mirror_lights = &lights,
+                                         .mirror = settings.mirror,
+                                         .near_field = settings.near_field},
+                                        {.stats = &st, .direct = deterministic ? &frame.direct : nullptr, .scratch = &packed.scratch});
   frame.gpu_inference_ms = st.inference_device_ms;
   GiStageTimes& t = frame.times;
   t.network_input = 0;  // inside the fused kernel, counted as inference

@@ -770,33 +770,30 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
 
 namespace {
 
-// What every stage of one real-time GI frame reads (shade_gi_realtime's
-// arguments), and the choices made once from them.
+// What every stage of one real-time GI frame reads: the request, and the
+// choices made once from it.
 struct GiFrameInputs {
-  const GBuffer& g;
-  const engine::rt::RtScene& scene;
-  const engine::scene::SceneAssets& assets;
-  const model::TransferModel* model;
-  const FusedDecoder* decoder;
-  const std::function<bool(engine::ecs::Entity)>& has_transfer;
-  std::span<const probes::ProbeField* const> fields;
-  const RealtimeGiSettings& settings;
-  const engine::render::LightSet* mirror_lights;
-  const MirrorRay& mirror;
-  const NearFieldRays& near_field;
-  TransferBatchDecoder* batch_decoder;
+  const RealtimeGiRequest& request;
   bool reuse = false;        // cells may take the previous frame's value (GiHistory)
-  bool with_direct = false;  // the probes' direct SH goes to direct_out too
+  bool with_direct = false;  // the probes' direct SH goes to the direct image too
   // Glossy dielectrics (MirrorRay::dielectric_max_roughness) take their
   // diffuse light from the probes' irradiance and their specular from a ray.
   bool reflections = false, glossy_dielectrics = false;
 
+  const GBuffer& g = request.gbuffer;
+  const engine::rt::RtScene& scene = request.scene;
+  const engine::scene::SceneAssets& assets = request.assets;
+  std::span<const probes::ProbeField* const> fields = request.fields;
+  const RealtimeGiSettings& settings = request.settings;
+  const MirrorRay& mirror = request.mirror;
+  const NearFieldRays& near_field = request.near_field;
+
   [[nodiscard]] bool is_glossy_dielectric(std::size_t p) const {
     return glossy_dielectrics && g.dielectric_roughness[p] <= mirror.dielectric_max_roughness;
   }
-  // Whether pixel p's sample is decoded by the network (else lit diffusely).
+  // Whether the network decodes entity e's samples (else they are lit diffusely).
   [[nodiscard]] bool network_decodes(engine::ecs::Entity e) const {
-    return model && decoder && (!has_transfer || has_transfer(e));
+    return request.model && request.decoder && (!request.has_transfer || request.has_transfer(e));
   }
 };
 
@@ -987,24 +984,24 @@ double decode_network_samples(const GiFrameInputs& in, RealtimeGiScratch::Impl& 
     }
   };
   double fill_seconds = 0;
-  ProbeLightMaker* maker = in.batch_decoder && in.settings.device_lights ? in.batch_decoder->probe_lights() : nullptr;
+  ProbeLightMaker* maker = in.request.batch_decoder && in.settings.device_lights ? in.request.batch_decoder->probe_lights() : nullptr;
   if (maker && !maker->set_probes(in.fields, static_cast<int>(rotated.count()),
                                   [&](int r, const probes::ProbeField* f, bool direct) { return rotated.sh(r, f, direct); }))
     maker = nullptr;  // more fields than the device takes: the CPU makes the lights
   if (maker)
     shade_transfer_device_lights(
-        *in.batch_decoder, *maker, *in.model, in.assets, sc.queries,
+        *in.request.batch_decoder, *maker, *in.request.model, in.assets, sc.queries,
         [&](std::size_t k) { return ProbeLightMaker::Point{sc.net_position[k], sc.rotation_of[k], sc.net_normal[k], 0.0f}; },
         shaded.data(), in.with_direct ? shaded_direct.data() : nullptr, &stats.inference_device_ms);
-  else if (in.batch_decoder)
-    fill_seconds = shade_transfer_batched(*in.batch_decoder, *in.model, in.assets, sc.queries, fill, shaded.data(),
+  else if (in.request.batch_decoder)
+    fill_seconds = shade_transfer_batched(*in.request.batch_decoder, *in.request.model, in.assets, sc.queries, fill, shaded.data(),
                                           in.with_direct ? shaded_direct.data() : nullptr, &stats.inference_device_ms);
   else
-    fill_seconds = shade_transfer_fused(*in.decoder, *in.model, in.assets, sc.queries, fill, shaded.data(),
+    fill_seconds = shade_transfer_fused(*in.request.decoder, *in.request.model, in.assets, sc.queries, fill, shaded.data(),
                                         in.with_direct ? shaded_direct.data() : nullptr);
   // Every sample's light is upsampled over its base colour (issue 37): a
   // demodulated model's already is; a format-1 model's is divided here.
-  const bool demodulated = in.model->demodulated;
+  const bool demodulated = in.request.model->demodulated;
   engine::jobs::parallel_for<std::size_t>(0, net.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       const glm::vec3 inv = demodulated ? glm::vec3(1.0f) : 1.0f / model::demodulation(in.g.albedo[sc.decode[net[k]]]);
@@ -1126,15 +1123,12 @@ void upsample_and_composite(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc
 
 }  // namespace
 
-engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
-                                          const engine::scene::SceneAssets& assets, const model::TransferModel* model,
-                                          const FusedDecoder* decoder,
-                                          const std::function<bool(engine::ecs::Entity)>& has_transfer,
-                                          std::span<const probes::ProbeField* const> fields,
-                                          const RealtimeGiSettings& settings, RealtimeGiStats* stats_out,
-                                          engine::image::ImageRGB* direct_out, RealtimeGiScratch* scratch,
-                                          const engine::render::LightSet* mirror_lights, const MirrorRay& mirror,
-                                          const NearFieldRays& near_field, TransferBatchDecoder* batch_decoder) {
+engine::image::ImageRGB shade_gi_realtime(const RealtimeGiRequest& request, const RealtimeGiOutputs& out) {
+  const GBuffer& g = request.gbuffer;
+  const std::span<const probes::ProbeField* const> fields = request.fields;
+  RealtimeGiStats* const stats_out = out.stats;
+  engine::image::ImageRGB* const direct_out = out.direct;
+  RealtimeGiScratch* const scratch = out.scratch;
   RealtimeGiStats stats;
   // A recycled image of the right size is not cleared: the upsampling below
   // writes every pixel.
@@ -1156,11 +1150,11 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
     throw std::invalid_argument("shade_gi_realtime: the G-buffer lacks its per-pixel arrays; make it with trace_gbuffer");
   RealtimeGiScratch local;
   RealtimeGiScratch::Impl& sc = *(scratch ? scratch : &local)->impl;
-  GiFrameInputs in{g, scene, assets, model, decoder, has_transfer, fields, settings, mirror_lights, mirror, near_field, batch_decoder};
-  in.reuse = settings.reuse_history && scratch != nullptr && g.camera.has_value();
-  in.with_direct = direct_out != nullptr;
-  in.reflections = mirror.max_roughness >= 0;
-  in.glossy_dielectrics = in.reflections && mirror.dielectric_max_roughness >= 0;
+  const GiFrameInputs in{request,
+                        request.settings.reuse_history && scratch != nullptr && g.camera.has_value(),
+                        direct_out != nullptr,
+                        request.mirror.max_roughness >= 0,
+                        request.mirror.max_roughness >= 0 && request.mirror.dielectric_max_roughness >= 0};
 
   auto t0 = Clock::now();
   plan_decode(in, sc, stats);
@@ -1193,13 +1187,13 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
   // The contact light, on the cells decoded this frame, before their values
   // become the next frame's history: a reused cell keeps the contact light
   // it was given when it was decoded, so the reuse still halves the work.
-  if (near_field.rays > 0) {
+  if (in.near_field.rays > 0) {
     t0 = Clock::now();
     // The lattice's cells need not be decoded this frame: their route as route_samples decides it.
     const std::function<bool(std::size_t)> skips_own = [&](std::size_t p) {
       return in.network_decodes(g.entity[p]) && !in.is_glossy_dielectric(p);
     };
-    add_contact_light(g, scene, fields, mirror_lights, near_field, sc.up, sc.decoded_cells, skips_own, sc.contact_gain,
+    add_contact_light(g, in.scene, fields, request.mirror_lights, in.near_field, sc.up, sc.decoded_cells, skips_own, sc.contact_gain,
                       in.reuse ? std::span<const std::int32_t>(sc.contact.track) : std::span<const std::int32_t>(),
                       in.reuse ? std::span<const std::uint8_t>(sc.contact.moved) : std::span<const std::uint8_t>(), sc.contact,
                       sc.value);
@@ -1213,9 +1207,9 @@ engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::Rt
 
   if (in.reflections) {
     t0 = Clock::now();
-    stats.reflection_rays = shade_metal_reflections(g, scene, fields, mirror, mirror_lights, image, direct_out);
+    stats.reflection_rays = shade_metal_reflections(g, in.scene, fields, in.mirror, request.mirror_lights, image, direct_out);
     if (in.glossy_dielectrics)
-      stats.reflection_rays += shade_dielectric_reflections(g, scene, fields, mirror_lights, mirror.dielectric_max_roughness,
+      stats.reflection_rays += shade_dielectric_reflections(g, in.scene, fields, request.mirror_lights, in.mirror.dielectric_max_roughness,
                                                             sc.dielectric_rays, image, direct_out);
     stats.reflect_ms = ms_since(t0);
   }

@@ -163,34 +163,48 @@ struct RealtimeGiStats {
   std::size_t reflection_rays = 0;                 // metals' (one a pixel) and glossy dielectrics' (one a 2x2 block at most)
 };
 
-// The GI image (output size = g's) from the probes of `fields` (a point
-// takes the first field whose grid holds it, else the first). Entities for
-// which has_transfer is false, or all of them if model is null, are shaded
-// diffusely: albedo / pi x irradiance. With direct_out, the probes' direct
-// sky and emitter light goes through the same transfer (or irradiance) and
-// upsampling and is added to it (an image of g's size holding the rest of
-// the direct light, or else made one of zeros): the real-time direct light
-// from everything but punctual lights and the split sun (see
-// realtime_direct.h). With
-// near_field.rays > 0, each decoded grid cell also gets the near field's
-// contact light (near_field.h; mirror_lights light its hits), filtered over
-// the grid; edge pixels decoded on their own do not. With batch_decoder (a
-// GPU backend's kernel) the network samples are decoded by it in one batch
-// instead of by `decoder` tile by tile. Unless mirror.max_roughness < 0,
-// metals and glossy dielectrics reflect by rays (MirrorRay): a metal's GI is
-// its ray's, a glossy dielectric's is its diffuse light from the probes plus
-// its filtered rays'; the sky and emitters those rays see, and not the
-// probes' direct SH through their transfer, are their direct light.
-engine::image::ImageRGB shade_gi_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
-                                          const engine::scene::SceneAssets& assets, const model::TransferModel* model,
-                                          const FusedDecoder* decoder,
-                                          const std::function<bool(engine::ecs::Entity)>& has_transfer,
-                                          std::span<const probes::ProbeField* const> fields,
-                                          const RealtimeGiSettings& settings, RealtimeGiStats* stats = nullptr,
-                                          engine::image::ImageRGB* direct_out = nullptr,
-                                          RealtimeGiScratch* scratch = nullptr,
-                                          const engine::render::LightSet* mirror_lights = nullptr, const MirrorRay& mirror = {},
-                                          const NearFieldRays& near_field = {},
-                                          TransferBatchDecoder* batch_decoder = nullptr);
+// What one real-time GI frame reads. Entities for which has_transfer is
+// false, or all of them if model or decoder is null, are shaded diffusely:
+// albedo / pi x irradiance. With near_field.rays > 0, each decoded grid cell
+// also gets the near field's contact light (near_field.h; mirror_lights light
+// its hits), filtered over the grid; edge pixels decoded on their own do not.
+// With batch_decoder (a GPU backend's kernel) the network samples are decoded
+// by it in one batch instead of by `decoder` tile by tile. Unless
+// mirror.max_roughness < 0, metals and glossy dielectrics reflect by rays
+// (MirrorRay): a metal's GI is its ray's, a glossy dielectric's is its
+// diffuse light from the probes plus its filtered rays'; the sky and
+// emitters those rays see, and not the probes' direct SH through their
+// transfer, are their direct light.
+struct RealtimeGiRequest {
+  const GBuffer& gbuffer;
+  const engine::rt::RtScene& scene;
+  const engine::scene::SceneAssets& assets;
+  // A point takes the first field whose grid holds it, else the first.
+  std::span<const probes::ProbeField* const> fields;
+  RealtimeGiSettings settings{};
+  const model::TransferModel* model = nullptr;
+  const FusedDecoder* decoder = nullptr;
+  std::function<bool(engine::ecs::Entity)> has_transfer{};
+  TransferBatchDecoder* batch_decoder = nullptr;
+  const engine::render::LightSet* mirror_lights = nullptr;
+  MirrorRay mirror{};
+  NearFieldRays near_field{};
+};
+
+// Where a real-time GI frame writes besides its image; each may be null.
+// With direct, the probes' direct sky and emitter light goes through the
+// same transfer (or irradiance) and upsampling and is added to it (an image
+// of the G-buffer's size holding the rest of the direct light, or else made
+// one of zeros): the real-time direct light from everything but punctual
+// lights and the split sun (see realtime_direct.h). scratch keeps storage
+// and the histories (the GI reuse's, the reflections') from frame to frame.
+struct RealtimeGiOutputs {
+  RealtimeGiStats* stats = nullptr;
+  engine::image::ImageRGB* direct = nullptr;
+  RealtimeGiScratch* scratch = nullptr;
+};
+
+// The GI image, of the G-buffer's size.
+engine::image::ImageRGB shade_gi_realtime(const RealtimeGiRequest& request, const RealtimeGiOutputs& out = {});
 
 }  // namespace transgi::shading
