@@ -203,52 +203,70 @@ void ProbeField::light_at_point(const glm::vec3& p, float* out, float* out_direc
   }
 }
 
-ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
-                                   const ProbeField* outer) {
+// One update's per-probe scratch, handed from stage to stage.
+struct ProbeField::UpdateWork {
+  std::uint64_t seed = 0;
+  bool classify = false;  // a classification frame: every probe traces
+  bool budgeted = false;  // only the budget's probes trace
+  std::vector<std::uint8_t> traced;                // per probe: it traces this frame
+  std::vector<int> tracing;                        // the probes that trace
+  std::vector<glm::vec3> directions;               // this frame's ray set
+  std::vector<std::vector<ShadedPoint>> points;    // per probe: what its rays found
+  std::vector<int> backfaces, hits;                // per probe: of its rays
+  std::vector<float> nearest;                      // per probe: its nearest hit
+  std::vector<float> direct_frame;                 // probes x 75: the sky and emitters its rays saw
+  std::atomic<std::size_t> nonfinite_rays{0};      // rare
+  std::vector<std::uint8_t> skip_this_frame;       // per probe: relocated, its rays left from elsewhere
+  std::vector<FrameSamples> samples;               // per updated probe: its map's samples this frame
+};
+
+bool ProbeField::takes_frame(const UpdateWork& w, int q) const {
+  const auto i = static_cast<std::size_t>(q);
+  return state_[i] == ProbeState::Active && (!w.budgeted || w.traced[i]) && !w.skip_this_frame[i];
+}
+
+void ProbeField::plan_update(UpdateWork& w) {
   using namespace engine;
-  ProbeFrameStats stats;
-  const ProbeGrid& grid = grid_;
-  const int probes = grid.count(), M = settings_.rays_per_probe;
-  const std::uint64_t seed = settings_.fixed_pattern ? 0x5EEDu : settings_.seed;
-  math::Pcg32 frame_rng = math::make_rng(seed, 0xF00D, frame_);
+  const int probes = grid_.count(), M = settings_.rays_per_probe;
+  w.seed = settings_.fixed_pattern ? 0x5EEDu : settings_.seed;
+  math::Pcg32 frame_rng = math::make_rng(w.seed, 0xF00D, frame_);
   const glm::quat rotation = settings_.fixed_pattern ? low_discrepancy_rotation(frame_) : random_rotation(frame_rng);
-  const bool classify = settings_.skip.classify && classify_pending_;
-  stats.classified = classify;
+  w.classify = settings_.skip.classify && classify_pending_;
   // A classification frame traces every probe, as buried and far probes may
   // have become useful; otherwise only the active ones do any work.
-  std::vector<std::uint8_t> traced(static_cast<std::size_t>(probes));
-  for (std::size_t q = 0; q < traced.size(); ++q)
-    traced[q] = classify || !settings_.skip.classify || state_[q] == ProbeState::Active;
+  w.traced.resize(static_cast<std::size_t>(probes));
+  for (std::size_t q = 0; q < w.traced.size(); ++q)
+    w.traced[q] = w.classify || !settings_.skip.classify || state_[q] == ProbeState::Active;
   last_traced_.resize(static_cast<std::size_t>(probes), 0);
   needs_classify_.resize(static_cast<std::size_t>(probes), 0);
   changed_.resize(static_cast<std::size_t>(probes), 0);
   const bool settling = frame_ < static_cast<std::uint64_t>(std::max(0, settings_.settle_frames));
-  const bool budgeted = settings_.update_budget > 0 && !classify && !settling;
-  if (budgeted) select_within_budget(traced);
-
-  // 1. Scatter and shade (reads the previous frame's SH for the feedback bounce).
-  auto t0 = Clock::now();
-  std::vector<std::vector<ShadedPoint>> points(static_cast<std::size_t>(probes));
-  std::vector<int> backfaces(static_cast<std::size_t>(probes), 0);
+  w.budgeted = settings_.update_budget > 0 && !w.classify && !settling;
+  if (w.budgeted) select_within_budget(w.traced);
+  w.directions.resize(static_cast<std::size_t>(M));
+  for (int i = 0; i < M; ++i) w.directions[static_cast<std::size_t>(i)] = glm::normalize(rotation * fibonacci_[static_cast<std::size_t>(i)]);
+  w.points.resize(static_cast<std::size_t>(probes));
+  w.backfaces.assign(static_cast<std::size_t>(probes), 0);
+  w.hits.assign(static_cast<std::size_t>(probes), 0);
+  w.nearest.assign(static_cast<std::size_t>(probes), std::numeric_limits<float>::infinity());
+  w.direct_frame.assign(static_cast<std::size_t>(probes) * 75, 0.0f);
+  w.skip_this_frame.assign(static_cast<std::size_t>(probes), 0);
   saw_light_.resize(static_cast<std::size_t>(probes), 0);
-  std::vector<float> nearest(static_cast<std::size_t>(probes), std::numeric_limits<float>::infinity());
-  // Hits per probe (each probe's rays are one thread's), summed below: a
-  // shared counter added to per ray bounces its cache line between cores.
-  std::vector<int> hits(static_cast<std::size_t>(probes), 0);
-  std::atomic<std::size_t> nonfinite_rays{0};  // rare
-  std::vector<float> direct_frame(static_cast<std::size_t>(probes) * 75, 0.0f);
-  // This frame's ray set, and the probes that trace it.
-  std::vector<glm::vec3> directions(static_cast<std::size_t>(M));
-  for (int i = 0; i < M; ++i) directions[static_cast<std::size_t>(i)] = glm::normalize(rotation * fibonacci_[static_cast<std::size_t>(i)]);
-  std::vector<int> tracing;
   for (int q = 0; q < probes; ++q)
-    if (traced[static_cast<std::size_t>(q)]) {
-      tracing.push_back(q);
-      points[static_cast<std::size_t>(q)].reserve(static_cast<std::size_t>(M));
+    if (w.traced[static_cast<std::size_t>(q)]) {
+      w.tracing.push_back(q);
+      w.points[static_cast<std::size_t>(q)].reserve(static_cast<std::size_t>(M));
       saw_light_[static_cast<std::size_t>(q)] = 0;
     }
+}
+
+void ProbeField::trace_and_shade(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                                 const ProbeField* outer, UpdateWork& w) {
+  using namespace engine;
+  const ProbeGrid& grid = grid_;
+  const int M = settings_.rays_per_probe;
   const auto ray_rng = [&](int q, int i) {
-    return math::make_rng(seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
+    return math::make_rng(w.seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
   };
   // Indirect light from last frame's probes at a probe ray's hit (multi-bounce feedback).
   const auto feedback = [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3&) {
@@ -258,135 +276,126 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   };
   // What each ray found, kept by the probe that shot it.
   const auto consume = [&](int q, int i, const ProbeRayHit& h) {
-        const glm::vec3& dir = directions[static_cast<std::size_t>(i)];
-        if (h.emitted != glm::vec3(0.0f)) {
-          // Monte Carlo projection over a near-uniform set: 4 pi / M per ray.
-          float* direct = direct_frame.data() + static_cast<std::size_t>(q) * 75;
-          const math::ShBasis y = math::sh_eval(dir);
-          const glm::vec3 e4 = h.emitted * (4.0f * math::kPi / static_cast<float>(M));
-          for (int c = 0; c < 3; ++c)
-            for (int k = 0; k < 25; ++k) direct[c * 25 + k] += e4[c] * y[static_cast<std::size_t>(k)];
-        }
-        ShadedPoint sp;
-        sp.direction = dir;
-        sp.distance = h.distance;
-        sp.position = h.position;
-        sp.radiance = h.radiance;
-        sp.normal = h.normal;
-        if (h.replaced_non_finite) nonfinite_rays.fetch_add(1, std::memory_order_relaxed);
-        if (h.hit) {
-          ++hits[static_cast<std::size_t>(q)];
-          backfaces[static_cast<std::size_t>(q)] += h.back_face ? 1 : 0;
-          nearest[static_cast<std::size_t>(q)] = std::min(nearest[static_cast<std::size_t>(q)], h.distance);
-        }
-        if (h.saw_light) saw_light_[static_cast<std::size_t>(q)] = 1;
-        points[static_cast<std::size_t>(q)].push_back(sp);
-      };
+    const auto qi = static_cast<std::size_t>(q);
+    const glm::vec3& dir = w.directions[static_cast<std::size_t>(i)];
+    if (h.emitted != glm::vec3(0.0f)) {
+      // Monte Carlo projection over a near-uniform set: 4 pi / M per ray.
+      float* direct = w.direct_frame.data() + qi * 75;
+      const math::ShBasis y = math::sh_eval(dir);
+      const glm::vec3 e4 = h.emitted * (4.0f * math::kPi / static_cast<float>(M));
+      for (int c = 0; c < 3; ++c)
+        for (int k = 0; k < 25; ++k) direct[c * 25 + k] += e4[c] * y[static_cast<std::size_t>(k)];
+    }
+    ShadedPoint sp;
+    sp.direction = dir;
+    sp.distance = h.distance;
+    sp.position = h.position;
+    sp.radiance = h.radiance;
+    sp.normal = h.normal;
+    if (h.replaced_non_finite) w.nonfinite_rays.fetch_add(1, std::memory_order_relaxed);
+    if (h.hit) {
+      ++w.hits[qi];
+      w.backfaces[qi] += h.back_face ? 1 : 0;
+      w.nearest[qi] = std::min(w.nearest[qi], h.distance);
+    }
+    if (h.saw_light) saw_light_[qi] = 1;
+    w.points[qi].push_back(sp);
+  };
   // The backend's device shades the rays where it can (the same random
   // numbers and bounce light as the CPU path below).
   const auto shade_on_device = [&] {
-    if (!kernels_ || tracing.empty()) return false;
+    if (!kernels_ || w.tracing.empty()) return false;
     std::vector<glm::vec3> origins;
-    origins.reserve(tracing.size());
-    for (const int q : tracing) origins.push_back(grid.position(q));
+    origins.reserve(w.tracing.size());
+    for (const int q : w.tracing) origins.push_back(grid.position(q));
     const auto source = [](const ProbeField& f) {
       return ProbeFeedbackSource{&f.grid_, f.settings_.map, &f.states_, f.sh_, f.usable_, f.settings_.interpolation};
     };
     const ProbeFeedbackSource self_source = source(*this);
     const ProbeFeedbackSource outer_source = outer ? source(*outer) : ProbeFeedbackSource{};
     std::vector<ProbeRayHit> shaded;
-    if (!kernels_->shade_probe_rays(scene, lights, origins, tracing, directions, seed, frame_ + 1,
+    if (!kernels_->shade_probe_rays(scene, lights, origins, w.tracing, w.directions, w.seed, frame_ + 1,
                                     frame_ > 0 ? &self_source : nullptr, outer ? &outer_source : nullptr, shaded))
       return false;
-    jobs::parallel_for(0, static_cast<int>(tracing.size()), 1, [&](int b, int e) {
+    jobs::parallel_for(0, static_cast<int>(w.tracing.size()), 1, [&](int b, int e) {
       for (int j = b; j < e; ++j)
         for (int i = 0; i < M; ++i)
-          consume(tracing[static_cast<std::size_t>(j)], i,
+          consume(w.tracing[static_cast<std::size_t>(j)], i,
                   shaded[static_cast<std::size_t>(j) * static_cast<std::size_t>(M) + static_cast<std::size_t>(i)]);
     });
     return true;
   };
   if (!shade_on_device())
     trace_probe_rays(
-        scene, lights, kernels_ ? kernels_->tracer() : nullptr, tracing, directions, [&](int q) { return grid.position(q); },
+        scene, lights, kernels_ ? kernels_->tracer() : nullptr, w.tracing, w.directions, [&](int q) { return grid.position(q); },
         ray_rng, feedback, consume);
-  for (std::uint8_t t : traced) stats.traced += t;
-  stats.rays = static_cast<std::size_t>(stats.traced) * static_cast<std::size_t>(M);
-  stats.hits = 0;
-  for (const int n : hits) stats.hits += static_cast<std::size_t>(n);
-  stats.nonfinite_rays = nonfinite_rays.load();
-  std::vector<std::uint8_t> skip_this_frame(static_cast<std::size_t>(probes), 0);  // relocated probes
-  if (classify || budgeted) {
-    const float far = settings_.skip.far_cells * glm::length(grid.spacing());
-    bool any_pending = classify;
-    for (std::size_t q = 0; q < state_.size() && !any_pending; ++q) any_pending = traced[q] && needs_classify_[q];
-    const OpenSpace open =
-        settings_.skip.open_space && any_pending ? find_open_space(scene, grid_, saw_light_, settings_.skip.relocation, kernels_ ? kernels_->tracer() : nullptr) : OpenSpace{};
-    if (!open.open.empty() && grid_.offsets.empty()) grid_.offsets.assign(state_.size(), glm::vec3(0.0f));
-    for (std::size_t q = 0; q < state_.size(); ++q) {
-      if (traced[q]) {
-        last_traced_[q] = frame_;
-        if (q < urgent_.size()) urgent_[q] = 0;
-      }
-      // Budgeted frames classify only the probes queued for it.
-      if (!classify && !(traced[q] && needs_classify_[q])) continue;
-      needs_classify_[q] = 0;
-      const bool buried = static_cast<float>(backfaces[q]) > settings_.skip.buried_backface_fraction * static_cast<float>(M) ||
-                          (!open.open.empty() && !open.open[q]);
-      bool moved = false;
-      if (!open.open.empty() && !buried && open.offsets[q] != grid_.offsets[q]) {
-        // This frame's rays left from where the probe stood: it starts afresh
-        // from its new place next frame.
-        grid_.offsets[q] = open.offsets[q];
-        moved = true;
-      }
-      const bool relocated = !grid_.offsets.empty() && grid_.offsets[q] != glm::vec3(0.0f);
-      state_[q] = buried ? ProbeState::Buried : nearest[q] > far && !relocated ? ProbeState::Far : ProbeState::Active;
-      if (moved) skip_this_frame[q] = 1;
-      usable_[q] = state_[q] == ProbeState::Active ? 1 : 0;
-      // Holds no light (and starts afresh if it becomes active again), or its
-      // light was gathered where it no longer stands.
-      if (moved || !usable_[q]) {
-        forget_light(static_cast<int>(q));
-        points[q].clear();
-      } else if (!states_[q].held()) {
-        // Active again: fresh maps (as forget_light left them when it was
-        // released); this frame's rays count.
-        states_[q].reset(settings_.map.texel_count(), depth_unit());
-      }
-      // No light, no maps.
-      if (!usable_[q]) states_[q].release();
-    }
-    classify_pending_ = false;
-  }
-  stats.scatter_ms = ms_since(t0);
+}
 
-  // 2. Share and rasterize.
-  t0 = Clock::now();
-  // Untraced probes (outside the budget) keep their state this frame.
-  auto updates = [&](int q) {
-    return state_[static_cast<std::size_t>(q)] == ProbeState::Active && (!budgeted || traced[static_cast<std::size_t>(q)]) &&
-           !skip_this_frame[static_cast<std::size_t>(q)];
-  };
+void ProbeField::classify_traced(const engine::rt::RtScene& scene, UpdateWork& w) {
+  const int M = settings_.rays_per_probe;
+  const float far = settings_.skip.far_cells * glm::length(grid_.spacing());
+  bool any_pending = w.classify;
+  for (std::size_t q = 0; q < state_.size() && !any_pending; ++q) any_pending = w.traced[q] && needs_classify_[q];
+  const OpenSpace open =
+      settings_.skip.open_space && any_pending ? find_open_space(scene, grid_, saw_light_, settings_.skip.relocation, kernels_ ? kernels_->tracer() : nullptr) : OpenSpace{};
+  if (!open.open.empty() && grid_.offsets.empty()) grid_.offsets.assign(state_.size(), glm::vec3(0.0f));
+  for (std::size_t q = 0; q < state_.size(); ++q) {
+    if (w.traced[q]) {
+      last_traced_[q] = frame_;
+      if (q < urgent_.size()) urgent_[q] = 0;
+    }
+    // Budgeted frames classify only the probes queued for it.
+    if (!w.classify && !(w.traced[q] && needs_classify_[q])) continue;
+    needs_classify_[q] = 0;
+    const bool buried = static_cast<float>(w.backfaces[q]) > settings_.skip.buried_backface_fraction * static_cast<float>(M) ||
+                        (!open.open.empty() && !open.open[q]);
+    bool moved = false;
+    if (!open.open.empty() && !buried && open.offsets[q] != grid_.offsets[q]) {
+      // This frame's rays left from where the probe stood: it starts afresh
+      // from its new place next frame.
+      grid_.offsets[q] = open.offsets[q];
+      moved = true;
+    }
+    const bool relocated = !grid_.offsets.empty() && grid_.offsets[q] != glm::vec3(0.0f);
+    state_[q] = buried ? ProbeState::Buried : w.nearest[q] > far && !relocated ? ProbeState::Far : ProbeState::Active;
+    if (moved) w.skip_this_frame[q] = 1;
+    usable_[q] = state_[q] == ProbeState::Active ? 1 : 0;
+    // Holds no light (and starts afresh if it becomes active again), or its
+    // light was gathered where it no longer stands.
+    if (moved || !usable_[q]) {
+      forget_light(static_cast<int>(q));
+      w.points[q].clear();
+    } else if (!states_[q].held()) {
+      // Active again: fresh maps (as forget_light left them when it was
+      // released); this frame's rays count.
+      states_[q].reset(settings_.map.texel_count(), depth_unit());
+    }
+    // No light, no maps.
+    if (!usable_[q]) states_[q].release();
+  }
+  classify_pending_ = false;
+}
+
+SharingStats ProbeField::share_and_raster(UpdateWork& w) {
+  const int probes = grid_.count();
   // Each probe's depth map from its own rays only: probes in parallel.
   engine::jobs::parallel_for(0, probes, 8, [&](int q0, int q1) {
     for (int q = q0; q < q1; ++q)
-      if (updates(q))
-        update_own_depth(states_[static_cast<std::size_t>(q)], settings_.map, points[static_cast<std::size_t>(q)], settings_.accumulation);
+      if (takes_frame(w, q))
+        update_own_depth(states_[static_cast<std::size_t>(q)], settings_.map, w.points[static_cast<std::size_t>(q)], settings_.accumulation);
   });
   std::vector<const DepthMap*> depth(static_cast<std::size_t>(probes));
   for (int q = 0; q < probes; ++q) depth[static_cast<std::size_t>(q)] = &states_[static_cast<std::size_t>(q)].depth;
-  std::vector<FrameSamples> frame;  // only the updated probes' maps are filled (and allocated)
   std::vector<std::uint8_t> targets(static_cast<std::size_t>(probes));
-  for (int q = 0; q < probes; ++q) targets[static_cast<std::size_t>(q)] = updates(q) ? 1 : 0;
-  const SharingStats ss = kernels_ ? kernels_->rasterize(grid, settings_.map, points, depth, settings_.sharing, frame, targets)
-                                   : rasterize_shared(grid, settings_.map, points, depth, settings_.sharing, frame, targets);
-  stats.shared_accepted = ss.accepted;
-  stats.shared_rejected = ss.rejected_by_guard;
-  stats.raster_ms = ms_since(t0);
+  for (int q = 0; q < probes; ++q) targets[static_cast<std::size_t>(q)] = takes_frame(w, q) ? 1 : 0;
+  // Only the updated probes' maps are filled (and allocated).
+  return kernels_ ? kernels_->rasterize(grid_, settings_.map, w.points, depth, settings_.sharing, w.samples, targets)
+                  : rasterize_shared(grid_, settings_.map, w.points, depth, settings_.sharing, w.samples, targets);
+}
 
-  // 3. Accumulate, fill, project.
-  t0 = Clock::now();
+int ProbeField::accumulate_and_project(UpdateWork& w) {
+  using namespace engine;
+  const int probes = grid_.count();
   std::atomic<int> bad_probes{0};
   // After probe q's map took its frame (changed: it detected a change of
   // light): its convergence and its direct-light mean.
@@ -399,14 +408,14 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
     const std::uint32_t frames = direct_frames_[static_cast<std::size_t>(q)] =
         std::min<std::uint32_t>(direct_frames_[static_cast<std::size_t>(q)] + 1, static_cast<std::uint32_t>(std::max(1, settings_.direct_history)));
     for (int k = 0; k < 75; ++k)
-      direct_mean_[at + k] += (direct_frame[at + k] - direct_mean_[at + k]) / static_cast<float>(frames);
+      direct_mean_[at + k] += (w.direct_frame[at + k] - direct_mean_[at + k]) / static_cast<float>(frames);
     std::copy_n(direct_mean_.data() + at, 75, direct_sh_.data() + at);
     if (settings_.direct_window) apply_hanning_window(direct_sh_.data() + at);
   };
   // Accumulates probe q's frame on the CPU; returns the filled map to project.
   auto accumulate_probe = [&](int q) {
     ProbeMapState& st = states_[static_cast<std::size_t>(q)];
-    after_accumulation(q, accumulate(st, frame[static_cast<std::size_t>(q)], settings_.accumulation));
+    after_accumulation(q, accumulate(st, w.samples[static_cast<std::size_t>(q)], settings_.accumulation));
     return filled_radiance(st, settings_.map, settings_.accumulation.fill_passes);
   };
   // After probe q's SH is projected into sh_.
@@ -428,47 +437,49 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
     // One probe at a time: its filled map stays in cache for the projection.
     jobs::parallel_for(0, probes, 1, [&](int b, int e) {
       for (int q = b; q < e; ++q) {
-        if (!updates(q)) continue;
+        if (!takes_frame(w, q)) continue;
         const auto filled = accumulate_probe(q);
         projector_.project(filled.data(), sh_.data() + static_cast<std::size_t>(q) * 75);
         finish_probe(q);
       }
     });
-  } else {
-    // Every updated probe's map in one batch for the backend.
-    std::vector<int> batch;
-    for (int q = 0; q < probes; ++q)
-      if (updates(q)) batch.push_back(q);
-    const auto texels = static_cast<std::size_t>(settings_.map.texel_count());
-    std::vector<glm::vec3> maps(batch.size() * texels);
-    std::vector<ProbeMapState*> batch_states;
-    std::vector<const FrameSamples*> batch_frames;
-    for (const int q : batch) {
-      batch_states.push_back(&states_[static_cast<std::size_t>(q)]);
-      batch_frames.push_back(&frame[static_cast<std::size_t>(q)]);
-    }
-    std::vector<std::uint8_t> batch_changed(batch.size());
-    if (kernels_->accumulate(settings_.map, batch_states, batch_frames, settings_.accumulation, batch_changed, maps)) {
-      jobs::parallel_for(0, static_cast<int>(batch.size()), 1, [&](int b, int e) {
-        for (int i = b; i < e; ++i) after_accumulation(batch[static_cast<std::size_t>(i)], batch_changed[static_cast<std::size_t>(i)] != 0);
-      });
-    } else {
-      jobs::parallel_for(0, static_cast<int>(batch.size()), 1, [&](int b, int e) {
-        for (int i = b; i < e; ++i) {
-          const auto filled = accumulate_probe(batch[static_cast<std::size_t>(i)]);
-          std::copy(filled.begin(), filled.end(), maps.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(i) * texels));
-        }
-      });
-    }
-    std::vector<float> projected(batch.size() * 75);
-    kernels_->project(projector_, maps, projected);
-    for (std::size_t i = 0; i < batch.size(); ++i) {
-      std::copy_n(projected.data() + i * 75, 75, sh_.data() + static_cast<std::size_t>(batch[i]) * 75);
-      finish_probe(batch[i]);
-    }
+    return bad_probes.load();
   }
-  stats.nonfinite_probes = bad_probes.load();
-  stats.project_ms = ms_since(t0);
+  // Every updated probe's map in one batch for the backend.
+  std::vector<int> batch;
+  for (int q = 0; q < probes; ++q)
+    if (takes_frame(w, q)) batch.push_back(q);
+  const auto texels = static_cast<std::size_t>(settings_.map.texel_count());
+  std::vector<glm::vec3> maps(batch.size() * texels);
+  std::vector<ProbeMapState*> batch_states;
+  std::vector<const FrameSamples*> batch_frames;
+  for (const int q : batch) {
+    batch_states.push_back(&states_[static_cast<std::size_t>(q)]);
+    batch_frames.push_back(&w.samples[static_cast<std::size_t>(q)]);
+  }
+  std::vector<std::uint8_t> batch_changed(batch.size());
+  if (kernels_->accumulate(settings_.map, batch_states, batch_frames, settings_.accumulation, batch_changed, maps)) {
+    jobs::parallel_for(0, static_cast<int>(batch.size()), 1, [&](int b, int e) {
+      for (int i = b; i < e; ++i) after_accumulation(batch[static_cast<std::size_t>(i)], batch_changed[static_cast<std::size_t>(i)] != 0);
+    });
+  } else {
+    jobs::parallel_for(0, static_cast<int>(batch.size()), 1, [&](int b, int e) {
+      for (int i = b; i < e; ++i) {
+        const auto filled = accumulate_probe(batch[static_cast<std::size_t>(i)]);
+        std::copy(filled.begin(), filled.end(), maps.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(i) * texels));
+      }
+    });
+  }
+  std::vector<float> projected(batch.size() * 75);
+  kernels_->project(projector_, maps, projected);
+  for (std::size_t i = 0; i < batch.size(); ++i) {
+    std::copy_n(projected.data() + i * 75, 75, sh_.data() + static_cast<std::size_t>(batch[i]) * 75);
+    finish_probe(batch[i]);
+  }
+  return bad_probes.load();
+}
+
+void ProbeField::update_means_and_counts(ProbeFrameStats& stats) {
   // The ambient term: the mean of the probes that hold light.
   std::fill(mean_sh_.begin(), mean_sh_.end(), 0.0f);
   std::fill(mean_direct_sh_.begin(), mean_direct_sh_.end(), 0.0f);
@@ -492,6 +503,39 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
     stats.far += state_[q] == ProbeState::Far;
     stats.relocated += !grid_.offsets.empty() && grid_.offsets[q] != glm::vec3(0.0f) && state_[q] != ProbeState::Buried;
   }
+}
+
+ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                                   const ProbeField* outer) {
+  ProbeFrameStats stats;
+  UpdateWork w;
+  plan_update(w);
+  stats.classified = w.classify;
+
+  // 1. Scatter and shade (reads the previous frame's SH for the feedback
+  // bounce), then classify what traced.
+  auto t0 = Clock::now();
+  trace_and_shade(scene, lights, outer, w);
+  for (std::uint8_t t : w.traced) stats.traced += t;
+  stats.rays = static_cast<std::size_t>(stats.traced) * static_cast<std::size_t>(settings_.rays_per_probe);
+  stats.hits = 0;
+  for (const int n : w.hits) stats.hits += static_cast<std::size_t>(n);
+  stats.nonfinite_rays = w.nonfinite_rays.load();
+  if (w.classify || w.budgeted) classify_traced(scene, w);
+  stats.scatter_ms = ms_since(t0);
+
+  // 2. Share and rasterize.
+  t0 = Clock::now();
+  const SharingStats ss = share_and_raster(w);
+  stats.shared_accepted = ss.accepted;
+  stats.shared_rejected = ss.rejected_by_guard;
+  stats.raster_ms = ms_since(t0);
+
+  // 3. Accumulate, fill, project.
+  t0 = Clock::now();
+  stats.nonfinite_probes = accumulate_and_project(w);
+  stats.project_ms = ms_since(t0);
+  update_means_and_counts(stats);
   ++frame_;
   return stats;
 }
