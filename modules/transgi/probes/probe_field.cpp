@@ -29,20 +29,14 @@ double ms_since(Clock::time_point t) { return std::chrono::duration<double, std:
 
 ProbeField::ProbeField(ProbeFieldSettings s)
     : settings_(s), grid_(s.grid), projector_(s.map), fibonacci_(spherical_fibonacci(s.rays_per_probe)) {
-  states_.resize(static_cast<std::size_t>(s.grid.count()));
-  for (auto& st : states_) st.reset(s.map.texel_count(), depth_unit());
-  state_.assign(states_.size(), ProbeState::Active);
-  usable_.assign(states_.size(), 1);
-  sh_.assign(static_cast<std::size_t>(s.grid.count()) * 75, 0.0f);
-  direct_mean_.assign(sh_.size(), 0.0f);
-  direct_sh_.assign(sh_.size(), 0.0f);
-  direct_frames_.assign(states_.size(), 0);
+  probes_.resize(static_cast<std::size_t>(s.grid.count()));
+  for (auto& st : probes_.maps) st.reset(s.map.texel_count(), depth_unit());
 }
 
-bool ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, float* out) const { return interpolate(p, n, sh_.data(), out); }
+bool ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, float* out) const { return interpolate(p, n, probes_.sh.data(), out); }
 
 bool ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float* probe_sh, float* out) const {
-  const InterpolationResult r = interpolate_probes(grid_, settings_.map, states_, p, n, settings_.interpolation, usable_);
+  const InterpolationResult r = interpolate_probes(grid_, settings_.map, probes_.maps, p, n, settings_.interpolation, probes_.usable);
   for (int k = 0; k < 75; ++k) out[k] = 0.0f;
   bool lit = false;
   for (std::size_t i = 0; i < 8; ++i) {
@@ -76,7 +70,7 @@ ENGINE_ISA_DISPATCH(void, blend_two, (const InterpolationResult& r, const float*
 
 bool ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float* sh_a, float* out_a, const float* sh_b,
                              float* out_b) const {
-  const InterpolationResult r = interpolate_probes(grid_, settings_.map, states_, p, n, settings_.interpolation, usable_);
+  const InterpolationResult r = interpolate_probes(grid_, settings_.map, probes_.maps, p, n, settings_.interpolation, probes_.usable);
   blend_two(r, sh_a, out_a, sh_b, out_b);
   if (r.fallback) return false;
   for (float w : r.weights)
@@ -91,25 +85,25 @@ glm::vec3 ProbeField::irradiance(const glm::vec3& p, const glm::vec3& n) const {
 }
 
 std::size_t ProbeField::memory_bytes() const {
-  std::size_t b = (sh_.size() + direct_mean_.size() + direct_sh_.size()) * sizeof(float) +
-                  direct_frames_.size() * sizeof(std::uint32_t);
-  for (const ProbeMapState& st : states_)
+  std::size_t b = (probes_.sh.size() + probes_.direct_mean.size() + probes_.direct_sh.size()) * sizeof(float) +
+                  probes_.direct_frames.size() * sizeof(std::uint32_t);
+  for (const ProbeMapState& st : probes_.maps)
     b += st.radiance.size() * sizeof(HalfRgb) + st.sampled.size() * sizeof(std::uint8_t) +
          st.depth.texels.size() * sizeof(DepthMap::Texel);
   return b;
 }
 
 void ProbeField::notify_scene_changed(bool geometry_moved) {
-  for (std::size_t q = 0; q < states_.size(); ++q) {
-    if (state_[q] == ProbeState::Converged) state_[q] = ProbeState::Active;
-    states_[q].stable_frames = 0;
-    if (geometry_moved) states_[q].depth_frames = 0;
+  for (std::size_t q = 0; q < probes_.maps.size(); ++q) {
+    if (probes_.state[q] == ProbeState::Converged) probes_.state[q] = ProbeState::Active;
+    probes_.maps[q].stable_frames = 0;
+    if (geometry_moved) probes_.maps[q].depth_frames = 0;
     // The direct light may have changed: keep a short history so the mean follows.
-    direct_frames_[q] = std::min<std::uint32_t>(direct_frames_[q], 4);
+    probes_.direct_frames[q] = std::min<std::uint32_t>(probes_.direct_frames[q], 4);
   }
   if (geometry_moved && settings_.skip.classify) {
     if (settings_.update_budget > 0 && !classify_pending_)
-      std::fill(needs_classify_.begin(), needs_classify_.end(), std::uint8_t{1});
+      std::fill(probes_.needs_classify.begin(), probes_.needs_classify.end(), std::uint8_t{1});
     else
       classify_pending_ = true;
   }
@@ -118,11 +112,10 @@ void ProbeField::notify_scene_changed(bool geometry_moved) {
 void ProbeField::notify_region_changed(const glm::vec3& lo, const glm::vec3& hi) {
   const ProbeGrid& grid = grid_;
   const glm::vec3 margin = grid.spacing();
-  urgent_.resize(states_.size(), 0);
   for (int q = 0; q < grid.count(); ++q) {
     const glm::vec3 p = grid.position(q);
     if (glm::all(glm::greaterThanEqual(p, lo - margin)) && glm::all(glm::lessThanEqual(p, hi + margin)))
-      urgent_[static_cast<std::size_t>(q)] = 1;
+      probes_.urgent[static_cast<std::size_t>(q)] = 1;
   }
 }
 
@@ -136,11 +129,11 @@ void ProbeField::select_within_budget(std::vector<std::uint8_t>& traced) const {
   std::vector<std::tuple<int, std::uint64_t, float, std::size_t, std::size_t>> order;  // (not urgent, last traced, distance^2, turn, probe)
   for (std::size_t q = 0; q < n; ++q) {
     traced[q] = 0;
-    const bool changed = settings_.changed_first && q < changed_.size() && changed_[q];
-    const int not_urgent = (q < urgent_.size() && urgent_[q]) || changed ? 0 : 1;
-    if (state_[q] == ProbeState::Active || needs_classify_[q]) {
+    const bool changed = settings_.changed_first && probes_.changed[q];
+    const int not_urgent = probes_.urgent[q] || changed ? 0 : 1;
+    if (probes_.state[q] == ProbeState::Active || probes_.needs_classify[q]) {
       const glm::vec3 d = has_focus_ ? grid_.grid_point(static_cast<int>(q)) - focus_ : glm::vec3(0.0f);
-      order.emplace_back(not_urgent, last_traced_[q], glm::dot(d, d), (q + n - offset) % n, q);
+      order.emplace_back(not_urgent, probes_.last_traced[q], glm::dot(d, d), (q + n - offset) % n, q);
     }
   }
   const std::size_t k = std::min(order.size(), static_cast<std::size_t>(settings_.update_budget));
@@ -150,35 +143,31 @@ void ProbeField::select_within_budget(std::vector<std::uint8_t>& traced) const {
 
 void ProbeField::forget_light(int probe) {
   const auto q = static_cast<std::size_t>(probe);
-  states_[q].reset(settings_.map.texel_count(), depth_unit());
-  std::fill_n(sh_.data() + q * 75, 75, 0.0f);
-  std::fill_n(direct_mean_.data() + q * 75, 75, 0.0f);
-  std::fill_n(direct_sh_.data() + q * 75, 75, 0.0f);
-  direct_frames_[q] = 0;
+  probes_.maps[q].reset(settings_.map.texel_count(), depth_unit());
+  std::fill_n(probes_.sh.data() + q * 75, 75, 0.0f);
+  std::fill_n(probes_.direct_mean.data() + q * 75, 75, 0.0f);
+  std::fill_n(probes_.direct_sh.data() + q * 75, 75, 0.0f);
+  probes_.direct_frames[q] = 0;
 }
 
 int ProbeField::scroll(glm::ivec3 cells, const ProbeField* seed) {
   if (cells == glm::ivec3(0)) return 0;
   settings_.grid.scroll_by(cells);
   grid_.scroll_by(cells);
-  const std::size_t n = states_.size();
-  last_traced_.resize(n, 0);
-  needs_classify_.resize(n, 0);
-  urgent_.resize(n, 0);
-  saw_light_.resize(n, 0);
+  const std::size_t n = probes_.maps.size();
   int entered = 0;
   for (std::size_t q = 0; q < n; ++q) {
     if (!grid_.entered_by_scroll(static_cast<int>(q), cells)) continue;
     ++entered;
     forget_light(static_cast<int>(q));
     if (!grid_.offsets.empty()) grid_.offsets[q] = glm::vec3(0.0f);
-    state_[q] = ProbeState::Active;
-    usable_[q] = 1;
-    saw_light_[q] = 0;
-    needs_classify_[q] = settings_.skip.classify ? 1 : 0;
-    urgent_[q] = 1;
-    last_traced_[q] = 0;
-    if (seed) seed->light_at_point(grid_.grid_point(static_cast<int>(q)), sh_.data() + q * 75, direct_sh_.data() + q * 75);
+    probes_.state[q] = ProbeState::Active;
+    probes_.usable[q] = 1;
+    probes_.saw_light[q] = 0;
+    probes_.needs_classify[q] = settings_.skip.classify ? 1 : 0;
+    probes_.urgent[q] = 1;
+    probes_.last_traced[q] = 0;
+    if (seed) seed->light_at_point(grid_.grid_point(static_cast<int>(q)), probes_.sh.data() + q * 75, probes_.direct_sh.data() + q * 75);
   }
   // Without a budget only a classification frame classifies: make the next one.
   if (settings_.skip.classify && settings_.update_budget <= 0) classify_pending_ = true;
@@ -190,15 +179,15 @@ void ProbeField::light_at_point(const glm::vec3& p, float* out, float* out_direc
   std::fill_n(out, 75, 0.0f);
   std::fill_n(out_direct, 75, 0.0f);
   float sum = 0;
-  for (std::size_t i = 0; i < 8; ++i) sum += usable_[static_cast<std::size_t>(cage.probes[i])] ? cage.weights[i] : 0.0f;
+  for (std::size_t i = 0; i < 8; ++i) sum += probes_.usable[static_cast<std::size_t>(cage.probes[i])] ? cage.weights[i] : 0.0f;
   if (!(sum > 0)) return;
   for (std::size_t i = 0; i < 8; ++i) {
     const auto q = static_cast<std::size_t>(cage.probes[i]);
-    if (!usable_[q] || cage.weights[i] == 0.0f) continue;
+    if (!probes_.usable[q] || cage.weights[i] == 0.0f) continue;
     const float w = cage.weights[i] / sum;
     for (int k = 0; k < 75; ++k) {
-      out[k] += w * sh_[q * 75 + static_cast<std::size_t>(k)];
-      out_direct[k] += w * direct_sh_[q * 75 + static_cast<std::size_t>(k)];
+      out[k] += w * probes_.sh[q * 75 + static_cast<std::size_t>(k)];
+      out_direct[k] += w * probes_.direct_sh[q * 75 + static_cast<std::size_t>(k)];
     }
   }
 }
@@ -222,7 +211,7 @@ struct ProbeField::UpdateWork {
 
 bool ProbeField::takes_frame(const UpdateWork& w, int q) const {
   const auto i = static_cast<std::size_t>(q);
-  return state_[i] == ProbeState::Active && (!w.budgeted || w.traced[i]) && !w.skip_this_frame[i];
+  return probes_.state[i] == ProbeState::Active && (!w.budgeted || w.traced[i]) && !w.skip_this_frame[i];
 }
 
 void ProbeField::plan_update(UpdateWork& w) {
@@ -236,10 +225,7 @@ void ProbeField::plan_update(UpdateWork& w) {
   // have become useful; otherwise only the active ones do any work.
   w.traced.resize(static_cast<std::size_t>(probes));
   for (std::size_t q = 0; q < w.traced.size(); ++q)
-    w.traced[q] = w.classify || !settings_.skip.classify || state_[q] == ProbeState::Active;
-  last_traced_.resize(static_cast<std::size_t>(probes), 0);
-  needs_classify_.resize(static_cast<std::size_t>(probes), 0);
-  changed_.resize(static_cast<std::size_t>(probes), 0);
+    w.traced[q] = w.classify || !settings_.skip.classify || probes_.state[q] == ProbeState::Active;
   const bool settling = frame_ < static_cast<std::uint64_t>(std::max(0, settings_.settle_frames));
   w.budgeted = settings_.update_budget > 0 && !w.classify && !settling;
   if (w.budgeted) select_within_budget(w.traced);
@@ -251,12 +237,11 @@ void ProbeField::plan_update(UpdateWork& w) {
   w.nearest.assign(static_cast<std::size_t>(probes), std::numeric_limits<float>::infinity());
   w.direct_frame.assign(static_cast<std::size_t>(probes) * 75, 0.0f);
   w.skip_this_frame.assign(static_cast<std::size_t>(probes), 0);
-  saw_light_.resize(static_cast<std::size_t>(probes), 0);
   for (int q = 0; q < probes; ++q)
     if (w.traced[static_cast<std::size_t>(q)]) {
       w.tracing.push_back(q);
       w.points[static_cast<std::size_t>(q)].reserve(static_cast<std::size_t>(M));
-      saw_light_[static_cast<std::size_t>(q)] = 0;
+      probes_.saw_light[static_cast<std::size_t>(q)] = 0;
     }
 }
 
@@ -298,7 +283,7 @@ void ProbeField::trace_and_shade(const engine::rt::RtScene& scene, const engine:
       w.backfaces[qi] += h.back_face ? 1 : 0;
       w.nearest[qi] = std::min(w.nearest[qi], h.distance);
     }
-    if (h.saw_light) saw_light_[qi] = 1;
+    if (h.saw_light) probes_.saw_light[qi] = 1;
     w.points[qi].push_back(sp);
   };
   // The backend's device shades the rays where it can (the same random
@@ -309,7 +294,7 @@ void ProbeField::trace_and_shade(const engine::rt::RtScene& scene, const engine:
     origins.reserve(w.tracing.size());
     for (const int q : w.tracing) origins.push_back(grid.position(q));
     const auto source = [](const ProbeField& f) {
-      return ProbeFeedbackSource{&f.grid_, f.settings_.map, &f.states_, f.sh_, f.usable_, f.settings_.interpolation};
+      return ProbeFeedbackSource{&f.grid_, f.settings_.map, &f.probes_.maps, f.probes_.sh, f.probes_.usable, f.settings_.interpolation};
     };
     const ProbeFeedbackSource self_source = source(*this);
     const ProbeFeedbackSource outer_source = outer ? source(*outer) : ProbeFeedbackSource{};
@@ -335,18 +320,18 @@ void ProbeField::classify_traced(const engine::rt::RtScene& scene, UpdateWork& w
   const int M = settings_.rays_per_probe;
   const float far = settings_.skip.far_cells * glm::length(grid_.spacing());
   bool any_pending = w.classify;
-  for (std::size_t q = 0; q < state_.size() && !any_pending; ++q) any_pending = w.traced[q] && needs_classify_[q];
+  for (std::size_t q = 0; q < probes_.state.size() && !any_pending; ++q) any_pending = w.traced[q] && probes_.needs_classify[q];
   const OpenSpace open =
-      settings_.skip.open_space && any_pending ? find_open_space(scene, grid_, saw_light_, settings_.skip.relocation, kernels_ ? kernels_->tracer() : nullptr) : OpenSpace{};
-  if (!open.open.empty() && grid_.offsets.empty()) grid_.offsets.assign(state_.size(), glm::vec3(0.0f));
-  for (std::size_t q = 0; q < state_.size(); ++q) {
+      settings_.skip.open_space && any_pending ? find_open_space(scene, grid_, probes_.saw_light, settings_.skip.relocation, kernels_ ? kernels_->tracer() : nullptr) : OpenSpace{};
+  if (!open.open.empty() && grid_.offsets.empty()) grid_.offsets.assign(probes_.state.size(), glm::vec3(0.0f));
+  for (std::size_t q = 0; q < probes_.state.size(); ++q) {
     if (w.traced[q]) {
-      last_traced_[q] = frame_;
-      if (q < urgent_.size()) urgent_[q] = 0;
+      probes_.last_traced[q] = frame_;
+      probes_.urgent[q] = 0;
     }
     // Budgeted frames classify only the probes queued for it.
-    if (!w.classify && !(w.traced[q] && needs_classify_[q])) continue;
-    needs_classify_[q] = 0;
+    if (!w.classify && !(w.traced[q] && probes_.needs_classify[q])) continue;
+    probes_.needs_classify[q] = 0;
     const bool buried = static_cast<float>(w.backfaces[q]) > settings_.skip.buried_backface_fraction * static_cast<float>(M) ||
                         (!open.open.empty() && !open.open[q]);
     bool moved = false;
@@ -357,21 +342,21 @@ void ProbeField::classify_traced(const engine::rt::RtScene& scene, UpdateWork& w
       moved = true;
     }
     const bool relocated = !grid_.offsets.empty() && grid_.offsets[q] != glm::vec3(0.0f);
-    state_[q] = buried ? ProbeState::Buried : w.nearest[q] > far && !relocated ? ProbeState::Far : ProbeState::Active;
+    probes_.state[q] = buried ? ProbeState::Buried : w.nearest[q] > far && !relocated ? ProbeState::Far : ProbeState::Active;
     if (moved) w.skip_this_frame[q] = 1;
-    usable_[q] = state_[q] == ProbeState::Active ? 1 : 0;
+    probes_.usable[q] = probes_.state[q] == ProbeState::Active ? 1 : 0;
     // Holds no light (and starts afresh if it becomes active again), or its
     // light was gathered where it no longer stands.
-    if (moved || !usable_[q]) {
+    if (moved || !probes_.usable[q]) {
       forget_light(static_cast<int>(q));
       w.points[q].clear();
-    } else if (!states_[q].held()) {
+    } else if (!probes_.maps[q].held()) {
       // Active again: fresh maps (as forget_light left them when it was
       // released); this frame's rays count.
-      states_[q].reset(settings_.map.texel_count(), depth_unit());
+      probes_.maps[q].reset(settings_.map.texel_count(), depth_unit());
     }
     // No light, no maps.
-    if (!usable_[q]) states_[q].release();
+    if (!probes_.usable[q]) probes_.maps[q].release();
   }
   classify_pending_ = false;
 }
@@ -382,10 +367,10 @@ SharingStats ProbeField::share_and_raster(UpdateWork& w) {
   engine::jobs::parallel_for(0, probes, 8, [&](int q0, int q1) {
     for (int q = q0; q < q1; ++q)
       if (takes_frame(w, q))
-        update_own_depth(states_[static_cast<std::size_t>(q)], settings_.map, w.points[static_cast<std::size_t>(q)], settings_.accumulation);
+        update_own_depth(probes_.maps[static_cast<std::size_t>(q)], settings_.map, w.points[static_cast<std::size_t>(q)], settings_.accumulation);
   });
   std::vector<const DepthMap*> depth(static_cast<std::size_t>(probes));
-  for (int q = 0; q < probes; ++q) depth[static_cast<std::size_t>(q)] = &states_[static_cast<std::size_t>(q)].depth;
+  for (int q = 0; q < probes; ++q) depth[static_cast<std::size_t>(q)] = &probes_.maps[static_cast<std::size_t>(q)].depth;
   std::vector<std::uint8_t> targets(static_cast<std::size_t>(probes));
   for (int q = 0; q < probes; ++q) targets[static_cast<std::size_t>(q)] = takes_frame(w, q) ? 1 : 0;
   // Only the updated probes' maps are filled (and allocated).
@@ -400,32 +385,32 @@ int ProbeField::accumulate_and_project(UpdateWork& w) {
   // After probe q's map took its frame (changed: it detected a change of
   // light): its convergence and its direct-light mean.
   auto after_accumulation = [&](int q, bool changed) {
-    const ProbeMapState& st = states_[static_cast<std::size_t>(q)];
-    changed_[static_cast<std::size_t>(q)] = changed ? 1 : 0;
+    const ProbeMapState& st = probes_.maps[static_cast<std::size_t>(q)];
+    probes_.changed[static_cast<std::size_t>(q)] = changed ? 1 : 0;
     if (settings_.skip.skip_converged && st.stable_frames >= settings_.skip.settle_frames)
-      state_[static_cast<std::size_t>(q)] = ProbeState::Converged;
+      probes_.state[static_cast<std::size_t>(q)] = ProbeState::Converged;
     const std::size_t at = static_cast<std::size_t>(q) * 75;
-    const std::uint32_t frames = direct_frames_[static_cast<std::size_t>(q)] =
-        std::min<std::uint32_t>(direct_frames_[static_cast<std::size_t>(q)] + 1, static_cast<std::uint32_t>(std::max(1, settings_.direct_history)));
+    const std::uint32_t frames = probes_.direct_frames[static_cast<std::size_t>(q)] =
+        std::min<std::uint32_t>(probes_.direct_frames[static_cast<std::size_t>(q)] + 1, static_cast<std::uint32_t>(std::max(1, settings_.direct_history)));
     for (int k = 0; k < 75; ++k)
-      direct_mean_[at + k] += (w.direct_frame[at + k] - direct_mean_[at + k]) / static_cast<float>(frames);
-    std::copy_n(direct_mean_.data() + at, 75, direct_sh_.data() + at);
-    if (settings_.direct_window) apply_hanning_window(direct_sh_.data() + at);
+      probes_.direct_mean[at + k] += (w.direct_frame[at + k] - probes_.direct_mean[at + k]) / static_cast<float>(frames);
+    std::copy_n(probes_.direct_mean.data() + at, 75, probes_.direct_sh.data() + at);
+    if (settings_.direct_window) apply_hanning_window(probes_.direct_sh.data() + at);
   };
   // Accumulates probe q's frame on the CPU; returns the filled map to project.
   auto accumulate_probe = [&](int q) {
-    ProbeMapState& st = states_[static_cast<std::size_t>(q)];
+    ProbeMapState& st = probes_.maps[static_cast<std::size_t>(q)];
     after_accumulation(q, accumulate(st, w.samples[static_cast<std::size_t>(q)], settings_.accumulation));
     return filled_radiance(st, settings_.map, settings_.accumulation.fill_passes);
   };
-  // After probe q's SH is projected into sh_.
+  // After probe q's SH is projected into probes_.sh.
   auto finish_probe = [&](int q) {
     const std::size_t at = static_cast<std::size_t>(q) * 75;
-    float* out = sh_.data() + at;
+    float* out = probes_.sh.data() + at;
     if (settings_.window) apply_hanning_window(out);
     bool finite = true;
     for (int k = 0; k < 75; ++k)
-      finite = finite && std::isfinite(out[k]) && std::isfinite(direct_sh_[at + k]) && std::isfinite(direct_mean_[at + k]);
+      finite = finite && std::isfinite(out[k]) && std::isfinite(probes_.direct_sh[at + k]) && std::isfinite(probes_.direct_mean[at + k]);
     if (!finite) {
       // A value that got past the ray guards (an overflowing sum): this
       // probe's light is unusable, so it starts afresh rather than spread it.
@@ -439,7 +424,7 @@ int ProbeField::accumulate_and_project(UpdateWork& w) {
       for (int q = b; q < e; ++q) {
         if (!takes_frame(w, q)) continue;
         const auto filled = accumulate_probe(q);
-        projector_.project(filled.data(), sh_.data() + static_cast<std::size_t>(q) * 75);
+        projector_.project(filled.data(), probes_.sh.data() + static_cast<std::size_t>(q) * 75);
         finish_probe(q);
       }
     });
@@ -454,7 +439,7 @@ int ProbeField::accumulate_and_project(UpdateWork& w) {
   std::vector<ProbeMapState*> batch_states;
   std::vector<const FrameSamples*> batch_frames;
   for (const int q : batch) {
-    batch_states.push_back(&states_[static_cast<std::size_t>(q)]);
+    batch_states.push_back(&probes_.maps[static_cast<std::size_t>(q)]);
     batch_frames.push_back(&w.samples[static_cast<std::size_t>(q)]);
   }
   std::vector<std::uint8_t> batch_changed(batch.size());
@@ -473,7 +458,7 @@ int ProbeField::accumulate_and_project(UpdateWork& w) {
   std::vector<float> projected(batch.size() * 75);
   kernels_->project(projector_, maps, projected);
   for (std::size_t i = 0; i < batch.size(); ++i) {
-    std::copy_n(projected.data() + i * 75, 75, sh_.data() + static_cast<std::size_t>(batch[i]) * 75);
+    std::copy_n(projected.data() + i * 75, 75, probes_.sh.data() + static_cast<std::size_t>(batch[i]) * 75);
     finish_probe(batch[i]);
   }
   return bad_probes.load();
@@ -484,24 +469,24 @@ void ProbeField::update_means_and_counts(ProbeFrameStats& stats) {
   std::fill(mean_sh_.begin(), mean_sh_.end(), 0.0f);
   std::fill(mean_direct_sh_.begin(), mean_direct_sh_.end(), 0.0f);
   std::size_t lit = 0;
-  for (std::size_t q = 0; q < state_.size(); ++q) {
-    if (!usable_[q]) continue;
+  for (std::size_t q = 0; q < probes_.state.size(); ++q) {
+    if (!probes_.usable[q]) continue;
     ++lit;
     for (std::size_t k = 0; k < 75; ++k) {
-      mean_sh_[k] += sh_[q * 75 + k];
-      mean_direct_sh_[k] += direct_sh_[q * 75 + k];
+      mean_sh_[k] += probes_.sh[q * 75 + k];
+      mean_direct_sh_[k] += probes_.direct_sh[q * 75 + k];
     }
   }
   for (std::size_t k = 0; k < 75 && lit > 0; ++k) {
     mean_sh_[k] /= static_cast<float>(lit);
     mean_direct_sh_[k] /= static_cast<float>(lit);
   }
-  for (std::size_t q = 0; q < state_.size(); ++q) {
-    stats.active += state_[q] == ProbeState::Active;
-    stats.converged += state_[q] == ProbeState::Converged;
-    stats.buried += state_[q] == ProbeState::Buried;
-    stats.far += state_[q] == ProbeState::Far;
-    stats.relocated += !grid_.offsets.empty() && grid_.offsets[q] != glm::vec3(0.0f) && state_[q] != ProbeState::Buried;
+  for (std::size_t q = 0; q < probes_.state.size(); ++q) {
+    stats.active += probes_.state[q] == ProbeState::Active;
+    stats.converged += probes_.state[q] == ProbeState::Converged;
+    stats.buried += probes_.state[q] == ProbeState::Buried;
+    stats.far += probes_.state[q] == ProbeState::Far;
+    stats.relocated += !grid_.offsets.empty() && grid_.offsets[q] != glm::vec3(0.0f) && probes_.state[q] != ProbeState::Buried;
   }
 }
 

@@ -165,6 +165,41 @@ struct ProbeFrameStats {
   }
 };
 
+// Every probe's data, one entry a probe (75 floats a probe for the SH),
+// sized together by resize so that no per-probe array falls out of step.
+struct ProbeSet {
+  std::vector<ProbeMapState> maps;           // radiance and depth maps
+  std::vector<ProbeState> state;
+  std::vector<std::uint8_t> usable;          // 1 unless buried or far (read by interpolation)
+  std::vector<std::uint8_t> saw_light;       // from its latest traced frame (open_space.h)
+  // Budgeted updates: the frame each probe last traced, and whether it
+  // must be classified again when next traced.
+  std::vector<std::uint64_t> last_traced;
+  std::vector<std::uint8_t> needs_classify;
+  std::vector<std::uint8_t> urgent;          // in a changed region, not yet traced since
+  std::vector<std::uint8_t> changed;         // its last update detected a lighting change (changed_first)
+  std::vector<float> sh;                     // x 75: indirect light
+  std::vector<float> direct_mean, direct_sh;  // x 75: the sky and emitters' running mean, and that windowed
+  std::vector<std::uint32_t> direct_frames;  // frames in each probe's running mean
+
+  // count probes, active and usable, holding nothing.
+  void resize(std::size_t count) {
+    maps.resize(count);
+    state.assign(count, ProbeState::Active);
+    usable.assign(count, 1);
+    saw_light.assign(count, 0);
+    last_traced.assign(count, 0);
+    needs_classify.assign(count, 0);
+    urgent.assign(count, 0);
+    changed.assign(count, 0);
+    sh.assign(count * 75, 0.0f);
+    direct_mean.assign(count * 75, 0.0f);
+    direct_sh.assign(count * 75, 0.0f);
+    direct_frames.assign(count, 0);
+  }
+  [[nodiscard]] std::size_t count() const { return state.size(); }
+};
+
 class ProbeField {
  public:
   explicit ProbeField(ProbeFieldSettings settings);
@@ -206,7 +241,7 @@ class ProbeField {
                            std::uint64_t seed);
 
   // 75 SH coefficients of probe i, [c * 25 + k], world space.
-  [[nodiscard]] const float* light_sh(int probe) const { return sh_.data() + static_cast<std::size_t>(probe) * 75; }
+  [[nodiscard]] const float* light_sh(int probe) const { return probes_.sh.data() + static_cast<std::size_t>(probe) * 75; }
   // Interpolated SH light at a surface point (pruned trilinear). Each
   // overload returns whether probes that hold light and see the point
   // weighed in: false where every probe around p is buried or far (out all
@@ -224,13 +259,13 @@ class ProbeField {
   [[nodiscard]] const float* mean_light_sh() const { return mean_sh_.data(); }
   [[nodiscard]] const float* mean_direct_sh() const { return mean_direct_sh_.data(); }
   // The direct sky and emitter light of every probe, probes x 75, world space.
-  [[nodiscard]] const std::vector<float>& direct_sh_all() const { return direct_sh_; }
+  [[nodiscard]] const std::vector<float>& direct_sh_all() const { return probes_.direct_sh; }
   // The same weights applied to another copy of the probes' SH (probes x 75,
   // e.g. rotated into an object's frame: interpolation is linear, so rotating
   // the probes once equals rotating every interpolated result).
   bool interpolate(const glm::vec3& position, const glm::vec3& normal, const float* probe_sh, float* out75) const;
   // All probes' SH, probes x 75, world space.
-  [[nodiscard]] const std::vector<float>& light_sh_all() const { return sh_; }
+  [[nodiscard]] const std::vector<float>& light_sh_all() const { return probes_.sh; }
   // Irradiance from the interpolated SH (clamped-cosine convolution).
   [[nodiscard]] glm::vec3 irradiance(const glm::vec3& position, const glm::vec3& normal) const;
 
@@ -245,13 +280,13 @@ class ProbeField {
   // settings().grid with each probe where relocation moved it.
   [[nodiscard]] const ProbeGrid& grid() const { return grid_; }
   [[nodiscard]] std::uint64_t frame() const { return frame_; }
-  [[nodiscard]] const std::vector<ProbeMapState>& states() const { return states_; }
-  [[nodiscard]] ProbeState state(int probe) const { return state_[static_cast<std::size_t>(probe)]; }
+  [[nodiscard]] const std::vector<ProbeMapState>& states() const { return probes_.maps; }
+  [[nodiscard]] ProbeState state(int probe) const { return probes_.state[static_cast<std::size_t>(probe)]; }
   // Per probe, 1 unless buried or far: what interpolation weighs.
-  [[nodiscard]] const std::vector<std::uint8_t>& usable() const { return usable_; }
+  [[nodiscard]] const std::vector<std::uint8_t>& usable() const { return probes_.usable; }
   // The frame probe last traced rays (budgeted fields; 0 before it ever did).
   [[nodiscard]] std::uint64_t last_traced(int probe) const {
-    return static_cast<std::size_t>(probe) < last_traced_.size() ? last_traced_[static_cast<std::size_t>(probe)] : 0;
+    return static_cast<std::size_t>(probe) < probes_.last_traced.size() ? probes_.last_traced[static_cast<std::size_t>(probe)] : 0;
   }
   // Bytes held by the probes' maps, depth moments and SH.
   [[nodiscard]] std::size_t memory_bytes() const;
@@ -291,20 +326,8 @@ class ProbeField {
   MapProjector projector_;
   // The length probe depths are stored in units of (ProbeMapState::reset).
   [[nodiscard]] float depth_unit() const { return grid_.min_spacing() > 0 ? grid_.min_spacing() : 1.0f; }
-  std::vector<ProbeMapState> states_;
-  std::vector<ProbeState> state_;
-  std::vector<std::uint8_t> usable_;  // 1 unless buried or far (read by interpolation)
-  std::vector<std::uint8_t> saw_light_;  // per probe, from its latest traced frame (open_space.h)
+  ProbeSet probes_;
   bool classify_pending_ = true;
-  // Budgeted updates: the frame each probe last traced, and which probes
-  // must be classified again when next traced.
-  std::vector<std::uint64_t> last_traced_;
-  std::vector<std::uint8_t> needs_classify_;
-  std::vector<std::uint8_t> urgent_;  // in a changed region, not yet traced since
-  std::vector<std::uint8_t> changed_;  // its last update detected a lighting change (changed_first)
-  std::vector<float> sh_;  // probes x 75
-  std::vector<float> direct_mean_, direct_sh_;  // probes x 75: running mean, and that windowed
-  std::vector<std::uint32_t> direct_frames_;    // frames in each probe's running mean
   std::vector<float> mean_sh_ = std::vector<float>(75, 0.0f), mean_direct_sh_ = std::vector<float>(75, 0.0f);
   std::vector<glm::vec3> fibonacci_;
   std::uint64_t frame_ = 0;

@@ -22,8 +22,8 @@ void ProbeField::replace_with_oracle(const engine::rt::RtScene& scene, const eng
   core::ProgressBar bar("oracle probes (" + std::to_string(side * side) + " paths per texel)", static_cast<std::uint64_t>(probes));
   for (int q = 0; q < probes; ++q) {
     bar.update(static_cast<std::uint64_t>(q));
-    if (!usable_[static_cast<std::size_t>(q)]) continue;
-    ProbeMapState& st = states_[static_cast<std::size_t>(q)];
+    if (!probes_.usable[static_cast<std::size_t>(q)]) continue;
+    ProbeMapState& st = probes_.maps[static_cast<std::size_t>(q)];
     st.reset(texels, depth_unit());
     std::vector<glm::vec3> radiance(static_cast<std::size_t>(texels));
     const glm::vec3 origin = grid_.position(q);
@@ -67,8 +67,8 @@ void ProbeField::replace_with_oracle(const engine::rt::RtScene& scene, const eng
     for (const glm::vec3& v : radiance) peak = std::max(peak, std::max(v.r, std::max(v.g, v.b)));
     st.radiance_scale = fitted_scale(st.radiance_scale, peak);  // the state was just reset: nothing to rescale
     for (std::size_t t = 0; t < radiance.size(); ++t) st.set_radiance(t, radiance[t]);
-    projector_.project(radiance.data(), sh_.data() + static_cast<std::size_t>(q) * 75);
-    if (settings_.window) apply_hanning_window(sh_.data() + static_cast<std::size_t>(q) * 75);
+    projector_.project(radiance.data(), probes_.sh.data() + static_cast<std::size_t>(q) * 75);
+    if (settings_.window) apply_hanning_window(probes_.sh.data() + static_cast<std::size_t>(q) * 75);
   }
   bar.finish();
 }
