@@ -1,0 +1,334 @@
+#include "shading/realtime_reflections.h"
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include "engine/jobs/parallel_for.h"
+#include "engine/material/specular_albedo.h"
+#include "engine/math/rng.h"
+#include "probes/cascades.h"
+#include "shading/sh_light.h"
+
+namespace transgi::shading {
+
+// The directional albedo of a dielectric's specular layer towards the
+// viewer, per channel: the mean weight of its reflection rays.
+glm::vec3 specular_layer_albedo(const GSample& s) {
+  using namespace engine::material;
+  const float cos_o = std::clamp(glm::dot(s.normal_world, s.wo_world), 0.0f, 1.0f);
+  const SpecularAlbedo e = ggx_albedo(cos_o, std::max(s.brdf.roughness * s.brdf.roughness, kMinAlpha));
+  const glm::vec3 f0 = glm::min(kDielectricF0 * s.brdf.specular_color, glm::vec3(1.0f));
+  return s.brdf.specular * glm::vec3(e.with_f0(f0.r), e.with_f0(f0.g), e.with_f0(f0.b));
+}
+
+void ReflectionHistory::begin(const GBuffer& g) {
+  const Frame& prev = frames_[current_ ^ 1];
+  has_prev_ = prev.camera && g.camera && prev.width == g.width && prev.height == g.height;
+  Frame& next = frames_[current_];
+  next.width = g.width;
+  next.height = g.height;
+  next.jitter = g.jitter;
+  next.camera = g.camera;
+  next.frames.assign(g.samples.size(), 0);
+  next.position.resize(g.samples.size());
+  next.direct.resize(g.samples.size());
+  next.gi.resize(g.samples.size());
+  spread_ = g.camera ? g.camera->pixel_spread() : 0.0f;
+}
+
+void ReflectionHistory::blend(const GBuffer& g, std::size_t p, glm::vec3& direct, glm::vec3& gi) {
+  const Frame& prev = frames_[current_ ^ 1];
+  Frame& next = frames_[current_];
+  const glm::vec3& position = g.position[p];
+  std::uint8_t frames = 1;
+  if (has_prev_) {
+    if (const std::optional<glm::vec2> film = prev.camera->project(position)) {
+      const int px = static_cast<int>(std::lround(film->x - 0.5f - prev.jitter.x));
+      const int py = static_cast<int>(std::lround(film->y - 0.5f - prev.jitter.y));
+      if (px >= 0 && py >= 0 && px < prev.width && py < prev.height) {
+        const std::size_t q = static_cast<std::size_t>(py) * static_cast<std::size_t>(prev.width) + static_cast<std::size_t>(px);
+        const float reach = 3.0f * spread_ * g.guide[p].w;
+        const glm::vec3 d = prev.position[q] - position;
+        if (prev.frames[q] > 0 && glm::dot(d, d) < reach * reach) {
+          frames = static_cast<std::uint8_t>(std::min<int>(prev.frames[q] + 1, kFrames));
+          const float a = 1.0f / static_cast<float>(frames);
+          direct = prev.direct[q] + a * (direct - prev.direct[q]);
+          gi = prev.gi[q] + a * (gi - prev.gi[q]);
+        }
+      }
+    }
+  }
+  next.frames[p] = frames;
+  next.position[p] = position;
+  next.direct[p] = direct;
+  next.gi[p] = gi;
+}
+
+namespace {
+
+// A reflection ray's hit in the real-time frame, lit by the probes'
+// indirect and direct SH and a shadow ray to each punctual light (not by
+// MirrorRay::light_samples samples of every light, as a mirror's hit is).
+HitIrradiance probe_hit_irradiance(const engine::rt::RtScene& scene, std::span<const probes::ProbeField* const> fields,
+                                   const engine::render::LightSet* lights) {
+  return [&scene, fields, lights](const engine::render::Surface& hit) {
+    using namespace engine;
+    float sh[75], sh_direct[75];
+    probes::interpolate_fields_with(
+        fields, hit.position, hit.shading_normal, [](const probes::ProbeField* f) { return f->light_sh_all().data(); },
+        [](const probes::ProbeField* f) { return f->direct_sh_all().data(); }, sh, sh_direct);
+    glm::vec3 irradiance = sh_irradiance(sh, hit.shading_normal) + sh_irradiance(sh_direct, hit.shading_normal);
+    if (!lights) return irradiance;
+    const glm::vec3 origin = rt::offset_ray_origin(hit.position, hit.geometric_normal, scene.offset_scale());
+    for (std::size_t l = 0; l < lights->punctual_count(); ++l) {
+      render::LightSample ls;
+      if (!lights->sample_punctual(l, hit.position, glm::vec2(0.5f), ls) || glm::dot(ls.direction, hit.geometric_normal) <= 0) continue;
+      const float cos_i = glm::dot(ls.direction, hit.shading_normal);
+      if (cos_i <= 0) continue;
+      const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
+      if (!scene.occluded(rt::Ray{origin, ls.direction, 0.0f, tmax})) irradiance += ls.radiance * cos_i;
+    }
+    return irradiance;
+  };
+}
+
+// The antialiasing's jitter phase as a number: the stream a reflection's
+// random choices follow, so each of the resolve's points sees other rays and
+// it averages them; no seed.
+std::uint64_t jitter_phase(const GBuffer& g) {
+  return static_cast<std::uint64_t>(std::bit_cast<std::uint32_t>(g.jitter.x)) << 32 | std::bit_cast<std::uint32_t>(g.jitter.y);
+}
+
+
+// Where two G-buffer pixels lie on one surface, for the reflection filter:
+// q within 2 % of p's depth of p's tangent plane and its normal within about
+// 25 degrees. The weight falls to 0 at those limits.
+float same_plane_weight(const GBuffer& g, std::size_t p, std::size_t q) {
+  const glm::vec3 n = glm::vec3(g.guide[p]);
+  const float plane = glm::dot(n, g.position[q] - g.position[p]) / (0.02f * g.guide[p].w);
+  const float cos_n = glm::dot(n, glm::vec3(g.guide[q]));
+  if (!(plane * plane < 1.0f) || cos_n < 0.9f) return 0.0f;
+  return (1.0f - plane * plane) * (cos_n - 0.9f) * 10.0f;
+}
+
+// The glossy dielectric pixels (the tiles whose least roughness says they
+// may hold one) and their rays' pixels, directions and weights: row of
+// tiles by row in parallel, then joined in row order, so the lists are the
+// same whatever the thread count. See trace_dielectric_rays for which
+// pixels trace.
+void choose_dielectric_rays(const GBuffer& g, float max_roughness, DielectricRays& rays) {
+  using namespace engine;
+  const std::uint64_t phase = jitter_phase(g);
+  const int ox = g.jitter.x >= 0 ? 1 : 0, oy = g.jitter.y >= 0 ? 1 : 0;
+  const std::size_t width = static_cast<std::size_t>(g.width);
+  const int bw = (g.width + 1) / 2, bh = (g.height + 1) / 2;
+  if (bw != rays.bw || bh != rays.bh) {
+    rays.bw = bw;
+    rays.bh = bh;
+    rays.ray_of_block.assign(static_cast<std::size_t>(bw) * bh, kNoRay);
+  } else {
+    for (const std::size_t blk : rays.traced) rays.ray_of_block[blk] = kNoRay;  // the last frame's
+  }
+  const int tiles_x = (g.width + 3) / 4, tiles_y = (g.height + 3) / 4;
+  rays.rows.resize(static_cast<std::size_t>(tiles_y));
+  jobs::parallel_for(0, tiles_y, 4, [&](int r0, int r1) {
+    for (int row = r0; row < r1; ++row) {
+      DielectricRays::Row& out = rays.rows[static_cast<std::size_t>(row)];
+      out.glossy.clear();
+      out.ray_pixel.clear();
+      out.direction.clear();
+      out.weight.clear();
+      for (int tile = 0; tile < tiles_x; ++tile) {
+        if (!(g.tile_dielectric_roughness[static_cast<std::size_t>(row) * tiles_x + tile] <= max_roughness)) continue;
+        for (int y = row * 4; y < std::min(row * 4 + 4, g.height); ++y)
+          for (int x = tile * 4; x < std::min(tile * 4 + 4, g.width); ++x) {
+            const std::size_t p = static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x);
+            if (!(g.dielectric_roughness[p] <= max_roughness)) continue;
+            out.glossy.push_back(p);
+            if (x % 2 != ox || y % 2 != oy) continue;
+            math::Pcg32 rng = math::make_rng(0xD1E1ull, p, phase);
+            glm::vec3 wi, weight;
+            if (!sample_reflection(g.samples[p], false, {rng.next_float(), rng.next_float()}, wi, weight)) continue;
+            out.ray_pixel.push_back(p);
+            out.direction.push_back(wi);
+            out.weight.push_back(weight);
+          }
+      }
+    }
+  });
+  rays.glossy.clear();
+  rays.traced.clear();
+  rays.ray_pixel.clear();
+  rays.direction.clear();
+  rays.weight.clear();
+  for (const DielectricRays::Row& row : rays.rows) {
+    rays.glossy.insert(rays.glossy.end(), row.glossy.begin(), row.glossy.end());
+    for (const std::size_t p : row.ray_pixel) {
+      rays.ray_of_block[rays.block_of(p, width)] = static_cast<std::uint32_t>(rays.traced.size());
+      rays.traced.push_back(rays.block_of(p, width));
+    }
+    rays.ray_pixel.insert(rays.ray_pixel.end(), row.ray_pixel.begin(), row.ray_pixel.end());
+    rays.direction.insert(rays.direction.end(), row.direction.begin(), row.direction.end());
+    rays.weight.insert(rays.weight.end(), row.weight.begin(), row.weight.end());
+  }
+}
+
+// Traces the rays choose_dielectric_rays picked: one per 2x2 block, from
+// its pixel on the jitter's side of the centre, so the antialiasing's phases
+// visit the four in turn; none where that pixel is no glossy dielectric or
+// its sample falls below the surface. Each ray keeps its weight (F G1) and
+// its weighted light, both over its pixel's specular albedo E: the filter
+// divides the one sum by the other (a ratio estimator), so light the same
+// in every direction comes out exactly E L, without the noise of the
+// Fresnel's spread between samples (a plain mean of the weighted light) and
+// keeping the Fresnel's correlation with where the light is (which a
+// split-sum mean of the light alone loses; docs/image-quality.md).
+void trace_dielectric_rays(const GBuffer& g, const engine::rt::RtScene& scene, const engine::scene::Environment* sky,
+                           const HitIrradiance& irradiance, DielectricRays& rays) {
+  using namespace engine;
+  const std::size_t n = rays.traced.size();
+  rays.direct.resize(n);
+  rays.gi.resize(n);
+  jobs::parallel_for<std::size_t>(0, n, 64, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      const GSample& s = g.samples[rays.ray_pixel[k]];
+      const ReflectedLight r = reflected_light(scene, s, rays.direction[k], sky, irradiance);
+      rays.weight[k] /= glm::max(specular_layer_albedo(s), glm::vec3(1e-6f));
+      rays.direct[k] = rays.weight[k] * r.direct;
+      rays.gi[k] = rays.weight[k] * r.gi;
+    }
+  });
+}
+
+// Per ray: the light of the rays within kReach blocks on its plane, the sum
+// of their weighted light over the sum of their weights, each Gaussian in
+// their pixels' distance; a sharper lobe gathers from nearer rays (its
+// reflection changes faster across the surface).
+void gather_rays(const GBuffer& g, DielectricRays& rays) {
+  constexpr int kReach = 3;
+  constexpr float kSigma = 2.5f;  // pixels, at roughness 0.4 and above
+  const std::size_t width = static_cast<std::size_t>(g.width);
+  rays.mean_direct.resize(rays.traced.size());
+  rays.mean_gi.resize(rays.traced.size());
+  rays.has_mean.resize(rays.traced.size());
+  engine::jobs::parallel_for<std::size_t>(0, rays.traced.size(), 256, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      const std::size_t p = rays.ray_pixel[k];
+      const float sigma = kSigma * std::clamp(g.dielectric_roughness[p] / 0.4f, 0.25f, 1.0f);
+      const float inv_2s2 = 0.5f / (sigma * sigma);
+      const int x = static_cast<int>(p % width), y = static_cast<int>(p / width);
+      const int bx0 = x / 2, by0 = y / 2;
+      glm::vec3 sum_direct(0.0f), sum_gi(0.0f), sum_weight(0.0f);
+      for (int by = std::max(0, by0 - kReach); by <= std::min(rays.bh - 1, by0 + kReach); ++by)
+        for (int bx = std::max(0, bx0 - kReach); bx <= std::min(rays.bw - 1, bx0 + kReach); ++bx) {
+          const std::uint32_t j = rays.ray_of_block[static_cast<std::size_t>(by) * rays.bw + bx];
+          if (j == kNoRay) continue;
+          const std::size_t q = rays.ray_pixel[j];
+          const float dx = static_cast<float>(static_cast<int>(q % width) - x);
+          const float dy = static_cast<float>(static_cast<int>(q / width) - y);
+          const float w = same_plane_weight(g, p, q) * std::exp(-(dx * dx + dy * dy) * inv_2s2);
+          sum_direct += w * rays.direct[j];
+          sum_gi += w * rays.gi[j];
+          sum_weight += w * rays.weight[j];
+        }
+      const bool some = sum_weight.r > 0 && sum_weight.g > 0 && sum_weight.b > 0;
+      rays.has_mean[k] = some;
+      rays.mean_direct[k] = some ? sum_direct / sum_weight : glm::vec3(0.0f);
+      rays.mean_gi[k] = some ? sum_gi / sum_weight : glm::vec3(0.0f);
+    }
+  });
+}
+
+}  // namespace
+
+// Metals' reflections at full resolution (transfer_renderer.h's MirrorRay):
+// a metal's whole light, replacing its decoded GI (its direct light was left
+// out of the composite); the sky and emitters its ray sees go to direct_out.
+std::size_t shade_metal_reflections(const GBuffer& g, const engine::rt::RtScene& scene,
+                                   std::span<const probes::ProbeField* const> fields, const MirrorRay& mirror,
+                                   const engine::render::LightSet* lights, engine::image::ImageRGB& image,
+                                   engine::image::ImageRGB* direct_out) {
+  using namespace engine;
+  const scene::Environment* sky = lights ? lights->environment() : nullptr;
+  const HitIrradiance irradiance = probe_hit_irradiance(scene, fields, lights);
+  const float metal_roughness = std::max(mirror.max_roughness, mirror.glossy_max_roughness);
+  const std::uint64_t phase = jitter_phase(g);
+  std::atomic<std::size_t> traced{0};
+  jobs::parallel_for<std::size_t>(0, g.samples.size(), 1024, [&](std::size_t b, std::size_t e) {
+    std::size_t n = 0;
+    for (std::size_t p = b; p < e; ++p) {
+      // metal_roughness <= max_roughness is is_mirror() on the pixel's material.
+      if (!(g.metal_roughness[p] <= metal_roughness)) continue;
+      ++n;
+      const bool mirror_direction = g.metal_roughness[p] <= mirror.max_roughness;
+      math::Pcg32 rng = math::make_rng(0x6105ull, p, phase);
+      const glm::vec2 u{rng.next_float(), rng.next_float()};
+      glm::vec3 wi, weight(0.0f);
+      ReflectedLight r;
+      if (sample_reflection(g.samples[p], mirror_direction, u, wi, weight)) r = reflected_light(scene, g.samples[p], wi, sky, irradiance);
+      // No history here, unlike the glossy dielectrics': on the sample
+      // level's gold sphere a running mean smeared its glints over
+      // neighbouring points while the camera walked (docs/image-quality.md).
+      image.pixels[p] = weight * r.gi;
+      if (direct_out) direct_out->pixels[p] += weight * r.direct;
+    }
+    traced.fetch_add(n, std::memory_order_relaxed);
+  });
+  return traced.load();
+}
+
+// Glossy dielectrics' specular layer (MirrorRay::dielectric_max_roughness),
+// added to the diffuse light their cells were given. A floor can fill half
+// the screen, so a quarter of its pixels trace a ray a frame
+// (trace_dielectric_rays), each ray gathers its neighbours' (gather_rays),
+// and every glossy pixel takes the rays' means around it on its own plane,
+// times its own specular albedo; the antialiasing's 16 phases average the
+// rest. Work in proportion to the glossy pixels, none without.
+std::size_t shade_dielectric_reflections(const GBuffer& g, const engine::rt::RtScene& scene,
+                                  std::span<const probes::ProbeField* const> fields, const engine::render::LightSet* lights,
+                                  float max_roughness, DielectricRays& rays, engine::image::ImageRGB& image,
+                                  engine::image::ImageRGB* direct_out) {
+  // The glossy pixels, tile by tile: most tiles have none.
+  choose_dielectric_rays(g, max_roughness, rays);
+  if (rays.glossy.empty()) return 0;
+  trace_dielectric_rays(g, scene, lights ? lights->environment() : nullptr, probe_hit_irradiance(scene, fields, lights), rays);
+  gather_rays(g, rays);
+  const std::size_t width = static_cast<std::size_t>(g.width);
+  rays.history.begin(g);
+  engine::jobs::parallel_for<std::size_t>(0, rays.glossy.size(), 1024, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const std::size_t p = rays.glossy[i];
+      const int x = static_cast<int>(p % width), y = static_cast<int>(p / width);
+      const int bx0 = x / 2, by0 = y / 2;
+      glm::vec3 sum_direct(0.0f), sum_gi(0.0f);
+      float sum_w = 0;
+      for (int by = std::max(0, by0 - 1); by <= std::min(rays.bh - 1, by0 + 1); ++by)
+        for (int bx = std::max(0, bx0 - 1); bx <= std::min(rays.bw - 1, bx0 + 1); ++bx) {
+          const std::uint32_t j = rays.ray_of_block[static_cast<std::size_t>(by) * rays.bw + bx];
+          if (j == kNoRay || !rays.has_mean[j]) continue;
+          const std::size_t q = rays.ray_pixel[j];
+          // A tent over the blocks' spacing, so neighbouring pixels blend
+          // between blocks instead of taking their own block's value.
+          const float dx = std::abs(static_cast<float>(static_cast<int>(q % width) - x));
+          const float dy = std::abs(static_cast<float>(static_cast<int>(q / width) - y));
+          const float w = same_plane_weight(g, p, q) * std::max(0.0f, 1.0f - dx / 3.0f) * std::max(0.0f, 1.0f - dy / 3.0f);
+          sum_direct += w * rays.mean_direct[j];
+          sum_gi += w * rays.mean_gi[j];
+          sum_w += w;
+        }
+      if (!(sum_w > 0)) continue;
+      glm::vec3 light_direct = sum_direct / sum_w, light_gi = sum_gi / sum_w;
+      rays.history.blend(g, p, light_direct, light_gi);
+      const glm::vec3 albedo = specular_layer_albedo(g.samples[p]);
+      image.pixels[p] += albedo * light_gi;
+      if (direct_out) direct_out->pixels[p] += albedo * light_direct;
+    }
+  });
+  rays.history.end();
+  return rays.traced.size();
+}
+
+}  // namespace transgi::shading
