@@ -24,7 +24,6 @@ B="--scene /tmp/pk/bitterli/scene.gltf --model /tmp/pk/bitterli/bitterli.tgm --w
 run() { name=$1; shift; echo "== $name: $*"; t0=$(date +%s); timeout 120 $T bench-frame "$@" --csv $R/$name.csv > $R/$name.txt 2>&1; echo "rc $? in $(( $(date +%s) - t0 )) s"; grep -vE "^\s*(bench-frame|frame) .*ETA|\[#" $R/$name.txt | tail -25; }
 run level_vk $L --backend vulkan
 run level_cpu $L --backend cpu
-run level_vk_shading_off $L --backend vulkan --device-shading off
 run level_vk_di $L --backend vulkan --device-inference on
 run level_vk2 $L --backend vulkan
 run bitterli_vk $B --backend vulkan

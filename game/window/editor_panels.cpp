@@ -180,7 +180,6 @@ void EditorUi::gi_settings() {
   changed |= ImGui::SliderFloat("others traced to", &edit.mirror.dielectric_max_roughness, -0.05f, 1.0f,
                                 "roughness %.2f (<0 off)");
   changed |= ImGui::Checkbox("decode transfer on the GPU (vulkan backend)", &edit.device_inference);
-  changed |= ImGui::Checkbox("shade probe rays on the GPU (vulkan backend)", &edit.device_shading);
   changed |= ImGui::Checkbox("make the decoded samples' light on the GPU", &edit.realtime.device_lights);
   if (changed) *s = edit;
   // The backend at run time (issue 12): Vulkan, lavapipe where there is no GPU.

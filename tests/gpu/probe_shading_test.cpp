@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "engine/gpu/gpu_error.h"
 #include "engine/gpu/gpu_ray_tracer.h"
 #include "engine/math/rng.h"
 #include "engine/render/light_set.h"
@@ -236,9 +237,11 @@ TEST(VulkanProbeShading, EqualsTheCpuStagesOnTheSampleLevelWithEveryKindOfLight)
 }
 
 // A device whose largest buffer cannot hold the level's shading data: the
-// kernels decline, the CPU shades, and the backend says why, naming what did
-// not fit.
-TEST(VulkanProbeShading, ASceneTooBigForTheDeviceIsShadedOnTheCpuAndSaysWhy) {
+// kernels throw, naming what did not fit, and the plugin runs that frame and
+// every later one on the CPU backend whole, saying why: the frame is the CPU
+// backend's own, bit for bit (the device's first stage threw before any
+// field changed).
+TEST(VulkanProbeShading, ASceneTooBigForTheDeviceRunsTheWholeFrameOnTheCpuBackend) {
   GPU_TEST_CONTEXT_OR_SKIP(unused);
   engine::gpu::GpuOptions options;
   options.storage_buffer_range_cap = 64 * 1024;  // the level's triangles and texels take more
@@ -246,17 +249,49 @@ TEST(VulkanProbeShading, ASceneTooBigForTheDeviceIsShadedOnTheCpuAndSaysWhy) {
   std::shared_ptr<engine::gpu::VulkanContext> ctx(engine::gpu::VulkanContext::create(options, &why));
   ASSERT_TRUE(ctx) << why;
   if (!transgi::gpu::VulkanProbeShading::supported(*ctx, &why)) GTEST_SKIP() << why;
-  transgi::gpu::VulkanProbeKernels kernels(ctx);
-  eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
-  const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
-  const render::LightSet lights(scene, test_punctual(), nullptr);
-  const std::vector<glm::vec3> origins{0.5f * (scene.bounds_min() + scene.bounds_max())}, directions{glm::vec3(0, -1, 0)};
-  const std::vector<int> probe_ids{0};
-  std::vector<probes::ProbeRayHit> out;
-  EXPECT_FALSE(kernels.shade_probe_rays(scene, lights, origins, probe_ids, directions, 1, 1, nullptr, nullptr, out));
-  EXPECT_TRUE(out.empty());
-  EXPECT_NE(kernels.probe_shading_why().find("largest storage buffer"), std::string::npos) << kernels.probe_shading_why();
-  std::printf("declined: %s\n", kernels.probe_shading_why().c_str());
-  // And stays declined, without trying again every frame.
-  EXPECT_FALSE(kernels.shade_probe_rays(scene, lights, origins, probe_ids, directions, 1, 1, nullptr, nullptr, out));
+  const std::string level = std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf";
+  {
+    transgi::gpu::VulkanProbeKernels kernels(ctx);
+    eval::LoadedScene loaded = eval::load_scene(level, "", 2);
+    const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
+    const render::LightSet lights(scene, test_punctual(), nullptr);
+    const std::vector<glm::vec3> origins{0.5f * (scene.bounds_min() + scene.bounds_max())}, directions{glm::vec3(0, -1, 0)};
+    const std::vector<int> probe_ids{0};
+    const probes::ProbeGrid grid;
+    probes::ProbeFeedbackSource self;
+    self.grid = &grid;
+    self.lit = false;
+    std::vector<probes::ProbeRayHit> out;
+    try {
+      kernels.shade_probe_rays(scene, lights, origins, probe_ids, directions, 1, 1, self, nullptr, out);
+      ADD_FAILURE() << "expected the kernels to throw engine::gpu::GpuError";
+    } catch (const engine::gpu::GpuError& e) {
+      EXPECT_NE(std::string(e.what()).find("largest storage buffer"), std::string::npos) << e.what();
+      std::printf("declined: %s\n", e.what());
+    }
+    EXPECT_TRUE(out.empty());
+  }
+  const auto run = [&](runtime::Backend backend, std::shared_ptr<engine::gpu::VulkanContext> host) {
+    eval::TransgiRunOptions t;
+    t.frames = 3;
+    t.progress = false;
+    t.settings.backend = backend;
+    t.settings.direct_spp = 0;
+    t.settings.probes.map = probes::MapLayout{16, 8};
+    t.settings.probes.rays_per_probe = 32;
+    t.placement.mode = runtime::ProbeVolumeMode::Scene;
+    t.placement.scene_dims = glm::ivec3(4);
+    t.host_gpu = std::move(host);
+    eval::LoadedScene scene = eval::load_scene(level, "", 2);
+    return eval::run_transgi(scene, std::make_shared<const model::TransferModel>(), 32, 18, t);
+  };
+  const eval::MethodRun capped = run(runtime::Backend::Vulkan, ctx), cpu = run(runtime::Backend::Cpu, nullptr);
+  EXPECT_EQ(capped.backend.rfind("cpu; the CPU backend runs the frame (scene too large): ", 0), 0u) << capped.backend;
+  EXPECT_NE(capped.backend.find("largest storage buffer"), std::string::npos) << capped.backend;
+  EXPECT_EQ(cpu.backend, "cpu");
+  ASSERT_GT(gpu_test::mean_rgb(cpu.gi), 1e-4) << "the level's GI should not be black";
+  ASSERT_EQ(capped.gi.pixels.size(), cpu.gi.pixels.size());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < cpu.gi.pixels.size(); ++i) differ += capped.gi.pixels[i] != cpu.gi.pixels[i] ? 1 : 0;
+  EXPECT_EQ(differ, 0u) << "expected the CPU backend's frame exactly";
 }

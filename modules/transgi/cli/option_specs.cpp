@@ -78,8 +78,6 @@ std::vector<OptionSpec> runtime_option_specs(const std::string& default_preset) 
       text("device", "NAME", "the first discrete GPU", "the Vulkan device to take (a part of its name)"),
       choice("device-inference", {"on", "off"}, on_off_by_preset(q.device_inference, r.device_inference),
              "run the real-time transfer inference on the Vulkan device"),
-      choice("device-shading", {"on", "off"}, on_off_by_preset(q.device_shading, r.device_shading),
-             "shade the probe rays' hits on the Vulkan device"),
       choice("device-lights", {"on", "off"}, on_off_by_preset(q.realtime.device_lights, r.realtime.device_lights),
              "interpolate the network samples' light on the device (32 bytes a sample cross the bus, not 600)"),
       choice("reflections", {"on", "off"}, on_off_by_preset(q.mirror.max_roughness >= 0, r.mirror.max_roughness >= 0),

@@ -26,7 +26,6 @@ runtime::TransGISettings runtime_settings_from(const Args& args, const char* def
   s.backend = args.choice("backend", {"cpu", "vulkan"}, "cpu") == "vulkan" ? runtime::Backend::Vulkan : runtime::Backend::Cpu;
   s.gpu_device = args.str("device", std::string());
   if (args.has("device-inference")) s.device_inference = args.choice("device-inference", {"on", "off"}, "off") == "on";
-  if (args.has("device-shading")) s.device_shading = args.choice("device-shading", {"on", "off"}, "on") == "on";
   if (args.has("device-lights")) s.realtime.device_lights = args.choice("device-lights", {"on", "off"}, "on") == "on";
   if (args.has("reflections") && args.choice("reflections", {"on", "off"}, "on") == "off") s.mirror.max_roughness = -1.0f;
   near_field_from(args, s.near_field);

@@ -7,6 +7,10 @@
 
 namespace transgi::gpu {
 
+VulkanProbeKernels::VulkanProbeKernels(std::shared_ptr<engine::gpu::VulkanContext> ctx)
+    : ctx_(std::move(ctx)), tracer_(*ctx_), shading_(std::make_unique<VulkanProbeShading>(*ctx_)),
+      name_(engine::gpu::describe(ctx_->info())) {}
+
 probes::SharingStats VulkanProbeKernels::rasterize(const probes::ProbeGrid& grid, const probes::MapLayout& layout,
                                                    const std::vector<std::vector<probes::ShadedPoint>>& points,
                                                    const std::vector<const probes::DepthMap*>& own_depth,
@@ -29,41 +33,28 @@ void VulkanProbeKernels::project(const probes::MapProjector& projector, std::spa
   project_ms_ += std::max(0.0, p->project(radiance, out));
 }
 
-bool VulkanProbeKernels::accumulate(const probes::MapLayout& layout, std::span<probes::ProbeMapState* const> states,
-                                    std::span<const probes::FrameSamples* const> frames,
-                                    const probes::AccumulationSettings& settings, std::span<std::uint8_t> changed,
-                                    std::span<glm::vec3> filled) {
+void VulkanProbeKernels::accumulate_and_project(const probes::MapProjector& projector,
+                                                std::span<probes::ProbeMapState* const> states,
+                                                std::span<const probes::FrameSamples* const> frames,
+                                                const probes::AccumulationSettings& settings,
+                                                std::span<std::uint8_t> changed, std::span<float> sh) {
+  const auto& layout = projector.layout();
   auto& a = accumulators_[{layout.width, layout.height}];
   if (!a) a = std::make_unique<VulkanProbeAccumulator>(*ctx_, layout);
+  std::vector<glm::vec3> filled(states.size() * static_cast<std::size_t>(layout.texel_count()));
   accumulate_ms_ += std::max(0.0, a->accumulate(states, frames, settings, changed, filled));
-  return true;
+  project(projector, filled, sh);
 }
 
-bool VulkanProbeKernels::shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+void VulkanProbeKernels::shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
                                           std::span<const glm::vec3> origins, std::span<const int> probe_ids,
                                           std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
-                                          const probes::ProbeFeedbackSource* self, const probes::ProbeFeedbackSource* outer,
+                                          const probes::ProbeFeedbackSource& self, const probes::ProbeFeedbackSource* outer,
                                           std::vector<probes::ProbeRayHit>& out) {
-  if (!device_shading_) return false;
-  if (!shading_tried_) {
-    shading_tried_ = true;
-    try {
-      if (VulkanProbeShading::supported(*ctx_, &shading_why_)) shading_ = std::make_unique<VulkanProbeShading>(*ctx_);
-    } catch (const std::exception& e) {
-      // A kernel the device cannot build: the CPU shades, and says why.
-      shading_why_ = e.what();
-    }
-  }
-  if (!shading_) return false;
-  try {
-    return shading_->shade(scene, lights, tracer_, origins, probe_ids, directions, seed, sample, self, outer, out);
-  } catch (const engine::gpu::GpuError& e) {
-    // A scene the device cannot hold (textures past its largest buffer, out
-    // of memory): the CPU shades from now on, and the frame says why.
-    shading_.reset();
-    shading_why_ = e.what();
-    return false;
-  }
+  // The kernel reads no field it is not given: a field with no light yet is left out.
+  if (!shading_->shade(scene, lights, tracer_, origins, probe_ids, directions, seed, sample, self.lit ? &self : nullptr,
+                       outer, out))
+    throw engine::gpu::GpuError("the Vulkan backend traces only scenes built with their assets (RtScene::assets())");
 }
 
 shading::TransferBatchDecoder* VulkanProbeKernels::transfer_decoder(const std::shared_ptr<const model::TransferModel>& model) {
@@ -83,25 +74,40 @@ shading::TransferBatchDecoder* VulkanProbeKernels::transfer_decoder(const std::s
   return decoder_.get();
 }
 
-std::shared_ptr<VulkanProbeKernels> make_probe_kernels(std::shared_ptr<engine::gpu::VulkanContext> context, std::string* why) {
-  if (!context) return nullptr;
+std::shared_ptr<VulkanProbeKernels> make_probe_kernels(std::shared_ptr<engine::gpu::VulkanContext> context,
+                                                       probes::BackendFallback* reason, std::string* why) {
+  const auto refuse = [&](probes::BackendFallback r, const std::string& w) {
+    if (reason) *reason = r;
+    if (why) *why = w;
+    return nullptr;
+  };
+  if (!context) return refuse(probes::BackendFallback::NoDevice, "no Vulkan context");
+  std::string missing;
+  if (!VulkanProbeShading::supported(*context, &missing)) return refuse(probes::BackendFallback::MissingCapability, missing);
   try {
-    return std::make_shared<VulkanProbeKernels>(std::move(context));
-  } catch (const std::exception& e) {  // a kernel the device cannot build: the CPU runs them, and says why
-    if (why) *why = e.what();
+    auto kernels = std::make_shared<VulkanProbeKernels>(std::move(context));
+    if (reason) *reason = probes::BackendFallback::None;
+    return kernels;
+  } catch (const std::exception& e) {  // a kernel the device cannot build
+    return refuse(probes::BackendFallback::KernelBuildFailed, e.what());
   }
-  return nullptr;
 }
 
-std::shared_ptr<VulkanProbeKernels> make_probe_kernels(const std::string& device, std::string* why) {
+std::shared_ptr<VulkanProbeKernels> make_probe_kernels(const std::string& device, probes::BackendFallback* reason,
+                                                       std::string* why) {
   engine::gpu::GpuOptions options;
   options.device = device;
+  std::shared_ptr<engine::gpu::VulkanContext> context;
   try {
-    if (auto ctx = engine::gpu::VulkanContext::create(options, why)) return make_probe_kernels(std::shared_ptr<engine::gpu::VulkanContext>(std::move(ctx)), why);
+    context = engine::gpu::VulkanContext::create(options, why);
   } catch (const std::exception& e) {
     if (why) *why = e.what();
   }
-  return nullptr;
+  if (!context) {
+    if (reason) *reason = probes::BackendFallback::NoDevice;
+    return nullptr;
+  }
+  return make_probe_kernels(std::move(context), reason, why);
 }
 
 }  // namespace transgi::gpu

@@ -1,6 +1,7 @@
 #pragma once
-// The probe field's raster and SH projection on a Vulkan device
-// (probes::ProbeKernels). One instance serves every field of a scene; the
+// The probe field's stages on a Vulkan device (probes::ProbeKernels): the
+// probe rays traced and shaded, the radiance raster, the accumulation and
+// the SH projection. One instance serves every field of a scene; the
 // kernels for each map size are made on first use.
 #include <map>
 #include <memory>
@@ -21,30 +22,31 @@ namespace transgi::gpu {
 
 class VulkanProbeKernels : public probes::ProbeKernels {
  public:
-  explicit VulkanProbeKernels(std::shared_ptr<engine::gpu::VulkanContext> ctx)
-      : ctx_(std::move(ctx)), tracer_(*ctx_), name_(engine::gpu::describe(ctx_->info())) {}
+  // Builds every stage's kernels; throws where the device cannot
+  // (make_probe_kernels checks the capabilities first and says why).
+  explicit VulkanProbeKernels(std::shared_ptr<engine::gpu::VulkanContext> ctx);
 
+  // Throws engine::gpu::GpuError where the device cannot hold the scene (its
+  // textures past the largest buffer, out of memory) or the scene was made
+  // without its assets (nothing to upload): the owner then runs the CPU
+  // backend whole.
+  void shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                        std::span<const glm::vec3> origins, std::span<const int> probe_ids,
+                        std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
+                        const probes::ProbeFeedbackSource& self, const probes::ProbeFeedbackSource* outer,
+                        std::vector<probes::ProbeRayHit>& out) override;
   probes::SharingStats rasterize(const probes::ProbeGrid& grid, const probes::MapLayout& layout,
                                  const std::vector<std::vector<probes::ShadedPoint>>& points,
                                  const std::vector<const probes::DepthMap*>& own_depth,
                                  const probes::SharingSettings& settings, std::vector<probes::FrameSamples>& out,
                                  std::span<const std::uint8_t> targets) override;
-  void project(const probes::MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out) override;
-  bool accumulate(const probes::MapLayout& layout, std::span<probes::ProbeMapState* const> states,
-                  std::span<const probes::FrameSamples* const> frames, const probes::AccumulationSettings& settings,
-                  std::span<std::uint8_t> changed, std::span<glm::vec3> filled) override;
-  // On the device unless switched off (set_device_shading) or the device
-  // cannot (VulkanProbeShading::supported; probe_shading_why() says why).
-  bool shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
-                        std::span<const glm::vec3> origins, std::span<const int> probe_ids,
-                        std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
-                        const probes::ProbeFeedbackSource* self, const probes::ProbeFeedbackSource* outer,
-                        std::vector<probes::ProbeRayHit>& out) override;
-  // Whether probe rays are shaded on the device (on by default) or on the CPU.
-  void set_device_shading(bool on) { device_shading_ = on; }
-  [[nodiscard]] bool device_shading() const { return device_shading_; }
-  // Why the device does not shade probe rays (empty when it does).
-  [[nodiscard]] const std::string& probe_shading_why() const { return shading_why_; }
+  void accumulate_and_project(const probes::MapProjector& projector, std::span<probes::ProbeMapState* const> states,
+                              std::span<const probes::FrameSamples* const> frames,
+                              const probes::AccumulationSettings& settings, std::span<std::uint8_t> changed,
+                              std::span<float> sh) override;
+  // The SH projection alone, as MapProjector::project for `maps` maps stored
+  // one after another: radiance maps x texel_count(), out maps x 75.
+  void project(const probes::MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out);
   engine::rt::RayBatchTracer* tracer() override { return &tracer_; }
   // The real-time frame's transfer decoder on this device, made for
   // `model`'s network when first asked (and again for another model); null
@@ -66,7 +68,7 @@ class VulkanProbeKernels : public probes::ProbeKernels {
     return since;
   }
   StageMs take_stage_ms() {
-    StageMs s{tracer_.take_device_ms(), raster_ms_, project_ms_, shading_ ? shading_->take_gpu_ms() : 0.0, accumulate_ms_};
+    StageMs s{tracer_.take_device_ms(), raster_ms_, project_ms_, shading_->take_gpu_ms(), accumulate_ms_};
     raster_ms_ = project_ms_ = accumulate_ms_ = 0.0;
     return s;
   }
@@ -81,17 +83,19 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   std::unique_ptr<VulkanFusedDecoder> decoder_;
   std::string decoder_why_;
   std::unique_ptr<VulkanProbeShading> shading_;
-  bool device_shading_ = true, shading_tried_ = false;
-  std::string shading_why_;
   std::string name_;
   double raster_ms_ = 0.0, project_ms_ = 0.0, accumulate_ms_ = 0.0;
   engine::gpu::GpuTraffic traffic_taken_;
 };
 
 // The Vulkan kernels on the chosen device (empty: ENGINE_GPU_DEVICE, then
-// the ranked default), or null with *why set where no device can be had.
-std::shared_ptr<VulkanProbeKernels> make_probe_kernels(const std::string& device, std::string* why);
+// the ranked default), or null where the device cannot run every stage:
+// *reason says which check failed and *why how (the caller then runs the
+// CPU backend whole).
+std::shared_ptr<VulkanProbeKernels> make_probe_kernels(const std::string& device, probes::BackendFallback* reason,
+                                                       std::string* why);
 // The same on a context the caller made (a host engine's device).
-std::shared_ptr<VulkanProbeKernels> make_probe_kernels(std::shared_ptr<engine::gpu::VulkanContext> context, std::string* why);
+std::shared_ptr<VulkanProbeKernels> make_probe_kernels(std::shared_ptr<engine::gpu::VulkanContext> context,
+                                                       probes::BackendFallback* reason, std::string* why);
 
 }  // namespace transgi::gpu

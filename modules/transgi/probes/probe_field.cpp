@@ -14,6 +14,7 @@
 #include "engine/math/rng.h"
 #include "engine/math/sampling.h"
 #include "engine/math/sh.h"
+#include "probes/cpu_probe_kernels.h"
 #include "probes/open_space.h"
 #include "probes/probe_rays.h"
 #include "probes/radiance_map.h"
@@ -28,7 +29,7 @@ double ms_since(Clock::time_point t) { return std::chrono::duration<double, std:
 
 
 ProbeField::ProbeField(ProbeFieldSettings s)
-    : settings_(s), grid_(s.grid), projector_(s.map), fibonacci_(spherical_fibonacci(s.rays_per_probe)) {
+    : settings_(s), kernels_(cpu_probe_kernels()), grid_(s.grid), projector_(s.map), fibonacci_(spherical_fibonacci(s.rays_per_probe)) {
   probes_.resize(static_cast<std::size_t>(s.grid.count()));
   for (auto& st : probes_.maps) st.reset(s.map.texel_count(), depth_unit());
 }
@@ -79,9 +80,13 @@ bool ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float
 }
 
 glm::vec3 ProbeField::irradiance(const glm::vec3& p, const glm::vec3& n) const {
-  float L[75];
-  interpolate(p, n, L);
-  return shading::sh_irradiance(L, n);
+  ProbeFeedbackSource self = feedback_source();
+  self.lit = true;
+  return probe_irradiance(self, p, n);
+}
+
+void ProbeField::set_kernels(std::shared_ptr<ProbeKernels> kernels) {
+  kernels_ = kernels ? std::move(kernels) : cpu_probe_kernels();
 }
 
 std::size_t ProbeField::memory_bytes() const {
@@ -245,20 +250,14 @@ void ProbeField::plan_update(UpdateWork& w) {
     }
 }
 
+ProbeFeedbackSource ProbeField::feedback_source() const {
+  return ProbeFeedbackSource{&grid_, settings_.map, &probes_.maps, probes_.sh, probes_.usable, settings_.interpolation, frame_ > 0};
+}
+
 void ProbeField::trace_and_shade(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
                                  const ProbeField* outer, UpdateWork& w) {
   using namespace engine;
-  const ProbeGrid& grid = grid_;
   const int M = settings_.rays_per_probe;
-  const auto ray_rng = [&](int q, int i) {
-    return math::make_rng(w.seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
-  };
-  // Indirect light from last frame's probes at a probe ray's hit (multi-bounce feedback).
-  const auto feedback = [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3&) {
-    if (outer && (glm::any(glm::lessThan(p, grid.min)) || glm::any(glm::greaterThan(p, grid.max))))
-      return outer->irradiance(p, n);
-    return frame_ > 0 ? irradiance(p, n) : glm::vec3(0.0f);
-  };
   // What each ray found, kept by the probe that shot it.
   const auto consume = [&](int q, int i, const ProbeRayHit& h) {
     const auto qi = static_cast<std::size_t>(q);
@@ -286,34 +285,24 @@ void ProbeField::trace_and_shade(const engine::rt::RtScene& scene, const engine:
     if (h.saw_light) probes_.saw_light[qi] = 1;
     w.points[qi].push_back(sp);
   };
-  // The backend's device shades the rays where it can (the same random
-  // numbers and bounce light as the CPU path below).
-  const auto shade_on_device = [&] {
-    if (!kernels_ || w.tracing.empty()) return false;
-    std::vector<glm::vec3> origins;
-    origins.reserve(w.tracing.size());
-    for (const int q : w.tracing) origins.push_back(grid.position(q));
-    const auto source = [](const ProbeField& f) {
-      return ProbeFeedbackSource{&f.grid_, f.settings_.map, &f.probes_.maps, f.probes_.sh, f.probes_.usable, f.settings_.interpolation};
-    };
-    const ProbeFeedbackSource self_source = source(*this);
-    const ProbeFeedbackSource outer_source = outer ? source(*outer) : ProbeFeedbackSource{};
-    std::vector<ProbeRayHit> shaded;
-    if (!kernels_->shade_probe_rays(scene, lights, origins, w.tracing, w.directions, w.seed, frame_ + 1,
-                                    frame_ > 0 ? &self_source : nullptr, outer ? &outer_source : nullptr, shaded))
-      return false;
-    jobs::parallel_for(0, static_cast<int>(w.tracing.size()), 1, [&](int b, int e) {
-      for (int j = b; j < e; ++j)
-        for (int i = 0; i < M; ++i)
-          consume(w.tracing[static_cast<std::size_t>(j)], i,
-                  shaded[static_cast<std::size_t>(j) * static_cast<std::size_t>(M) + static_cast<std::size_t>(i)]);
-    });
-    return true;
-  };
-  if (!shade_on_device())
-    trace_probe_rays(
-        scene, lights, kernels_ ? kernels_->tracer() : nullptr, w.tracing, w.directions, [&](int q) { return grid.position(q); },
-        ray_rng, feedback, consume);
+  if (w.tracing.empty()) return;
+  std::vector<glm::vec3> origins;
+  origins.reserve(w.tracing.size());
+  for (const int q : w.tracing) origins.push_back(grid_.position(q));
+  // The bounce light reads last frame's SH (multi-bounce feedback): this
+  // field's inside its box, the next coarser cascade's beyond it.
+  const ProbeFeedbackSource self_source = feedback_source();
+  const ProbeFeedbackSource outer_source = outer ? outer->feedback_source() : ProbeFeedbackSource{};
+  std::vector<ProbeRayHit> shaded;
+  kernels_->shade_probe_rays(scene, lights, origins, w.tracing, w.directions, w.seed, frame_ + 1, self_source,
+                             outer ? &outer_source : nullptr, shaded);
+  // One probe's rays on one thread, in order: consume writes its data unlocked.
+  jobs::parallel_for(0, static_cast<int>(w.tracing.size()), 1, [&](int b, int e) {
+    for (int j = b; j < e; ++j)
+      for (int i = 0; i < M; ++i)
+        consume(w.tracing[static_cast<std::size_t>(j)], i,
+                shaded[static_cast<std::size_t>(j) * static_cast<std::size_t>(M) + static_cast<std::size_t>(i)]);
+  });
 }
 
 void ProbeField::classify_traced(const engine::rt::RtScene& scene, UpdateWork& w) {
@@ -322,7 +311,7 @@ void ProbeField::classify_traced(const engine::rt::RtScene& scene, UpdateWork& w
   bool any_pending = w.classify;
   for (std::size_t q = 0; q < probes_.state.size() && !any_pending; ++q) any_pending = w.traced[q] && probes_.needs_classify[q];
   const OpenSpace open =
-      settings_.skip.open_space && any_pending ? find_open_space(scene, grid_, probes_.saw_light, settings_.skip.relocation, kernels_ ? kernels_->tracer() : nullptr) : OpenSpace{};
+      settings_.skip.open_space && any_pending ? find_open_space(scene, grid_, probes_.saw_light, settings_.skip.relocation, kernels_->tracer()) : OpenSpace{};
   if (!open.open.empty() && grid_.offsets.empty()) grid_.offsets.assign(probes_.state.size(), glm::vec3(0.0f));
   for (std::size_t q = 0; q < probes_.state.size(); ++q) {
     if (w.traced[q]) {
@@ -374,8 +363,7 @@ SharingStats ProbeField::share_and_raster(UpdateWork& w) {
   std::vector<std::uint8_t> targets(static_cast<std::size_t>(probes));
   for (int q = 0; q < probes; ++q) targets[static_cast<std::size_t>(q)] = takes_frame(w, q) ? 1 : 0;
   // Only the updated probes' maps are filled (and allocated).
-  return kernels_ ? kernels_->rasterize(grid_, settings_.map, w.points, depth, settings_.sharing, w.samples, targets)
-                  : rasterize_shared(grid_, settings_.map, w.points, depth, settings_.sharing, w.samples, targets);
+  return kernels_->rasterize(grid_, settings_.map, w.points, depth, settings_.sharing, w.samples, targets);
 }
 
 int ProbeField::accumulate_and_project(UpdateWork& w) {
@@ -397,12 +385,6 @@ int ProbeField::accumulate_and_project(UpdateWork& w) {
     std::copy_n(probes_.direct_mean.data() + at, 75, probes_.direct_sh.data() + at);
     if (settings_.direct_window) apply_hanning_window(probes_.direct_sh.data() + at);
   };
-  // Accumulates probe q's frame on the CPU; returns the filled map to project.
-  auto accumulate_probe = [&](int q) {
-    ProbeMapState& st = probes_.maps[static_cast<std::size_t>(q)];
-    after_accumulation(q, accumulate(st, w.samples[static_cast<std::size_t>(q)], settings_.accumulation));
-    return filled_radiance(st, settings_.map, settings_.accumulation.fill_passes);
-  };
   // After probe q's SH is projected into probes_.sh.
   auto finish_probe = [&](int q) {
     const std::size_t at = static_cast<std::size_t>(q) * 75;
@@ -418,24 +400,10 @@ int ProbeField::accumulate_and_project(UpdateWork& w) {
       bad_probes.fetch_add(1, std::memory_order_relaxed);
     }
   };
-  if (!kernels_) {
-    // One probe at a time: its filled map stays in cache for the projection.
-    jobs::parallel_for(0, probes, 1, [&](int b, int e) {
-      for (int q = b; q < e; ++q) {
-        if (!takes_frame(w, q)) continue;
-        const auto filled = accumulate_probe(q);
-        projector_.project(filled.data(), probes_.sh.data() + static_cast<std::size_t>(q) * 75);
-        finish_probe(q);
-      }
-    });
-    return bad_probes.load();
-  }
   // Every updated probe's map in one batch for the backend.
   std::vector<int> batch;
   for (int q = 0; q < probes; ++q)
     if (takes_frame(w, q)) batch.push_back(q);
-  const auto texels = static_cast<std::size_t>(settings_.map.texel_count());
-  std::vector<glm::vec3> maps(batch.size() * texels);
   std::vector<ProbeMapState*> batch_states;
   std::vector<const FrameSamples*> batch_frames;
   for (const int q : batch) {
@@ -443,24 +411,16 @@ int ProbeField::accumulate_and_project(UpdateWork& w) {
     batch_frames.push_back(&w.samples[static_cast<std::size_t>(q)]);
   }
   std::vector<std::uint8_t> batch_changed(batch.size());
-  if (kernels_->accumulate(settings_.map, batch_states, batch_frames, settings_.accumulation, batch_changed, maps)) {
-    jobs::parallel_for(0, static_cast<int>(batch.size()), 1, [&](int b, int e) {
-      for (int i = b; i < e; ++i) after_accumulation(batch[static_cast<std::size_t>(i)], batch_changed[static_cast<std::size_t>(i)] != 0);
-    });
-  } else {
-    jobs::parallel_for(0, static_cast<int>(batch.size()), 1, [&](int b, int e) {
-      for (int i = b; i < e; ++i) {
-        const auto filled = accumulate_probe(batch[static_cast<std::size_t>(i)]);
-        std::copy(filled.begin(), filled.end(), maps.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(i) * texels));
-      }
-    });
-  }
   std::vector<float> projected(batch.size() * 75);
-  kernels_->project(projector_, maps, projected);
-  for (std::size_t i = 0; i < batch.size(); ++i) {
-    std::copy_n(projected.data() + i * 75, 75, probes_.sh.data() + static_cast<std::size_t>(batch[i]) * 75);
-    finish_probe(batch[i]);
-  }
+  kernels_->accumulate_and_project(projector_, batch_states, batch_frames, settings_.accumulation, batch_changed, projected);
+  jobs::parallel_for(0, static_cast<int>(batch.size()), 1, [&](int b, int e) {
+    for (int i = b; i < e; ++i) {
+      const int q = batch[static_cast<std::size_t>(i)];
+      after_accumulation(q, batch_changed[static_cast<std::size_t>(i)] != 0);
+      std::copy_n(projected.data() + static_cast<std::size_t>(i) * 75, 75, probes_.sh.data() + static_cast<std::size_t>(q) * 75);
+      finish_probe(q);
+    }
+  });
   return bad_probes.load();
 }
 

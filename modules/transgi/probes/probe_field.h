@@ -269,10 +269,12 @@ class ProbeField {
   // Irradiance from the interpolated SH (clamped-cosine convolution).
   [[nodiscard]] glm::vec3 irradiance(const glm::vec3& position, const glm::vec3& normal) const;
 
-  // Runs the raster and the SH projection through `kernels` (a GPU backend)
-  // from the next update on; null = the CPU functions. Shared: one backend
-  // serves every field of a scene.
-  void set_kernels(std::shared_ptr<ProbeKernels> kernels) { kernels_ = std::move(kernels); }
+  // Runs every stage of the next updates through `kernels` (the Vulkan
+  // backend, or the CPU's: the default, and what null selects). Shared: one
+  // backend serves every field of a scene.
+  void set_kernels(std::shared_ptr<ProbeKernels> kernels);
+  // This field as its own and finer cascades' probe rays read its light.
+  [[nodiscard]] ProbeFeedbackSource feedback_source() const;
 
   [[nodiscard]] const ProbeFieldSettings& settings() const { return settings_; }
   // The grid as placed (settings().grid), before relocation (cascade_follow.h).

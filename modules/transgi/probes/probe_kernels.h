@@ -1,10 +1,13 @@
 #pragma once
-// The probe field's data-parallel stages (ray tracing, raster, SH projection)
-// behind one interface, so a backend
-// can run them elsewhere (pbrt's split of interface and backend). The CPU
-// functions (rasterize_shared, MapProjector) are the oracle; a ProbeField
-// without kernels calls them directly. The Vulkan backend is
-// gpu/vulkan_probe_kernels.h.
+// The probe field's data-parallel stages (ray tracing and hit shading,
+// raster, accumulation and SH projection) behind one interface with two
+// complete implementations (pbrt's split of interface and backend): the CPU
+// backend (cpu_probe_kernels.h, the oracle) and the Vulkan backend
+// (gpu/vulkan_probe_kernels.h). A field always runs every stage through the
+// one backend it holds; a backend never hands a stage back. A device that
+// cannot run a stage is refused when the backend is made, and a scene it
+// cannot hold throws engine::gpu::GpuError: the owner then swaps the whole
+// backend for the CPU's.
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -15,6 +18,7 @@
 #include "probes/interpolation.h"
 #include "probes/probe_map.h"
 #include "probes/probe_rays.h"
+#include "probes/radiance_map.h"
 #include "probes/radiance_sharing.h"
 
 namespace transgi::probes {
@@ -28,44 +32,57 @@ struct ProbeFeedbackSource {
   std::span<const float> sh;                // probes x 75
   std::span<const std::uint8_t> usable;     // probes
   InterpolationSettings interpolation;
+  // Whether the SH hold light yet (a field's first frame has none to give).
+  bool lit = true;
 };
+
+// ProbeField::irradiance of the field `source` describes: the pruned
+// interpolation of its SH at p, convolved with the clamped cosine about n.
+glm::vec3 probe_irradiance(const ProbeFeedbackSource& source, const glm::vec3& p, const glm::vec3& n);
+// The bounce light at a probe ray's hit p (normal n): from `outer` (the next
+// coarser cascade) outside self's grid box, else from self; 0 from a field
+// that is not lit yet.
+glm::vec3 bounce_irradiance(const ProbeFeedbackSource& self, const ProbeFeedbackSource* outer, const glm::vec3& p,
+                            const glm::vec3& n);
+
+// Why a frame that asked for a device runs on the CPU backend instead.
+enum class BackendFallback : std::uint8_t {
+  None,                   // the backend asked for runs
+  NoDevice,               // no Vulkan device could be had (driver, loader, device name)
+  MissingCapability,      // the device lacks a feature a stage needs (e.g. shaderInt64)
+  KernelBuildFailed,      // a stage's kernel did not compile or link on the device
+  SceneTooLarge,          // the device could not hold the scene (memory, buffer size)
+};
+// "none", "no device", "missing capability", "kernel build failed", "scene too large".
+const char* to_string(BackendFallback reason);
 
 class ProbeKernels {
  public:
   virtual ~ProbeKernels() = default;
+  // Traces and shades the rays of probes origins[j] (index probe_ids[j])
+  // along each of `directions` as trace_probe_ray does, ray i of probe q
+  // drawing from make_rng(seed, q * 4096 + i, sample), the bounce light as
+  // bounce_irradiance(self, outer, ...). out: origins.size() x
+  // directions.size(), probe-major.
+  virtual void shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                                std::span<const glm::vec3> origins, std::span<const int> probe_ids,
+                                std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
+                                const ProbeFeedbackSource& self, const ProbeFeedbackSource* outer,
+                                std::vector<ProbeRayHit>& out) = 0;
   // As rasterize_shared.
   virtual SharingStats rasterize(const ProbeGrid& grid, const MapLayout& layout,
                                  const std::vector<std::vector<ShadedPoint>>& points,
                                  const std::vector<const DepthMap*>& own_depth, const SharingSettings& settings,
                                  std::vector<FrameSamples>& out, std::span<const std::uint8_t> targets) = 0;
   // For each i: accumulate(*states[i], *frames[i], settings) (changed[i] its
-  // result), then filled_radiance(*states[i], layout, settings.fill_passes)
-  // into filled (states.size() x texel_count()). Returns false, touching
-  // nothing, where the backend does not accumulate (the caller does).
-  virtual bool accumulate(const MapLayout& /*layout*/, std::span<ProbeMapState* const> /*states*/,
-                          std::span<const FrameSamples* const> /*frames*/, const AccumulationSettings& /*settings*/,
-                          std::span<std::uint8_t> /*changed*/, std::span<glm::vec3> /*filled*/) {
-    return false;
-  }
-  // As MapProjector::project for `maps` maps stored one after another:
-  // radiance maps x texel_count(), out maps x 75.
-  virtual void project(const MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out) = 0;
-  // Traces and shades the rays of probes origins[j] (index probe_ids[j])
-  // along each of `directions` as trace_probe_rays does, ray i of probe q
-  // drawing from make_rng(seed, q * 4096 + i, sample), the bounce light from
-  // `self` inside its grid's box and from `outer` beyond it (null: none).
-  // out: origins.size() x directions.size(), probe-major. Returns false, out
-  // untouched, where the backend does not shade (the caller then shades on
-  // the CPU).
-  virtual bool shade_probe_rays(const engine::rt::RtScene& /*scene*/, const engine::render::LightSet& /*lights*/,
-                                std::span<const glm::vec3> /*origins*/, std::span<const int> /*probe_ids*/,
-                                std::span<const glm::vec3> /*directions*/, std::uint64_t /*seed*/, std::uint64_t /*sample*/,
-                                const ProbeFeedbackSource* /*self*/, const ProbeFeedbackSource* /*outer*/,
-                                std::vector<ProbeRayHit>& /*out*/) {
-    return false;
-  }
-  // The backend's ray tracer for the probe rays (and the G-buffer's camera
-  // rays); null = Embree.
+  // result), then filled_radiance(*states[i], projector.layout(),
+  // settings.fill_passes) projected as projector.project into
+  // sh[i * 75, i * 75 + 75).
+  virtual void accumulate_and_project(const MapProjector& projector, std::span<ProbeMapState* const> states,
+                                      std::span<const FrameSamples* const> frames, const AccumulationSettings& settings,
+                                      std::span<std::uint8_t> changed, std::span<float> sh) = 0;
+  // The backend's ray tracer for the probes' relocation rays (and the
+  // G-buffer's camera rays); null = the RtScene's own (Embree) queries.
   virtual engine::rt::RayBatchTracer* tracer() = 0;
   [[nodiscard]] virtual const char* name() const = 0;
 };

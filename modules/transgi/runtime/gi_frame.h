@@ -63,13 +63,13 @@ struct GiFrame {
   // device), and why not the one asked for, if it could not.
   std::string backend = "cpu";
   std::string backend_fallback;
+  probes::BackendFallback backend_fallback_reason = probes::BackendFallback::None;
   // The backend's GPU time by timestamps, per stage: the real-time
   // G-buffer's camera rays and its direct light's shadow rays; ray tracing
   // since (probe rays and their shadow rays, and any other batch traced
   // since the last G-buffer); the radiance raster; the SH projection; the
   // real-time path's transfer inference (fused decoder and SH dots); the
-  // probe rays' hit shading (TransGISettings::device_shading); the probes'
-  // accumulation.
+  // probe rays' hit shading; the probes' accumulation.
   double gpu_gbuffer_ms = 0.0, gpu_trace_ms = 0.0, gpu_raster_ms = 0.0, gpu_projection_ms = 0.0, gpu_inference_ms = 0.0,
          gpu_shading_ms = 0.0, gpu_accumulation_ms = 0.0;
   // Host-device traffic since the last image (the probe updates and this

@@ -61,13 +61,6 @@ struct TransGISettings {
   // a sample still crossed the bus; they are now made on the device
   // (RealtimeGiSettings::device_lights), which no GPU has timed yet.
   bool device_inference = false;
-  // Backend::Vulkan: shade the probe rays' hits on the device (materials,
-  // textures, a light sample, the bounce from the probes), as the CPU would
-  // with the same random numbers. On = the probe update leaves the CPU but
-  // for building rays and sorting results, at the cost of uploading the
-  // probes' depth maps and SH each frame. Where the device cannot (no 64-bit
-  // integers in shaders) the CPU shades and the frame says why.
-  bool device_shading = true;
   // Bumped to rebuild the GPU kernels from the shader folder as it is now
   // (hot reload; gpu::check_module_shaders first, so a broken edit keeps
   // the running kernels).

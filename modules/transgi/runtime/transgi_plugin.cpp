@@ -4,6 +4,7 @@
 #include <optional>
 #include <span>
 
+#include "engine/gpu/gpu_error.h"
 #include "engine/jobs/parallel_for.h"
 #include "engine/render/camera_rays.h"
 #include "engine/render/light_plugin.h"
@@ -12,6 +13,7 @@
 #include "engine/scene/components.h"
 #include "engine/transform/transform.h"
 #include "gpu/vulkan_probe_kernels.h"
+#include "probes/cpu_probe_kernels.h"
 #include "shading/realtime_direct.h"
 #include "shading/realtime_gi.h"
 #include "engine/render/temporal_accumulation.h"
@@ -39,65 +41,100 @@ void request_light_settings(Res<TransGISettings> settings, ResMut<render::LightS
   if (lights->split_sun != split) lights->split_sun = split;
 }
 
-// The GI backend (probe kernels and ray tracer), made when the settings
-// first ask for it; a resource, as render_gi traces the G-buffer with it too.
+// The GI backend (probe kernels and ray tracer), chosen once when the
+// settings first ask for it; a resource, as render_gi traces the G-buffer
+// with it too. Every field runs every stage on it.
 struct ProbeBackend {
   Backend made_for = Backend::Cpu;
   std::string device;
   std::uint32_t shader_generation = 0;
-  std::shared_ptr<gpu::VulkanProbeKernels> kernels;  // null: the CPU functions
-  std::string fallback;
+  std::shared_ptr<gpu::VulkanProbeKernels> vulkan;  // null: the CPU backend runs the frame
+  probes::BackendFallback fallback = probes::BackendFallback::None;
+  std::string fallback_why;
   std::shared_ptr<engine::gpu::VulkanContext> host;  // the host engine's device, if it gave one
+
+  [[nodiscard]] std::shared_ptr<probes::ProbeKernels> kernels() const {
+    return vulkan ? std::shared_ptr<probes::ProbeKernels>(vulkan) : probes::cpu_probe_kernels();
+  }
+  // The CPU backend whole from now on, and why.
+  void fall_back(probes::BackendFallback reason, std::string why) {
+    vulkan.reset();
+    fallback = reason;
+    fallback_why = std::move(why);
+  }
 };
 
-void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> cascades, Res<rt::RtScene> rt,
-                   Res<render::SceneLights> lights, Res<TransGISettings> settings, ResMut<GiFrame> frame,
-                   ResMut<ProbeBackend> backend) {
-  if (settings->freeze_probes) return;
-  if (backend->made_for != settings->backend || backend->device != settings->gpu_device ||
-      backend->shader_generation != settings->shader_generation) {
-    *backend = ProbeBackend{settings->backend, settings->gpu_device, settings->shader_generation, nullptr, "", backend->host};
-    if (settings->backend == Backend::Vulkan) {
-      std::string why;
-      backend->kernels = backend->host ? gpu::make_probe_kernels(backend->host, &why) : gpu::make_probe_kernels(settings->gpu_device, &why);
-      if (!backend->kernels) backend->fallback = "Vulkan backend unavailable, the CPU runs the probes: " + why;
-    }
-  }
-  frame->backend = backend->kernels ? backend->kernels->name() : "cpu";
-  frame->backend_fallback = backend->fallback;
-  if (backend->kernels) backend->kernels->set_device_shading(settings->device_shading);
+void choose_backend(const TransGISettings& settings, ProbeBackend& backend) {
+  if (backend.made_for == settings.backend && backend.device == settings.gpu_device &&
+      backend.shader_generation == settings.shader_generation)
+    return;
+  backend = ProbeBackend{settings.backend, settings.gpu_device, settings.shader_generation, nullptr,
+                         probes::BackendFallback::None, "", backend.host};
+  if (settings.backend != Backend::Vulkan) return;
+  probes::BackendFallback reason = probes::BackendFallback::None;
+  std::string why;
+  backend.vulkan = backend.host ? gpu::make_probe_kernels(backend.host, &reason, &why)
+                                : gpu::make_probe_kernels(settings.gpu_device, &reason, &why);
+  if (!backend.vulkan) backend.fall_back(reason, why);
+}
+
+// Every probe volume's and cascade's update on `kernels`.
+probes::ProbeFrameStats update_all_fields(View<Get<ProbeVolume>>& volumes, View<Get<ProbeCascades>>& cascades,
+                                          const rt::RtScene& rt, const render::LightSet& lights,
+                                          const std::shared_ptr<probes::ProbeKernels>& kernels,
+                                          std::vector<probes::ProbeFrameStats>& cascade_stats) {
   probes::ProbeFrameStats total;
   volumes.each([&](ProbeVolume& v) {
     if (!v.field) return;
-    v.field->set_kernels(backend->kernels);
-    total += v.field->update(*rt, lights->set);
+    v.field->set_kernels(kernels);
+    total += v.field->update(rt, lights);
   });
-  frame->cascade_stats.clear();
+  cascade_stats.clear();
   cascades.each([&](ProbeCascades& set) {
     for (std::size_t k = 0; k < set.state.fields.size(); ++k) {
       // Hits beyond a cascade are lit by the next coarser one.
       const probes::ProbeField* outer = k + 1 < set.state.fields.size() ? set.state.fields[k + 1].get() : nullptr;
       if (!set.state.fields[k]) continue;
-      set.state.fields[k]->set_kernels(backend->kernels);
-      const probes::ProbeFrameStats st = set.state.fields[k]->update(*rt, lights->set, outer);
-      if (frame->cascade_stats.size() <= k) frame->cascade_stats.resize(k + 1);
-      frame->cascade_stats[k] += st;
+      set.state.fields[k]->set_kernels(kernels);
+      const probes::ProbeFrameStats st = set.state.fields[k]->update(rt, lights, outer);
+      if (cascade_stats.size() <= k) cascade_stats.resize(k + 1);
+      cascade_stats[k] += st;
       total += st;
     }
   });
+  return total;
+}
+
+void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> cascades, Res<rt::RtScene> rt,
+                   Res<render::SceneLights> lights, Res<TransGISettings> settings, ResMut<GiFrame> frame,
+                   ResMut<ProbeBackend> backend) {
+  if (settings->freeze_probes) return;
+  choose_backend(*settings, *backend);
+  probes::ProbeFrameStats total;
+  try {
+    total = update_all_fields(volumes, cascades, *rt, lights->set, backend->kernels(), frame->cascade_stats);
+  } catch (const engine::gpu::GpuError& e) {
+    if (!backend->vulkan) throw;
+    // The device cannot hold this scene. Every field runs this frame again,
+    // on the CPU: those that finished on the device, or threw after their
+    // plan and classification, take a second frame of probe work, which
+    // moves their light on as one more frame would.
+    backend->fall_back(probes::BackendFallback::SceneTooLarge, e.what());
+    total = update_all_fields(volumes, cascades, *rt, lights->set, backend->kernels(), frame->cascade_stats);
+  }
+  frame->backend = backend->vulkan ? backend->vulkan->name() : "cpu";
+  frame->backend_fallback_reason = backend->fallback;
+  frame->backend_fallback = backend->fallback == probes::BackendFallback::None
+                                ? std::string()
+                                : std::string("the CPU backend runs the frame (") + probes::to_string(backend->fallback) +
+                                      "): " + backend->fallback_why;
   frame->probe_stats = total;
-  const gpu::VulkanProbeKernels::StageMs gpu_ms = backend->kernels ? backend->kernels->take_stage_ms() : gpu::VulkanProbeKernels::StageMs{};
+  const gpu::VulkanProbeKernels::StageMs gpu_ms = backend->vulkan ? backend->vulkan->take_stage_ms() : gpu::VulkanProbeKernels::StageMs{};
   frame->gpu_trace_ms = gpu_ms.trace;
   frame->gpu_raster_ms = gpu_ms.raster;
   frame->gpu_projection_ms = gpu_ms.projection;
   frame->gpu_shading_ms = gpu_ms.shading;
   frame->gpu_accumulation_ms = gpu_ms.accumulation;
-  // The device could not shade the probe rays, so the CPU did.
-  if (backend->kernels && settings->device_shading && !backend->kernels->probe_shading_why().empty()) {
-    const std::string note = "probe rays shaded on the CPU: " + backend->kernels->probe_shading_why();
-    if (frame->backend_fallback.find(note) == std::string::npos)
-      frame->backend_fallback += (frame->backend_fallback.empty() ? "" : "; ") + note;
-  }
   ++frame->probe_frames;
 }
 
@@ -240,7 +277,7 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
       frame.gpu_upload_bytes = t.host_to_device_bytes;
       frame.gpu_download_bytes = t.device_to_host_bytes;
     }
-  } record_traffic{*frame, backend->kernels.get()};
+  } record_traffic{*frame, backend->vulkan.get()};
 
   // One scene decoder: the model of the first LatentMesh found.
   std::shared_ptr<const model::TransferModel> model;
@@ -274,12 +311,12 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
   frame->gpu_gbuffer_ms = frame->gpu_inference_ms = 0.0;
   if (settings->gi_path == GiPath::Realtime) {
     shading::TransferBatchDecoder* batch_decoder = nullptr;
-    if (backend->kernels && settings->device_inference && model) {
-      batch_decoder = backend->kernels->transfer_decoder(model);
+    if (backend->vulkan && settings->device_inference && model) {
+      batch_decoder = backend->vulkan->transfer_decoder(model);
       // update_probes resets backend_fallback each frame, but not while the
       // probes are frozen: say it once.
       if (!batch_decoder) {
-        const std::string note = "transfer inference on the CPU: " + backend->kernels->transfer_decoder_why();
+        const std::string note = "transfer inference on the CPU: " + backend->vulkan->transfer_decoder_why();
         if (frame->backend_fallback.find(note) == std::string::npos)
           frame->backend_fallback += (frame->backend_fallback.empty() ? "" : "; ") + note;
       }
@@ -290,7 +327,7 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
     packed->lights_version = lights->version;
     packed->geometry_version = lights->geometry_version;
     render_realtime(*rays, model, rs.has_transfer, fields, *rt, *assets, lights->set, *settings, rs.seed, *packed, *frame,
-                    backend->kernels ? backend->kernels->tracer() : nullptr, batch_decoder, light_changed);
+                    backend->kernels()->tracer(), batch_decoder, light_changed);
     frame->times.collect_points = frame->probe_stats.scatter_ms;
     frame->times.probe_raster = frame->probe_stats.raster_ms;
     frame->times.probe_projection = frame->probe_stats.project_ms;

@@ -1,0 +1,89 @@
+#include "probes/cpu_probe_kernels.h"
+
+#include <numeric>
+
+#include "engine/jobs/parallel_for.h"
+#include "engine/math/rng.h"
+#include "shading/sh_light.h"
+
+namespace transgi::probes {
+
+const char* to_string(BackendFallback reason) {
+  switch (reason) {
+    case BackendFallback::None: return "none";
+    case BackendFallback::NoDevice: return "no device";
+    case BackendFallback::MissingCapability: return "missing capability";
+    case BackendFallback::KernelBuildFailed: return "kernel build failed";
+    case BackendFallback::SceneTooLarge: return "scene too large";
+  }
+  return "unknown";
+}
+
+glm::vec3 probe_irradiance(const ProbeFeedbackSource& s, const glm::vec3& p, const glm::vec3& n) {
+  const InterpolationResult r = interpolate_probes(*s.grid, s.layout, *s.states, p, n, s.interpolation, s.usable);
+  float L[75];
+  for (float& v : L) v = 0.0f;
+  for (std::size_t i = 0; i < 8; ++i) {
+    if (r.weights[i] == 0.0f) continue;
+    const float* probe = s.sh.data() + static_cast<std::size_t>(r.probes[i]) * 75;
+    for (int k = 0; k < 75; ++k) L[k] += r.weights[i] * probe[k];
+  }
+  return shading::sh_irradiance(L, n);
+}
+
+glm::vec3 bounce_irradiance(const ProbeFeedbackSource& self, const ProbeFeedbackSource* outer, const glm::vec3& p,
+                            const glm::vec3& n) {
+  const ProbeGrid& box = *self.grid;
+  if (outer && (glm::any(glm::lessThan(p, box.min)) || glm::any(glm::greaterThan(p, box.max))))
+    return outer->lit ? probe_irradiance(*outer, p, n) : glm::vec3(0.0f);
+  return self.lit ? probe_irradiance(self, p, n) : glm::vec3(0.0f);
+}
+
+void CpuProbeKernels::shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                                       std::span<const glm::vec3> origins, std::span<const int> probe_ids,
+                                       std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
+                                       const ProbeFeedbackSource& self, const ProbeFeedbackSource* outer,
+                                       std::vector<ProbeRayHit>& out) {
+  const std::size_t m = directions.size();
+  out.resize(origins.size() * m);
+  // The rays are traced by the list's position j; probe_ids[j] seeds them.
+  std::vector<int> slots(origins.size());
+  std::iota(slots.begin(), slots.end(), 0);
+  trace_probe_rays(
+      scene, lights, nullptr, slots, directions, [&](int j) { return origins[static_cast<std::size_t>(j)]; },
+      [&](int j, int i) {
+        return engine::math::make_rng(
+            seed, static_cast<std::uint64_t>(probe_ids[static_cast<std::size_t>(j)]) * 4096 + static_cast<std::uint64_t>(i), sample);
+      },
+      [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3&) { return bounce_irradiance(self, outer, p, n); },
+      [&](int j, int i, const ProbeRayHit& h) { out[static_cast<std::size_t>(j) * m + static_cast<std::size_t>(i)] = h; });
+}
+
+SharingStats CpuProbeKernels::rasterize(const ProbeGrid& grid, const MapLayout& layout,
+                                        const std::vector<std::vector<ShadedPoint>>& points,
+                                        const std::vector<const DepthMap*>& own_depth, const SharingSettings& settings,
+                                        std::vector<FrameSamples>& out, std::span<const std::uint8_t> targets) {
+  return rasterize_shared(grid, layout, points, own_depth, settings, out, targets);
+}
+
+void CpuProbeKernels::accumulate_and_project(const MapProjector& projector, std::span<ProbeMapState* const> states,
+                                             std::span<const FrameSamples* const> frames,
+                                             const AccumulationSettings& settings, std::span<std::uint8_t> changed,
+                                             std::span<float> sh) {
+  // One probe at a time: its filled map stays in cache for the projection.
+  engine::jobs::parallel_for(0, static_cast<int>(states.size()), 1, [&](int b, int e) {
+    for (int i = b; i < e; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      changed[k] = accumulate(*states[k], *frames[k], settings) ? 1 : 0;
+      const std::vector<glm::vec3> filled = filled_radiance(*states[k], projector.layout(), settings.fill_passes);
+      projector.project(filled.data(), sh.data() + k * 75);
+    }
+  });
+}
+
+std::shared_ptr<ProbeKernels> cpu_probe_kernels() {
+  static const std::shared_ptr<ProbeKernels> kernels = std::make_shared<CpuProbeKernels>();
+  return kernels;
+}
+
+}  // namespace transgi::probes
