@@ -1,6 +1,7 @@
 #include "engine/gpu/gpu_rt_scene.h"
 
 #include <cstddef>
+#include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <string_view>
@@ -28,10 +29,20 @@ std::filesystem::path engine_shader_dir() {
   return ENGINE_SOURCE_SHADER_DIR;
 }
 
+// `what` names the data in the error where it is larger than a kernel can
+// bind: the owner then runs its work on the CPU (a device would read past
+// the binding's end).
 template <class T>
-void upload_to(VulkanContext& ctx, GpuBuffer& b, const std::vector<T>& v,
+void upload_to(VulkanContext& ctx, GpuBuffer& b, const std::vector<T>& v, const char* what,
                GpuBuffer::Placement placement = GpuBuffer::Placement::Mapped, VkBufferUsageFlags usage = 0) {
   const std::size_t bytes = v.size() * sizeof(T);
+  const std::uint64_t limit = ctx.info().max_storage_buffer_range;
+  if (limit > 0 && bytes > limit) {
+    char text[160];
+    std::snprintf(text, sizeof(text), "GpuRtScene: the scene's %s take %.2f MiB, more than the device's largest storage buffer (%.2f MiB)",
+                  what, static_cast<double>(bytes) / (1024.0 * 1024.0), static_cast<double>(limit) / (1024.0 * 1024.0));
+    throw GpuError(text);
+  }
   if (b.handle() == VK_NULL_HANDLE || b.size() < bytes) b = GpuBuffer(ctx, bytes, placement, usage);
   b.upload(std::span<const T>(v));
 }
@@ -192,16 +203,16 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
     if (alpha_materials.empty()) alpha_materials.push_back({});
     if (alpha_textures.empty()) alpha_textures.push_back({});
     if (alpha_bytes.empty()) alpha_bytes.push_back(0);
-    upload_to(ctx_, triangle_uvs_, uvs, kStatic);
-    upload_to(ctx_, alpha_materials_, alpha_materials, kStatic);
-    upload_to(ctx_, alpha_bytes_, alpha_bytes, kStatic);
-    upload_to(ctx_, alpha_textures_, alpha_textures, kStatic);
+    upload_to(ctx_, triangle_uvs_, uvs, "triangle texture coordinates", kStatic);
+    upload_to(ctx_, alpha_materials_, alpha_materials, "alpha-tested materials", kStatic);
+    upload_to(ctx_, alpha_bytes_, alpha_bytes, "alpha textures", kStatic);
+    upload_to(ctx_, alpha_textures_, alpha_textures, "alpha texture table", kStatic);
     if (nodes.empty()) nodes.push_back(to_gpu(rt::BvhNode{}));
     if (tris.empty()) tris.push_back({});
-    upload_to(ctx_, blas_, nodes, kStatic);
+    upload_to(ctx_, blas_, nodes, "mesh BVH nodes", kStatic);
     const VkBufferUsageFlags build_input =
         stats_.ray_query ? VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT : 0;
-    upload_to(ctx_, triangles_, tris, kStatic, build_input);
+    upload_to(ctx_, triangles_, tris, "triangles", kStatic, build_input);
     stats_.blas_nodes = stats_.ray_query ? 0 : nodes.size();
     stats_.triangles = tris.size();
     if (structures_) {
@@ -248,7 +259,7 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
     }
   }
   if (instances.empty()) instances.push_back({});
-  upload_to(ctx_, instances_, instances, kStatic);
+  upload_to(ctx_, instances_, instances, "instances", kStatic);
   stats_.instances = live.size();
   if (structures_) {
     structures_->build_top(tlas_instances);
@@ -256,7 +267,7 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
   }
   std::vector<BvhNodeGpu> nodes;
   for (const auto& n : tlas.nodes) nodes.push_back(to_gpu(n));
-  upload_to(ctx_, tlas_, nodes, kStatic);
+  upload_to(ctx_, tlas_, nodes, "instance BVH nodes", kStatic);
   stats_.tlas_nodes = nodes.size();
 }
 

@@ -212,10 +212,7 @@ void GameSession::set_backend(const std::string& backend) {
   auto& settings = w.resource<transgi::runtime::TransGISettings>();
   settings.backend = backend == "vulkan" ? transgi::runtime::Backend::Vulkan : transgi::runtime::Backend::Cpu;
   ddgi_backend_ = backend;
-  if (auto* d = w.try_resource<transgi::ddgi::DdgiBackend>()) {
-    std::string why;
-    d->kernels = transgi::gpu::make_ddgi_kernels(backend, settings.gpu_device, &why);
-  }
+  if (auto* d = w.try_resource<transgi::ddgi::DdgiBackend>()) *d = transgi::gpu::make_ddgi_backend(backend, settings.gpu_device);
 }
 
 std::vector<std::string> GameSession::reload_shaders() {

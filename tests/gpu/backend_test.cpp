@@ -156,9 +156,8 @@ eval::MethodRun cornell_ddgi(bool gpu, const runtime::ProbePlacement& placement,
   d.settings.rays_per_probe = 64;
   d.settings.warmup_frames = 8;
   d.placement = placement;
-  std::string why;
-  if (gpu) d.kernels = gpu::make_ddgi_kernels("vulkan", "", &why);
-  EXPECT_TRUE(!gpu || d.kernels) << why;
+  if (gpu) d.backend = gpu::make_ddgi_backend("vulkan", "");
+  EXPECT_EQ(d.backend.fallback, probes::BackendFallback::None) << d.backend.fallback_why;
   eval::LoadedScene scene = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/test_scenes/cornell_box/scene.gltf", "", 2);
   return eval::run_ddgi(scene, width, 48, d);
 }
@@ -183,8 +182,8 @@ TEST(VulkanBackend, ACornellBoxDdgiFrameEqualsTheCpuBackends) {
 // The game's real-time DDGI frame (one G-buffer ray a pixel, deterministic
 // direct light, a probe budget after the warm-up) on both backends: the
 // G-buffer's and the probes' rays traced on the device, the blend as a
-// kernel, the lookups as a kernel (without emitted maps; with them, on the
-// CPU). The full image and both passes. 51 pixels wide: at an even width the
+// kernel, the lookups as a kernel (with emitted maps, theirs too, through
+// each volume's emitted view). The full image and both passes. 51 pixels wide: at an even width the
 // box's corner edges run through pixel centres, where the compute traversal
 // and Embree pick different ones of two tied walls.
 TEST(VulkanBackend, ACornellBoxRealtimeDdgiFrameEqualsTheCpuBackends) {
@@ -230,4 +229,39 @@ TEST(VulkanBackend, ACornellBoxDdgiFrameWithCascadesEqualsTheCpuBackends) {
   std::printf("Cornell box DDGI, 3 cascades, 16 updates, 48x48: GI RMSE between backends %.3g, mean GI %.4f (%s)\n", rmse,
               mean, gpu.probe_summary.c_str());
   EXPECT_LT(rmse, 1e-4 * mean) << "expected the backends within 1e-4 of the mean GI, got RMSE " << rmse;
+}
+
+// A device whose largest buffer cannot hold the sample level's triangles:
+// DDGI's first device stage throws, and the plugin runs that frame and every
+// later one on the CPU backend whole, saying why. The frame is the CPU
+// backend's, bit for bit.
+TEST(VulkanBackend, ADdgiSceneTooBigForTheDeviceRunsTheWholeFrameOnTheCpuBackend) {
+  GPU_TEST_CONTEXT_OR_SKIP(unused);
+  engine::gpu::GpuOptions options;
+  options.storage_buffer_range_cap = 64 * 1024;  // the level's triangles take more
+  std::string why;
+  std::shared_ptr<engine::gpu::VulkanContext> ctx(engine::gpu::VulkanContext::create(options, &why));
+  ASSERT_TRUE(ctx) << why;
+  const auto run = [&](std::shared_ptr<ddgi::DdgiKernels> kernels) {
+    eval::DdgiRunOptions d;
+    d.frames = 12;
+    d.settings.warmup_frames = 8;
+    d.progress = false;
+    d.render.direct_spp = 0;
+    d.settings.rays_per_probe = 32;
+    d.placement.mode = runtime::ProbeVolumeMode::Scene;
+    d.placement.scene_dims = glm::ivec3(4);
+    if (kernels) d.backend.kernels = std::move(kernels);
+    eval::LoadedScene scene = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
+    return eval::run_ddgi(scene, 32, 18, d);
+  };
+  const eval::MethodRun capped = run(std::make_shared<gpu::VulkanDdgiKernels>(ctx)), cpu = run(nullptr);
+  EXPECT_EQ(capped.backend.rfind("cpu; the CPU backend runs the frame (scene too large): ", 0), 0u) << capped.backend;
+  EXPECT_NE(capped.backend.find("largest storage buffer"), std::string::npos) << capped.backend;
+  EXPECT_EQ(cpu.backend, "cpu");
+  ASSERT_GT(gpu_test::mean_rgb(cpu.gi), 1e-4) << "the level's GI should not be black";
+  ASSERT_EQ(capped.gi.pixels.size(), cpu.gi.pixels.size());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < cpu.gi.pixels.size(); ++i) differ += capped.gi.pixels[i] != cpu.gi.pixels[i] ? 1 : 0;
+  EXPECT_EQ(differ, 0u) << "expected the CPU backend's frame exactly";
 }

@@ -179,14 +179,11 @@ int render_ddgi(const Args& args, eval::LoadedScene& scene, int width, int heigh
   d.frames = static_cast<int>(args.integer("frames", 1, 100000, 400));
   d.timing_frames = static_cast<int>(args.integer("timing-frames", 1, 1000, 3));
   d.placement = probe_placement_from(args, runtime::ProbeVolumeMode::Cascades);
-  std::string why;
-  const std::string backend = args.choice("backend", {"cpu", "vulkan"}, "cpu");
-  d.kernels = transgi::gpu::make_ddgi_kernels(backend, args.str("device", std::string()), &why);
+  d.backend = transgi::gpu::make_ddgi_backend(args.choice("backend", {"cpu", "vulkan"}, "cpu"), args.str("device", std::string()));
   const eval::MethodRun r = eval::run_ddgi(scene, width, height, d);
   write_passes(o, r.full, r.direct, r.gi);
   std::printf("rendered %s (ddgi, %s pass) %dx%d at %d spp\n", o.out.c_str(), o.pass.c_str(), width, height, d.render.gbuffer_spp);
-  std::printf("probe kernels: %s%s\n", d.kernels ? d.kernels->name() : "cpu",
-              backend == "vulkan" && !d.kernels ? ("; Vulkan backend unavailable, the CPU runs the probes: " + why).c_str() : "");
+  std::printf("probe kernels: %s\n", r.backend.c_str());
   print_stages(r, std::min(d.timing_frames, d.frames));
   return 0;
 }

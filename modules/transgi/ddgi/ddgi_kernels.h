@@ -1,32 +1,54 @@
 #pragma once
 // DDGI's data-parallel stages behind one interface, as TransGI's
-// probes::ProbeKernels: the probe rays' tracing and the per-probe blend. A
-// DdgiVolume without kernels runs the CPU functions (the oracle); the
-// Vulkan backend is gpu/vulkan_ddgi_kernels.h.
+// probes::ProbeKernels, with two complete implementations: the CPU backend
+// (cpu_ddgi_kernels.h, the oracle) and the Vulkan backend
+// (gpu/vulkan_ddgi_kernels.h). Every volume and the renderer run every stage
+// through the one backend the plugin holds (DdgiBackend); a backend never
+// hands a stage back. A scene the device cannot hold throws
+// engine::gpu::GpuError, and the plugin then swaps in the CPU backend whole.
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
+#include <glm/mat2x3.hpp>
+
 #include "ddgi/ddgi_blend.h"
+#include "engine/image/image.h"
+#include "engine/render/camera_rays.h"
 #include "engine/rt/ray_batch_tracer.h"
 
 namespace transgi::ddgi {
 
+class DdgiVolume;
+
+struct DdgiRenderSettings {
+  int spp = 1;
+  std::uint64_t seed = 0;
+  float filter_width = 1.5f;
+};
+
 class DdgiKernels {
  public:
   virtual ~DdgiKernels() = default;
-  // The probe rays' tracer; null = Embree.
+  // The probe rays' (and the real-time G-buffer's) tracer; null = the
+  // RtScene's own (Embree) queries.
   virtual engine::rt::RayBatchTracer* tracer() = 0;
   // blend_irradiance and blend_distance for every probe with records (an
   // empty list leaves that probe).
   virtual void blend(std::vector<OctahedralMap<glm::vec3>>& irradiance, std::vector<OctahedralMap<glm::vec2>>& distance,
                      const std::vector<std::vector<RayRecord>>& records, const DdgiSettings& settings, float hysteresis,
                      bool clamp_brightness, float max_distance) = 0;
-  // DdgiVolume::irradiance at each point (out[i]; 0 where no active probe
-  // weighs in, and lit[i] = 0 then, else 1). Returns false, out and lit
-  // untouched, where the backend cannot.
-  virtual bool irradiance(const DdgiVolume& volume, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
-                          std::span<const glm::vec3> view_dirs, std::span<glm::vec3> out, std::span<std::uint8_t> lit) = 0;
+  // For each point k, the volumes' light blended as irradiance_from blends
+  // it: out[k][0] from the irradiance maps, out[k][1] from the emitted maps
+  // (DdgiSettings::emitted_maps; 0 from a volume without them).
+  virtual void irradiance(std::span<const DdgiVolume* const> volumes, std::span<const glm::vec3> positions,
+                          std::span<const glm::vec3> normals, std::span<const glm::vec3> view_dirs,
+                          std::span<glm::mat2x3> out) = 0;
+  // The offline GI pass (ddgi_renderer.h, render_ddgi_gi).
+  virtual engine::image::ImageRGB render_gi(const engine::rt::RtScene& scene, std::span<const DdgiVolume* const> volumes,
+                                            const engine::render::CameraRays& camera, int width, int height,
+                                            const DdgiRenderSettings& settings) = 0;
   [[nodiscard]] virtual const char* name() const = 0;
 };
 

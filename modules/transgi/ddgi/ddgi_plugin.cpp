@@ -1,5 +1,7 @@
 #include "ddgi/ddgi_plugin.h"
 
+#include "engine/gpu/gpu_error.h"
+
 #include <chrono>
 
 #include "ddgi/ddgi_renderer.h"
@@ -57,8 +59,35 @@ struct SkylessLights {
   render::LightSet set;
 };
 
+// Every volume's and cascade's update on `kernels`.
+DdgiFrameStats update_all_volumes(View<Get<DdgiProbeVolume>>& volumes, View<Get<DdgiCascades>>& cascades,
+                                  const rt::RtScene& rt, const render::LightSet& set, const scene::Environment* sky,
+                                  const std::shared_ptr<DdgiKernels>& kernels) {
+  DdgiFrameStats total;
+  const auto add = [&](const DdgiFrameStats& s) {
+    total.rays += s.rays;
+    total.inactive += s.inactive;
+    total.trace_ms += s.trace_ms;
+    total.blend_ms += s.blend_ms;
+  };
+  volumes.each([&](DdgiProbeVolume& v) {
+    if (!v.volume) return;
+    v.volume->set_kernels(kernels);
+    add(v.volume->update(rt, set, sky));
+  });
+  cascades.each([&](DdgiCascades& c) {
+    const auto& fields = c.state.fields;
+    for (std::size_t k = 0; k < fields.size(); ++k) {
+      if (!fields[k]) continue;
+      fields[k]->set_kernels(kernels);
+      add(fields[k]->update(rt, set, sky, k + 1 < fields.size() ? fields[k + 1].get() : nullptr));
+    }
+  });
+  return total;
+}
+
 void update_volumes(View<Get<DdgiProbeVolume>> volumes, View<Get<DdgiCascades>> cascades, Res<rt::RtScene> rt, Res<render::SceneLights> lights,
-                    Res<DdgiSettings> settings, ResMut<DdgiFrame> frame, Res<DdgiBackend> backend, Local<SkylessLights> skyless) {
+                    Res<DdgiSettings> settings, ResMut<DdgiFrame> frame, ResMut<DdgiBackend> backend, Local<SkylessLights> skyless) {
   const render::LightSet* set = &lights->set;
   const scene::Environment* sky = lights->set.environment();
   if (settings->escaped == EscapedRays::Environment && sky) {
@@ -69,25 +98,16 @@ void update_volumes(View<Get<DdgiProbeVolume>> volumes, View<Get<DdgiCascades>> 
     set = &skyless->set;
   }
   DdgiFrameStats total;
-  const auto add = [&](const DdgiFrameStats& s) {
-    total.rays += s.rays;
-    total.inactive += s.inactive;
-    total.trace_ms += s.trace_ms;
-    total.blend_ms += s.blend_ms;
-  };
-  volumes.each([&](DdgiProbeVolume& v) {
-    if (!v.volume) return;
-    v.volume->set_kernels(backend->kernels);
-    add(v.volume->update(*rt, *set, sky));
-  });
-  cascades.each([&](DdgiCascades& c) {
-    const auto& fields = c.state.fields;
-    for (std::size_t k = 0; k < fields.size(); ++k) {
-      if (!fields[k]) continue;
-      fields[k]->set_kernels(backend->kernels);
-      add(fields[k]->update(*rt, *set, sky, k + 1 < fields.size() ? fields[k + 1].get() : nullptr));
-    }
-  });
+  try {
+    total = update_all_volumes(volumes, cascades, *rt, *set, sky, backend->kernels);
+  } catch (const engine::gpu::GpuError& e) {
+    if (backend->kernels == cpu_ddgi_kernels()) throw;
+    // The device cannot hold this scene: every volume runs this frame again
+    // on the CPU (one that finished on the device takes a second frame of
+    // probe work, as one more frame would).
+    backend->fall_back(probes::BackendFallback::SceneTooLarge, e.what());
+    total = update_all_volumes(volumes, cascades, *rt, *set, sky, backend->kernels);
+  }
   frame->probe_stats = total;
   frame->times.probe_trace = total.trace_ms;
   frame->times.probe_blend = total.blend_ms;
@@ -97,13 +117,12 @@ void update_volumes(View<Get<DdgiProbeVolume>> volumes, View<Get<DdgiCascades>> 
 // The offline shape: filtered primary rays, DDGI's light at their hits,
 // averaged over still frames, and path-traced direct light.
 void render_offline(const rt::RtScene& rt, const render::LightSet& lights, const render::CameraRays& rays,
-                    std::span<const DdgiVolume* const> all, DdgiKernels* kernels, std::uint64_t geometry_version,
+                    std::span<const DdgiVolume* const> all, DdgiKernels& kernels, std::uint64_t geometry_version,
                     std::uint64_t lights_version, const DdgiRenderOptions& options, render::TemporalAccumulation& history,
                     DdgiFrame& frame) {
   const std::uint64_t seed = options.seed + frame.frames;
   auto t0 = Clock::now();
-  frame.gi = render::accumulate(history, render_ddgi_gi(rt, all, rays, frame.width, frame.height, {.spp = options.gbuffer_spp, .seed = seed},
-                                                        kernels),
+  frame.gi = render::accumulate(history, kernels.render_gi(rt, all, rays, frame.width, frame.height, {.spp = options.gbuffer_spp, .seed = seed}),
                                 render::view_key(rays.to_world(), frame.width, frame.height, geometry_version, lights_version),
                                 options.temporal_window);
   frame.times.shading = ms_since(t0);
@@ -126,14 +145,14 @@ struct DdgiRealtimeScratch {
 // direct light shaded tile by tile as it is traced, then DDGI's light at its
 // pixels.
 void render_realtime(const rt::RtScene& rt, const scene::SceneAssets& assets, const render::SceneLights& scene_lights,
-                     const render::CameraRays& rays, std::span<const DdgiVolume* const> volumes, DdgiKernels* kernels,
+                     const render::CameraRays& rays, std::span<const DdgiVolume* const> volumes, DdgiKernels& kernels,
                      const DdgiRenderOptions& options, DdgiRealtimeScratch& scratch, DdgiFrame& frame) {
   const render::LightSet& lights = scene_lights.set;
   shading::GBuffer& g = scratch.gbuffer;
   auto t0 = Clock::now();
   shading::DirectTileShader direct(rt, lights, rays, frame.width, frame.height);
   const glm::vec2 jitter = options.taa.enabled ? scratch.taa.next_jitter(options.taa) : glm::vec2(0.0f);
-  shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, g, &direct, kernels ? kernels->tracer() : nullptr,
+  shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, g, &direct, kernels.tracer(),
                          jitter, options.taa.texture_lod_bias_in_use());
   frame.direct = direct.take(g);
   frame.times.direct = ms_since(t0);
@@ -162,7 +181,7 @@ void render_realtime(const rt::RtScene& rt, const scene::SceneAssets& assets, co
 
 void render_frame(CameraView cameras, View<Get<const DdgiProbeVolume>> volumes, View<Get<const DdgiCascades>> cascades,
                   Res<rt::RtScene> rt, Res<scene::SceneAssets> assets, Res<render::SceneLights> lights,
-                  Res<DdgiRenderOptions> options, ResMut<DdgiFrame> frame, Res<DdgiBackend> backend,
+                  Res<DdgiRenderOptions> options, ResMut<DdgiFrame> frame, ResMut<DdgiBackend> backend,
                   Local<render::TemporalAccumulation> history, Local<DdgiRealtimeScratch> scratch) {
   if (frame->width <= 0 || frame->height <= 0) return;
   const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
@@ -177,14 +196,23 @@ void render_frame(CameraView cameras, View<Get<const DdgiProbeVolume>> volumes, 
       if (f) all.push_back(f.get());
   });
   if (all.empty()) throw std::runtime_error("ddgi::render: no DdgiProbeVolume or DdgiCascades in the world");
-  if (options->realtime) {
-    render_realtime(*rt, *assets, *lights, *rays, all, backend->kernels.get(), *options, *scratch, *frame);
-    return;
+  const auto render = [&] {
+    if (options->realtime) {
+      render_realtime(*rt, *assets, *lights, *rays, all, *backend->kernels, *options, *scratch, *frame);
+      return;
+    }
+    render_offline(*rt, lights->set, *rays, all, *backend->kernels, lights->geometry_version, lights->version, *options,
+                   *history, *frame);
+    frame->full = frame->gi;
+    shading::add_image(frame->full, frame->direct);
+  };
+  try {
+    render();
+  } catch (const engine::gpu::GpuError& e) {
+    if (backend->kernels == cpu_ddgi_kernels()) throw;
+    backend->fall_back(probes::BackendFallback::SceneTooLarge, e.what());
+    render();  // nothing of this frame's image was kept
   }
-  render_offline(*rt, lights->set, *rays, all, backend->kernels.get(), lights->geometry_version, lights->version, *options,
-                 *history, *frame);
-  frame->full = frame->gi;
-  shading::add_image(frame->full, frame->direct);
 }
 
 }  // namespace

@@ -11,7 +11,9 @@
 //                 images and stage times are this frame's.
 #include <memory>
 
+#include "ddgi/cpu_ddgi_kernels.h"
 #include "ddgi/ddgi_kernels.h"
+#include "probes/probe_kernels.h"
 #include "ddgi/ddgi_volume.h"
 #include "shading/realtime_gi.h"
 #include "probes/cascade_follow.h"
@@ -69,11 +71,28 @@ struct DdgiStageTimes {
   double probe_trace = 0, probe_blend = 0, shading = 0, direct = 0, antialiasing = 0;
 };
 
-// Where the DDGI volumes trace and blend: null kernels = the CPU (the
-// default); a GPU backend is set here by whoever made it (the CLI's
-// --backend vulkan), and every volume follows it from its next update.
+// Where the DDGI volumes trace and blend and the renderer looks up their
+// light: the CPU backend by default; a device's is set here by whoever made
+// it (gpu::make_ddgi_backend, from the CLI's --backend vulkan), and every
+// volume follows it from its next update. Where a device was asked for and
+// the CPU runs instead, `fallback` says why.
 struct DdgiBackend {
-  std::shared_ptr<DdgiKernels> kernels;
+  std::shared_ptr<DdgiKernels> kernels = cpu_ddgi_kernels();  // never null
+  probes::BackendFallback fallback = probes::BackendFallback::None;
+  std::string fallback_why;
+  // The CPU backend whole from now on, and why.
+  void fall_back(probes::BackendFallback reason, std::string why) {
+    kernels = cpu_ddgi_kernels();
+    fallback = reason;
+    fallback_why = std::move(why);
+  }
+  // "cpu", or the device's name; with the reason where the CPU stands in.
+  [[nodiscard]] std::string describe() const {
+    std::string s = kernels->name();
+    if (fallback != probes::BackendFallback::None)
+      s += std::string("; the CPU backend runs the frame (") + probes::to_string(fallback) + "): " + fallback_why;
+    return s;
+  }
 };
 
 struct DdgiFrame {

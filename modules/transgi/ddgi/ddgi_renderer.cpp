@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "engine/gpu/gpu_error.h"
 #include "engine/jobs/parallel_for.h"
 #include "engine/material/specular_albedo.h"
 #include "engine/math/rng.h"
@@ -43,39 +44,35 @@ glm::vec3 irradiance_from(std::span<const DdgiVolume* const> volumes, const glm:
   return mixed_irradiance(volumes, p, [&](const DdgiVolume* volume, bool* lit) { return volume->irradiance(p, n, v, lit); });
 }
 
-namespace {
+glm::mat2x3 irradiance_and_emitted_from(std::span<const DdgiVolume* const> volumes, const glm::vec3& p, const glm::vec3& n,
+                                        const glm::vec3& v) {
+  return mixed_irradiance(volumes, p, [&](const DdgiVolume* volume, bool* is_lit) {
+    glm::mat2x3 both(0.0f);
+    both[0] = volume->irradiance(p, n, v, is_lit, &both[1]);
+    return both;
+  });
+}
 
-// Every point's irradiance through `kernels`, one batch per volume (cascades
-// hand points on, so any may be asked), blended across the volumes as
-// irradiance_from does. False, `out` untouched, where the backend declines.
-bool irradiance_batched(DdgiKernels& kernels, std::span<const DdgiVolume* const> volumes, std::span<const glm::vec3> positions,
-                        std::span<const glm::vec3> normals, std::span<const glm::vec3> views, std::vector<glm::vec3>& out) {
-  std::vector<std::vector<glm::vec3>> per_volume(volumes.size(), std::vector<glm::vec3>(positions.size()));
-  std::vector<std::vector<std::uint8_t>> lit(volumes.size(), std::vector<std::uint8_t>(positions.size()));
-  for (std::size_t v = 0; v < volumes.size(); ++v)
-    if (!kernels.irradiance(*volumes[v], positions, normals, views, per_volume[v], lit[v])) return false;
-  out.resize(positions.size());
+void mix_volume_batches(std::span<const DdgiVolume* const> volumes, std::span<const glm::vec3> positions,
+                        const std::vector<std::vector<glm::mat2x3>>& value, const std::vector<std::vector<std::uint8_t>>& lit,
+                        std::span<glm::mat2x3> out) {
   engine::jobs::parallel_for<std::size_t>(0, positions.size(), 256, [&](std::size_t b, std::size_t end) {
     for (std::size_t k = b; k < end; ++k)
       out[k] = mixed_irradiance(volumes, positions[k], [&](const DdgiVolume* volume, bool* is_lit) {
         const auto v = static_cast<std::size_t>(std::find(volumes.begin(), volumes.end(), volume) - volumes.begin());
         *is_lit = lit[v][k] != 0;
-        return per_volume[v][k];
+        return value[v][k];
       });
   });
-  return true;
 }
 
-// The batched path: every sample's ray traced by the backend, its surface
-// made here, the irradiance looked up by the backend in every volume and
-// blended here as irradiance_from does. False where the backend declines;
-// then the per-pixel path below runs.
-bool render_batched(const engine::rt::RtScene& scene, std::span<const DdgiVolume* const> volumes,
-                    const engine::render::CameraRays& camera,
-                    int width, int height, const DdgiRenderSettings& s, DdgiKernels& kernels, engine::image::ImageRGB& img) {
+engine::image::ImageRGB render_ddgi_gi_batched(const engine::rt::RtScene& scene, std::span<const DdgiVolume* const> volumes,
+                                               const engine::render::CameraRays& camera, int width, int height,
+                                               const DdgiRenderSettings& s, engine::rt::RayBatchTracer& tracer,
+                                               DdgiKernels& kernels) {
   using namespace engine;
-  rt::RayBatchTracer* tracer = kernels.tracer();
-  if (!tracer) return false;
+  image::ImageRGB img(width, height);
+  if (volumes.empty()) return img;
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height), spp = static_cast<std::size_t>(s.spp);
   std::vector<rt::Ray> rays(pixels * spp);
   jobs::parallel_for<std::size_t>(0, pixels, 256, [&](std::size_t b, std::size_t e) {
@@ -89,7 +86,8 @@ bool render_batched(const engine::rt::RtScene& scene, std::span<const DdgiVolume
   });
   std::vector<rt::Hit> hits(rays.size());
   std::vector<std::uint8_t> found(rays.size());
-  if (!tracer->intersect(scene, rays, hits, found)) return false;
+  if (!tracer.intersect(scene, rays, hits, found))
+    throw gpu::GpuError("render_ddgi_gi_batched: the device traces only scenes built with their assets (RtScene::assets())");
   std::vector<glm::vec3> position(rays.size()), normal(rays.size()), view(rays.size()), albedo(rays.size(), glm::vec3(0.0f));
   jobs::parallel_for<std::size_t>(0, rays.size(), 256, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
@@ -101,27 +99,24 @@ bool render_batched(const engine::rt::RtScene& scene, std::span<const DdgiVolume
       albedo[k] = material::diffuse_albedo(surf.brdf) * math::kInvPi;
     }
   });
-  std::vector<glm::vec3> e;
-  if (!irradiance_batched(kernels, volumes, position, normal, view, e)) return false;
+  std::vector<glm::mat2x3> e(rays.size());
+  kernels.irradiance(volumes, position, normal, view, e);
   for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
     glm::vec3 sum(0.0f);
     for (std::size_t si = 0; si < spp; ++si) {
       const std::size_t k = pixel * spp + si;
-      if (found[k]) sum += albedo[k] * e[k];
+      if (found[k]) sum += albedo[k] * e[k][0];
     }
     img.pixels[pixel] = sum / static_cast<float>(s.spp);
   }
-  return true;
+  return img;
 }
-
-}  // namespace
 
 engine::image::ImageRGB render_ddgi_gi(const engine::rt::RtScene& scene, std::span<const DdgiVolume* const> volumes,
                                        const engine::render::CameraRays& camera, int width, int height,
-                                       const DdgiRenderSettings& s, DdgiKernels* kernels) {
+                                       const DdgiRenderSettings& s) {
   using namespace engine;
   image::ImageRGB img(width, height);
-  if (kernels && !volumes.empty() && render_batched(scene, volumes, camera, width, height, s, *kernels, img)) return img;
   jobs::parallel_for(0, height, 1, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < width; ++x) {
@@ -152,49 +147,18 @@ struct Lookup {
 };
 
 // Every lookup's indirect irradiance (column 0) and emitted irradiance
-// (column 1: DdgiSettings::emitted_maps, else 0) through the volumes: with
-// `kernels`, batches through irradiance_batched, the emitted maps through the
-// volumes' emitted views (the same weights); where they decline, point by
-// point on the CPU.
+// (column 1: DdgiSettings::emitted_maps, else 0) through the volumes, in one
+// batch through the backend.
 std::vector<glm::mat2x3> look_up(const shading::GBuffer& g, std::span<const Lookup> lookups,
-                                 std::span<const DdgiVolume* const> volumes, DdgiKernels* kernels) {
-  using namespace engine;
-  std::vector<glm::mat2x3> e(lookups.size(), glm::mat2x3(0.0f));
-  const auto position = [&](std::size_t k) { return g.samples[lookups[k].pixel].position; };
-  const auto view = [&](std::size_t k) { return -g.samples[lookups[k].pixel].wo_world; };
-  if (kernels) {
-    std::vector<glm::vec3> positions(lookups.size()), normals(lookups.size()), views(lookups.size());
-    for (std::size_t k = 0; k < lookups.size(); ++k) {
-      positions[k] = position(k);
-      normals[k] = lookups[k].normal;
-      views[k] = view(k);
-    }
-    std::vector<const DdgiVolume*> emitted_views;
-    for (const DdgiVolume* v : volumes)
-      if (v->has_emitted_maps()) emitted_views.push_back(v->emitted_view());
-    const bool with_emitted = !emitted_views.empty();
-    const bool views_complete = emitted_views.size() == volumes.size() &&
-                                std::find(emitted_views.begin(), emitted_views.end(), nullptr) == emitted_views.end();
-    std::vector<glm::vec3> indirect, emitted;
-    if ((!with_emitted || views_complete) && irradiance_batched(*kernels, volumes, positions, normals, views, indirect) &&
-        (!with_emitted || irradiance_batched(*kernels, emitted_views, positions, normals, views, emitted))) {
-      for (std::size_t k = 0; k < lookups.size(); ++k) {
-        e[k][0] = indirect[k];
-        if (with_emitted) e[k][1] = emitted[k];
-      }
-      return e;
-    }
+                                 std::span<const DdgiVolume* const> volumes, DdgiKernels& kernels) {
+  std::vector<glm::vec3> positions(lookups.size()), normals(lookups.size()), views(lookups.size());
+  for (std::size_t k = 0; k < lookups.size(); ++k) {
+    positions[k] = g.samples[lookups[k].pixel].position;
+    normals[k] = lookups[k].normal;
+    views[k] = -g.samples[lookups[k].pixel].wo_world;
   }
-  jobs::parallel_for<std::size_t>(0, lookups.size(), 256, [&](std::size_t b, std::size_t end) {
-    for (std::size_t k = b; k < end; ++k) {
-      const glm::vec3 p = position(k), n = lookups[k].normal, v = view(k);
-      e[k] = mixed_irradiance(volumes, p, [&](const DdgiVolume* volume, bool* is_lit) {
-        glm::mat2x3 both(0.0f);
-        both[0] = volume->irradiance(p, n, v, is_lit, &both[1]);
-        return both;
-      });
-    }
-  });
+  std::vector<glm::mat2x3> e(lookups.size(), glm::mat2x3(0.0f));
+  kernels.irradiance(volumes, positions, normals, views, e);
   return e;
 }
 
@@ -210,7 +174,7 @@ glm::vec3 metal_albedo(const shading::GSample& s) {
 }  // namespace
 
 DdgiPixels shade_ddgi_gbuffer(const shading::GBuffer& g, std::span<const DdgiVolume* const> volumes,
-                              const shading::RealtimeGiSettings& upsampling, shading::UpsamplingPlan& plan, DdgiKernels* kernels) {
+                              const shading::RealtimeGiSettings& upsampling, shading::UpsamplingPlan& plan, DdgiKernels& kernels) {
   using namespace engine;
   using shading::UpsamplingPlan;
   DdgiPixels out{image::ImageRGB(g.width, g.height), image::ImageRGB(g.width, g.height)};

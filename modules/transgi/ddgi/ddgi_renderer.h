@@ -13,25 +13,37 @@
 
 namespace transgi::ddgi {
 
-struct DdgiRenderSettings {
-  int spp = 1;
-  std::uint64_t seed = 0;
-  float filter_width = 1.5f;
-};
-
 // Irradiance from several volumes (authored ones, then cascades finest
 // first), blended as probes::mix_at says; a volume with no active probe
 // around the point hands it to the next one holding it. With one volume,
 // exactly its DdgiVolume::irradiance.
 glm::vec3 irradiance_from(std::span<const DdgiVolume* const> volumes, const glm::vec3& position, const glm::vec3& normal,
                           const glm::vec3& view_dir);
+// The same blend of the irradiance maps' light (column 0) and the emitted
+// maps' (column 1; 0 from a volume without them): DdgiKernels::irradiance
+// on the CPU, point by point.
+glm::mat2x3 irradiance_and_emitted_from(std::span<const DdgiVolume* const> volumes, const glm::vec3& position,
+                                        const glm::vec3& normal, const glm::vec3& view_dir);
+// The blend of irradiance_from over values a backend looked up per volume,
+// all points of volume v at once: value[v][k] and lit[v][k] are volume v's
+// DdgiVolume::irradiance at point k (column 1: its emitted maps').
+void mix_volume_batches(std::span<const DdgiVolume* const> volumes, std::span<const glm::vec3> positions,
+                        const std::vector<std::vector<glm::mat2x3>>& value, const std::vector<std::vector<std::uint8_t>>& lit,
+                        std::span<glm::mat2x3> out);
 
-// With `kernels` (a GPU backend) and a single volume, the primary rays go to
-// its tracer and the irradiance lookups to its kernel, each in one batch;
-// the surfaces are made on the CPU between the two.
+// The offline GI pass on the CPU (CpuDdgiKernels::render_gi): each sample's
+// ray traced and its surface lit point by point.
 engine::image::ImageRGB render_ddgi_gi(const engine::rt::RtScene& scene, std::span<const DdgiVolume* const> volumes,
                                        const engine::render::CameraRays& camera, int width, int height,
-                                       const DdgiRenderSettings& settings, DdgiKernels* kernels = nullptr);
+                                       const DdgiRenderSettings& settings);
+// The same pass in batches, for a device backend: every sample's ray through
+// `tracer`, the surfaces made on the CPU, every lookup through
+// kernels.irradiance. Throws engine::gpu::GpuError where the tracer declines
+// the scene (one built without its assets).
+engine::image::ImageRGB render_ddgi_gi_batched(const engine::rt::RtScene& scene, std::span<const DdgiVolume* const> volumes,
+                                               const engine::render::CameraRays& camera, int width, int height,
+                                               const DdgiRenderSettings& settings, engine::rt::RayBatchTracer& tracer,
+                                               DdgiKernels& kernels);
 
 // DDGI's light on a real-time G-buffer (one sample per pixel, as TransGI's
 // real-time frame traces it): diffuse albedo / pi x the volumes' irradiance,
@@ -45,15 +57,14 @@ engine::image::ImageRGB render_ddgi_gi(const engine::rt::RtScene& scene, std::sp
 // marks it) has little diffuse albedo and would be black: it gets its GGX
 // specular albedo x the irradiance about its mirror direction / pi at its
 // own pixel, a blurred reflection (engines use reflection probes there; DDGI
-// has none). With `kernels` every lookup goes to its irradiance kernel in one
-// batch per volume (and per emitted view). `plan` is scratch kept between
-// frames.
+// has none). Every lookup goes to kernels.irradiance in one batch. `plan` is
+// scratch kept between frames.
 struct DdgiPixels {
   engine::image::ImageRGB gi;       // from the irradiance maps: indirect light
   engine::image::ImageRGB emitted;  // from the emitted maps (DdgiSettings::emitted_maps): direct light, else 0
 };
 DdgiPixels shade_ddgi_gbuffer(const shading::GBuffer& g, std::span<const DdgiVolume* const> volumes,
-                                           const shading::RealtimeGiSettings& upsampling, shading::UpsamplingPlan& plan,
-                                           DdgiKernels* kernels = nullptr);
+                              const shading::RealtimeGiSettings& upsampling, shading::UpsamplingPlan& plan,
+                              DdgiKernels& kernels);
 
 }  // namespace transgi::ddgi

@@ -1,6 +1,7 @@
 #include "ddgi/ddgi_volume.h"
 
 #include "ddgi/ddgi_blend.h"
+#include "ddgi/cpu_ddgi_kernels.h"
 #include "ddgi/ddgi_kernels.h"
 
 #include <algorithm>
@@ -37,7 +38,7 @@ glm::vec3 to_gamma_two(const glm::vec3& x, float gamma) {
 }  // namespace
 
 DdgiVolume::DdgiVolume(const probes::ProbeGrid& grid, const DdgiSettings& settings)
-    : grid_(grid), placed_(grid), settings_(settings), directions_(probes::spherical_fibonacci(settings.rays_per_probe)) {
+    : kernels_(cpu_ddgi_kernels()), grid_(grid), placed_(grid), settings_(settings), directions_(probes::spherical_fibonacci(settings.rays_per_probe)) {
   const auto count = static_cast<std::size_t>(grid.count());
   irradiance_.assign(count, OctahedralMap<glm::vec3>(settings.irradiance_texels, glm::vec3(0.0f)));
   // Until measured, distances read as "far": nothing is occluded.
@@ -54,8 +55,13 @@ std::size_t DdgiVolume::memory_bytes() const {
   return b;
 }
 
+void DdgiVolume::set_kernels(std::shared_ptr<DdgiKernels> kernels) {
+  kernels_ = kernels ? std::move(kernels) : cpu_ddgi_kernels();
+}
+
 int DdgiVolume::scroll(glm::ivec3 cells, const DdgiVolume* seed) {
   if (cells == glm::ivec3(0)) return 0;
+  emitted_view_.reset();  // its maps are about to move
   grid_.scroll_by(cells);
   placed_.scroll_by(cells);
   int entered = 0;
@@ -131,7 +137,7 @@ DdgiVolume::UpdateRays DdgiVolume::trace(const engine::rt::RtScene& scene, const
     if (!emitted_.empty()) u.emitted[static_cast<std::size_t>(q)].resize(static_cast<std::size_t>(M));
   }
   probes::trace_probe_rays(
-      scene, lights, kernels_ ? kernels_->tracer() : nullptr, tracing, ray_directions,
+      scene, lights, kernels_->tracer(), tracing, ray_directions,
       [&](int q) { return placed_.position(q); }, ray_rng, feedback, [&](int q, int i, const probes::ProbeRayHit& h) {
         if (h.saw_light) u.saw_light[static_cast<std::size_t>(q)] = 1;
         const glm::vec3& dir = ray_directions[static_cast<std::size_t>(i)];
@@ -160,7 +166,7 @@ DdgiVolume::UpdateRays DdgiVolume::trace(const engine::rt::RtScene& scene, const
 void DdgiVolume::classify(const engine::rt::RtScene& scene, UpdateRays& u) {
   const int probes = grid_.count(), M = settings_.rays_per_probe;
   const probes::OpenSpace open =
-      probes::find_open_space(scene, grid_, u.saw_light, settings_.relocation, kernels_ ? kernels_->tracer() : nullptr);
+      probes::find_open_space(scene, grid_, u.saw_light, settings_.relocation, kernels_->tracer());
   placed_.offsets.assign(static_cast<std::size_t>(probes), glm::vec3(0.0f));
   for (int q = 0; q < probes; ++q) {
     const auto i = static_cast<std::size_t>(q);
@@ -178,24 +184,13 @@ void DdgiVolume::classify(const engine::rt::RtScene& scene, UpdateRays& u) {
 }
 
 // The records into the maps with hysteresis h: irradiance and distance
-// (through the kernels where set), then the emitted maps.
+// through the backend, then the emitted maps.
 void DdgiVolume::blend(UpdateRays& u, float h, bool warming) {
   const int probes = grid_.count();
   const float max_distance = 1.5f * glm::length(grid_.spacing());
-  if (kernels_) {
-    for (int q = 0; q < probes; ++q)
-      if (!active_[static_cast<std::size_t>(q)]) u.records[static_cast<std::size_t>(q)].clear();
-    kernels_->blend(irradiance_, distance_, u.records, settings_, h, !warming, max_distance);
-  } else {
-    engine::jobs::parallel_for(0, probes, 1, [&](int b, int e) {
-      for (int q = b; q < e; ++q) {
-        const auto& rec = u.records[static_cast<std::size_t>(q)];
-        if (rec.empty() || !active_[static_cast<std::size_t>(q)]) continue;
-        blend_irradiance(irradiance_[static_cast<std::size_t>(q)], rec, settings_, h, !warming);
-        blend_distance(distance_[static_cast<std::size_t>(q)], rec, settings_, max_distance, h);
-      }
-    });
-  }
+  for (int q = 0; q < probes; ++q)
+    if (!active_[static_cast<std::size_t>(q)]) u.records[static_cast<std::size_t>(q)].clear();
+  kernels_->blend(irradiance_, distance_, u.records, settings_, h, !warming, max_distance);
   if (emitted_.empty()) return;
   // A small emitter is met by a ray now and then: a bright texel one
   // update, dark the next. RTXGI's running mean of gamma-encoded texels,
@@ -233,15 +228,19 @@ DdgiFrameStats DdgiVolume::update(const engine::rt::RtScene& scene, const engine
   stats.blend_ms = ms_since(t0);
   for (std::uint8_t a : active_) stats.inactive += a ? 0 : 1;
   ++frame_;
-  // Only a backend's kernel reads the view; the CPU reads the maps themselves.
-  if (!emitted_.empty() && kernels_)
-    make_emitted_view();
-  else
-    emitted_view_.reset();
   return stats;
 }
 
-void DdgiVolume::make_emitted_view() {
+const DdgiVolume& DdgiVolume::emitted_view() const {
+  if (emitted_.empty()) throw std::logic_error("DdgiVolume::emitted_view: the volume has no emitted maps");
+  if (!emitted_view_ || emitted_view_frame_ != frame_) {
+    make_emitted_view();
+    emitted_view_frame_ = frame_;
+  }
+  return *emitted_view_;
+}
+
+void DdgiVolume::make_emitted_view() const {
   DdgiSettings linear = settings_;
   linear.emitted_maps = false;
   linear.irradiance_gamma = 1.0f;

@@ -119,9 +119,10 @@ class DdgiVolume {
   DdgiFrameStats update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
                         const engine::scene::Environment* sky = nullptr, const DdgiVolume* outer = nullptr);
 
-  // Runs the probe rays' tracing and the blend through `kernels` (a GPU
-  // backend) from the next update on; null = the CPU functions.
-  void set_kernels(std::shared_ptr<DdgiKernels> kernels) { kernels_ = std::move(kernels); }
+  // Runs the probe rays' tracing and the blend through `kernels` (the
+  // Vulkan backend, or the CPU's: the default, and what null selects) from
+  // the next update on.
+  void set_kernels(std::shared_ptr<DdgiKernels> kernels);
 
   // Irradiance at a surface point with unit normal n, seen along view_dir
   // (from the eye towards the point), as RTXGI's DDGIGetVolumeIrradiance.
@@ -151,11 +152,12 @@ class DdgiVolume {
   [[nodiscard]] const OctahedralMap<glm::vec3>& irradiance_map(int probe) const { return irradiance_[static_cast<std::size_t>(probe)]; }
   [[nodiscard]] bool has_emitted_maps() const { return !emitted_.empty(); }
   // With emitted maps: a volume whose irradiance maps are these emitted maps
-  // (linear, so gamma 1), made at the end of each update, so that a
-  // backend's irradiance kernel looks them up as it looks up any volume:
-  // the same weights, the same sums as irradiance()'s `emitted`. Null
-  // without emitted maps or kernels, or before the first update.
-  [[nodiscard]] const DdgiVolume* emitted_view() const { return emitted_view_.get(); }
+  // (linear, so gamma 1), so that a device's irradiance kernel looks them up
+  // as it looks up any volume: the same weights, the same sums as
+  // irradiance()'s `emitted`. Made when first asked after each update (the
+  // CPU backend never asks: it reads the maps themselves); throws
+  // std::logic_error without emitted maps.
+  [[nodiscard]] const DdgiVolume& emitted_view() const;
   [[nodiscard]] const OctahedralMap<glm::vec2>& distance_map(int probe) const { return distance_[static_cast<std::size_t>(probe)]; }
   [[nodiscard]] bool active(int probe) const { return active_[static_cast<std::size_t>(probe)] != 0; }
   [[nodiscard]] std::uint64_t frame() const { return frame_; }
@@ -188,8 +190,9 @@ class DdgiVolume {
   bool classified_ = false;
   std::uint64_t frame_ = 0;
   std::uint64_t budget_turn_ = 0;  // updates made under probes_per_update: whose turn it is
-  std::shared_ptr<const DdgiVolume> emitted_view_;
-  void make_emitted_view();
+  mutable std::shared_ptr<const DdgiVolume> emitted_view_;
+  mutable std::uint64_t emitted_view_frame_ = 0;
+  void make_emitted_view() const;
 };
 
 }  // namespace transgi::ddgi

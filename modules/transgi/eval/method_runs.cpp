@@ -188,7 +188,7 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
 MethodRun run_ddgi(LoadedScene& scene, int width, int height, const DdgiRunOptions& o) {
   ecs::World& world = scene.app->world();
   scene.app->add_plugin<ddgi::DdgiPlugin>(o.settings, o.render);
-  world.resource<ddgi::DdgiBackend>().kernels = o.kernels;
+  world.resource<ddgi::DdgiBackend>() = o.backend;
   // The same placement as TransGI's, so both compare on the same probes.
   if (o.placement.mode != runtime::ProbeVolumeMode::Scene) {
     const auto boxes = runtime::authored_boxes(world);
@@ -235,6 +235,7 @@ MethodRun run_ddgi(LoadedScene& scene, int width, int height, const DdgiRunOptio
     std::snprintf(line, sizeof(line), fitted ? " (the scene fits one grid)" : " (%d cascades)", cascades);
     r.probe_summary += line;
   }
+  r.backend = world.resource<ddgi::DdgiBackend>().describe();
   return r;
 }
 

@@ -66,8 +66,9 @@ struct DdgiRunOptions {
   // Where the probes go, as for TransGI (scene_dims is the scene grid's).
   runtime::ProbePlacement placement{.mode = runtime::ProbeVolumeMode::Scene};
   bool progress = true;
-  // A GPU backend for the probes' tracing and blend (null = the CPU).
-  std::shared_ptr<ddgi::DdgiKernels> kernels;
+  // Where the probes trace and blend and the image looks them up (the CPU by
+  // default; gpu::make_ddgi_backend for a device).
+  ddgi::DdgiBackend backend;
 };
 
 MethodRun run_ddgi(LoadedScene& scene, int width, int height, const DdgiRunOptions& options);

@@ -6,6 +6,9 @@
 #include <string>
 
 #include "ddgi/ddgi_kernels.h"
+#include "ddgi/ddgi_plugin.h"
+#include "ddgi/cpu_ddgi_kernels.h"
+#include "ddgi/ddgi_renderer.h"
 #include "engine/gpu/gpu_ray_tracer.h"
 #include "gpu/vulkan_ddgi_blend.h"
 #include "gpu/vulkan_ddgi_irradiance.h"
@@ -23,12 +26,28 @@ class VulkanDdgiKernels : public ddgi::DdgiKernels {
              bool clamp_brightness, float max_distance) override {
     blend_.blend(irradiance, distance, records, settings, hysteresis, clamp_brightness, max_distance);
   }
-  bool irradiance(const ddgi::DdgiVolume& volume, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
-                  std::span<const glm::vec3> view_dirs, std::span<glm::vec3> out, std::span<std::uint8_t> lit) override {
-    const GpuDdgiIrradiance r = irradiance_.irradiance(volume, positions, normals, view_dirs);
-    std::copy(r.irradiance.begin(), r.irradiance.end(), out.begin());
-    std::copy(r.lit.begin(), r.lit.end(), lit.begin());
-    return true;
+  // Each volume's lookups in one batch (its emitted maps' in a second,
+  // through its emitted view), blended on the CPU as the CPU backend blends
+  // them.
+  void irradiance(std::span<const ddgi::DdgiVolume* const> volumes, std::span<const glm::vec3> positions,
+                  std::span<const glm::vec3> normals, std::span<const glm::vec3> view_dirs,
+                  std::span<glm::mat2x3> out) override {
+    std::vector<std::vector<glm::mat2x3>> value(volumes.size(), std::vector<glm::mat2x3>(positions.size(), glm::mat2x3(0.0f)));
+    std::vector<std::vector<std::uint8_t>> lit(volumes.size());
+    for (std::size_t v = 0; v < volumes.size(); ++v) {
+      GpuDdgiIrradiance r = irradiance_.irradiance(*volumes[v], positions, normals, view_dirs);
+      for (std::size_t k = 0; k < positions.size(); ++k) value[v][k][0] = r.irradiance[k];
+      lit[v] = std::move(r.lit);
+      if (!volumes[v]->has_emitted_maps()) continue;
+      const GpuDdgiIrradiance emitted = irradiance_.irradiance(volumes[v]->emitted_view(), positions, normals, view_dirs);
+      for (std::size_t k = 0; k < positions.size(); ++k) value[v][k][1] = emitted.irradiance[k];
+    }
+    ddgi::mix_volume_batches(volumes, positions, value, lit, out);
+  }
+  engine::image::ImageRGB render_gi(const engine::rt::RtScene& scene, std::span<const ddgi::DdgiVolume* const> volumes,
+                                    const engine::render::CameraRays& camera, int width, int height,
+                                    const ddgi::DdgiRenderSettings& settings) override {
+    return ddgi::render_ddgi_gi_batched(scene, volumes, camera, width, height, settings, tracer_, *this);
   }
   [[nodiscard]] const char* name() const override { return name_.c_str(); }
 
@@ -40,20 +59,31 @@ class VulkanDdgiKernels : public ddgi::DdgiKernels {
   std::string name_;
 };
 
-// The backend --backend NAME asks for: null for "cpu", or for "vulkan" when
-// no device can be had (then *why says why).
-inline std::shared_ptr<ddgi::DdgiKernels> make_ddgi_kernels(const std::string& backend, const std::string& device,
-                                                           std::string* why) {
-  if (backend != "vulkan") return nullptr;
+// The backend --backend NAME asks for: the CPU's for "cpu"; for "vulkan" the
+// device's, or the CPU's with the reason no device could run it.
+inline ddgi::DdgiBackend make_ddgi_backend(const std::string& backend, const std::string& device) {
+  ddgi::DdgiBackend b;
+  if (backend != "vulkan") return b;
   engine::gpu::GpuOptions options;
   options.device = device;
-  try {  // as make_probe_kernels: a device or shader failure falls back to the CPU with its reason
-    if (auto ctx = engine::gpu::VulkanContext::create(options, why))
-      return std::make_shared<VulkanDdgiKernels>(std::shared_ptr<engine::gpu::VulkanContext>(std::move(ctx)));
+  std::shared_ptr<engine::gpu::VulkanContext> ctx;
+  try {
+    ctx = engine::gpu::VulkanContext::create(options, &b.fallback_why);
   } catch (const std::exception& e) {
-    if (why) *why = e.what();
+    b.fallback_why = e.what();
   }
-  return nullptr;
+  if (!ctx) {
+    b.fallback = probes::BackendFallback::NoDevice;
+    return b;
+  }
+  try {
+    b.kernels = std::make_shared<VulkanDdgiKernels>(std::move(ctx));
+    b.fallback_why.clear();
+  } catch (const std::exception& e) {  // a kernel the device cannot build
+    b.fallback = probes::BackendFallback::KernelBuildFailed;
+    b.fallback_why = e.what();
+  }
+  return b;
 }
 
 }  // namespace transgi::gpu
