@@ -19,6 +19,9 @@ layout(std430, set = 0, binding = 3) readonly buffer Frame { vec4 frame[]; };  /
 layout(std430, set = 0, binding = 4) writeonly buffer Filled { float filled[]; };  // per texel: rgb to project
 layout(std430, set = 0, binding = 5) readonly buffer SolidAngle { float solid_angle[]; };  // per texel of the layout
 layout(std430, set = 0, binding = 6) buffer KnownPass { uint known_pass[]; };  // scratch: the fill pass a texel became known in
+// Per probe of the batch: which map of Frame holds its samples (the raster
+// writes one map per probe of the grid, the batch is the updated ones).
+layout(std430, set = 0, binding = 7) readonly buffer FrameProbe { uint frame_probe[]; };
 layout(push_constant) uniform PushBlock { AccumulatePush p; };
 
 #include "half_bits.glsl"
@@ -116,7 +119,7 @@ uint stored_bits(float target, float before, uint was, bool same_scale) {
 void main() {
   const uint q = gl_WorkGroupID.x, lane = gl_LocalInvocationID.x;
   if (q >= p.probes) return;
-  const uint base = q * p.texels;
+  const uint base = q * p.texels, frame_base = frame_probe[q] * p.texels;
 
   // 1. The peak and the change groups over this frame's sampled texels.
   {
@@ -127,7 +130,7 @@ void main() {
     for (uint t = lane; t < p.texels; t += kAccumulateGroupSize) {
       const vec3 old = history_at(base + t, scale);
       peak = max(peak, max3(old));
-      const vec4 f = frame[base + t];
+      const vec4 f = frame[frame_base + t];
       if (f.w > 0.0) {
         const vec3 mean = f.rgb / f.w;
         peak = max(peak, max3(mean));
@@ -156,7 +159,7 @@ void main() {
     const vec3 old = vec3(from_half_bits(rg), from_half_bits(rg >> 16), from_half_bits(b)) * old_scale;
     vec3 next = old;
     uint was_sampled = sampled[at];
-    const vec4 f = frame[at];
+    const vec4 f = frame[frame_base + t];
     if (f.w <= 0.0) {
       if (changed) was_sampled = 0u;
     } else {

@@ -168,7 +168,7 @@ std::string VulkanContext::make_submission_objects(const VkPhysicalDevicePropert
   if (fam[queue_family_].timestampValidBits > 0 && props.limits.timestampPeriod > 0) {
     VkQueryPoolCreateInfo qpi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
     qpi.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    qpi.queryCount = 2;
+    qpi.queryCount = kMaxStageMarks + 2;  // the start, the stage marks, the end
     ENGINE_VK_CHECK(vkCreateQueryPool(device_, &qpi, nullptr, &timestamps_));
     info_.timestamp_period_ns = props.limits.timestampPeriod;
   }
@@ -396,8 +396,9 @@ double VulkanContext::submit_and_wait(const std::function<void(VkCommandBuffer)>
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   ENGINE_VK_CHECK(vkBeginCommandBuffer(cmd_, &bi));
+  marks_ = 0;
   if (timestamps_) {
-    vkCmdResetQueryPool(cmd_, timestamps_, 0, 2);
+    vkCmdResetQueryPool(cmd_, timestamps_, 0, kMaxStageMarks + 2);
     vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, timestamps_, 0);
   }
   record(cmd_);
@@ -408,7 +409,8 @@ double VulkanContext::submit_and_wait(const std::function<void(VkCommandBuffer)>
   to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
   vkCmdPipelineBarrier(cmd_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                        VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0, nullptr, 0, nullptr);
-  if (timestamps_) vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, timestamps_, 1);
+  const std::uint32_t last = marks_ + 1;
+  if (timestamps_) vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, timestamps_, last);
   ENGINE_VK_CHECK(vkEndCommandBuffer(cmd_));
   VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   si.commandBufferCount = 1;
@@ -417,11 +419,20 @@ double VulkanContext::submit_and_wait(const std::function<void(VkCommandBuffer)>
   ENGINE_VK_CHECK(vkQueueSubmit(queue_, 1, &si, fence_));
   submissions_.fetch_add(1, std::memory_order_relaxed);
   ENGINE_VK_CHECK(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX));
+  last_stage_ms_.clear();
   if (!timestamps_) return -1.0;
-  std::uint64_t ticks[2] = {0, 0};
-  ENGINE_VK_CHECK(vkGetQueryPoolResults(device_, timestamps_, 0, 2, sizeof(ticks), ticks, sizeof(std::uint64_t),
+  std::uint64_t ticks[kMaxStageMarks + 2] = {};
+  ENGINE_VK_CHECK(vkGetQueryPoolResults(device_, timestamps_, 0, last + 1, sizeof(ticks), ticks, sizeof(std::uint64_t),
                                         VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
-  return static_cast<double>(ticks[1] - ticks[0]) * info_.timestamp_period_ns * 1e-6;
+  const double ms_per_tick = info_.timestamp_period_ns * 1e-6;
+  for (std::uint32_t i = 1; i <= last; ++i) last_stage_ms_.push_back(static_cast<double>(ticks[i] - ticks[i - 1]) * ms_per_tick);
+  return static_cast<double>(ticks[last] - ticks[0]) * ms_per_tick;
+}
+
+void VulkanContext::mark_stage(VkCommandBuffer cmd) {
+  if (!timestamps_ || marks_ >= kMaxStageMarks) return;
+  ++marks_;
+  vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, timestamps_, marks_);
 }
 
 }  // namespace engine::gpu

@@ -170,6 +170,16 @@ class VulkanContext {
   // time between the first and last command in milliseconds (timestamps), or
   // -1 where the queue has none.
   double submit_and_wait(const std::function<void(VkCommandBuffer)>& record);
+  // Inside submit_and_wait's `record`: ends a stage of the submission here
+  // (a timestamp once the commands recorded so far are done), so that one
+  // submission of several stages still times each. Ignored past
+  // kMaxStageMarks marks, or where the queue has no timestamps.
+  void mark_stage(VkCommandBuffer cmd);
+  // The last submission's stage times in milliseconds: one per mark_stage,
+  // then one for the commands after the last mark; they sum to its total.
+  // Empty where the queue has no timestamps.
+  [[nodiscard]] const std::vector<double>& last_stage_ms() const { return last_stage_ms_; }
+  static constexpr std::uint32_t kMaxStageMarks = 30;
 
   // The traffic since the context was made (thread-safe); a frame's is the
   // difference of two readings.
@@ -207,6 +217,8 @@ class VulkanContext {
   AccelerationStructureApi as_api_;
   int validation_errors_ = 0;
   std::atomic<std::uint64_t> submissions_{0}, host_to_device_{0}, device_to_host_{0};
+  std::uint32_t marks_ = 0;  // stage marks recorded in the submission being recorded
+  std::vector<double> last_stage_ms_;
 };
 
 }  // namespace engine::gpu

@@ -4,11 +4,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
+#include <memory>
 #include <vector>
 
 #include "engine/math/rng.h"
+#include "gpu/vulkan_probe_kernels.h"
 #include "gpu/vulkan_radiance_raster.h"
+#include "probes/cpu_probe_kernels.h"
 #include "gpu_fixture.h"
 
 using namespace transgi;
@@ -130,4 +134,71 @@ TEST(VulkanRadianceRaster, WithoutGuardsEveryPointIsCountedOncePerNeighbour) {
   EXPECT_EQ(stats.accepted, expected);
   EXPECT_EQ(stats.rejected_by_guard, 0u);
   EXPECT_EQ(total, static_cast<double>(expected));
+}
+
+// The probe field's last stages as the Vulkan backend runs them: the raster,
+// the accumulation and the SH projection in one submission, the samples and
+// the filled maps kept on the device (only the maps' states, the SH and the
+// guard's counts come back), against the CPU backend over two frames.
+// Bounds: the raster's (above) and the accumulation's (the change test sums
+// in float on the device, in double on the CPU): each SH coefficient within
+// 1e-3 of the largest, every change flag equal.
+TEST(VulkanProbeKernels, ShareAccumulateProjectIsOneSubmissionAndEqualsTheCpuBackend) {
+  GPU_TEST_CONTEXT_OR_SKIP(unused);
+  std::string why;
+  std::shared_ptr<engine::gpu::VulkanContext> ctx(engine::gpu::VulkanContext::create({}, &why));
+  ASSERT_TRUE(ctx) << why;
+  std::shared_ptr<gpu::VulkanProbeKernels> gpu_kernels = gpu::make_probe_kernels(ctx, nullptr, &why);
+  if (!gpu_kernels) GTEST_SKIP() << why;
+  probes::CpuProbeKernels cpu_kernels;
+  const Frame f = random_frame(29);
+  const probes::MapProjector projector(f.layout);
+  const probes::SharingSettings sharing;
+  const probes::AccumulationSettings accumulation;
+  std::vector<int> batch;
+  for (int q = 0; q < f.grid.count(); ++q)
+    if (f.targets[static_cast<std::size_t>(q)]) batch.push_back(q);
+  const auto fresh_states = [&] {
+    std::vector<probes::ProbeMapState> s(batch.size());
+    for (auto& m : s) m.reset(f.layout.texel_count(), f.grid.min_spacing());
+    return s;
+  };
+  std::vector<probes::ProbeMapState> cpu_states = fresh_states(), gpu_states = fresh_states();
+  const auto pointers = [](std::vector<probes::ProbeMapState>& s) {
+    std::vector<probes::ProbeMapState*> p;
+    for (auto& m : s) p.push_back(&m);
+    return p;
+  };
+  const std::vector<probes::ProbeMapState*> cpu_ptrs = pointers(cpu_states), gpu_ptrs = pointers(gpu_states);
+  for (int frame = 0; frame < 2; ++frame) {
+    std::vector<std::uint8_t> cpu_changed(batch.size()), gpu_changed(batch.size());
+    std::vector<float> cpu_sh(batch.size() * 75), gpu_sh(batch.size() * 75);
+    probes::ShareAccumulateTimes times;
+    const auto cpu_stats = cpu_kernels.share_accumulate_project(f.grid, projector, f.points, f.depth_ptrs, sharing, batch, cpu_ptrs,
+                                                                accumulation, cpu_changed, cpu_sh, times);
+    const engine::gpu::GpuTraffic before = ctx->traffic();
+    const auto gpu_stats = gpu_kernels->share_accumulate_project(f.grid, projector, f.points, f.depth_ptrs, sharing, batch, gpu_ptrs,
+                                                                 accumulation, gpu_changed, gpu_sh, times);
+    const engine::gpu::GpuTraffic t = ctx->traffic() - before;
+    const std::size_t texels = static_cast<std::size_t>(f.layout.texel_count());
+    // The maps' states (binary16 history, sampled flags, 32-byte state), the
+    // SH and the guard's two counts; not the samples (16 bytes a texel of
+    // every grid probe) nor the filled maps (12 bytes a texel).
+    const std::uint64_t states_back = batch.size() * (texels * (8 + 4) + 32), sh_back = batch.size() * 75 * 4;
+    std::printf("frame %d: %llu submission(s), %llu bytes back (states %llu, SH %llu)\n", frame,
+                static_cast<unsigned long long>(t.submissions), static_cast<unsigned long long>(t.device_to_host_bytes),
+                static_cast<unsigned long long>(states_back), static_cast<unsigned long long>(sh_back));
+    EXPECT_EQ(t.submissions, 1u);
+    EXPECT_LE(t.device_to_host_bytes, states_back + sh_back + 8);
+    EXPECT_NEAR(static_cast<double>(gpu_stats.accepted), static_cast<double>(cpu_stats.accepted), 1e-3 * cpu_stats.accepted);
+    EXPECT_NEAR(static_cast<double>(gpu_stats.rejected_by_guard), static_cast<double>(cpu_stats.rejected_by_guard),
+                1e-3 * cpu_stats.rejected_by_guard + 1);
+    EXPECT_EQ(gpu_changed, cpu_changed) << "frame " << frame;
+    float largest = 0.0f, worst = 0.0f;
+    for (const float v : cpu_sh) largest = std::max(largest, std::abs(v));
+    ASSERT_GT(largest, 0.0f);
+    for (std::size_t k = 0; k < cpu_sh.size(); ++k) worst = std::max(worst, std::abs(gpu_sh[k] - cpu_sh[k]));
+    std::printf("frame %d: largest SH coefficient %.4g, largest difference %.3g\n", frame, largest, worst);
+    EXPECT_LE(worst, 1e-3f * largest) << "frame " << frame;
+  }
 }

@@ -1,5 +1,6 @@
 #include "gpu/vulkan_probe_kernels.h"
 
+#include <chrono>
 #include <exception>
 #include <stdexcept>
 
@@ -11,20 +12,6 @@ VulkanProbeKernels::VulkanProbeKernels(std::shared_ptr<engine::gpu::VulkanContex
     : ctx_(std::move(ctx)), tracer_(*ctx_), shading_(std::make_unique<VulkanProbeShading>(*ctx_)),
       name_(engine::gpu::describe(ctx_->info())) {}
 
-probes::SharingStats VulkanProbeKernels::rasterize(const probes::ProbeGrid& grid, const probes::MapLayout& layout,
-                                                   const std::vector<std::vector<probes::ShadedPoint>>& points,
-                                                   const std::vector<const probes::DepthMap*>& own_depth,
-                                                   const probes::SharingSettings& settings,
-                                                   std::vector<probes::FrameSamples>& out,
-                                                   std::span<const std::uint8_t> targets) {
-  auto& r = rasters_[{layout.width, layout.height}];
-  if (!r) r = std::make_unique<VulkanRadianceRaster>(*ctx_, layout);
-  double ms = 0;
-  const auto stats = r->rasterize(grid, points, own_depth, settings, out, targets, &ms);
-  raster_ms_ += std::max(0.0, ms);
-  return stats;
-}
-
 void VulkanProbeKernels::project(const probes::MapProjector& projector, std::span<const glm::vec3> radiance,
                                  std::span<float> out) {
   const auto& l = projector.layout();
@@ -33,17 +20,55 @@ void VulkanProbeKernels::project(const probes::MapProjector& projector, std::spa
   project_ms_ += std::max(0.0, p->project(radiance, out));
 }
 
-void VulkanProbeKernels::accumulate_and_project(const probes::MapProjector& projector,
-                                                std::span<probes::ProbeMapState* const> states,
-                                                std::span<const probes::FrameSamples* const> frames,
-                                                const probes::AccumulationSettings& settings,
-                                                std::span<std::uint8_t> changed, std::span<float> sh) {
+probes::SharingStats VulkanProbeKernels::share_accumulate_project(
+    const probes::ProbeGrid& grid, const probes::MapProjector& projector,
+    const std::vector<std::vector<probes::ShadedPoint>>& points, const std::vector<const probes::DepthMap*>& own_depth,
+    const probes::SharingSettings& sharing, std::span<const int> batch, std::span<probes::ProbeMapState* const> states,
+    const probes::AccumulationSettings& accumulation, std::span<std::uint8_t> changed, std::span<float> sh,
+    probes::ShareAccumulateTimes& times) {
+  using Clock = std::chrono::steady_clock;
+  const auto ms_since = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
+  const auto t0 = Clock::now();
   const auto& layout = projector.layout();
-  auto& a = accumulators_[{layout.width, layout.height}];
+  const std::pair<int, int> size{layout.width, layout.height};
+  auto& r = rasters_[size];
+  if (!r) r = std::make_unique<VulkanRadianceRaster>(*ctx_, layout);
+  auto& a = accumulators_[size];
   if (!a) a = std::make_unique<VulkanProbeAccumulator>(*ctx_, layout);
-  std::vector<glm::vec3> filled(states.size() * static_cast<std::size_t>(layout.texel_count()));
-  accumulate_ms_ += std::max(0.0, a->accumulate(states, frames, settings, changed, filled));
-  project(projector, filled, sh);
+  auto& p = projectors_[size];
+  if (!p) p = std::make_unique<VulkanShProjector>(*ctx_, projector);
+  std::vector<std::uint8_t> targets(static_cast<std::size_t>(grid.count()), 0);
+  std::vector<std::uint32_t> frame_maps(batch.size());
+  for (std::size_t i = 0; i < batch.size(); ++i) {
+    targets[static_cast<std::size_t>(batch[i])] = 1;
+    frame_maps[i] = static_cast<std::uint32_t>(batch[i]);
+  }
+  r->prepare(grid, points, own_depth, sharing, targets);
+  a->prepare(states, r->samples_on_device(), frame_maps, accumulation);
+  times.share_ms = ms_since(t0);
+  const auto t1 = Clock::now();
+  // One submission, a timestamp after each stage: the samples and the
+  // filled maps never leave the device.
+  ctx_->submit_and_wait([&](VkCommandBuffer cmd) {
+    r->record(cmd);
+    ctx_->mark_stage(cmd);
+    engine::gpu::record_compute_barrier(cmd);
+    a->record(cmd);
+    ctx_->mark_stage(cmd);
+    engine::gpu::record_compute_barrier(cmd);
+    p->record(cmd, a->filled_on_device(), states.size());
+  });
+  const std::vector<double>& stage_ms = ctx_->last_stage_ms();
+  if (stage_ms.size() == 3) {
+    raster_ms_ += stage_ms[0];
+    accumulate_ms_ += stage_ms[1];
+    project_ms_ += stage_ms[2];
+  }
+  const probes::SharingStats stats = r->finish(nullptr);
+  a->finish(states, changed, {});
+  p->read(sh);
+  times.accumulate_ms = ms_since(t1);
+  return stats;
 }
 
 void VulkanProbeKernels::shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,

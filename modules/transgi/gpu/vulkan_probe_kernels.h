@@ -35,15 +35,16 @@ class VulkanProbeKernels : public probes::ProbeKernels {
                         std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
                         const probes::ProbeFeedbackSource& self, const probes::ProbeFeedbackSource* outer,
                         std::vector<probes::ProbeRayHit>& out) override;
-  probes::SharingStats rasterize(const probes::ProbeGrid& grid, const probes::MapLayout& layout,
-                                 const std::vector<std::vector<probes::ShadedPoint>>& points,
-                                 const std::vector<const probes::DepthMap*>& own_depth,
-                                 const probes::SharingSettings& settings, std::vector<probes::FrameSamples>& out,
-                                 std::span<const std::uint8_t> targets) override;
-  void accumulate_and_project(const probes::MapProjector& projector, std::span<probes::ProbeMapState* const> states,
-                              std::span<const probes::FrameSamples* const> frames,
-                              const probes::AccumulationSettings& settings, std::span<std::uint8_t> changed,
-                              std::span<float> sh) override;
+  // The raster, the accumulation and the projection in one submission:
+  // the samples and the filled maps stay on the device.
+  probes::SharingStats share_accumulate_project(const probes::ProbeGrid& grid, const probes::MapProjector& projector,
+                                                const std::vector<std::vector<probes::ShadedPoint>>& points,
+                                                const std::vector<const probes::DepthMap*>& own_depth,
+                                                const probes::SharingSettings& sharing, std::span<const int> batch,
+                                                std::span<probes::ProbeMapState* const> states,
+                                                const probes::AccumulationSettings& accumulation,
+                                                std::span<std::uint8_t> changed, std::span<float> sh,
+                                                probes::ShareAccumulateTimes& times) override;
   // The SH projection alone, as MapProjector::project for `maps` maps stored
   // one after another: radiance maps x texel_count(), out maps x 75.
   void project(const probes::MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out);

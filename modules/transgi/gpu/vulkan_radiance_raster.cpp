@@ -18,12 +18,9 @@ VulkanRadianceRaster::VulkanRadianceRaster(engine::gpu::VulkanContext& ctx, prob
                                                               static_cast<std::uint32_t>(sizeof(RasterPush)));
 }
 
-probes::SharingStats VulkanRadianceRaster::rasterize(const probes::ProbeGrid& grid,
-                                                     const std::vector<std::vector<probes::ShadedPoint>>& points,
-                                                     const std::vector<const probes::DepthMap*>& own_depth,
-                                                     const probes::SharingSettings& s,
-                                                     std::vector<probes::FrameSamples>& out,
-                                                     std::span<const std::uint8_t> targets, double* gpu_ms) {
+void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vector<std::vector<probes::ShadedPoint>>& points,
+                                   const std::vector<const probes::DepthMap*>& own_depth, const probes::SharingSettings& s,
+                                   std::span<const std::uint8_t> targets) {
   const auto count = static_cast<std::size_t>(grid.count());
   const auto texels = static_cast<std::size_t>(layout_.texel_count());
   if (points.size() != count || (!own_depth.empty() && own_depth.size() != count) ||
@@ -31,7 +28,7 @@ probes::SharingStats VulkanRadianceRaster::rasterize(const probes::ProbeGrid& gr
     throw std::invalid_argument("VulkanRadianceRaster: " + std::to_string(count) + " probes but points for " +
                                 std::to_string(points.size()) + ", depth for " + std::to_string(own_depth.size()) +
                                 ", " + std::to_string(targets.size()) + " target flags");
-  out.resize(count);
+  count_ = count;
 
   // Inputs go straight into the mapped buffers and results come straight out,
   // in parallel over probes: tens of MB of depth maps and samples a frame,
@@ -43,7 +40,8 @@ probes::SharingStats VulkanRadianceRaster::rasterize(const probes::ProbeGrid& gr
   const bool has_depth = !own_depth.empty();
   const std::size_t depth_texels = has_depth ? count * texels : 1;
   std::vector<ProbeGpu> info(count);
-  std::vector<std::uint32_t> target_flags(count, 1);
+  std::vector<std::uint32_t>& target_flags = target_flags_;
+  target_flags.assign(count, 1);
   for (std::size_t q = 0; q < count; ++q) {
     const probes::DepthMap* d = has_depth ? own_depth[q] : nullptr;
     const glm::vec3 off = grid.offsets.empty() ? glm::vec3(0.0f) : grid.offsets[q];
@@ -86,26 +84,46 @@ probes::SharingStats VulkanRadianceRaster::rasterize(const probes::ProbeGrid& gr
   push.map_width = static_cast<uint>(layout_.width);
   push.map_height = static_cast<uint>(layout_.height);
   push.texels = static_cast<uint>(texels);
-  const double ms = ctx_.submit_and_wait(
-      [&](VkCommandBuffer cmd) { pipeline_->record_dispatch(cmd, static_cast<std::uint32_t>(count), 1, 1, &push); });
-  if (gpu_ms) *gpu_ms = ms;
+  push_.assign(reinterpret_cast<const std::uint8_t*>(&push), reinterpret_cast<const std::uint8_t*>(&push) + sizeof(push));
+}
 
-  const auto samples = samples_.mapped_as<const float>(count * texels * 4);
-  engine::jobs::parallel_for<std::size_t>(0, count, 8, [&](std::size_t q0, std::size_t q1) {
-    for (std::size_t q = q0; q < q1; ++q) {
-      if (!target_flags[q]) continue;
-      auto& fs = out[q];
-      fs.reset(static_cast<int>(texels));
-      for (std::size_t t = 0; t < texels; ++t) {
-        const float* v = &samples[(q * texels + t) * 4];
-        fs.sum[t] = glm::vec3(v[0], v[1], v[2]);
-        fs.count[t] = v[3];
+void VulkanRadianceRaster::record(VkCommandBuffer cmd) const {
+  if (count_ > 0) pipeline_->record_dispatch(cmd, static_cast<std::uint32_t>(count_), 1, 1, push_.data());
+}
+
+probes::SharingStats VulkanRadianceRaster::finish(std::vector<probes::FrameSamples>* out) const {
+  const std::size_t count = count_, texels = static_cast<std::size_t>(layout_.texel_count());
+  if (out) {
+    out->resize(count);
+    const auto samples = samples_.mapped_as<const float>(count * texels * 4);
+    engine::jobs::parallel_for<std::size_t>(0, count, 8, [&](std::size_t q0, std::size_t q1) {
+      for (std::size_t q = q0; q < q1; ++q) {
+        if (!target_flags_[q]) continue;
+        auto& fs = (*out)[q];
+        fs.reset(static_cast<int>(texels));
+        for (std::size_t t = 0; t < texels; ++t) {
+          const float* v = &samples[(q * texels + t) * 4];
+          fs.sum[t] = glm::vec3(v[0], v[1], v[2]);
+          fs.count[t] = v[3];
+        }
       }
-    }
-  });
+    });
+  }
   std::uint32_t stats[2];
   stats_.download(std::span<std::uint32_t>(stats));
   return {stats[0], stats[1]};
+}
+
+probes::SharingStats VulkanRadianceRaster::rasterize(const probes::ProbeGrid& grid,
+                                                     const std::vector<std::vector<probes::ShadedPoint>>& points,
+                                                     const std::vector<const probes::DepthMap*>& own_depth,
+                                                     const probes::SharingSettings& s,
+                                                     std::vector<probes::FrameSamples>& out,
+                                                     std::span<const std::uint8_t> targets, double* gpu_ms) {
+  prepare(grid, points, own_depth, s, targets);
+  const double ms = ctx_.submit_and_wait([&](VkCommandBuffer cmd) { record(cmd); });
+  if (gpu_ms) *gpu_ms = ms;
+  return finish(&out);
 }
 
 }  // namespace transgi::gpu

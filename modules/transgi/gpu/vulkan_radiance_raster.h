@@ -23,11 +23,28 @@ class VulkanRadianceRaster {
                                  const probes::SharingSettings& settings, std::vector<probes::FrameSamples>& out,
                                  std::span<const std::uint8_t> targets = {}, double* gpu_ms = nullptr);
 
+  // The same in three steps, for a submission that holds other stages too.
+  // prepare: the points, depth maps and targets written for the kernel.
+  void prepare(const probes::ProbeGrid& grid, const std::vector<std::vector<probes::ShadedPoint>>& points,
+               const std::vector<const probes::DepthMap*>& own_depth, const probes::SharingSettings& settings,
+               std::span<const std::uint8_t> targets = {});
+  // record: the dispatch, into a command buffer being recorded.
+  void record(VkCommandBuffer cmd) const;
+  // The samples on the device after the submission: vec4 (sum, count) per
+  // texel, one map per probe of the grid (the targets' written).
+  [[nodiscard]] const engine::gpu::GpuBuffer& samples_on_device() const { return samples_; }
+  // After the submission: the guard's counts; with `out`, the targets'
+  // samples read back (out resized to the grid's probes).
+  probes::SharingStats finish(std::vector<probes::FrameSamples>* out) const;
+
  private:
   engine::gpu::VulkanContext& ctx_;
   probes::MapLayout layout_;
   engine::gpu::GpuBuffer points_, ranges_, depth_, probes_, targets_, samples_, stats_;
   std::unique_ptr<engine::gpu::ComputePipeline> pipeline_;
+  std::size_t count_ = 0;                 // the prepared grid's probes
+  std::vector<std::uint32_t> target_flags_;
+  std::vector<std::uint8_t> push_;
 };
 
 }  // namespace transgi::gpu

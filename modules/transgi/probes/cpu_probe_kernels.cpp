@@ -1,5 +1,6 @@
 #include "probes/cpu_probe_kernels.h"
 
+#include <chrono>
 #include <numeric>
 
 #include "engine/jobs/parallel_for.h"
@@ -59,26 +60,35 @@ void CpuProbeKernels::shade_probe_rays(const engine::rt::RtScene& scene, const e
       [&](int j, int i, const ProbeRayHit& h) { out[static_cast<std::size_t>(j) * m + static_cast<std::size_t>(i)] = h; });
 }
 
-SharingStats CpuProbeKernels::rasterize(const ProbeGrid& grid, const MapLayout& layout,
-                                        const std::vector<std::vector<ShadedPoint>>& points,
-                                        const std::vector<const DepthMap*>& own_depth, const SharingSettings& settings,
-                                        std::vector<FrameSamples>& out, std::span<const std::uint8_t> targets) {
-  return rasterize_shared(grid, layout, points, own_depth, settings, out, targets);
-}
-
-void CpuProbeKernels::accumulate_and_project(const MapProjector& projector, std::span<ProbeMapState* const> states,
-                                             std::span<const FrameSamples* const> frames,
-                                             const AccumulationSettings& settings, std::span<std::uint8_t> changed,
-                                             std::span<float> sh) {
+SharingStats CpuProbeKernels::share_accumulate_project(const ProbeGrid& grid, const MapProjector& projector,
+                                                       const std::vector<std::vector<ShadedPoint>>& points,
+                                                       const std::vector<const DepthMap*>& own_depth,
+                                                       const SharingSettings& sharing, std::span<const int> batch,
+                                                       std::span<ProbeMapState* const> states,
+                                                       const AccumulationSettings& accumulation,
+                                                       std::span<std::uint8_t> changed, std::span<float> sh,
+                                                       ShareAccumulateTimes& times) {
+  using Clock = std::chrono::steady_clock;
+  const auto ms_since = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
+  auto t0 = Clock::now();
+  std::vector<std::uint8_t> targets(static_cast<std::size_t>(grid.count()), 0);
+  for (const int q : batch) targets[static_cast<std::size_t>(q)] = 1;
+  // Only the batch's maps are filled (and allocated).
+  std::vector<FrameSamples> samples;
+  const SharingStats stats = rasterize_shared(grid, projector.layout(), points, own_depth, sharing, samples, targets);
+  times.share_ms = ms_since(t0);
+  t0 = Clock::now();
   // One probe at a time: its filled map stays in cache for the projection.
-  engine::jobs::parallel_for(0, static_cast<int>(states.size()), 1, [&](int b, int e) {
+  engine::jobs::parallel_for(0, static_cast<int>(batch.size()), 1, [&](int b, int e) {
     for (int i = b; i < e; ++i) {
       const auto k = static_cast<std::size_t>(i);
-      changed[k] = accumulate(*states[k], *frames[k], settings) ? 1 : 0;
-      const std::vector<glm::vec3> filled = filled_radiance(*states[k], projector.layout(), settings.fill_passes);
+      changed[k] = accumulate(*states[k], samples[static_cast<std::size_t>(batch[k])], accumulation) ? 1 : 0;
+      const std::vector<glm::vec3> filled = filled_radiance(*states[k], projector.layout(), accumulation.fill_passes);
       projector.project(filled.data(), sh.data() + k * 75);
     }
   });
+  times.accumulate_ms = ms_since(t0);
+  return stats;
 }
 
 std::shared_ptr<ProbeKernels> cpu_probe_kernels() {

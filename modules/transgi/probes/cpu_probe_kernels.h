@@ -15,12 +15,12 @@ class CpuProbeKernels final : public ProbeKernels {
                         std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
                         const ProbeFeedbackSource& self, const ProbeFeedbackSource* outer,
                         std::vector<ProbeRayHit>& out) override;
-  SharingStats rasterize(const ProbeGrid& grid, const MapLayout& layout, const std::vector<std::vector<ShadedPoint>>& points,
-                         const std::vector<const DepthMap*>& own_depth, const SharingSettings& settings,
-                         std::vector<FrameSamples>& out, std::span<const std::uint8_t> targets) override;
-  void accumulate_and_project(const MapProjector& projector, std::span<ProbeMapState* const> states,
-                              std::span<const FrameSamples* const> frames, const AccumulationSettings& settings,
-                              std::span<std::uint8_t> changed, std::span<float> sh) override;
+  SharingStats share_accumulate_project(const ProbeGrid& grid, const MapProjector& projector,
+                                        const std::vector<std::vector<ShadedPoint>>& points,
+                                        const std::vector<const DepthMap*>& own_depth, const SharingSettings& sharing,
+                                        std::span<const int> batch, std::span<ProbeMapState* const> states,
+                                        const AccumulationSettings& accumulation, std::span<std::uint8_t> changed,
+                                        std::span<float> sh, ShareAccumulateTimes& times) override;
   engine::rt::RayBatchTracer* tracer() override { return nullptr; }
   [[nodiscard]] const char* name() const override { return "cpu"; }
 };

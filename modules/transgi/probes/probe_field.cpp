@@ -211,7 +211,6 @@ struct ProbeField::UpdateWork {
   std::vector<float> direct_frame;                 // probes x 75: the sky and emitters its rays saw
   std::atomic<std::size_t> nonfinite_rays{0};      // rare
   std::vector<std::uint8_t> skip_this_frame;       // per probe: relocated, its rays left from elsewhere
-  std::vector<FrameSamples> samples;               // per updated probe: its map's samples this frame
 };
 
 bool ProbeField::takes_frame(const UpdateWork& w, int q) const {
@@ -350,25 +349,29 @@ void ProbeField::classify_traced(const engine::rt::RtScene& scene, UpdateWork& w
   classify_pending_ = false;
 }
 
-SharingStats ProbeField::share_and_raster(UpdateWork& w) {
+ProbeField::LightIntoProbes ProbeField::share_accumulate_project(UpdateWork& w) {
+  using namespace engine;
   const int probes = grid_.count();
   // Each probe's depth map from its own rays only: probes in parallel.
-  engine::jobs::parallel_for(0, probes, 8, [&](int q0, int q1) {
+  jobs::parallel_for(0, probes, 8, [&](int q0, int q1) {
     for (int q = q0; q < q1; ++q)
       if (takes_frame(w, q))
         update_own_depth(probes_.maps[static_cast<std::size_t>(q)], settings_.map, w.points[static_cast<std::size_t>(q)], settings_.accumulation);
   });
   std::vector<const DepthMap*> depth(static_cast<std::size_t>(probes));
   for (int q = 0; q < probes; ++q) depth[static_cast<std::size_t>(q)] = &probes_.maps[static_cast<std::size_t>(q)].depth;
-  std::vector<std::uint8_t> targets(static_cast<std::size_t>(probes));
-  for (int q = 0; q < probes; ++q) targets[static_cast<std::size_t>(q)] = takes_frame(w, q) ? 1 : 0;
-  // Only the updated probes' maps are filled (and allocated).
-  return kernels_->rasterize(grid_, settings_.map, w.points, depth, settings_.sharing, w.samples, targets);
-}
+  // Every updated probe in one batch for the backend.
+  std::vector<int> batch;
+  for (int q = 0; q < probes; ++q)
+    if (takes_frame(w, q)) batch.push_back(q);
+  std::vector<ProbeMapState*> batch_states;
+  for (const int q : batch) batch_states.push_back(&probes_.maps[static_cast<std::size_t>(q)]);
+  std::vector<std::uint8_t> batch_changed(batch.size());
+  std::vector<float> projected(batch.size() * 75);
+  LightIntoProbes result;
+  result.sharing = kernels_->share_accumulate_project(grid_, projector_, w.points, depth, settings_.sharing, batch, batch_states,
+                                                      settings_.accumulation, batch_changed, projected, result.times);
 
-int ProbeField::accumulate_and_project(UpdateWork& w) {
-  using namespace engine;
-  const int probes = grid_.count();
   std::atomic<int> bad_probes{0};
   // After probe q's map took its frame (changed: it detected a change of
   // light): its convergence and its direct-light mean.
@@ -400,19 +403,7 @@ int ProbeField::accumulate_and_project(UpdateWork& w) {
       bad_probes.fetch_add(1, std::memory_order_relaxed);
     }
   };
-  // Every updated probe's map in one batch for the backend.
-  std::vector<int> batch;
-  for (int q = 0; q < probes; ++q)
-    if (takes_frame(w, q)) batch.push_back(q);
-  std::vector<ProbeMapState*> batch_states;
-  std::vector<const FrameSamples*> batch_frames;
-  for (const int q : batch) {
-    batch_states.push_back(&probes_.maps[static_cast<std::size_t>(q)]);
-    batch_frames.push_back(&w.samples[static_cast<std::size_t>(q)]);
-  }
-  std::vector<std::uint8_t> batch_changed(batch.size());
-  std::vector<float> projected(batch.size() * 75);
-  kernels_->accumulate_and_project(projector_, batch_states, batch_frames, settings_.accumulation, batch_changed, projected);
+  const auto t0 = Clock::now();
   jobs::parallel_for(0, static_cast<int>(batch.size()), 1, [&](int b, int e) {
     for (int i = b; i < e; ++i) {
       const int q = batch[static_cast<std::size_t>(i)];
@@ -421,7 +412,9 @@ int ProbeField::accumulate_and_project(UpdateWork& w) {
       finish_probe(q);
     }
   });
-  return bad_probes.load();
+  result.times.accumulate_ms += ms_since(t0);
+  result.nonfinite_probes = bad_probes.load();
+  return result;
 }
 
 void ProbeField::update_means_and_counts(ProbeFrameStats& stats) {
@@ -469,17 +462,15 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   if (w.classify || w.budgeted) classify_traced(scene, w);
   stats.scatter_ms = ms_since(t0);
 
-  // 2. Share and rasterize.
+  // 2. Share, accumulate, fill, project.
   t0 = Clock::now();
-  const SharingStats ss = share_and_raster(w);
-  stats.shared_accepted = ss.accepted;
-  stats.shared_rejected = ss.rejected_by_guard;
-  stats.raster_ms = ms_since(t0);
-
-  // 3. Accumulate, fill, project.
-  t0 = Clock::now();
-  stats.nonfinite_probes = accumulate_and_project(w);
-  stats.project_ms = ms_since(t0);
+  const LightIntoProbes light = share_accumulate_project(w);
+  stats.shared_accepted = light.sharing.accepted;
+  stats.shared_rejected = light.sharing.rejected_by_guard;
+  stats.nonfinite_probes = light.nonfinite_probes;
+  // The own depth maps' update and the batch's set-up count as sharing.
+  stats.project_ms = light.times.accumulate_ms;
+  stats.raster_ms = ms_since(t0) - stats.project_ms;
   update_means_and_counts(stats);
   ++frame_;
   return stats;

@@ -305,18 +305,22 @@ class ProbeField {
   //    the sky and emitters it saw;
   //  classify_traced (classification and budgeted frames): buried, far and
   //    relocated probes marked, their light forgotten;
-  //  share_and_raster: each updating probe's depth from its own rays and
-  //    this frame's samples from its own and its neighbours' points;
-  //  accumulate_and_project: each updating probe's maps, SH and direct-light
-  //    mean; returns the probes whose light came out non-finite (reset);
+  //  share_accumulate_project: each updating probe's depth from its own
+  //    rays, this frame's samples from its own and its neighbours' points
+  //    accumulated into its maps, its SH and direct-light mean; counts the
+  //    probes whose light came out non-finite (reset);
   //  update_means_and_counts: the ambient means and the state counts.
   struct UpdateWork;
   void plan_update(UpdateWork& w);
   void trace_and_shade(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, const ProbeField* outer,
                        UpdateWork& w);
   void classify_traced(const engine::rt::RtScene& scene, UpdateWork& w);
-  SharingStats share_and_raster(UpdateWork& w);
-  int accumulate_and_project(UpdateWork& w);
+  struct LightIntoProbes {
+    SharingStats sharing;
+    ShareAccumulateTimes times;
+    int nonfinite_probes = 0;
+  };
+  LightIntoProbes share_accumulate_project(UpdateWork& w);
   void update_means_and_counts(ProbeFrameStats& stats);
   // Whether probe q's maps take this frame (untraced probes, outside the
   // budget, and relocated ones keep their state).

@@ -56,6 +56,14 @@ enum class BackendFallback : std::uint8_t {
 // "none", "no device", "missing capability", "kernel build failed", "scene too large".
 const char* to_string(BackendFallback reason);
 
+// Host milliseconds of ProbeKernels::share_accumulate_project's parts (the
+// frame's "probe raster" and "probe accumulation + projection" times). A
+// backend that submits both parts at once counts the writing of its inputs
+// as sharing and the submission and the read-back as the rest.
+struct ShareAccumulateTimes {
+  double share_ms = 0.0, accumulate_ms = 0.0;
+};
+
 class ProbeKernels {
  public:
   virtual ~ProbeKernels() = default;
@@ -69,18 +77,20 @@ class ProbeKernels {
                                 std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
                                 const ProbeFeedbackSource& self, const ProbeFeedbackSource* outer,
                                 std::vector<ProbeRayHit>& out) = 0;
-  // As rasterize_shared.
-  virtual SharingStats rasterize(const ProbeGrid& grid, const MapLayout& layout,
-                                 const std::vector<std::vector<ShadedPoint>>& points,
-                                 const std::vector<const DepthMap*>& own_depth, const SharingSettings& settings,
-                                 std::vector<FrameSamples>& out, std::span<const std::uint8_t> targets) = 0;
-  // For each i: accumulate(*states[i], *frames[i], settings) (changed[i] its
-  // result), then filled_radiance(*states[i], projector.layout(),
-  // settings.fill_passes) projected as projector.project into
-  // sh[i * 75, i * 75 + 75).
-  virtual void accumulate_and_project(const MapProjector& projector, std::span<ProbeMapState* const> states,
-                                      std::span<const FrameSamples* const> frames, const AccumulationSettings& settings,
-                                      std::span<std::uint8_t> changed, std::span<float> sh) = 0;
+  // This frame's light into the probes of `batch`, in one stage so that a
+  // device keeps its intermediate maps: each batch probe's samples from its
+  // own and its neighbours' points (rasterize_shared with the batch as its
+  // targets), accumulated into *states[i] (accumulate; its result in
+  // changed[i]), filled (filled_radiance with accumulation.fill_passes) and
+  // projected as projector.project into sh[i * 75, i * 75 + 75). `times`
+  // gets the host time of the sharing and of the rest.
+  virtual SharingStats share_accumulate_project(const ProbeGrid& grid, const MapProjector& projector,
+                                                const std::vector<std::vector<ShadedPoint>>& points,
+                                                const std::vector<const DepthMap*>& own_depth,
+                                                const SharingSettings& sharing, std::span<const int> batch,
+                                                std::span<ProbeMapState* const> states,
+                                                const AccumulationSettings& accumulation, std::span<std::uint8_t> changed,
+                                                std::span<float> sh, ShareAccumulateTimes& times) = 0;
   // The backend's ray tracer for the probes' relocation rays (and the
   // G-buffer's camera rays); null = the RtScene's own (Embree) queries.
   virtual engine::rt::RayBatchTracer* tracer() = 0;
