@@ -30,6 +30,8 @@ constexpr const char* kUsage =
     "usage: transgi-game [--headless] [--frames N] [--script-input replay.txt] [--record DIR] [--screenshot F.png]\n"
     "                    [--scene level.gltf] [--model M.tgm] [--game game.json] [--width W] [--height H]\n"
     "                    [--method transgi|ddgi|reference] [--view full|gi|direct] [--exposure STOPS] [--threads T]\n"
+    "                    [--backend cpu|vulkan] (vulkan: the GI's probe work on the GPU; in a window, the frames\n"
+    "                    presented through a Vulkan swapchain on the same device)\n"
     "                    [--script ENTITY=FILE[,ENTITY=FILE...]] (the entity runs that Lua file instead of its own)\n"
     "  window only: [--select NAME] [--gizmo translate|rotate] [--probes] (what the editor shows at start)\n"
     "  headless only: [--script-input replay.txt] [--record DIR]\n"
@@ -41,7 +43,7 @@ constexpr const char* kUsage =
 engine::core::Args parse(int argc, char** argv) {
   return engine::core::Args("transgi-game", std::vector<std::string>(argv + 1, argv + argc),
                             {"frames", "script-input", "record", "screenshot", "scene", "model", "game", "width", "height", "view",
-                             "method", "script", "exposure", "threads", "select", "gizmo"},
+                             "method", "script", "exposure", "threads", "select", "gizmo", "backend"},
                             {"headless", "help", "probes"});
 }
 
@@ -63,6 +65,7 @@ game::GameOptions game_options(const engine::core::Args& args) {
   o.threads = static_cast<int>(args.integer("threads", 0, 1024, 0));
   o.view = args.choice("view", {"full", "gi", "direct"}, "full");
   o.method = game::parse_method(args.choice("method", {"transgi", "ddgi", "reference"}, "transgi"));
+  o.backend = args.choice("backend", {"cpu", "vulkan"}, "cpu");
   if (args.has("script")) {
     std::stringstream list(args.str("script"));
     for (std::string item; std::getline(list, item, ',');) {

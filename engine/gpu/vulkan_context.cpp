@@ -23,13 +23,15 @@ DeviceKind kind_of(VkPhysicalDeviceType t) {
   }
 }
 
-std::optional<std::uint32_t> compute_family(VkPhysicalDevice d) {
+// The first queue family with compute that `accepts` (if set) accepts too.
+std::optional<std::uint32_t> compute_family(VkInstance instance, VkPhysicalDevice d,
+                                            const std::function<bool(VkInstance, VkPhysicalDevice, std::uint32_t)>& accepts) {
   std::uint32_t n = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(d, &n, nullptr);
   std::vector<VkQueueFamilyProperties> families(n);
   vkGetPhysicalDeviceQueueFamilyProperties(d, &n, families.data());
   for (std::uint32_t i = 0; i < n; ++i)
-    if (families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) return i;
+    if ((families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) && (!accepts || accepts(instance, d, i))) return i;
   return std::nullopt;
 }
 
@@ -205,6 +207,7 @@ std::unique_ptr<VulkanContext> VulkanContext::create(const GpuOptions& options, 
     layers.push_back(kValidation);
     extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
   }
+  extensions.insert(extensions.end(), options.instance_extensions.begin(), options.instance_extensions.end());
   VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
   ici.pApplicationInfo = &app;
   ici.enabledLayerCount = static_cast<std::uint32_t>(layers.size());
@@ -233,7 +236,8 @@ std::unique_ptr<VulkanContext> VulkanContext::create(const GpuOptions& options, 
   for (auto p : physicals) {
     VkPhysicalDeviceProperties props;
     vkGetPhysicalDeviceProperties(p, &props);
-    candidates.push_back({props.deviceName, kind_of(props.deviceType), compute_family(p).has_value()});
+    candidates.push_back({props.deviceName, kind_of(props.deviceType),
+                          compute_family(ctx->instance_, p, options.queue_family_accepts).has_value()});
   }
   std::string requested = options.device;
   if (requested.empty())
@@ -241,7 +245,7 @@ std::unique_ptr<VulkanContext> VulkanContext::create(const GpuOptions& options, 
   const DeviceChoice choice = choose_device(candidates, requested);
   if (!choice.index) return fail(choice.why);
   ctx->physical_ = physicals[*choice.index];
-  ctx->queue_family_ = *compute_family(ctx->physical_);
+  ctx->queue_family_ = *compute_family(ctx->instance_, ctx->physical_, options.queue_family_accepts);
 
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(ctx->physical_, &props);
@@ -268,6 +272,7 @@ std::unique_ptr<VulkanContext> VulkanContext::create(const GpuOptions& options, 
     device_extensions = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_QUERY_EXTENSION_NAME,
                          VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME};
   }
+  device_extensions.insert(device_extensions.end(), options.device_extensions.begin(), options.device_extensions.end());
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
   qci.queueFamilyIndex = ctx->queue_family_;

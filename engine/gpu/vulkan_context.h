@@ -57,6 +57,13 @@ struct GpuOptions {
   // it; false: the compute-shader BVH traversal everywhere.
   // ENGINE_GPU_RAY_QUERY=off turns it off for A/B runs (on: as asked here).
   bool ray_query = true;
+  // For a window that presents on the kernels' device: instance extensions
+  // to enable (GLFW's surface extensions), device extensions to enable
+  // (VK_KHR_swapchain), and a test the queue family must pass besides
+  // compute (graphics, and presentation to the window). Empty and null:
+  // a compute queue, nothing more.
+  std::vector<const char*> instance_extensions, device_extensions;
+  std::function<bool(VkInstance, VkPhysicalDevice, std::uint32_t family)> queue_family_accepts;
 };
 
 // The VK_KHR_acceleration_structure entry points, which the loader does not
@@ -151,6 +158,11 @@ class VulkanContext {
 
   [[nodiscard]] VkDevice device() const { return device_; }
   [[nodiscard]] VkPhysicalDevice physical_device() const { return physical_; }
+  [[nodiscard]] VkInstance instance() const { return instance_; }
+  // The one queue the context submits to, and its family: a host that
+  // presents on it submits from the thread that runs the kernels.
+  [[nodiscard]] VkQueue queue() const { return queue_; }
+  [[nodiscard]] std::uint32_t queue_family() const { return queue_family_; }
   [[nodiscard]] const DeviceInfo& info() const { return info_; }
   // Valid where info().ray_query.
   [[nodiscard]] const AccelerationStructureApi& acceleration_structures() const { return as_api_; }

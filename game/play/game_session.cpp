@@ -80,7 +80,7 @@ GameSession::GameSession(const GameOptions& options) : options_(options), refere
     model = std::make_shared<const transgi::model::TransferModel>(transgi::model::load_model(model_path));
     transgi::model::validate_model(*model, world.resource<engine::scene::SceneAssets>(), model_path);
   }
-  app_->add_plugin<transgi::runtime::TransGIPlugin>(transgi::runtime::realtime_preset());
+  app_->add_plugin<transgi::runtime::TransGIPlugin>(transgi::runtime::realtime_preset(), options_.host_gpu);
   if (model) transgi::runtime::attach_latent_meshes(world, model);
   // Cascades around the camera; the sample level is small enough that they
   // stand as one grid over it (CascadeSettings::fit_scene_cell).
@@ -112,6 +112,7 @@ GameSession::GameSession(const GameOptions& options) : options_(options), refere
 
   auto& frame = world.resource<transgi::runtime::GiFrame>();
   frame.camera = camera_;
+  if (options_.backend != "cpu") set_backend(options_.backend);  // the warm-up runs on it too
   warm_up();
   frame.width = options_.width;
   frame.height = options_.height;

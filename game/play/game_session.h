@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "editor/editor_tools.h"
+#include "engine/gpu/vulkan_context.h"
 #include "engine/app/app.h"
 #include "engine/image/image.h"
 #include "engine/input/input_state.h"
@@ -44,6 +45,13 @@ struct GameOptions {
   // its own (--script ENTITY=FILE), for quick tries; a relative file is
   // taken from the working directory.
   std::vector<std::pair<std::string, std::filesystem::path>> scripts;
+  // Where GI's probe work runs from the first frame: "cpu" or "vulkan"
+  // (set_backend's choice).
+  std::string backend = "cpu";
+  // With "vulkan": the kernels run on this device (the window's own, which
+  // presents the frames through its swapchain) rather than on one the
+  // plugin makes. Null: the plugin makes its own.
+  std::shared_ptr<engine::gpu::VulkanContext> host_gpu;
 };
 
 // "transgi" | "ddgi" | "reference", as the command line and replays name them.

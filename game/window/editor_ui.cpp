@@ -25,7 +25,8 @@ ViewRect EditorUi::view_rect() const {
 
 void EditorUi::draw(ImTextureID frame_texture) {
   const ViewRect view = view_rect();
-  ImGui::GetBackgroundDrawList()->AddImage(frame_texture, ImVec2(view.min.x, view.min.y), ImVec2(view.max.x, view.max.y));
+  if (frame_texture)
+    ImGui::GetBackgroundDrawList()->AddImage(frame_texture, ImVec2(view.min.x, view.min.y), ImVec2(view.max.x, view.max.y));
   frame_ms_.push_back(static_cast<float>(session_.last_frame_ms()));
   while (frame_ms_.size() > 240) frame_ms_.pop_front();
   menu_bar();

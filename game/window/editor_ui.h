@@ -35,6 +35,8 @@ class EditorUi {
   // The game view's rectangle for this frame (below the menu bar, the
   // image's aspect kept).
   [[nodiscard]] ViewRect view_rect() const;
+  // frame_texture: the game image to draw in the view, or null where the
+  // presenter has put it under the UI already (Vulkan: a blit).
   void draw(ImTextureID frame_texture);
   [[nodiscard]] float exposure() const { return exposure_; }
   [[nodiscard]] bool quit_requested() const { return quit_; }

@@ -4,17 +4,13 @@
 #include <deque>
 #include <stdexcept>
 
-#define GL_GLEXT_PROTOTYPES
-#include <GL/gl.h>
 #include <GLFW/glfw3.h>
 #include <imgui.h>
-#include <backends/imgui_impl_glfw.h>
-#include <backends/imgui_impl_opengl3.h>
 
-#include "engine/image/png.h"
 #include "engine/image/tonemap.h"
-#include "window/editor_ui.h"
 #include "play/input_queue.h"
+#include "window/editor_ui.h"
+#include "window/presenter.h"
 #include "window/window_input.h"
 
 namespace game {
@@ -22,20 +18,6 @@ namespace game {
 namespace {
 
 void glfw_error(int code, const char* text) { std::fprintf(stderr, "transgi-game: GLFW error %d: %s\n", code, text); }
-
-// The window's back buffer as a PNG (rows flipped: GL's origin is bottom-left).
-void save_back_buffer(GLFWwindow* w, const std::filesystem::path& out) {
-  int fw = 0, fh = 0;
-  glfwGetFramebufferSize(w, &fw, &fh);
-  engine::image::Rgb8Image img(fw, fh);
-  std::vector<std::uint8_t> rows(static_cast<std::size_t>(fw) * fh * 3);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadBuffer(GL_BACK);
-  glReadPixels(0, 0, fw, fh, GL_RGB, GL_UNSIGNED_BYTE, rows.data());
-  for (int y = 0; y < fh; ++y)
-    std::copy_n(rows.data() + static_cast<std::size_t>(fh - 1 - y) * fw * 3, static_cast<std::size_t>(fw) * 3, img.at(0, y));
-  engine::image::write_png(out, img);
-}
 
 // GLFW's callbacks queue every key and button change for the frame loop
 // (play/input_queue.h). Installed before ImGui's, which chains to them.
@@ -70,24 +52,31 @@ struct Glfw {
 
 }  // namespace
 
-int run_window(const GameOptions& game_options, const WindowOptions& wo) {
+int run_window(const GameOptions& options, const WindowOptions& wo) {
   Glfw glfw;
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
-  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-  GLFWwindow* window = glfwCreateWindow(wo.window_width, wo.window_height, "TransGI - sample level", nullptr, nullptr);
-  if (!window) throw std::runtime_error("cannot create an OpenGL 3.3 window (is an OpenGL driver, such as Mesa, installed?)");
-  glfwMakeContextCurrent(window);
-  glfwSwapInterval(0);
-
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini beside whoever runs the game
   ImGui::StyleColorsDark();
-  glfwSetKeyCallback(window, on_key);
-  glfwSetMouseButtonCallback(window, on_mouse_button);
-  ImGui_ImplGlfw_InitForOpenGL(window, true);  // chains to the callbacks above
-  ImGui_ImplOpenGL3_Init("#version 330");
+  const auto install_callbacks = [](GLFWwindow* window) {
+    glfwSetKeyCallback(window, on_key);
+    glfwSetMouseButtonCallback(window, on_mouse_button);
+  };
+  // Chosen once: with the Vulkan backend the frames are presented on the
+  // device the GI kernels run on, which the session is given.
+  const char* title = "TransGI - sample level";
+  std::unique_ptr<Presenter> presenter;
+  try {
+    presenter = options.backend == "vulkan" ? make_vulkan_presenter(wo.window_width, wo.window_height, title, install_callbacks)
+                                            : make_gl_presenter(wo.window_width, wo.window_height, title, install_callbacks);
+  } catch (...) {
+    ImGui::DestroyContext();
+    throw;
+  }
+  GameOptions game_options = options;
+  game_options.host_gpu = presenter->device();
+  std::printf("transgi-game: presenting through %s\n", presenter->name());
+  GLFWwindow* window = presenter->window();
 
   int code = 0;
   {
@@ -100,16 +89,10 @@ int run_window(const GameOptions& game_options, const WindowOptions& wo) {
     if (wo.gizmo != "translate" && wo.gizmo != "rotate") throw std::runtime_error("--gizmo: expected translate or rotate, got '" + wo.gizmo + "'");
     session.editor().mode = wo.gizmo == "rotate" ? GizmoMode::Rotate : GizmoMode::Translate;
     ui.show_probes(wo.probes);
-    GLuint texture = 0;
-    glGenTextures(1, &texture);
-    glBindTexture(GL_TEXTURE_2D, texture);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     for (int frame = 0; !glfwWindowShouldClose(window) && (wo.frames <= 0 || frame < wo.frames); ++frame) {
       session.begin_input();
       glfwPollEvents();
-      ImGui_ImplOpenGL3_NewFrame();
-      ImGui_ImplGlfw_NewFrame();
+      presenter->new_frame();
       ImGui::NewFrame();
       // The game view fills the window below the menu bar; the game sees
       // keys and the mouse only when ImGui does not want them.
@@ -128,35 +111,18 @@ int run_window(const GameOptions& game_options, const WindowOptions& wo) {
       if (in.was_pressed("escape")) glfwSetWindowShouldClose(window, 1);
 
       session.frame();
-      const engine::image::Rgb8Image shown = engine::image::to_srgb8(session.image(), ui.exposure());
-      glBindTexture(GL_TEXTURE_2D, texture);
-      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-      if (!shown.pixels.empty())
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, shown.width, shown.height, 0, GL_RGB, GL_UNSIGNED_BYTE, shown.pixels.data());
-      ui.draw(reinterpret_cast<ImTextureID>(static_cast<std::uintptr_t>(texture)));
+      ui.draw(presenter->show(engine::image::to_srgb8(session.image(), ui.exposure())));
       if (ui.quit_requested()) glfwSetWindowShouldClose(window, 1);
 
       ImGui::Render();
-      int fw = 0, fh = 0;
-      glfwGetFramebufferSize(window, &fw, &fh);
-      glViewport(0, 0, fw, fh);
-      glClearColor(0.08f, 0.08f, 0.09f, 1.0f);
-      glClear(GL_COLOR_BUFFER_BIT);
-      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
       const bool last = wo.frames > 0 && frame + 1 == wo.frames;
-      if (last && !wo.screenshot.empty()) {
-        save_back_buffer(window, wo.screenshot);
-        std::printf("wrote %s\n", wo.screenshot.string().c_str());
-      }
-      glfwSwapBuffers(window);
+      presenter->present(view, last ? wo.screenshot : std::filesystem::path());
+      if (last && !wo.screenshot.empty()) std::printf("wrote %s\n", wo.screenshot.string().c_str());
     }
-    glDeleteTextures(1, &texture);
     std::printf("transgi-game: window closed after %llu frames\n", static_cast<unsigned long long>(session.frames()));
   }
-  ImGui_ImplOpenGL3_Shutdown();
-  ImGui_ImplGlfw_Shutdown();
+  presenter.reset();
   ImGui::DestroyContext();
-  glfwDestroyWindow(window);
   return code;
 }
 

@@ -461,6 +461,52 @@ TEST(WindowSmoke, TheProbeOverlayLeavesTheMenuBarAndPanelsAsTheyAre) {
   fs::remove_all(dir);
 }
 
+// Issue 36: with --backend vulkan the window presents through a Vulkan
+// swapchain on the device the GI kernels run on (the game image blitted
+// under ImGui's Vulkan backend) and says so; the game view looks as the
+// OpenGL window's does: the same frame up to the two backends' rounding and
+// the two bilinear filters, within 2/255 on average over the view's middle.
+TEST(WindowSmoke, TheVulkanBackendPresentsThroughASwapchainAsTheOpenGlWindowDoes) {
+  if (shell("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (Debian package xvfb)";
+  const fs::path dir = fs::temp_directory_path() / ("swapchain_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const auto shot = [&](const std::string& name, const std::string& extra) {
+    const fs::path png = dir / (name + ".png"), log = dir / (name + ".txt");
+    const std::string cmd = "ASAN_OPTIONS=detect_leaks=0 xvfb-run -a -s '-screen 0 1280x720x24' '" TRANSGI_GAME_BINARY
+                            "' --frames 3 --width 160 --height 90 " + extra + " --screenshot '" + png.string() + "' > '" +
+                            log.string() + "' 2>&1";
+    const int code = shell(cmd);
+    std::ifstream in(log);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    return std::pair{code == 0 && fs::exists(png) ? std::optional<engine::image::Rgb8Image>(engine::image::read_png(png)) : std::nullopt,
+                     text};
+  };
+  const auto [gl, gl_log] = shot("gl", "");
+  if (!gl) GTEST_SKIP() << "no X server could start under xvfb-run: " << gl_log;
+  const auto [vk, vk_log] = shot("vulkan", "--backend vulkan");
+  ASSERT_TRUE(vk) << vk_log;
+  EXPECT_NE(gl_log.find("presenting through OpenGL 3.3"), std::string::npos) << gl_log;
+  EXPECT_NE(vk_log.find("presenting through Vulkan swapchain"), std::string::npos) << vk_log;
+  ASSERT_EQ(gl->width, vk->width);
+  ASSERT_EQ(gl->height, vk->height);
+  // The view's middle, clear of the panels at their default places.
+  double diff = 0, mean_gl = 0;
+  std::size_t n = 0;
+  for (int y = 230; y < 530; ++y)
+    for (int x = 270; x < 890; ++x, ++n)
+      for (int c = 0; c < 3; ++c) {
+        const std::size_t at = (static_cast<std::size_t>(y) * static_cast<std::size_t>(gl->width) + static_cast<std::size_t>(x)) * 3 + c;
+        diff += std::abs(static_cast<int>(gl->pixels[at]) - static_cast<int>(vk->pixels[at]));
+        mean_gl += gl->pixels[at];
+      }
+  diff /= 3.0 * static_cast<double>(n);
+  mean_gl /= 3.0 * static_cast<double>(n);
+  std::printf("game view, OpenGL against the Vulkan swapchain: mean |difference| %.3f of 255 (mean level %.1f)\n", diff, mean_gl);
+  EXPECT_GT(mean_gl, 20.0) << "the view should show the lit room";
+  EXPECT_LT(diff, 2.0);
+  fs::remove_all(dir);
+}
+
 // Issue 32: at the old 280 px the inspector's widgets took ImGui's default
 // 65 % and cut labels such as "range (0 = infinite)" off. Every widget label
 // in editor_panels.cpp, measured with ImGui's default font, fits the column
