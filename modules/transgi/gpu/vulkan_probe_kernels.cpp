@@ -12,14 +12,6 @@ VulkanProbeKernels::VulkanProbeKernels(std::shared_ptr<engine::gpu::VulkanContex
     : ctx_(std::move(ctx)), tracer_(*ctx_), shading_(std::make_unique<VulkanProbeShading>(*ctx_)),
       name_(engine::gpu::describe(ctx_->info())) {}
 
-void VulkanProbeKernels::project(const probes::MapProjector& projector, std::span<const glm::vec3> radiance,
-                                 std::span<float> out) {
-  const auto& l = projector.layout();
-  auto& p = projectors_[{l.width, l.height}];
-  if (!p) p = std::make_unique<VulkanShProjector>(*ctx_, projector);
-  project_ms_ += std::max(0.0, p->project(radiance, out));
-}
-
 probes::SharingStats VulkanProbeKernels::share_accumulate_project(
     const probes::ProbeGrid& grid, const probes::MapProjector& projector,
     const std::vector<std::vector<probes::ShadedPoint>>& points, const std::vector<const probes::DepthMap*>& own_depth,

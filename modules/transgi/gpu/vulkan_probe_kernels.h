@@ -45,9 +45,6 @@ class VulkanProbeKernels : public probes::ProbeKernels {
                                                 const probes::AccumulationSettings& accumulation,
                                                 std::span<std::uint8_t> changed, std::span<float> sh,
                                                 probes::ShareAccumulateTimes& times) override;
-  // The SH projection alone, as MapProjector::project for `maps` maps stored
-  // one after another: radiance maps x texel_count(), out maps x 75.
-  void project(const probes::MapProjector& projector, std::span<const glm::vec3> radiance, std::span<float> out);
   engine::rt::RayBatchTracer* tracer() override { return &tracer_; }
   // The real-time frame's transfer decoder on this device, made for
   // `model`'s network when first asked (and again for another model); null
