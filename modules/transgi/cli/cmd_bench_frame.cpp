@@ -155,9 +155,12 @@ int run_bench_frame(const std::vector<std::string>& argv) {
     if (s.inference > 0) inference_gflops.push_back(static_cast<double>(frame.realtime.inferred) * mlp_flop_per_point / (s.inference * 1e6));
     rows << f - warmup << ',' << ms;
     for (double v : row) rows << ',' << v;
-    rows << ',' << frame.probe_stats.traced << ',' << frame.shaded_samples << ',' << frame.gpu_trace_ms << ','
-         << frame.gpu_raster_ms << ',' << frame.gpu_projection_ms << ',' << frame.gpu_gbuffer_ms << ',' << frame.gpu_inference_ms << ','
-         << frame.gpu_shading_ms << ',' << frame.gpu_accumulation_ms << '\n';
+    rows << ',' << frame.probe_stats.traced << ',' << frame.shaded_samples << ','
+         << frame.device_stage_ms(runtime::device_stage::kOtherRays) << ',' << frame.device_stage_ms(runtime::device_stage::kRaster) << ',' << frame.device_stage_ms(runtime::device_stage::kProjection)
+         << ',' << frame.device_stage_ms(runtime::device_stage::kGbufferRays) << ','
+         << frame.device_stage_ms(runtime::device_stage::kInference) << ','
+         << frame.device_stage_ms(runtime::device_stage::kProbeRays) << ','
+         << frame.device_stage_ms(runtime::device_stage::kAccumulation) << '\n';
   }
   bar.finish();
   if (!csv.empty()) eval::write_text(csv, rows.str());
@@ -206,12 +209,11 @@ int run_bench_frame(const std::vector<std::string>& argv) {
   std::printf("probe kernels: %s%s%s", frame.backend.c_str(), frame.backend_fallback.empty() ? "" : "; ",
               frame.backend_fallback.c_str());
   std::printf("\n");
-  if (frame.gpu_ms() > 0)
-    std::printf("GPU timestamps, last frame (ms): G-buffer rays %.2f (camera and shadow rays); other rays %.2f; probe rays "
-                "made, traced and shaded %.2f; radiance raster %.2f; accumulation %.2f; SH projection %.2f; inference %.2f; "
-                "total %.2f\n",
-                frame.gpu_gbuffer_ms, frame.gpu_trace_ms, frame.gpu_shading_ms, frame.gpu_raster_ms, frame.gpu_accumulation_ms,
-                frame.gpu_projection_ms, frame.gpu_inference_ms, frame.gpu_ms());
+  if (frame.gpu_ms() > 0) {
+    std::printf("GPU timestamps, last frame (ms):");
+    for (const runtime::DeviceStageTime& stage : frame.device_stages) std::printf(" %s %.2f;", stage.name.c_str(), stage.ms);
+    std::printf(" total %.2f\n", frame.gpu_ms());
+  }
   if (frame.backend != "cpu")
     std::printf("host-device traffic, last frame: %llu submissions, %.2f MB to the device, %.2f MB back (the final image: "
                 "%.2f MB)\n",

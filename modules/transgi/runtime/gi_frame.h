@@ -1,5 +1,6 @@
 #pragma once
 #include <string>
+#include <string_view>
 // The GI renderer's per-frame output and what it cost, read by the game,
 // tools and the CLI after the Render phase.
 #include <cstddef>
@@ -8,6 +9,7 @@
 #include "engine/ecs/entity.h"
 #include "engine/image/image.h"
 #include "probes/probe_field.h"
+#include "runtime/gi_backend.h"
 #include "shading/realtime_direct.h"
 #include "shading/realtime_gi.h"
 
@@ -64,21 +66,35 @@ struct GiFrame {
   std::string backend = "cpu";
   std::string backend_fallback;
   probes::BackendFallback backend_fallback_reason = probes::BackendFallback::None;
-  // The backend's GPU time by timestamps, per stage: the real-time
-  // G-buffer's camera rays and its direct light's shadow rays; ray tracing
-  // since (probe rays and their shadow rays, and any other batch traced
-  // since the last G-buffer); the radiance raster; the SH projection; the
-  // real-time path's transfer inference (fused decoder and SH dots); the
-  // probe rays' hit shading; the probes' accumulation.
-  double gpu_gbuffer_ms = 0.0, gpu_trace_ms = 0.0, gpu_raster_ms = 0.0, gpu_projection_ms = 0.0, gpu_inference_ms = 0.0,
-         gpu_shading_ms = 0.0, gpu_accumulation_ms = 0.0;
+  // The backend's device time per stage, by timestamps, as the backend
+  // names them (runtime::device_stage): the probe stages in the order they
+  // ran, then the real-time G-buffer's rays and the inference. Empty on the
+  // CPU backend.
+  std::vector<DeviceStageTime> device_stages;
   // Host-device traffic since the last image (the probe updates and this
   // image; engine::gpu::GpuTraffic says how it is counted): command buffers
   // submitted, bytes written to the device and read back. 0 on the CPU.
   std::uint64_t gpu_submissions = 0, gpu_upload_bytes = 0, gpu_download_bytes = 0;
+  // The device's total over its stages.
   [[nodiscard]] double gpu_ms() const {
-    return gpu_gbuffer_ms + gpu_trace_ms + gpu_raster_ms + gpu_projection_ms + gpu_inference_ms + gpu_shading_ms +
-           gpu_accumulation_ms;
+    double ms = 0.0;
+    for (const DeviceStageTime& s : device_stages) ms += s.ms;
+    return ms;
+  }
+  // The device time of the stage named so (0 where there is none).
+  [[nodiscard]] double device_stage_ms(std::string_view name) const {
+    for (const DeviceStageTime& s : device_stages)
+      if (s.name == name) return s.ms;
+    return 0.0;
+  }
+  // Sets the stage named so, keeping its place in the list (appended when new).
+  void set_device_stage(std::string_view name, double ms) {
+    for (DeviceStageTime& s : device_stages)
+      if (s.name == name) {
+        s.ms = ms;
+        return;
+      }
+    device_stages.push_back({std::string(name), ms});
   }
 };
 

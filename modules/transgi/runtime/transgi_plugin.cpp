@@ -12,8 +12,6 @@
 #include "engine/rt/rt_scene.h"
 #include "engine/scene/components.h"
 #include "engine/transform/transform.h"
-#include "gpu/vulkan_probe_kernels.h"
-#include "probes/cpu_probe_kernels.h"
 #include "shading/realtime_direct.h"
 #include "shading/realtime_gi.h"
 #include "engine/render/temporal_accumulation.h"
@@ -41,41 +39,37 @@ void request_light_settings(Res<TransGISettings> settings, ResMut<render::LightS
   if (lights->split_sun != split) lights->split_sun = split;
 }
 
-// The GI backend (probe kernels and ray tracer), chosen once when the
-// settings first ask for it; a resource, as render_gi traces the G-buffer
-// with it too. Every field runs every stage on it.
-struct ProbeBackend {
+// The GI backend, chosen once when the settings first ask for it; a
+// resource, as render_gi traces the G-buffer and decodes with it too. Every
+// field runs every stage on it.
+struct GiBackendChoice {
   Backend made_for = Backend::Cpu;
   std::string device;
   std::uint32_t shader_generation = 0;
-  std::shared_ptr<gpu::VulkanProbeKernels> vulkan;  // null: the CPU backend runs the frame
+  std::shared_ptr<GiBackend> active = cpu_gi_backend();  // never null
   probes::BackendFallback fallback = probes::BackendFallback::None;
   std::string fallback_why;
   std::shared_ptr<engine::gpu::VulkanContext> host;  // the host engine's device, if it gave one
 
-  [[nodiscard]] std::shared_ptr<probes::ProbeKernels> kernels() const {
-    return vulkan ? std::shared_ptr<probes::ProbeKernels>(vulkan) : probes::cpu_probe_kernels();
-  }
   // The CPU backend whole from now on, and why.
   void fall_back(probes::BackendFallback reason, std::string why) {
-    vulkan.reset();
+    active = cpu_gi_backend();
     fallback = reason;
     fallback_why = std::move(why);
   }
 };
 
-void choose_backend(const TransGISettings& settings, ProbeBackend& backend) {
-  if (backend.made_for == settings.backend && backend.device == settings.gpu_device &&
-      backend.shader_generation == settings.shader_generation)
+void choose_backend(const TransGISettings& settings, GiBackendChoice& chosen) {
+  if (chosen.made_for == settings.backend && chosen.device == settings.gpu_device &&
+      chosen.shader_generation == settings.shader_generation)
     return;
-  backend = ProbeBackend{settings.backend, settings.gpu_device, settings.shader_generation, nullptr,
-                         probes::BackendFallback::None, "", backend.host};
+  chosen = GiBackendChoice{settings.backend, settings.gpu_device, settings.shader_generation, cpu_gi_backend(),
+                        probes::BackendFallback::None, "", chosen.host};
   if (settings.backend != Backend::Vulkan) return;
   probes::BackendFallback reason = probes::BackendFallback::None;
   std::string why;
-  backend.vulkan = backend.host ? gpu::make_probe_kernels(backend.host, &reason, &why)
-                                : gpu::make_probe_kernels(settings.gpu_device, &reason, &why);
-  if (!backend.vulkan) backend.fall_back(reason, why);
+  if (auto vulkan = make_vulkan_gi_backend(chosen.host, settings.gpu_device, &reason, &why)) chosen.active = std::move(vulkan);
+  else chosen.fall_back(reason, why);
 }
 
 // Every probe volume's and cascade's update on `kernels`.
@@ -107,34 +101,29 @@ probes::ProbeFrameStats update_all_fields(View<Get<ProbeVolume>>& volumes, View<
 
 void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> cascades, Res<rt::RtScene> rt,
                    Res<render::SceneLights> lights, Res<TransGISettings> settings, ResMut<GiFrame> frame,
-                   ResMut<ProbeBackend> backend) {
+                   ResMut<GiBackendChoice> backend) {
   if (settings->freeze_probes) return;
   choose_backend(*settings, *backend);
   probes::ProbeFrameStats total;
   try {
-    total = update_all_fields(volumes, cascades, *rt, lights->set, backend->kernels(), frame->cascade_stats);
+    total = update_all_fields(volumes, cascades, *rt, lights->set, backend->active->probe_kernels(), frame->cascade_stats);
   } catch (const engine::gpu::GpuError& e) {
-    if (!backend->vulkan) throw;
+    if (backend->active == cpu_gi_backend()) throw;
     // The device cannot hold this scene. Every field runs this frame again,
     // on the CPU: those that finished on the device, or threw after their
     // plan and classification, take a second frame of probe work, which
     // moves their light on as one more frame would.
     backend->fall_back(probes::BackendFallback::SceneTooLarge, e.what());
-    total = update_all_fields(volumes, cascades, *rt, lights->set, backend->kernels(), frame->cascade_stats);
+    total = update_all_fields(volumes, cascades, *rt, lights->set, backend->active->probe_kernels(), frame->cascade_stats);
   }
-  frame->backend = backend->vulkan ? backend->vulkan->name() : "cpu";
+  frame->backend = backend->active->name();
   frame->backend_fallback_reason = backend->fallback;
   frame->backend_fallback = backend->fallback == probes::BackendFallback::None
                                 ? std::string()
                                 : std::string("the CPU backend runs the frame (") + probes::to_string(backend->fallback) +
                                       "): " + backend->fallback_why;
   frame->probe_stats = total;
-  const gpu::VulkanProbeKernels::StageMs gpu_ms = backend->vulkan ? backend->vulkan->take_stage_ms() : gpu::VulkanProbeKernels::StageMs{};
-  frame->gpu_trace_ms = gpu_ms.trace;
-  frame->gpu_raster_ms = gpu_ms.raster;
-  frame->gpu_projection_ms = gpu_ms.projection;
-  frame->gpu_shading_ms = gpu_ms.shading;
-  frame->gpu_accumulation_ms = gpu_ms.accumulation;
+  for (const DeviceStageTime& stage : backend->active->take_probe_stage_times()) frame->set_device_stage(stage.name, stage.ms);
   ++frame->probe_frames;
 }
 
@@ -207,8 +196,8 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   if (deterministic && tracer)
     batched_direct = shading::shade_direct_realtime(packed.gbuffer, rt, lights, rays, &frame.direct_stats, tracer);
   // The device's time for the camera and shadow rays just traced; the probe
-  // update takes the rest (GiFrame::gpu_trace_ms).
-  frame.gpu_gbuffer_ms = tracer ? tracer->take_device_ms() : 0.0;
+  // update takes the rest (device_stage::kOtherRays).
+  if (tracer) frame.set_device_stage(device_stage::kGbufferRays, tracer->take_device_ms());
   const shading::GBuffer& g = packed.gbuffer;
   frame.times.gbuffer = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   // The direct light of punctual lights and the sun first: the probes' share
@@ -230,7 +219,7 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
                                          .mirror = settings.mirror,
                                          .near_field = settings.near_field},
                                         {.stats = &st, .direct = deterministic ? &frame.direct : nullptr, .scratch = &packed.scratch});
-  frame.gpu_inference_ms = st.inference_device_ms;
+  if (st.inference_device_ms > 0) frame.set_device_stage(device_stage::kInference, st.inference_device_ms);
   GiStageTimes& t = frame.times;
   t.network_input = 0;  // inside the fused kernel, counted as inference
   t.inference = st.inference_ms;
@@ -263,21 +252,21 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
 void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Get<const ProbeCascades>> cascades,
                View<Get<const LatentMesh>> latents,
                Res<rt::RtScene> rt, Res<scene::SceneAssets> assets, Res<render::SceneLights> lights,
-               Res<TransGISettings> settings, ResMut<GiFrame> frame, Res<ProbeBackend> backend, Local<PackedDecoder> packed) {
+               Res<TransGISettings> settings, ResMut<GiFrame> frame, Res<GiBackendChoice> backend, Local<PackedDecoder> packed) {
   if (frame->width <= 0 || frame->height <= 0) return;
   const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
   if (!rays) throw std::runtime_error("transgi::render_gi: GiFrame asks for an image but the world has no camera");
   // The traffic of the probe updates and this image, whichever path returns.
   struct RecordTraffic {
     GiFrame& frame;
-    gpu::VulkanProbeKernels* kernels;
+    GiBackend& backend;
     ~RecordTraffic() {
-      const engine::gpu::GpuTraffic t = kernels ? kernels->take_traffic() : engine::gpu::GpuTraffic{};
+      const engine::gpu::GpuTraffic t = backend.take_traffic();
       frame.gpu_submissions = t.submissions;
       frame.gpu_upload_bytes = t.host_to_device_bytes;
       frame.gpu_download_bytes = t.device_to_host_bytes;
     }
-  } record_traffic{*frame, backend->vulkan.get()};
+  } record_traffic{*frame, *backend->active};
 
   // One scene decoder: the model of the first LatentMesh found.
   std::shared_ptr<const model::TransferModel> model;
@@ -308,18 +297,18 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
     const LatentMesh* l = latents.try_read<LatentMesh>(e);
     return l && model && l->model == model;
   };
-  frame->gpu_gbuffer_ms = frame->gpu_inference_ms = 0.0;
+  frame->set_device_stage(device_stage::kGbufferRays, 0.0);
+  frame->set_device_stage(device_stage::kInference, 0.0);
   if (settings->gi_path == GiPath::Realtime) {
     shading::TransferBatchDecoder* batch_decoder = nullptr;
-    if (backend->vulkan && settings->device_inference && model) {
-      batch_decoder = backend->vulkan->transfer_decoder(model);
+    std::string decoder_why;
+    if (settings->device_inference && model) batch_decoder = backend->active->transfer_decoder(model, &decoder_why);
+    if (!decoder_why.empty()) {
       // update_probes resets backend_fallback each frame, but not while the
       // probes are frozen: say it once.
-      if (!batch_decoder) {
-        const std::string note = "transfer inference on the CPU: " + backend->vulkan->transfer_decoder_why();
-        if (frame->backend_fallback.find(note) == std::string::npos)
-          frame->backend_fallback += (frame->backend_fallback.empty() ? "" : "; ") + note;
-      }
+      const std::string note = "transfer inference on the CPU: " + decoder_why;
+      if (frame->backend_fallback.find(note) == std::string::npos)
+        frame->backend_fallback += (frame->backend_fallback.empty() ? "" : "; ") + note;
     }
     // Lights or geometry that changed (a moving object's shadow) change
     // pixels that did not move: the antialiasing clamps their history.
@@ -327,7 +316,7 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
     packed->lights_version = lights->version;
     packed->geometry_version = lights->geometry_version;
     render_realtime(*rays, model, rs.has_transfer, fields, *rt, *assets, lights->set, *settings, rs.seed, *packed, *frame,
-                    backend->kernels()->tracer(), batch_decoder, light_changed);
+                    backend->active->tracer(), batch_decoder, light_changed);
     frame->times.collect_points = frame->probe_stats.scatter_ms;
     frame->times.probe_raster = frame->probe_stats.raster_ms;
     frame->times.probe_projection = frame->probe_stats.project_ms;
@@ -401,8 +390,8 @@ void TransGIPlugin::build(app::App& app) {
   ecs::World& w = app.world();
   if (!w.has_resource<TransGISettings>()) w.insert_resource<TransGISettings>(settings_);
   if (!w.has_resource<GiFrame>()) w.insert_resource<GiFrame>();
-  if (!w.has_resource<ProbeBackend>()) w.insert_resource<ProbeBackend>();
-  if (host_gpu_) w.resource<ProbeBackend>().host = host_gpu_;
+  if (!w.has_resource<GiBackendChoice>()) w.insert_resource<GiBackendChoice>();
+  if (host_gpu_) w.resource<GiBackendChoice>().host = host_gpu_;
   app.add_system(Phase::PostUpdate, "transgi::request_light_settings", request_light_settings);
   app.add_system(Phase::PrepareRender, "transgi::sync_probe_volumes", sync_probe_volumes);
   app.add_system(Phase::PrepareRender, "transgi::sync_probe_cascades", sync_probe_cascades);
