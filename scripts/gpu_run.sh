@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The device check, in one call of the `device` tool (docs/gpu-h100.md):
+# The device check, in one call of the `device` tool (docs/gpu.md):
 # `scripts/gpu_pack.sh` here, then `bash scripts/gpu_run.sh` there with
 # carry [".gl", ".devpack"]. The GPU tests on the real GPU, then 1080p frames of the level
 # and Bitterli's Living Room, the Vulkan and CPU backends alternating; every
