@@ -213,7 +213,8 @@ void GameSession::set_backend(const std::string& backend) {
   auto& settings = w.resource<transgi::runtime::TransGISettings>();
   settings.backend = backend == "vulkan" ? transgi::runtime::Backend::Vulkan : transgi::runtime::Backend::Cpu;
   ddgi_backend_ = backend;
-  if (auto* d = w.try_resource<transgi::ddgi::DdgiBackend>()) *d = transgi::gpu::make_ddgi_backend(backend, settings.gpu_device);
+  if (auto* d = w.try_resource<transgi::ddgi::DdgiBackend>())
+    *d = transgi::gpu::make_ddgi_backend(backend, settings.gpu_device, options_.host_gpu);
 }
 
 std::vector<std::string> GameSession::reload_shaders() {

@@ -60,15 +60,18 @@ class VulkanDdgiKernels : public ddgi::DdgiKernels {
 };
 
 // The backend --backend NAME asks for: the CPU's for "cpu"; for "vulkan" the
-// device's, or the CPU's with the reason no device could run it.
-inline ddgi::DdgiBackend make_ddgi_backend(const std::string& backend, const std::string& device) {
+// device's (on `host`, a device the caller made, e.g. the game window's, or
+// else the device named: empty = ENGINE_GPU_DEVICE, then the ranked
+// default), or the CPU's with the reason no device could run it.
+inline ddgi::DdgiBackend make_ddgi_backend(const std::string& backend, const std::string& device,
+                                           std::shared_ptr<engine::gpu::VulkanContext> host = nullptr) {
   ddgi::DdgiBackend b;
   if (backend != "vulkan") return b;
   engine::gpu::GpuOptions options;
   options.device = device;
-  std::shared_ptr<engine::gpu::VulkanContext> ctx;
+  std::shared_ptr<engine::gpu::VulkanContext> ctx = std::move(host);
   try {
-    ctx = engine::gpu::VulkanContext::create(options, &b.fallback_why);
+    if (!ctx) ctx = engine::gpu::VulkanContext::create(options, &b.fallback_why);
   } catch (const std::exception& e) {
     b.fallback_why = e.what();
   }
