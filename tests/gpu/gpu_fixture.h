@@ -57,15 +57,18 @@ inline double mean_rgb(const engine::image::ImageRGB& img) {
   return mean / static_cast<double>(img.pixels.size());
 }
 
-// A run whose device could not hold the scene against the CPU backend's run
-// of the same frames: the first says it fell back whole, naming what did not
-// fit, and its GI is the CPU's bit for bit.
+// A run whose device was refused (reason: probes::to_string's words) against
+// the CPU backend's run of the same frames: the first says it fell back
+// whole, for that reason, its detail naming `detail`, and its GI is the
+// CPU's bit for bit.
 inline void expect_cpu_fallback_frame(const std::string& capped_backend, const engine::image::ImageRGB& capped_gi,
-                                      const std::string& cpu_backend, const engine::image::ImageRGB& cpu_gi) {
-  EXPECT_EQ(capped_backend.rfind("cpu; the CPU backend runs the frame (scene too large): ", 0), 0u) << capped_backend;
-  EXPECT_NE(capped_backend.find("largest storage buffer"), std::string::npos) << capped_backend;
+                                      const std::string& cpu_backend, const engine::image::ImageRGB& cpu_gi,
+                                      const std::string& reason = "scene too large",
+                                      const std::string& detail = "largest storage buffer") {
+  EXPECT_EQ(capped_backend.rfind("cpu; the CPU backend runs the frame (" + reason + "): ", 0), 0u) << capped_backend;
+  EXPECT_NE(capped_backend.find(detail), std::string::npos) << capped_backend;
   EXPECT_EQ(cpu_backend, "cpu");
-  ASSERT_GT(mean_rgb(cpu_gi), 1e-4) << "the level's GI should not be black";
+  ASSERT_GT(mean_rgb(cpu_gi), 1e-4) << "the GI should not be black";
   ASSERT_EQ(capped_gi.pixels.size(), cpu_gi.pixels.size());
   std::size_t differ = 0;
   for (std::size_t i = 0; i < cpu_gi.pixels.size(); ++i) differ += capped_gi.pixels[i] != cpu_gi.pixels[i] ? 1 : 0;

@@ -12,6 +12,7 @@
 
 #include "engine/image/metrics.h"
 #include "eval/method_runs.h"
+#include "gpu/vulkan_probe_kernels.h"
 #include "gpu_fixture.h"
 
 using namespace transgi;
@@ -36,7 +37,9 @@ struct HostDevice {
   }
 };
 
-std::unique_ptr<HostDevice> make_host_device(std::string* why) {
+// int64: whether the host enables shaderInt64 (false: a host that did not,
+// though the device has it).
+std::unique_ptr<HostDevice> make_host_device(std::string* why, bool int64 = true) {
   auto host = std::make_unique<HostDevice>();
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "host engine";
@@ -77,7 +80,7 @@ std::unique_ptr<HostDevice> make_host_device(std::string* why) {
   qci.queueCount = 1;
   qci.pQueuePriorities = &priority;
   VkPhysicalDeviceFeatures enable{};
-  enable.shaderInt64 = VK_TRUE;
+  enable.shaderInt64 = int64 ? VK_TRUE : VK_FALSE;
   VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
   dci.queueCreateInfoCount = 1;
   dci.pQueueCreateInfos = &qci;
@@ -90,11 +93,12 @@ std::unique_ptr<HostDevice> make_host_device(std::string* why) {
   return host;
 }
 
-eval::MethodRun cornell_on(std::shared_ptr<engine::gpu::VulkanContext> host_gpu) {
+eval::MethodRun cornell_on(std::shared_ptr<engine::gpu::VulkanContext> host_gpu,
+                           runtime::Backend backend = runtime::Backend::Vulkan) {
   eval::TransgiRunOptions t;
   t.frames = 8;
   t.progress = false;
-  t.settings.backend = runtime::Backend::Vulkan;
+  t.settings.backend = backend;
   t.settings.direct_spp = 0;
   t.settings.probes.map = probes::MapLayout{32, 16};
   t.settings.probes.fixed_pattern = true;  // the same rays on both runs
@@ -156,4 +160,30 @@ TEST(HostVulkanDevice, AnIncompleteOrComputelessDeviceIsRefusedWithAReason) {
   engine::gpu::HostVulkanDevice handles{host->instance, host->physical, host->device, host->queue, 1000, true, false, false};
   EXPECT_FALSE(engine::gpu::VulkanContext::adopt(handles, {}, &why));
   EXPECT_NE(why.find("queue family 1000 has no compute"), std::string::npos) << why;
+}
+
+// A host that did not enable shaderInt64, which the probe rays' shading needs:
+// the backend is refused when it is made, typed (missing capability), and
+// the CPU backend runs the whole frame, which is the CPU backend's own, bit
+// for bit: no stage of it ran on the device.
+TEST(HostVulkanDevice, ADeviceWithoutInt64GetsTheCpuBackendWholeAndSaysWhy) {
+  GPU_TEST_CONTEXT_OR_SKIP(own);
+  std::string why;
+  const std::unique_ptr<HostDevice> host = make_host_device(&why, false);
+  ASSERT_TRUE(host) << why;
+  engine::gpu::HostVulkanDevice handles;
+  handles.instance = host->instance;
+  handles.physical_device = host->physical;
+  handles.device = host->device;
+  handles.queue = host->queue;
+  handles.queue_family = host->family;
+  handles.enabled_shader_int64 = false;
+  std::shared_ptr<engine::gpu::VulkanContext> ctx = engine::gpu::VulkanContext::adopt(handles, {}, &why);
+  ASSERT_TRUE(ctx) << why;
+  probes::BackendFallback reason = probes::BackendFallback::None;
+  EXPECT_FALSE(gpu::make_probe_kernels(ctx, &reason, &why));
+  EXPECT_EQ(reason, probes::BackendFallback::MissingCapability) << probes::to_string(reason);
+  const eval::MethodRun refused = cornell_on(ctx), cpu = cornell_on(nullptr, runtime::Backend::Cpu);
+  EXPECT_EQ(ctx->traffic().submissions, 0u) << "nothing should have run on the refused device";
+  gpu_test::expect_cpu_fallback_frame(refused.backend, refused.gi, cpu.backend, cpu.gi, "missing capability", "shaderInt64");
 }
