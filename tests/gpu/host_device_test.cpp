@@ -93,6 +93,19 @@ std::unique_ptr<HostDevice> make_host_device(std::string* why, bool int64 = true
   return host;
 }
 
+// The handles a host passes to VulkanContext::adopt; int64: what it says
+// it enabled.
+engine::gpu::HostVulkanDevice handles_of(const HostDevice& host, bool int64) {
+  engine::gpu::HostVulkanDevice handles;
+  handles.instance = host.instance;
+  handles.physical_device = host.physical;
+  handles.device = host.device;
+  handles.queue = host.queue;
+  handles.queue_family = host.family;
+  handles.enabled_shader_int64 = int64;
+  return handles;
+}
+
 eval::MethodRun cornell_on(std::shared_ptr<engine::gpu::VulkanContext> host_gpu,
                            runtime::Backend backend = runtime::Backend::Vulkan) {
   eval::TransgiRunOptions t;
@@ -116,14 +129,7 @@ TEST(HostVulkanDevice, TheKernelsRunOnTheHostsDeviceAndLeaveItToTheHost) {
   std::string why;
   const std::unique_ptr<HostDevice> host = make_host_device(&why);
   ASSERT_TRUE(host) << why;
-  engine::gpu::HostVulkanDevice handles;
-  handles.instance = host->instance;
-  handles.physical_device = host->physical;
-  handles.device = host->device;
-  handles.queue = host->queue;
-  handles.queue_family = host->family;
-  handles.enabled_shader_int64 = true;
-  std::shared_ptr<engine::gpu::VulkanContext> ctx = engine::gpu::VulkanContext::adopt(handles, {}, &why);
+  std::shared_ptr<engine::gpu::VulkanContext> ctx = engine::gpu::VulkanContext::adopt(handles_of(*host, true), {}, &why);
   ASSERT_TRUE(ctx) << why;
   EXPECT_EQ(ctx->device(), host->device);
   EXPECT_FALSE(ctx->info().ray_query) << "the host did not enable ray queries";
@@ -171,14 +177,7 @@ TEST(HostVulkanDevice, ADeviceWithoutInt64GetsTheCpuBackendWholeAndSaysWhy) {
   std::string why;
   const std::unique_ptr<HostDevice> host = make_host_device(&why, false);
   ASSERT_TRUE(host) << why;
-  engine::gpu::HostVulkanDevice handles;
-  handles.instance = host->instance;
-  handles.physical_device = host->physical;
-  handles.device = host->device;
-  handles.queue = host->queue;
-  handles.queue_family = host->family;
-  handles.enabled_shader_int64 = false;
-  std::shared_ptr<engine::gpu::VulkanContext> ctx = engine::gpu::VulkanContext::adopt(handles, {}, &why);
+  std::shared_ptr<engine::gpu::VulkanContext> ctx = engine::gpu::VulkanContext::adopt(handles_of(*host, false), {}, &why);
   ASSERT_TRUE(ctx) << why;
   probes::BackendFallback reason = probes::BackendFallback::None;
   EXPECT_FALSE(gpu::make_probe_kernels(ctx, &reason, &why));
