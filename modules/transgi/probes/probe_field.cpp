@@ -18,7 +18,6 @@
 #include "probes/open_space.h"
 #include "probes/probe_rays.h"
 #include "probes/radiance_map.h"
-#include "shading/sh_light.h"
 
 namespace transgi::probes {
 
