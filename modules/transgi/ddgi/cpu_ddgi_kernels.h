@@ -8,6 +8,10 @@ namespace transgi::ddgi {
 
 class CpuDdgiKernels final : public DdgiKernels {
  public:
+  void shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                        std::span<const glm::vec3> origins, std::span<const int> probe_ids,
+                        std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
+                        const ProbeRayBounce& bounce, const ProbeRayConsumer& consume) override;
   engine::rt::RayBatchTracer* tracer() override { return nullptr; }
   void blend(std::vector<OctahedralMap<glm::vec3>>& irradiance, std::vector<OctahedralMap<glm::vec2>>& distance,
              const std::vector<std::vector<RayRecord>>& records, const DdgiSettings& settings, float hysteresis,

@@ -7,6 +7,7 @@
 // hands a stage back. A scene the device cannot hold throws
 // engine::gpu::GpuError, and the plugin then swaps in the CPU backend whole.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -16,7 +17,9 @@
 #include "ddgi/ddgi_blend.h"
 #include "engine/image/image.h"
 #include "engine/render/camera_rays.h"
+#include "engine/render/light_set.h"
 #include "engine/rt/ray_batch_tracer.h"
+#include "probes/probe_rays.h"
 
 namespace transgi::ddgi {
 
@@ -28,9 +31,26 @@ struct DdgiRenderSettings {
   float filter_width = 1.5f;
 };
 
+// The bounce light at a probe ray's hit: irradiance at p about n, seen from
+// the probe along to_probe (DDGI's volumes from the last update).
+using ProbeRayBounce = std::function<glm::vec3(const glm::vec3& p, const glm::vec3& n, const glm::vec3& to_probe)>;
+// Takes ray i of the j-th listed probe; a probe's rays come in order, on one
+// thread, so it may write that probe's data without locks.
+using ProbeRayConsumer = std::function<void(int j, int i, const probes::ProbeRayHit& hit)>;
+
 class DdgiKernels {
  public:
   virtual ~DdgiKernels() = default;
+  // The rays of probes origins[j] (index probe_ids[j]) along each of
+  // `directions`, traced and shaded as probes::trace_probe_ray does, ray i
+  // of probe q drawing from make_rng(seed, q * 4096 + i, sample), the
+  // bounce light from `bounce`, each handed to `consume` (the CPU streams
+  // them as they are shaded, a device hands them over after its batch). A
+  // device that cannot hold the scene throws engine::gpu::GpuError.
+  virtual void shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                                std::span<const glm::vec3> origins, std::span<const int> probe_ids,
+                                std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
+                                const ProbeRayBounce& bounce, const ProbeRayConsumer& consume) = 0;
   // The probe rays' (and the real-time G-buffer's) tracer; null = the
   // RtScene's own (Embree) queries.
   virtual engine::rt::RayBatchTracer* tracer() = 0;

@@ -121,10 +121,9 @@ DdgiVolume::UpdateRays DdgiVolume::trace(const engine::rt::RtScene& scene, const
   u.records.resize(static_cast<std::size_t>(probes));
   u.emitted.resize(emitted_.empty() ? 0 : static_cast<std::size_t>(probes));
   u.saw_light.assign(static_cast<std::size_t>(probes), 0);
-  const auto ray_rng = [&](int q, int i) {
-    return math::make_rng(settings_.seed, static_cast<std::uint64_t>(q) * 4096 + static_cast<std::uint64_t>(i), frame_ + 1);
-  };
-  const auto feedback = [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3& towards_probe) {
+  // The bounce light from the last update's maps: the next coarser
+  // cascade's outside this grid's box.
+  const ProbeRayBounce bounce = [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3& towards_probe) {
     if (outer && (glm::any(glm::lessThan(p, grid_.min)) || glm::any(glm::greaterThan(p, grid_.max))))
       return outer->irradiance(p, n, -towards_probe);
     return frame_ > 0 ? irradiance(p, n, -towards_probe) : glm::vec3(0.0f);
@@ -136,27 +135,32 @@ DdgiVolume::UpdateRays DdgiVolume::trace(const engine::rt::RtScene& scene, const
     u.records[static_cast<std::size_t>(q)].resize(static_cast<std::size_t>(M));
     if (!emitted_.empty()) u.emitted[static_cast<std::size_t>(q)].resize(static_cast<std::size_t>(M));
   }
-  probes::trace_probe_rays(
-      scene, lights, kernels_->tracer(), tracing, ray_directions,
-      [&](int q) { return placed_.position(q); }, ray_rng, feedback, [&](int q, int i, const probes::ProbeRayHit& h) {
-        if (h.saw_light) u.saw_light[static_cast<std::size_t>(q)] = 1;
-        const glm::vec3& dir = ray_directions[static_cast<std::size_t>(i)];
-        RayRecord& r = u.records[static_cast<std::size_t>(q)][static_cast<std::size_t>(i)];
-        r.direction = dir;
-        if (!h.hit) {
-          r.radiance = settings_.escaped == EscapedRays::Environment && sky ? sky->radiance(dir) : glm::vec3(0.0f);
-          r.distance = kMissDistance;
-        } else if (h.back_face) {
-          r.radiance = glm::vec3(0.0f);
-          r.distance = kBackfaceDistanceScale * h.distance;
-        } else {
-          r.radiance = h.radiance;
-          r.distance = h.distance;
-        }
-        if (!emitted_.empty())
-          u.emitted[static_cast<std::size_t>(q)][static_cast<std::size_t>(i)] = {dir, h.back_face ? glm::vec3(0.0f) : h.emitted,
-                                                                                r.distance};
-      });
+  std::vector<glm::vec3> origins;
+  origins.reserve(tracing.size());
+  for (const int q : tracing) origins.push_back(placed_.position(q));
+  // What each ray found, recorded by the probe that shot it.
+  const auto record = [&](int q, int i, const probes::ProbeRayHit& h) {
+    if (h.saw_light) u.saw_light[static_cast<std::size_t>(q)] = 1;
+    const glm::vec3& dir = ray_directions[static_cast<std::size_t>(i)];
+    RayRecord& r = u.records[static_cast<std::size_t>(q)][static_cast<std::size_t>(i)];
+    r.direction = dir;
+    if (!h.hit) {
+      r.radiance = settings_.escaped == EscapedRays::Environment && sky ? sky->radiance(dir) : glm::vec3(0.0f);
+      r.distance = kMissDistance;
+    } else if (h.back_face) {
+      r.radiance = glm::vec3(0.0f);
+      r.distance = kBackfaceDistanceScale * h.distance;
+    } else {
+      r.radiance = h.radiance;
+      r.distance = h.distance;
+    }
+    if (!emitted_.empty())
+      u.emitted[static_cast<std::size_t>(q)][static_cast<std::size_t>(i)] = {dir, h.back_face ? glm::vec3(0.0f) : h.emitted,
+                                                                            r.distance};
+  };
+  if (!tracing.empty())
+    kernels_->shade_probe_rays(scene, lights, origins, tracing, ray_directions, settings_.seed, frame_ + 1, bounce,
+                               [&](int j, int i, const probes::ProbeRayHit& h) { record(tracing[static_cast<std::size_t>(j)], i, h); });
   u.rays = tracing.size() * static_cast<std::size_t>(M);
   return u;
 }

@@ -12,13 +12,39 @@
 #include "engine/gpu/gpu_ray_tracer.h"
 #include "gpu/vulkan_ddgi_blend.h"
 #include "gpu/vulkan_ddgi_irradiance.h"
+#include "gpu/vulkan_probe_shading.h"
+#include "engine/gpu/gpu_error.h"
+#include "engine/jobs/parallel_for.h"
 
 namespace transgi::gpu {
 
 class VulkanDdgiKernels : public ddgi::DdgiKernels {
  public:
+  // Throws where a kernel cannot be made (make_ddgi_backend checks the
+  // device's capabilities first).
   explicit VulkanDdgiKernels(std::shared_ptr<engine::gpu::VulkanContext> ctx)
-      : ctx_(std::move(ctx)), tracer_(*ctx_), blend_(*ctx_), name_(engine::gpu::describe(ctx_->info())) {}
+      : ctx_(std::move(ctx)), tracer_(*ctx_), blend_(*ctx_), shading_(*ctx_), name_(engine::gpu::describe(ctx_->info())) {}
+
+  // Traced and shaded on the device (VulkanProbeShading); the bounce light
+  // from DDGI's volumes is added here, on the CPU, where the volumes are.
+  void shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                        std::span<const glm::vec3> origins, std::span<const int> probe_ids,
+                        std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
+                        const ddgi::ProbeRayBounce& bounce, const ddgi::ProbeRayConsumer& consume) override {
+    std::vector<probes::ProbeRayHit> out;
+    std::vector<BounceInput> inputs;
+    if (!shading_.shade(scene, lights, tracer_, origins, probe_ids, directions, seed, sample, nullptr, nullptr, out, &inputs))
+      throw engine::gpu::GpuError("the Vulkan backend traces only scenes built with their assets (RtScene::assets())");
+    const std::size_t m = directions.size();
+    engine::jobs::parallel_for(0, static_cast<int>(origins.size()), 1, [&](int b, int e) {
+      for (int j = b; j < e; ++j)
+        for (std::size_t i = 0; i < m; ++i) {
+          const std::size_t k = static_cast<std::size_t>(j) * m + i;
+          finish_bounce_light(out[k], inputs[k], directions[i], bounce);
+          consume(j, static_cast<int>(i), out[k]);
+        }
+    });
+  }
 
   engine::rt::RayBatchTracer* tracer() override { return &tracer_; }
   void blend(std::vector<ddgi::OctahedralMap<glm::vec3>>& irradiance, std::vector<ddgi::OctahedralMap<glm::vec2>>& distance,
@@ -55,6 +81,7 @@ class VulkanDdgiKernels : public ddgi::DdgiKernels {
   std::shared_ptr<engine::gpu::VulkanContext> ctx_;
   engine::gpu::GpuRayTracer tracer_;
   VulkanDdgiBlend blend_;
+  VulkanProbeShading shading_;
   VulkanDdgiIrradiance irradiance_{*ctx_};
   std::string name_;
 };
@@ -77,6 +104,11 @@ inline ddgi::DdgiBackend make_ddgi_backend(const std::string& backend, const std
   }
   if (!ctx) {
     b.fallback = probes::BackendFallback::NoDevice;
+    return b;
+  }
+  if (std::string missing; !VulkanProbeShading::supported(*ctx, &missing)) {
+    b.fallback = probes::BackendFallback::MissingCapability;
+    b.fallback_why = missing;
     return b;
   }
   try {

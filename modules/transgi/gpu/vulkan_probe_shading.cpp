@@ -66,7 +66,8 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
                                engine::gpu::GpuRayTracer& tracer, std::span<const glm::vec3> origins,
                                std::span<const int> probe_ids, std::span<const glm::vec3> directions, std::uint64_t seed,
                                std::uint64_t sample, const probes::ProbeFeedbackSource* self,
-                               const probes::ProbeFeedbackSource* outer, std::vector<probes::ProbeRayHit>& out) {
+                               const probes::ProbeFeedbackSource* outer, std::vector<probes::ProbeRayHit>& out,
+                               std::vector<BounceInput>* bounce_inputs) {
   using engine::gpu::HitGpu;
   using engine::gpu::RayGpu;
   if (probe_ids.size() != origins.size())
@@ -193,6 +194,16 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
       r.emitted = vec_of(g.er, g.eg, g.eb);
     }
   });
+  if (bounce_inputs) {
+    bounce_inputs->resize(n);
+    const auto pending = pending_.mapped_as<const PendingProbeRayGpu>(n);
+    engine::jobs::parallel_for<std::size_t>(0, n, kRaysPerTask, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        const PendingProbeRayGpu& p = pending[i];
+        (*bounce_inputs)[i] = {vec_of(p.ar, p.ag, p.ab), vec_of(p.sx, p.sy, p.sz), (p.flags & kProbeRayTakesFeedback) != 0};
+      }
+    });
+  }
   return true;
 }
 

@@ -7,6 +7,7 @@
 // probe fields). Only the probes' origins go in and the shaded hits come
 // out. The CPU functions are the oracle (tests/gpu/probe_shading_test.cpp);
 // the light sample draws the same random numbers.
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -25,6 +26,29 @@
 
 namespace transgi::gpu {
 
+// What a probe ray's hit needs for a bounce light the caller computes (DDGI's
+// volumes): the hit's diffuse albedo / pi and shading normal, and whether it
+// takes bounce light at all (not an emitter, the sky, or a back face).
+struct BounceInput {
+  glm::vec3 reflectance_over_pi{0.0f};
+  glm::vec3 shading_normal{0.0f};
+  bool takes_bounce = false;
+};
+
+// hit.radiance += reflectance_over_pi x bounce(hit.position, shading_normal,
+// -direction), as probes::finish_probe_ray adds its feedback, non-finite
+// sums replaced by 0 and counted; a ray the device already found
+// non-finite stays 0.
+template <class Bounce>
+void finish_bounce_light(probes::ProbeRayHit& hit, const BounceInput& in, const glm::vec3& direction, Bounce&& bounce) {
+  if (!in.takes_bounce || hit.replaced_non_finite) return;
+  hit.radiance += in.reflectance_over_pi * bounce(hit.position, in.shading_normal, -direction);
+  if (!std::isfinite(hit.radiance.r + hit.radiance.g + hit.radiance.b)) {
+    hit.radiance = glm::vec3(0.0f);
+    hit.replaced_non_finite = true;
+  }
+}
+
 class VulkanProbeShading {
  public:
   // Throws GpuError where a kernel cannot be made.
@@ -41,10 +65,13 @@ class VulkanProbeShading {
   // beyond it (either null: none). out: origins.size() x directions.size(),
   // probe-major. Returns false, out untouched, where the tracer declines the
   // scene.
+  // With `bounce_inputs` (and no fields), the bounce light is the caller's:
+  // each ray gets what it needs to add it (finish_bounce_light).
   bool shade(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, engine::gpu::GpuRayTracer& tracer,
              std::span<const glm::vec3> origins, std::span<const int> probe_ids, std::span<const glm::vec3> directions,
              std::uint64_t seed, std::uint64_t sample, const probes::ProbeFeedbackSource* self,
-             const probes::ProbeFeedbackSource* outer, std::vector<probes::ProbeRayHit>& out);
+             const probes::ProbeFeedbackSource* outer, std::vector<probes::ProbeRayHit>& out,
+             std::vector<BounceInput>* bounce_inputs = nullptr);
 
   [[nodiscard]] double take_gpu_ms() {
     const double ms = gpu_ms_;
