@@ -1,10 +1,8 @@
 #include "ddgi/cpu_ddgi_kernels.h"
 
-#include <numeric>
 
 #include "ddgi/ddgi_renderer.h"
 #include "engine/jobs/parallel_for.h"
-#include "engine/math/rng.h"
 
 namespace transgi::ddgi {
 
@@ -12,16 +10,7 @@ void CpuDdgiKernels::shade_probe_rays(const engine::rt::RtScene& scene, const en
                                       std::span<const glm::vec3> origins, std::span<const int> probe_ids,
                                       std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
                                       const ProbeRayBounce& bounce, const ProbeRayConsumer& consume) {
-  // The rays are traced by the list's position j; probe_ids[j] seeds them.
-  std::vector<int> slots(origins.size());
-  std::iota(slots.begin(), slots.end(), 0);
-  probes::trace_probe_rays(
-      scene, lights, nullptr, slots, directions, [&](int j) { return origins[static_cast<std::size_t>(j)]; },
-      [&](int j, int i) {
-        return engine::math::make_rng(
-            seed, static_cast<std::uint64_t>(probe_ids[static_cast<std::size_t>(j)]) * 4096 + static_cast<std::uint64_t>(i), sample);
-      },
-      bounce, consume);
+  probes::trace_listed_probe_rays(scene, lights, origins, probe_ids, directions, seed, sample, bounce, consume);
 }
 
 void CpuDdgiKernels::blend(std::vector<OctahedralMap<glm::vec3>>& irradiance, std::vector<OctahedralMap<glm::vec2>>& distance,

@@ -1,7 +1,6 @@
 #include "probes/cpu_probe_kernels.h"
 
 #include <chrono>
-#include <numeric>
 
 #include "engine/jobs/parallel_for.h"
 #include "engine/math/rng.h"
@@ -47,15 +46,8 @@ void CpuProbeKernels::shade_probe_rays(const engine::rt::RtScene& scene, const e
                                        std::vector<ProbeRayHit>& out) {
   const std::size_t m = directions.size();
   out.resize(origins.size() * m);
-  // The rays are traced by the list's position j; probe_ids[j] seeds them.
-  std::vector<int> slots(origins.size());
-  std::iota(slots.begin(), slots.end(), 0);
-  trace_probe_rays(
-      scene, lights, nullptr, slots, directions, [&](int j) { return origins[static_cast<std::size_t>(j)]; },
-      [&](int j, int i) {
-        return engine::math::make_rng(
-            seed, static_cast<std::uint64_t>(probe_ids[static_cast<std::size_t>(j)]) * 4096 + static_cast<std::uint64_t>(i), sample);
-      },
+  trace_listed_probe_rays(
+      scene, lights, origins, probe_ids, directions, seed, sample,
       [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3&) { return bounce_irradiance(self, outer, p, n); },
       [&](int j, int i, const ProbeRayHit& h) { out[static_cast<std::size_t>(j) * m + static_cast<std::size_t>(i)] = h; });
 }

@@ -198,4 +198,25 @@ void trace_probe_rays(const engine::rt::RtScene& scene, const engine::render::Li
   });
 }
 
+// The backends' form of trace_probe_rays, on Embree: the rays of probes
+// origins[j] (index probe_ids[j]) along each of `directions`, ray i of probe q
+// drawing from make_rng(seed, q * 4096 + i, sample), handed to
+// consume(j, i, hit) by the list's position j (one probe's rays in order,
+// on one thread).
+template <class Feedback, class Consume>
+void trace_listed_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                             std::span<const glm::vec3> origins, std::span<const int> probe_ids,
+                             std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
+                             Feedback&& feedback, Consume&& consume) {
+  std::vector<int> slots(origins.size());
+  for (std::size_t j = 0; j < slots.size(); ++j) slots[j] = static_cast<int>(j);
+  trace_probe_rays(
+      scene, lights, nullptr, slots, directions, [&](int j) { return origins[static_cast<std::size_t>(j)]; },
+      [&](int j, int i) {
+        return engine::math::make_rng(
+            seed, static_cast<std::uint64_t>(probe_ids[static_cast<std::size_t>(j)]) * 4096 + static_cast<std::uint64_t>(i), sample);
+      },
+      std::forward<Feedback>(feedback), std::forward<Consume>(consume));
+}
+
 }  // namespace transgi::probes
