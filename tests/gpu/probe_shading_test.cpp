@@ -263,7 +263,8 @@ TEST(VulkanProbeShading, ASceneTooBigForTheDeviceRunsTheWholeFrameOnTheCpuBacken
     self.lit = false;
     std::vector<probes::ProbeRayHit> out;
     try {
-      kernels.shade_probe_rays(scene, lights, origins, probe_ids, directions, 1, 1, self, nullptr, out);
+      kernels.shade_probe_rays(scene, lights, origins, probe_ids, directions, 1, 1, self, nullptr,
+                               [&](int, int, const probes::ProbeRayHit& h) { out.push_back(h); });
       ADD_FAILURE() << "expected the kernels to throw engine::gpu::GpuError";
     } catch (const engine::gpu::GpuError& e) {
       EXPECT_NE(std::string(e.what()).find("largest storage buffer"), std::string::npos) << e.what();

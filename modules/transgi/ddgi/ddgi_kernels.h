@@ -19,6 +19,7 @@
 #include "engine/render/camera_rays.h"
 #include "engine/render/light_set.h"
 #include "engine/rt/ray_batch_tracer.h"
+#include "probes/probe_kernels.h"
 #include "probes/probe_rays.h"
 
 namespace transgi::ddgi {
@@ -34,9 +35,7 @@ struct DdgiRenderSettings {
 // The bounce light at a probe ray's hit: irradiance at p about n, seen from
 // the probe along to_probe (DDGI's volumes from the last update).
 using ProbeRayBounce = std::function<glm::vec3(const glm::vec3& p, const glm::vec3& n, const glm::vec3& to_probe)>;
-// Takes ray i of the j-th listed probe; a probe's rays come in order, on one
-// thread, so it may write that probe's data without locks.
-using ProbeRayConsumer = std::function<void(int j, int i, const probes::ProbeRayHit& hit)>;
+using probes::ProbeRayConsumer;
 
 class DdgiKernels {
  public:

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "engine/gpu/gpu_error.h"
+#include "engine/jobs/parallel_for.h"
 
 namespace transgi::gpu {
 
@@ -67,11 +68,17 @@ void VulkanProbeKernels::shade_probe_rays(const engine::rt::RtScene& scene, cons
                                           std::span<const glm::vec3> origins, std::span<const int> probe_ids,
                                           std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
                                           const probes::ProbeFeedbackSource& self, const probes::ProbeFeedbackSource* outer,
-                                          std::vector<probes::ProbeRayHit>& out) {
+                                          const probes::ProbeRayConsumer& consume) {
+  std::vector<probes::ProbeRayHit> out;
   // The kernel reads no field it is not given: a field with no light yet is left out.
   if (!shading_->shade(scene, lights, tracer_, origins, probe_ids, directions, seed, sample, self.lit ? &self : nullptr,
                        outer, out))
     throw engine::gpu::GpuError("the Vulkan backend traces only scenes built with their assets (RtScene::assets())");
+  const std::size_t m = directions.size();
+  engine::jobs::parallel_for(0, static_cast<int>(origins.size()), 1, [&](int b, int e) {
+    for (int j = b; j < e; ++j)
+      for (std::size_t i = 0; i < m; ++i) consume(j, static_cast<int>(i), out[static_cast<std::size_t>(j) * m + i]);
+  });
 }
 
 shading::TransferBatchDecoder* VulkanProbeKernels::transfer_decoder(const std::shared_ptr<const model::TransferModel>& model) {

@@ -34,7 +34,7 @@ class VulkanProbeKernels : public probes::ProbeKernels {
                         std::span<const glm::vec3> origins, std::span<const int> probe_ids,
                         std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
                         const probes::ProbeFeedbackSource& self, const probes::ProbeFeedbackSource* outer,
-                        std::vector<probes::ProbeRayHit>& out) override;
+                        const probes::ProbeRayConsumer& consume) override;
   // The raster, the accumulation and the projection in one submission:
   // the samples and the filled maps stay on the device.
   probes::SharingStats share_accumulate_project(const probes::ProbeGrid& grid, const probes::MapProjector& projector,

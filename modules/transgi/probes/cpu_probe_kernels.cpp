@@ -43,13 +43,10 @@ void CpuProbeKernels::shade_probe_rays(const engine::rt::RtScene& scene, const e
                                        std::span<const glm::vec3> origins, std::span<const int> probe_ids,
                                        std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
                                        const ProbeFeedbackSource& self, const ProbeFeedbackSource* outer,
-                                       std::vector<ProbeRayHit>& out) {
-  const std::size_t m = directions.size();
-  out.resize(origins.size() * m);
+                                       const ProbeRayConsumer& consume) {
   trace_listed_probe_rays(
       scene, lights, origins, probe_ids, directions, seed, sample,
-      [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3&) { return bounce_irradiance(self, outer, p, n); },
-      [&](int j, int i, const ProbeRayHit& h) { out[static_cast<std::size_t>(j) * m + static_cast<std::size_t>(i)] = h; });
+      [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3&) { return bounce_irradiance(self, outer, p, n); }, consume);
 }
 
 SharingStats CpuProbeKernels::share_accumulate_project(const ProbeGrid& grid, const MapProjector& projector,

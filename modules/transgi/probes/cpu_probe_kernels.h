@@ -14,7 +14,7 @@ class CpuProbeKernels final : public ProbeKernels {
                         std::span<const glm::vec3> origins, std::span<const int> probe_ids,
                         std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
                         const ProbeFeedbackSource& self, const ProbeFeedbackSource* outer,
-                        std::vector<ProbeRayHit>& out) override;
+                        const ProbeRayConsumer& consume) override;
   SharingStats share_accumulate_project(const ProbeGrid& grid, const MapProjector& projector,
                                         const std::vector<std::vector<ShadedPoint>>& points,
                                         const std::vector<const DepthMap*>& own_depth, const SharingSettings& sharing,

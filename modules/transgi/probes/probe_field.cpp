@@ -291,16 +291,10 @@ void ProbeField::trace_and_shade(const engine::rt::RtScene& scene, const engine:
   // field's inside its box, the next coarser cascade's beyond it.
   const ProbeFeedbackSource self_source = feedback_source();
   const ProbeFeedbackSource outer_source = outer ? outer->feedback_source() : ProbeFeedbackSource{};
-  std::vector<ProbeRayHit> shaded;
-  kernels_->shade_probe_rays(scene, lights, origins, w.tracing, w.directions, w.seed, frame_ + 1, self_source,
-                             outer ? &outer_source : nullptr, shaded);
   // One probe's rays on one thread, in order: consume writes its data unlocked.
-  jobs::parallel_for(0, static_cast<int>(w.tracing.size()), 1, [&](int b, int e) {
-    for (int j = b; j < e; ++j)
-      for (int i = 0; i < M; ++i)
-        consume(w.tracing[static_cast<std::size_t>(j)], i,
-                shaded[static_cast<std::size_t>(j) * static_cast<std::size_t>(M) + static_cast<std::size_t>(i)]);
-  });
+  kernels_->shade_probe_rays(scene, lights, origins, w.tracing, w.directions, w.seed, frame_ + 1, self_source,
+                             outer ? &outer_source : nullptr,
+                             [&](int j, int i, const ProbeRayHit& h) { consume(w.tracing[static_cast<std::size_t>(j)], i, h); });
 }
 
 void ProbeField::classify_traced(const engine::rt::RtScene& scene, UpdateWork& w) {

@@ -9,6 +9,7 @@
 // cannot hold throws engine::gpu::GpuError: the owner then swaps the whole
 // backend for the CPU's.
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -64,19 +65,24 @@ struct ShareAccumulateTimes {
   double share_ms = 0.0, accumulate_ms = 0.0;
 };
 
+// Takes ray i of the j-th listed probe. A probe's rays come in order, on one
+// thread, so it may write that probe's data without locks.
+using ProbeRayConsumer = std::function<void(int j, int i, const ProbeRayHit& hit)>;
+
 class ProbeKernels {
  public:
   virtual ~ProbeKernels() = default;
   // Traces and shades the rays of probes origins[j] (index probe_ids[j])
   // along each of `directions` as trace_probe_ray does, ray i of probe q
   // drawing from make_rng(seed, q * 4096 + i, sample), the bounce light as
-  // bounce_irradiance(self, outer, ...). out: origins.size() x
-  // directions.size(), probe-major.
+  // bounce_irradiance(self, outer, ...), each handed to `consume` (the CPU
+  // streams them as they are shaded, a device hands them over after its
+  // batch).
   virtual void shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
                                 std::span<const glm::vec3> origins, std::span<const int> probe_ids,
                                 std::span<const glm::vec3> directions, std::uint64_t seed, std::uint64_t sample,
                                 const ProbeFeedbackSource& self, const ProbeFeedbackSource* outer,
-                                std::vector<ProbeRayHit>& out) = 0;
+                                const ProbeRayConsumer& consume) = 0;
   // This frame's light into the probes of `batch`, in one stage so that a
   // device keeps its intermediate maps: each batch probe's samples from its
   // own and its neighbours' points (rasterize_shared with the batch as its
