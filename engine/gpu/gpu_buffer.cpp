@@ -1,5 +1,7 @@
 #include "engine/gpu/gpu_buffer.h"
 
+#include <cstdio>
+
 #include <string>
 #include <utility>
 
@@ -136,6 +138,18 @@ void GpuBuffer::read_bytes(void* dst, std::size_t n) const {
     vkCmdCopyBuffer(cmd, buffer_, staging.buffer_, 1, &region);  // submit_and_wait makes it visible to the host
   });
   std::memcpy(dst, staging.mapped_, n);
+}
+
+void require_storage_range(const VulkanContext& ctx, std::size_t bytes, const char* owner, const char* what) {
+  const std::uint64_t limit = ctx.info().max_storage_buffer_range;
+  if (limit == 0 || bytes <= limit) return;
+  const auto mebibytes = [](std::uint64_t b) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.2f MiB", static_cast<double>(b) / (1024.0 * 1024.0));
+    return std::string(text);
+  };
+  throw GpuError(std::string(owner) + ": the scene's " + what + " take " + mebibytes(bytes) +
+                 ", more than the device's largest storage buffer (" + mebibytes(limit) + ")");
 }
 
 }  // namespace engine::gpu

@@ -75,4 +75,10 @@ class GpuBuffer {
   bool addressable_ = false;
 };
 
+// Throws GpuError, "<owner>: the scene's <what> take X MiB, more than the
+// device's largest storage buffer (Y MiB)", where `bytes` is more than a
+// kernel can bind on ctx's device (its owner then runs the work on the CPU:
+// a device would read past the binding's end).
+void require_storage_range(const VulkanContext& ctx, std::size_t bytes, const char* owner, const char* what);
+
 }  // namespace engine::gpu

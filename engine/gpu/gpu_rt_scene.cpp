@@ -1,7 +1,6 @@
 #include "engine/gpu/gpu_rt_scene.h"
 
 #include <cstddef>
-#include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <string_view>
@@ -29,20 +28,12 @@ std::filesystem::path engine_shader_dir() {
   return ENGINE_SOURCE_SHADER_DIR;
 }
 
-// `what` names the data in the error where it is larger than a kernel can
-// bind: the owner then runs its work on the CPU (a device would read past
-// the binding's end).
+// `what` names the data in the error where it is larger than a kernel can bind.
 template <class T>
 void upload_to(VulkanContext& ctx, GpuBuffer& b, const std::vector<T>& v, const char* what,
                GpuBuffer::Placement placement = GpuBuffer::Placement::Mapped, VkBufferUsageFlags usage = 0) {
   const std::size_t bytes = v.size() * sizeof(T);
-  const std::uint64_t limit = ctx.info().max_storage_buffer_range;
-  if (limit > 0 && bytes > limit) {
-    char text[160];
-    std::snprintf(text, sizeof(text), "GpuRtScene: the scene's %s take %.2f MiB, more than the device's largest storage buffer (%.2f MiB)",
-                  what, static_cast<double>(bytes) / (1024.0 * 1024.0), static_cast<double>(limit) / (1024.0 * 1024.0));
-    throw GpuError(text);
-  }
+  require_storage_range(ctx, bytes, "GpuRtScene", what);
   if (b.handle() == VK_NULL_HANDLE || b.size() < bytes) b = GpuBuffer(ctx, bytes, placement, usage);
   b.upload(std::span<const T>(v));
 }

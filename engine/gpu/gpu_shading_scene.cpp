@@ -16,21 +16,12 @@
 namespace engine::gpu {
 namespace {
 
-std::string mebibytes(std::uint64_t bytes) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.2f MiB", static_cast<double>(bytes) / (1024.0 * 1024.0));
-  return text;
-}
-
 // `what` names the data in the error where it is larger than a kernel can bind.
 template <class T>
 void upload_to(VulkanContext& ctx, GpuBuffer& b, std::vector<T> v, GpuBuffer::Placement placement, const char* what) {
   if (v.empty()) v.push_back(T{});  // a binding needs a buffer
   const std::size_t bytes = v.size() * sizeof(T);
-  const std::uint64_t limit = ctx.info().max_storage_buffer_range;
-  if (limit > 0 && bytes > limit)
-    throw GpuError("GpuShadingScene: the scene's " + std::string(what) + " take " + mebibytes(bytes) +
-                   ", more than the device's largest storage buffer (" + mebibytes(limit) + ")");
+  require_storage_range(ctx, bytes, "GpuShadingScene", what);
   if (b.handle() == VK_NULL_HANDLE || b.size() < bytes) b = GpuBuffer(ctx, bytes, placement);
   b.upload(std::span<const T>(v));
 }

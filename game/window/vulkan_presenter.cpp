@@ -17,6 +17,7 @@
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_vulkan.h>
 
+#include "engine/gpu/compute_pipeline.h"
 #include "engine/gpu/gpu_buffer.h"
 #include "engine/gpu/gpu_error.h"
 #include "engine/image/png.h"
@@ -25,10 +26,6 @@
 namespace game {
 
 namespace {
-
-void check(VkResult r, const char* call) {
-  if (r != VK_SUCCESS) throw std::runtime_error(std::string("Vulkan presenter: ") + call + " failed: " + engine::gpu::vk_result_name(r));
-}
 
 void check_imgui(VkResult r) {
   if (r != VK_SUCCESS) std::fprintf(stderr, "transgi-game: ImGui's Vulkan backend: %s\n", engine::gpu::vk_result_name(r).c_str());
@@ -107,16 +104,16 @@ class VulkanPresenter final : public Presenter {
       remake_swapchain();
       return;
     }
-    if (acquired != VK_SUBOPTIMAL_KHR) check(acquired, "vkAcquireNextImageKHR");
-    check(vkResetCommandBuffer(cmd_, 0), "vkResetCommandBuffer");
+    if (acquired != VK_SUBOPTIMAL_KHR) ENGINE_VK_CHECK(acquired);
+    ENGINE_VK_CHECK(vkResetCommandBuffer(cmd_, 0));
     VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    check(vkBeginCommandBuffer(cmd_, &begin), "vkBeginCommandBuffer");
+    ENGINE_VK_CHECK(vkBeginCommandBuffer(cmd_, &begin));
     record_view(images_[index], view, fw, fh);
     record_ui(index);
     const bool shoot = !screenshot.empty() && can_read_back_;
     if (shoot) record_read_back(images_[index]);
-    check(vkEndCommandBuffer(cmd_), "vkEndCommandBuffer");
+    ENGINE_VK_CHECK(vkEndCommandBuffer(cmd_));
     const VkPipelineStageFlags wait_stage = VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
     VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     submit.waitSemaphoreCount = 1;
@@ -126,11 +123,11 @@ class VulkanPresenter final : public Presenter {
     submit.pCommandBuffers = &cmd_;
     submit.signalSemaphoreCount = 1;
     submit.pSignalSemaphores = &rendered_;
-    check(vkResetFences(ctx_->device(), 1, &fence_), "vkResetFences");
-    check(vkQueueSubmit(ctx_->queue(), 1, &submit, fence_), "vkQueueSubmit");
+    ENGINE_VK_CHECK(vkResetFences(ctx_->device(), 1, &fence_));
+    ENGINE_VK_CHECK(vkQueueSubmit(ctx_->queue(), 1, &submit, fence_));
     // One frame in flight: the kernels' next submission and this frame's
     // staging buffer wait for this one.
-    check(vkWaitForFences(ctx_->device(), 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+    ENGINE_VK_CHECK(vkWaitForFences(ctx_->device(), 1, &fence_, VK_TRUE, UINT64_MAX));
     if (shoot) write_screenshot(screenshot);
     else if (!screenshot.empty())
       std::fprintf(stderr, "transgi-game: --screenshot: this swapchain's images cannot be read back (no transfer-source use)\n");
@@ -142,7 +139,7 @@ class VulkanPresenter final : public Presenter {
     info.pImageIndices = &index;
     const VkResult presented = vkQueuePresentKHR(ctx_->queue(), &info);
     if (presented == VK_ERROR_OUT_OF_DATE_KHR || presented == VK_SUBOPTIMAL_KHR) remake_swapchain();
-    else check(presented, "vkQueuePresentKHR");
+    else ENGINE_VK_CHECK(presented);
   }
 
  private:
@@ -166,7 +163,7 @@ class VulkanPresenter final : public Presenter {
     std::string why;
     ctx_ = engine::gpu::VulkanContext::create(options, &why);
     if (!ctx_) throw std::runtime_error("--backend vulkan: no device can both run the GI kernels and present to the window: " + why);
-    check(glfwCreateWindowSurface(ctx_->instance(), window_, nullptr, &surface_), "glfwCreateWindowSurface");
+    ENGINE_VK_CHECK(glfwCreateWindowSurface(ctx_->instance(), window_, nullptr, &surface_));
     VkBool32 supported = VK_FALSE;
     vkGetPhysicalDeviceSurfaceSupportKHR(ctx_->physical_device(), ctx_->queue_family(), surface_, &supported);
     if (!supported) throw std::runtime_error("--backend vulkan: the chosen queue cannot present to this window");
@@ -177,17 +174,17 @@ class VulkanPresenter final : public Presenter {
     VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
     pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
     pci.queueFamilyIndex = ctx_->queue_family();
-    check(vkCreateCommandPool(d, &pci, nullptr, &pool_), "vkCreateCommandPool");
+    ENGINE_VK_CHECK(vkCreateCommandPool(d, &pci, nullptr, &pool_));
     VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
     ai.commandPool = pool_;
     ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     ai.commandBufferCount = 1;
-    check(vkAllocateCommandBuffers(d, &ai, &cmd_), "vkAllocateCommandBuffers");
+    ENGINE_VK_CHECK(vkAllocateCommandBuffers(d, &ai, &cmd_));
     VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    check(vkCreateFence(d, &fci, nullptr, &fence_), "vkCreateFence");
+    ENGINE_VK_CHECK(vkCreateFence(d, &fci, nullptr, &fence_));
     VkSemaphoreCreateInfo sci{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-    check(vkCreateSemaphore(d, &sci, nullptr, &acquired_), "vkCreateSemaphore");
-    check(vkCreateSemaphore(d, &sci, nullptr, &rendered_), "vkCreateSemaphore");
+    ENGINE_VK_CHECK(vkCreateSemaphore(d, &sci, nullptr, &acquired_));
+    ENGINE_VK_CHECK(vkCreateSemaphore(d, &sci, nullptr, &rendered_));
   }
 
   // The surface's format: 8-bit UNORM (the image is sRGB-encoded already,
@@ -210,7 +207,7 @@ class VulkanPresenter final : public Presenter {
   void make_swapchain() {
     const VkDevice d = ctx_->device();
     VkSurfaceCapabilitiesKHR caps;
-    check(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(ctx_->physical_device(), surface_, &caps), "vkGetPhysicalDeviceSurfaceCapabilitiesKHR");
+    ENGINE_VK_CHECK(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(ctx_->physical_device(), surface_, &caps));
     if (!(caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_DST_BIT))
       throw std::runtime_error("--backend vulkan: the window's images cannot be written by transfers");
     const VkSurfaceFormatKHR format = choose_format();
@@ -247,10 +244,10 @@ class VulkanPresenter final : public Presenter {
     sci.compositeAlpha = VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR;
     sci.presentMode = mode;
     sci.clipped = VK_TRUE;
-    check(vkCreateSwapchainKHR(d, &sci, nullptr, &swapchain_), "vkCreateSwapchainKHR");
-    check(vkGetSwapchainImagesKHR(d, swapchain_, &n, nullptr), "vkGetSwapchainImagesKHR");
+    ENGINE_VK_CHECK(vkCreateSwapchainKHR(d, &sci, nullptr, &swapchain_));
+    ENGINE_VK_CHECK(vkGetSwapchainImagesKHR(d, swapchain_, &n, nullptr));
     images_.resize(n);
-    check(vkGetSwapchainImagesKHR(d, swapchain_, &n, images_.data()), "vkGetSwapchainImagesKHR");
+    ENGINE_VK_CHECK(vkGetSwapchainImagesKHR(d, swapchain_, &n, images_.data()));
     if (!render_pass_) make_render_pass();
     for (VkImage image : images_) {
       VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
@@ -259,7 +256,7 @@ class VulkanPresenter final : public Presenter {
       vci.format = format_;
       vci.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
       VkImageView view = VK_NULL_HANDLE;
-      check(vkCreateImageView(d, &vci, nullptr, &view), "vkCreateImageView");
+      ENGINE_VK_CHECK(vkCreateImageView(d, &vci, nullptr, &view));
       views_.push_back(view);
       VkFramebufferCreateInfo fci{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
       fci.renderPass = render_pass_;
@@ -269,7 +266,7 @@ class VulkanPresenter final : public Presenter {
       fci.height = extent_.height;
       fci.layers = 1;
       VkFramebuffer fb = VK_NULL_HANDLE;
-      check(vkCreateFramebuffer(d, &fci, nullptr, &fb), "vkCreateFramebuffer");
+      ENGINE_VK_CHECK(vkCreateFramebuffer(d, &fci, nullptr, &fb));
       framebuffers_.push_back(fb);
     }
   }
@@ -295,7 +292,7 @@ class VulkanPresenter final : public Presenter {
     rci.pAttachments = &color;
     rci.subpassCount = 1;
     rci.pSubpasses = &subpass;
-    check(vkCreateRenderPass(ctx_->device(), &rci, nullptr, &render_pass_), "vkCreateRenderPass");
+    ENGINE_VK_CHECK(vkCreateRenderPass(ctx_->device(), &rci, nullptr, &render_pass_));
   }
 
   void destroy_swapchain() {
@@ -323,7 +320,7 @@ class VulkanPresenter final : public Presenter {
     dpi.maxSets = 16;
     dpi.poolSizeCount = static_cast<std::uint32_t>(sizes.size());
     dpi.pPoolSizes = sizes.data();
-    check(vkCreateDescriptorPool(ctx_->device(), &dpi, nullptr, &imgui_pool_), "vkCreateDescriptorPool");
+    ENGINE_VK_CHECK(vkCreateDescriptorPool(ctx_->device(), &dpi, nullptr, &imgui_pool_));
     ImGui_ImplVulkan_InitInfo info{};
     info.Instance = ctx_->instance();
     info.PhysicalDevice = ctx_->physical_device();
@@ -339,17 +336,17 @@ class VulkanPresenter final : public Presenter {
     if (!ImGui_ImplVulkan_Init(&info, render_pass_)) throw std::runtime_error("--backend vulkan: ImGui's Vulkan backend did not start");
     imgui_vulkan_ = true;
     // The font atlas, uploaded once.
-    check(vkResetCommandBuffer(cmd_, 0), "vkResetCommandBuffer");
+    ENGINE_VK_CHECK(vkResetCommandBuffer(cmd_, 0));
     VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    check(vkBeginCommandBuffer(cmd_, &begin), "vkBeginCommandBuffer");
+    ENGINE_VK_CHECK(vkBeginCommandBuffer(cmd_, &begin));
     ImGui_ImplVulkan_CreateFontsTexture(cmd_);
-    check(vkEndCommandBuffer(cmd_), "vkEndCommandBuffer");
+    ENGINE_VK_CHECK(vkEndCommandBuffer(cmd_));
     VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     submit.commandBufferCount = 1;
     submit.pCommandBuffers = &cmd_;
-    check(vkQueueSubmit(ctx_->queue(), 1, &submit, VK_NULL_HANDLE), "vkQueueSubmit");
-    check(vkQueueWaitIdle(ctx_->queue()), "vkQueueWaitIdle");
+    ENGINE_VK_CHECK(vkQueueSubmit(ctx_->queue(), 1, &submit, VK_NULL_HANDLE));
+    ENGINE_VK_CHECK(vkQueueWaitIdle(ctx_->queue()));
     ImGui_ImplVulkan_DestroyFontUploadObjects();
   }
 
@@ -368,14 +365,14 @@ class VulkanPresenter final : public Presenter {
     ici.tiling = VK_IMAGE_TILING_OPTIMAL;
     ici.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
     ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    check(vkCreateImage(d, &ici, nullptr, &game_image_), "vkCreateImage");
+    ENGINE_VK_CHECK(vkCreateImage(d, &ici, nullptr, &game_image_));
     VkMemoryRequirements req;
     vkGetImageMemoryRequirements(d, game_image_, &req);
     VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     mai.allocationSize = req.size;
     mai.memoryTypeIndex = ctx_->memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    check(vkAllocateMemory(d, &mai, nullptr, &game_memory_), "vkAllocateMemory");
-    check(vkBindImageMemory(d, game_image_, game_memory_, 0), "vkBindImageMemory");
+    ENGINE_VK_CHECK(vkAllocateMemory(d, &mai, nullptr, &game_memory_));
+    ENGINE_VK_CHECK(vkBindImageMemory(d, game_image_, game_memory_, 0));
     image_width_ = width;
     image_height_ = height;
   }
@@ -449,10 +446,8 @@ class VulkanPresenter final : public Presenter {
     vkCmdCopyImageToBuffer(cmd_, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, read_back_.handle(), 1, &copy);
     transition(cmd_, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_ACCESS_TRANSFER_READ_BIT, 0,
                VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
-    VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(cmd_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0, nullptr, 0, nullptr);
+    engine::gpu::record_memory_barrier(cmd_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                                       VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
   }
 
   void write_screenshot(const std::filesystem::path& out) const {
