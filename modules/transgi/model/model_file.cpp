@@ -1,5 +1,6 @@
 #include "model/model_file.h"
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -83,7 +84,7 @@ struct Reader {
 
 }  // namespace
 
-void save_model(const std::filesystem::path& path, const TransferModel& model) {
+std::vector<std::byte> encode_model(const TransferModel& model) {
   Writer w;
   const MlpLayout& l = model.decoder.layout();
   w.value<std::int32_t>(l.inputs);
@@ -103,15 +104,20 @@ void save_model(const std::filesystem::path& path, const TransferModel& model) {
   w.string(model.metrics_json);
   w.value<std::uint32_t>(model.demodulated ? 1u : 0u);
 
-  std::vector<std::byte> file(kHeaderBytes);
-  std::memcpy(file.data(), kMagic, 4);
+  // The header goes in front of the payload, in place.
   const std::uint32_t version = kModelFormatVersion;
   const std::uint64_t size = w.out.size(), checksum = fnv1a(w.out.data(), w.out.size());
-  std::memcpy(file.data() + 4, &version, 4);
-  std::memcpy(file.data() + 8, &size, 8);
-  std::memcpy(file.data() + 16, &checksum, 8);
-  file.insert(file.end(), w.out.begin(), w.out.end());
-  engine::io::write_file_atomically(path, file);
+  std::array<std::byte, kHeaderBytes> header{};
+  std::memcpy(header.data(), kMagic, 4);
+  std::memcpy(header.data() + 4, &version, 4);
+  std::memcpy(header.data() + 8, &size, 8);
+  std::memcpy(header.data() + 16, &checksum, 8);
+  w.out.insert(w.out.begin(), header.begin(), header.end());
+  return std::move(w.out);
+}
+
+void save_model(const std::filesystem::path& path, const TransferModel& model) {
+  engine::io::write_file_atomically(path, encode_model(model));
 }
 
 TransferModel load_model(const std::filesystem::path& path) {
@@ -126,7 +132,13 @@ TransferModel load_model(const std::filesystem::path& path) {
   std::ifstream f(path, std::ios::binary);
   f.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(file_size));
   if (static_cast<std::uint64_t>(f.gcount()) != file_size) throw ModelFileError(name + ": cannot read the file");
+  return decode_model(bytes, name);
+}
 
+TransferModel decode_model(std::span<const std::byte> bytes, const std::string& name) {
+  const std::uint64_t file_size = bytes.size();
+  if (file_size < kHeaderBytes)
+    throw ModelFileError(name + ": truncated model file (" + std::to_string(file_size) + " bytes); re-run transgi bake");
   if (std::memcmp(bytes.data(), kMagic, 4) != 0) throw ModelFileError(name + ": not a TransGI model file (bad magic)");
   std::uint32_t version;
   std::uint64_t payload, checksum;
@@ -144,7 +156,7 @@ TransferModel load_model(const std::filesystem::path& path) {
   if (fnv1a(bytes.data() + kHeaderBytes, payload) != checksum)
     throw ModelFileError(name + ": checksum mismatch, the model file is corrupt; re-run transgi bake");
 
-  Reader r{std::span<const std::byte>(bytes).subspan(kHeaderBytes), 0, name};
+  Reader r{bytes.subspan(kHeaderBytes), 0, name};
   MlpLayout layout;
   layout.inputs = r.value<std::int32_t>("layout");
   layout.width = r.value<std::int32_t>("layout");

@@ -11,7 +11,11 @@
 // truncated, corrupt or newer-version file, and validate_model() rejects a
 // model whose meshes no longer match the scene, each with a message that
 // says what to do.
+#include <cstddef>
 #include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
 #include <stdexcept>
 
 #include "model/transfer_model.h"
@@ -28,6 +32,10 @@ class ModelFileError : public std::runtime_error {
 
 void save_model(const std::filesystem::path& path, const TransferModel& model);
 TransferModel load_model(const std::filesystem::path& path);
+// The same file's bytes, for containers that hold a model (a bake's
+// checkpoint); `name` is what errors call the bytes.
+std::vector<std::byte> encode_model(const TransferModel& model);
+TransferModel decode_model(std::span<const std::byte> bytes, const std::string& name);
 
 // Throws ModelFileError if the model does not belong to these assets (mesh
 // count, names or content hashes differ), naming the first stale mesh.
