@@ -1,5 +1,6 @@
 #include "model/gemm.h"
 
+#include <omp.h>
 #include <oneapi/dnnl/dnnl.h>
 #include <oneapi/dnnl/dnnl_debug.h>
 
@@ -223,5 +224,7 @@ const char* gemm_backend_name(GemmBackend b) {
     default: return "oneDNN f32";
   }
 }
+
+void set_gemm_threads(int threads) { omp_set_num_threads(threads > 0 ? threads : omp_get_num_procs()); }
 
 }  // namespace transgi::model

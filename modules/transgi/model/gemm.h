@@ -28,5 +28,9 @@ bool bf16_gemm_available();
 const char* gemm_backend_name(GemmBackend backend);
 // The instruction set oneDNN's kernels run with, after TRANSGI_MAX_ISA.
 std::string onednn_isa_name();
+// How many threads oneDNN's GEMMs use (its OpenMP pool); 0 = one per core.
+// The OpenMP runtime reads OMP_NUM_THREADS once, when the program loads, so a
+// command's --threads (or a bake rank's share of its machine) is set here.
+void set_gemm_threads(int threads);
 
 }  // namespace transgi::model
