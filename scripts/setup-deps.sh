@@ -6,6 +6,8 @@ set -euo pipefail
 
 # glslang-tools: glslang-dev's CMake config names /usr/bin/glslangValidator, and
 # with --no-install-recommends nothing else brings it, so find_package fails.
+# openmpi-*: the bake on many processes (mpirun -n N transgi bake, docs/bake.md);
+# the build turns it on where MPI is found, and the suite then runs a 2-rank bake.
 # mesa-vulkan-drivers (lavapipe) comes from bookworm-backports (Mesa 25), below:
 # bookworm's own 22.3 has no VK_KHR_ray_query, whose path the GPU tests run.
 packages=(
@@ -15,6 +17,7 @@ packages=(
   liblua5.4-dev libglfw3-dev libimgui-dev libgl-dev libgl1-mesa-dri
   libvulkan-dev glslang-dev glslang-tools spirv-tools vulkan-validationlayers
   xvfb xauth ffmpeg help2man
+  openmpi-bin libopenmpi-dev
 )
 # --fuzz: also the compiler of the `fuzz` preset (clang 14 with libFuzzer and
 # its sanitizer runtimes; tests/fuzz/README.md). The test suite does not need it.

@@ -24,17 +24,14 @@
 #include "engine/scene/gltf_loader.h"
 #include "engine/scene/scene_assets.h"
 #include "model/model_file.h"
+#include "child_process.h"
 
 namespace fs = std::filesystem;
+using namespace child_process;
 
 namespace {
 
 const std::string kScene = std::string(TRANSGI_CONTENT_DIR) + "/test_scenes/cornell_box/scene.gltf";
-
-std::vector<char> bytes_of(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 // A bake small enough to finish in about a second; `seed` changes the model.
 std::vector<std::string> bake_args(const fs::path& out, int seed, bool resume) {
@@ -43,34 +40,6 @@ std::vector<std::string> bake_args(const fs::path& out, int seed, bool resume) {
                              "--threads", "1", "--seed", std::to_string(seed)};
   if (resume) a.push_back("--resume");
   return a;
-}
-
-// Starts the command with stdout and stderr into `log`; `file_limit` > 0
-// caps the size of any file it writes, as a full disk would.
-pid_t spawn(const std::vector<std::string>& args, const fs::path& log, rlim_t file_limit = 0) {
-  const pid_t pid = ::fork();
-  if (pid != 0) return pid;
-  std::FILE* f = std::fopen(log.c_str(), "w");
-  if (f) {
-    ::dup2(::fileno(f), 1);
-    ::dup2(::fileno(f), 2);
-  }
-  if (file_limit > 0) {
-    ::signal(SIGXFSZ, SIG_IGN);  // a write past the limit then fails with EFBIG, as on a full disk
-    const rlimit r{file_limit, file_limit};
-    ::setrlimit(RLIMIT_FSIZE, &r);
-  }
-  std::vector<char*> argv;
-  for (const std::string& s : args) argv.push_back(const_cast<char*>(s.c_str()));
-  argv.push_back(nullptr);
-  ::execv(argv[0], argv.data());
-  ::_exit(127);
-}
-
-int wait_exit(pid_t pid) {
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
 }
 
 void expect_valid_model(const fs::path& p) {

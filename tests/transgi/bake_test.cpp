@@ -10,47 +10,14 @@
 #include "engine/core/fnv1a.h"
 #include "engine/scene/procedural.h"
 #include "model/model_file.h"
+#include "bake_fixtures.h"
 
 using namespace transgi;
 using namespace engine;
+using namespace bake_fixtures;
 namespace fs = std::filesystem;
 
 namespace {
-
-// A diffuse floor with a glossy gold sphere sitting on it (two meshes).
-scene::SceneAssets tiny_scene() {
-  scene::SceneAssets a;
-  a.generation = scene::next_scene_generation();
-  a.source = "tiny.gltf";
-  auto floor = scene::make_quad({1, 1}, 0);
-  auto ball = scene::make_uv_sphere(0.3f, 16, 8, 1);
-  for (auto& p : ball.positions) p.y += 0.3f;
-  ball.compute_bounds();
-  a.meshes = {std::make_shared<scene::MeshAsset>(floor), std::make_shared<scene::MeshAsset>(ball)};
-  material::Material diffuse;
-  diffuse.base_color_factor = glm::vec4(0.7f, 0.5f, 0.3f, 1);
-  diffuse.metallic_factor = 0;
-  diffuse.specular_factor = 0;
-  material::Material gold;
-  gold.base_color_factor = glm::vec4(1.0f, 0.8f, 0.35f, 1);
-  gold.metallic_factor = 1;
-  gold.roughness_factor = 0.35f;
-  a.materials = {diffuse, gold};
-  return a;
-}
-
-// Enough points that the glossy lobe is determined (with 600 points the net
-// overfits: validation RMSE 0.068 vs 0.072 for the constant predictor; with
-// 4000 points it reaches 0.027).
-bake::DatasetSettings tiny_data() {
-  bake::DatasetSettings s;
-  s.points = 4000;
-  s.min_points_per_mesh = 64;
-  s.outgoing_per_point = 4;
-  s.rays = 512;
-  s.validation_fraction = 0.1f;
-  return s;
-}
 
 // Points by area, capped per vertex: a 200 m ground plane of 4 vertices
 // (40,000 m^2) beside a 10 m^2 mesh of 1,000 vertices. By area alone the plane
@@ -73,12 +40,6 @@ TEST(BakeDataset, ACoarseGroundPlaneDoesNotTakeThePointsFromTheDetailedMeshes) {
   s.points = 131072;  // the CLI's default points: now the cap binds
   EXPECT_EQ(bake::points_per_mesh(area, vertices, s), (std::vector<int>{32768, 98304, 0}));
 }
-
-struct TempDir {
-  fs::path path = fs::temp_directory_path() / ("bake_test_" + std::to_string(::getpid()));
-  TempDir() { fs::create_directories(path); }
-  ~TempDir() { fs::remove_all(path); }
-};
 
 void expect_load_error(const fs::path& p, const std::string& fragment) {
   try {
@@ -259,7 +220,7 @@ TEST(BakeJob, ResumeContinuesFromTheLastCheckpointAndReusesTheDataset) {
   const fs::path out = d.path / "m.tgm";
   auto s = small_bake();
   bake::BakeCallbacks kill_at_450;
-  kill_at_450.training = [](int it, int, float) {
+  kill_at_450.training = [](int it, int, float, std::span<const double>) {
     if (it == 450) throw Interrupted();
   };
   EXPECT_THROW(bake::run_bake(assets, out, s, kill_at_450), Interrupted);
@@ -290,7 +251,7 @@ TEST(BakeJob, AKilledBakeLeavesTheOldModelIntact) {
   s.train.iterations = 600;
   s.data.seed = 99;
   bake::BakeCallbacks kill;
-  kill.training = [](int it, int, float) {
+  kill.training = [](int it, int, float, std::span<const double>) {
     if (it == 300) throw Interrupted();
   };
   EXPECT_THROW(bake::run_bake(assets, out, s, kill), Interrupted);

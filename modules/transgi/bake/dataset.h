@@ -52,6 +52,18 @@ struct TransferSample {
   glm::vec3 albedo{0.0f};
 };
 
+// Which of the bake's ranks samples (and trains on) which points.
+struct DatasetShard {
+  int rank = 0;
+  int count = 1;
+};
+
+// The rank that owns a point: a hash of the seed and the point's index over
+// the whole scene, so the points, their rays and their targets are the same
+// whatever the number of ranks; only who computes them changes.
+int shard_of_point(std::uint64_t seed, std::size_t point, int shard_count);
+
+// A rank's share of the training data (with one rank: all of it).
 struct TransferDataset {
   // Whether the targets are demodulated (DatasetSettings::demodulate); a
   // model trained on them is (Trainer sets TransferModel::demodulated).
@@ -60,9 +72,20 @@ struct TransferDataset {
   std::vector<float> targets;           // kTransferValues per sample
   std::size_t training_count = 0;
   double seconds = 0;
+  // The training points' ordinals among every rank's training points (the
+  // one-process dataset's order), ascending, `outgoing` samples each: the
+  // trainer draws each batch from all ranks' samples alike and each rank
+  // computes the ones it holds, so the batches do not depend on the rank count.
+  std::vector<std::uint64_t> training_points;
+  std::uint64_t all_training_samples = 0;  // over every rank
+  int outgoing = 1;
+  DatasetShard shard;  // whose share this is
 
   [[nodiscard]] const float* target(std::size_t i) const { return targets.data() + i * kTransferValues; }
   [[nodiscard]] std::size_t validation_count() const { return samples.size() - training_count; }
+  // The local index of the sample with this ordinal among all ranks'
+  // training samples, or -1 where another rank holds it.
+  [[nodiscard]] std::int64_t local_training_sample(std::uint64_t global) const;
 };
 
 // Points per mesh: area[m] / total of `points`, at least min_points_per_mesh
@@ -71,8 +94,14 @@ struct TransferDataset {
 std::vector<int> points_per_mesh(const std::vector<double>& area, const std::vector<std::size_t>& vertices,
                                  const DatasetSettings& settings);
 
-// progress(points_done, points_total). Deterministic for a seed, whatever the thread count.
+// The points are traced in kSamplingRounds rounds of equal shares of the
+// scene's points; progress(points_done, points_total) is called on the
+// calling thread after each, for this shard's points, on every rank alike (so
+// a caller can exchange progress between ranks there). Deterministic for a
+// seed, whatever the thread count and the shard count.
+inline constexpr int kSamplingRounds = 100;
 TransferDataset generate_dataset(const engine::scene::SceneAssets& assets, const DatasetSettings& settings,
-                                 const std::function<void(std::size_t, std::size_t)>& progress = {});
+                                 const std::function<void(std::size_t, std::size_t)>& progress = {},
+                                 DatasetShard shard = {});
 
 }  // namespace transgi::bake

@@ -1,8 +1,11 @@
 #include "bake/trainer.h"
 
 #include <algorithm>
+#include <chrono>
+#include <cstring>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace transgi::bake {
 
@@ -29,6 +32,17 @@ struct BandAccumulator {
         total += diff * diff;
         ++values;
       }
+  }
+  // The sums of every rank's accumulator, on every rank.
+  void sum_over(Communicator& comm) {
+    std::array<double, 12> all{};
+    for (std::size_t b = 0; b < 5; ++b) all[b] = sums[b], all[5 + b] = static_cast<double>(counts[b]);
+    all[10] = total;
+    all[11] = static_cast<double>(values);
+    comm.sum(all);
+    for (std::size_t b = 0; b < 5; ++b) sums[b] = all[b], counts[b] = static_cast<std::size_t>(all[5 + b]);
+    total = all[10];
+    values = static_cast<std::size_t>(all[11]);
   }
   [[nodiscard]] BandErrors result() const {
     BandErrors e;
@@ -60,9 +74,13 @@ model::TransferModel make_untrained_model(const engine::scene::SceneAssets& asse
 }
 
 Trainer::Trainer(const TransferDataset& data, const engine::scene::SceneAssets& assets, model::TransferModel& model,
-                 TrainSettings settings)
-    : data_(data), assets_(assets), model_(model), settings_(std::move(settings)), rng_(settings_.seed, 0x7a41) {
-  if (data.training_count == 0) throw std::invalid_argument("the dataset has no training samples");
+                 TrainSettings settings, Communicator& comm)
+    : data_(data), assets_(assets), model_(model), settings_(std::move(settings)), comm_(comm), rng_(settings_.seed, 0x7a41) {
+  if (data.all_training_samples == 0) throw std::invalid_argument("the dataset has no training samples");
+  if (data.shard.count != comm.size() || data.shard.rank != comm.rank())
+    throw std::invalid_argument("the dataset is rank " + std::to_string(data.shard.rank) + " of " + std::to_string(data.shard.count) +
+                                "'s shard, but this trainer is rank " + std::to_string(comm.rank()) + " of " +
+                                std::to_string(comm.size()));
   if (model.meshes.size() != assets.meshes.size()) throw std::invalid_argument("model and scene have different mesh counts");
   // The model predicts what its targets are: transfer over albedo or not.
   model_.demodulated = data.demodulated;
@@ -105,15 +123,26 @@ void Trainer::predict(std::span<const std::size_t> idx, std::vector<float>& x, s
   model_.decoder.forward(x.data(), static_cast<int>(idx.size()), y.data(), ws, settings_.backend);
 }
 
-float Trainer::step() {
-  const int batch = settings_.batch;
-  std::vector<std::size_t> idx(static_cast<std::size_t>(batch));
-  for (auto& i : idx) i = rng_.next_u32() % data_.training_count;
-  std::vector<float> x, y;
-  predict(idx, x, y, ws_);
+std::vector<std::size_t> Trainer::draw_local_batch() {
+  std::vector<std::size_t> local;
+  local.reserve(static_cast<std::size_t>(settings_.batch / std::max(1, comm_.size()) + 64));
+  for (int i = 0; i < settings_.batch; ++i) {
+    const std::uint64_t global = rng_.next_u32() % data_.all_training_samples;
+    const std::int64_t mine = comm_.size() == 1 ? static_cast<std::int64_t>(global) : data_.local_training_sample(global);
+    if (mine >= 0) local.push_back(static_cast<std::size_t>(mine));
+  }
+  return local;
+}
 
-  // L1 loss and its gradient.
-  const float scale = 1.0f / static_cast<float>(static_cast<std::size_t>(batch) * kTransferValues);
+float Trainer::step() {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::vector<std::size_t> idx = draw_local_batch();
+  const int rows = static_cast<int>(idx.size());
+  std::vector<float> x, y;
+  if (rows > 0) predict(idx, x, y, ws_);
+
+  // L1 loss and its gradient, over the whole batch of every rank.
+  const float scale = 1.0f / static_cast<float>(static_cast<std::size_t>(settings_.batch) * kTransferValues);
   std::vector<float> dy(y.size());
   double loss = 0;
   for (std::size_t i = 0; i < idx.size(); ++i) {
@@ -124,29 +153,86 @@ float Trainer::step() {
       dy[i * kTransferValues + static_cast<std::size_t>(k)] = diff > 0 ? scale : diff < 0 ? -scale : 0.0f;
     }
   }
-  loss *= scale;
 
   std::fill(grad_.begin(), grad_.end(), 0.0f);
   const std::size_t n_dec = model_.decoder.params().size();
-  const int in = model_.decoder.layout().inputs, d = model_.latent_dim;
-  std::vector<float> dx(x.size());
-  model_.decoder.backward(x.data(), batch, dy.data(), ws_, std::span(grad_).first(n_dec), dx.data(), settings_.backend);
-  for (std::size_t i = 0; i < idx.size(); ++i) {
-    const TransferSample& s = data_.samples[idx[i]];
-    model_.meshes[s.mesh].latents.scatter_gradient(*assets_.meshes[s.mesh], s.triangle, s.barycentric,
-                                                   dx.data() + i * static_cast<std::size_t>(in),
-                                                   std::span(grad_).subspan(n_dec + latent_offset_[s.mesh]));
+  const int in = model_.decoder.layout().inputs;
+  if (rows > 0) {
+    std::vector<float> dx(x.size());
+    model_.decoder.backward(x.data(), rows, dy.data(), ws_, std::span(grad_).first(n_dec), dx.data(), settings_.backend);
+    for (std::size_t i = 0; i < idx.size(); ++i) {
+      const TransferSample& s = data_.samples[idx[i]];
+      model_.meshes[s.mesh].latents.scatter_gradient(*assets_.meshes[s.mesh], s.triangle, s.barycentric,
+                                                     dx.data() + i * static_cast<std::size_t>(in),
+                                                     std::span(grad_).subspan(n_dec + latent_offset_[s.mesh]));
+    }
   }
-  (void)d;
+  times_.samples += idx.size();
+  const auto t1 = std::chrono::steady_clock::now();
+  if (comm_.size() > 1) exchange_gradients(idx, loss);
+  const auto t2 = std::chrono::steady_clock::now();
+  loss *= scale;
 
   bool finite = std::isfinite(loss);
   for (std::size_t i = 0; finite && i < grad_.size(); ++i) finite = std::isfinite(grad_[i]);
-  if (!finite) {
-    rollback();
-    return static_cast<float>(loss);
-  }
+  if (!finite) rollback();
+  else adam_step();
+  const auto t3 = std::chrono::steady_clock::now();
+  times_.compute_seconds += std::chrono::duration<double>((t1 - t0) + (t3 - t2)).count();
+  times_.exchange_seconds += std::chrono::duration<double>(t2 - t1).count();
+  return static_cast<float>(loss);
+}
 
-  // Adam with bias correction; the latents get their own rate.
+// The decoder's gradients and the loss are summed densely. A latent row gets
+// gradients only from the samples on its triangles, at most 3 x batch rows a
+// step however large the level, so the ranks exchange only the rows they
+// touched (a row index and its values): for a 10 M-vertex level that is
+// about 200 KB a step where the dense table would be 280 MB (docs/bake.md).
+void Trainer::exchange_gradients(std::span<const std::size_t> batch, double& loss) {
+  const std::size_t n_dec = model_.decoder.params().size();
+  comm_.sum(std::span(grad_).first(n_dec));
+  comm_.sum(std::span(&loss, 1));
+  const auto d = static_cast<std::size_t>(model_.latent_dim);
+  if (d == 0) return;
+
+  std::vector<std::uint64_t> touched;  // flat latent row indices over every mesh
+  for (std::size_t i : batch) {
+    const TransferSample& s = data_.samples[i];
+    const auto& table = model_.meshes[s.mesh].latents;
+    const glm::uvec3 t = assets_.meshes[s.mesh]->triangles[s.triangle];
+    for (std::uint32_t v : {t.x, t.y, t.z}) touched.push_back(latent_offset_[s.mesh] / d + table.vertex_to_latent[v]);
+  }
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+  const std::size_t row_bytes = sizeof(std::uint64_t) + d * sizeof(float);
+  std::vector<std::byte> mine(touched.size() * row_bytes);
+  for (std::size_t r = 0; r < touched.size(); ++r) {
+    std::memcpy(mine.data() + r * row_bytes, &touched[r], sizeof(std::uint64_t));
+    std::memcpy(mine.data() + r * row_bytes + sizeof(std::uint64_t), grad_.data() + n_dec + touched[r] * d, d * sizeof(float));
+  }
+  const auto all = comm_.all_gather(mine);
+  // Every rank adds the same rows in rank order: the same sums on every rank.
+  float* latent_grad = grad_.data() + n_dec;
+  std::vector<float> row_values(d);
+  for (int add = 0; add < 2; ++add)
+    for (const auto& part : all)
+      for (std::size_t at = 0; at + row_bytes <= part.size(); at += row_bytes) {
+        std::uint64_t row = 0;
+        std::memcpy(&row, part.data() + at, sizeof(row));
+        if (row * d + d > latent_count_) throw std::runtime_error("bake: a rank sent a latent row outside the model");
+        float* g = latent_grad + row * d;
+        if (add == 0) {
+          std::fill_n(g, d, 0.0f);
+        } else {
+          std::memcpy(row_values.data(), part.data() + at + sizeof(row), d * sizeof(float));
+          for (std::size_t k = 0; k < d; ++k) g[k] += row_values[k];
+        }
+      }
+}
+
+// Adam with bias correction; the latents get their own rate.
+void Trainer::adam_step() {
+  const std::size_t n_dec = model_.decoder.params().size();
   ++iteration_;
   const float lr = current_learning_rate();
   const float lr_latent = settings_.latent_learning_rate * (lr / settings_.learning_rate);
@@ -164,7 +250,6 @@ float Trainer::step() {
   for (auto& mesh : model_.meshes)
     for (float& p : mesh.latents.values) update(n_dec + flat++, p, lr_latent);
   if (iteration_ % kSnapshotEvery == 0) snapshot();
-  return static_cast<float>(loss);
 }
 
 void Trainer::snapshot() {
@@ -202,17 +287,21 @@ BandErrors Trainer::validate() const {
     predict(idx, x, y, ws);
     for (std::size_t i = 0; i < idx.size(); ++i) acc.add(y.data() + i * kTransferValues, data_.target(idx[i]));
   }
+  acc.sum_over(comm_);
   return acc.result();
 }
 
 BandErrors Trainer::constant_predictor() const {
-  std::array<double, kTransferValues> mean{};
+  std::array<double, kTransferValues + 1> sum{};  // the targets' sums, then their count
   for (std::size_t i = 0; i < data_.training_count; ++i)
-    for (int k = 0; k < kTransferValues; ++k) mean[static_cast<std::size_t>(k)] += data_.target(i)[k];
+    for (int k = 0; k < kTransferValues; ++k) sum[static_cast<std::size_t>(k)] += data_.target(i)[k];
+  sum[kTransferValues] = static_cast<double>(data_.training_count);
+  comm_.sum(sum);
   std::array<float, kTransferValues> prediction{};
-  for (std::size_t k = 0; k < mean.size(); ++k) prediction[k] = static_cast<float>(mean[k] / static_cast<double>(data_.training_count));
+  for (std::size_t k = 0; k < prediction.size(); ++k) prediction[k] = static_cast<float>(sum[k] / sum[kTransferValues]);
   BandAccumulator acc;
   for (std::size_t i = 0; i < data_.validation_count(); ++i) acc.add(prediction.data(), data_.target(data_.training_count + i));
+  acc.sum_over(comm_);
   return acc.result();
 }
 

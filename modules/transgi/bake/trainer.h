@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "bake/communicator.h"
 #include "bake/dataset.h"
 #include "model/transfer_model.h"
 
@@ -31,12 +32,19 @@ struct BandErrors {
   double total = 0;              // over all 75 values
 };
 
+// Data-parallel over the ranks of `comm` (docs/bake.md, "Baking on many
+// machines"): every rank holds the whole model and draws the same batches
+// from all ranks' samples; each computes the gradients of the samples its
+// shard holds; the decoder's gradients are summed over the ranks and the
+// latents' as sparse rows (only the rows the batch touched), so every rank
+// takes the same optimiser step. With one rank nothing is exchanged and the
+// steps are the one-process bake's, bit for bit.
 class Trainer {
  public:
   // The model must already hold a decoder of the right input size and
   // latent tables for every mesh (make_untrained_model()).
   Trainer(const TransferDataset& data, const engine::scene::SceneAssets& assets, model::TransferModel& model,
-          TrainSettings settings);
+          TrainSettings settings, Communicator& comm = solo());
 
   // One optimisation step; returns the batch's mean L1 loss.
   float step();
@@ -47,6 +55,14 @@ class Trainer {
   [[nodiscard]] int iteration() const { return iteration_; }
   [[nodiscard]] int rollbacks() const { return rollbacks_; }
   [[nodiscard]] float current_learning_rate() const;
+
+  // Where this rank's time went since construction, and what it computed.
+  struct Times {
+    double compute_seconds = 0;   // forward, backward, optimiser step
+    double exchange_seconds = 0;  // summing over the ranks (waiting for the slowest included)
+    std::uint64_t samples = 0;    // samples of the batches this rank computed
+  };
+  [[nodiscard]] const Times& times() const { return times_; }
 
   // Checkpoint state (optimizer moments included) for --resume.
   struct State {
@@ -63,6 +79,10 @@ class Trainer {
                model::MlpWorkspace& ws) const;
   float* latent_ptr(std::size_t flat);
   std::size_t parameter_count() const;
+  // This rank's share of a batch drawn over every rank's training samples.
+  std::vector<std::size_t> draw_local_batch();
+  void exchange_gradients(std::span<const std::size_t> batch, double& loss);
+  void adam_step();
   void snapshot();
   void rollback();
 
@@ -70,6 +90,8 @@ class Trainer {
   const engine::scene::SceneAssets& assets_;
   model::TransferModel& model_;
   TrainSettings settings_;
+  Communicator& comm_;
+  Times times_;
   std::vector<std::size_t> latent_offset_;  // per mesh, into the flat latent index space
   std::size_t latent_count_ = 0;
   std::vector<float> m_, v_, grad_;

@@ -1,0 +1,49 @@
+#pragma once
+// The processes that bake one model together (docs/bake.md, "Baking on many
+// machines"). A bake is written against this interface; the single-process
+// bake gets `solo()`, `mpirun -n N transgi bake` an MPI communicator (the CLI
+// links it when the build has MPI), and tests an in-process group of threads.
+//
+// Every call is collective: every rank makes the same calls in the same order,
+// as in MPI. Results are identical on every rank, so state that every rank
+// updates from them (the model, the optimiser's moments) stays replicated.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+namespace transgi::bake {
+
+class Communicator {
+ public:
+  virtual ~Communicator() = default;
+  [[nodiscard]] virtual int rank() const = 0;
+  [[nodiscard]] virtual int size() const = 0;
+
+  // In-place element-wise sums over the ranks.
+  virtual void sum(std::span<float> values) = 0;
+  virtual void sum(std::span<double> values) = 0;
+  // Every rank's bytes, in rank order, on every rank (the ranks may send
+  // different sizes).
+  [[nodiscard]] virtual std::vector<std::vector<std::byte>> all_gather(std::span<const std::byte> mine) = 0;
+
+  // Bytes this rank has handed to the transport so far (what it sent, as the
+  // payload sizes of its calls; the transport's own algorithm may move more).
+  [[nodiscard]] std::uint64_t bytes_sent() const { return bytes_sent_; }
+
+ protected:
+  void count_sent(std::size_t bytes) { bytes_sent_ += bytes; }
+
+ private:
+  std::uint64_t bytes_sent_ = 0;
+};
+
+// One process alone: sums are the values themselves, nothing is sent.
+Communicator& solo();
+
+// Helpers over all_gather for plain values.
+std::vector<double> gather_each(Communicator& comm, double mine);
+std::vector<std::uint64_t> gather_each(Communicator& comm, std::uint64_t mine);
+
+}  // namespace transgi::bake

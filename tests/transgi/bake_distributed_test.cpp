@@ -1,0 +1,244 @@
+// The bake on several ranks (docs/bake.md, "Baking on many machines"), with
+// the ranks played by threads (bake/thread_communicator.h), so the sharding
+// and the data-parallel training are tested whether or not the build has MPI.
+// The MPI transport itself: mpi_bake_test.cpp.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <thread>
+
+#include "bake/bake_job.h"
+#include "bake/thread_communicator.h"
+#include "bake/trainer.h"
+#include "bake_fixtures.h"
+#include "model/model_file.h"
+
+using namespace bake_fixtures;
+
+namespace {
+
+bake::DatasetSettings small_data() {
+  auto s = tiny_data();
+  s.points = 600;
+  s.rays = 64;
+  return s;
+}
+
+// Runs fn(rank, communicator) on `ranks` threads at once.
+template <class Fn>
+void on_ranks(int ranks, Fn fn) {
+  auto group = bake::make_thread_group(ranks);
+  std::vector<std::thread> threads;
+  for (int r = 0; r < ranks; ++r) threads.emplace_back([&, r] { fn(r, *group[static_cast<std::size_t>(r)]); });
+  for (auto& t : threads) t.join();
+}
+
+std::vector<float> weights(const model::TransferModel& m) {
+  std::vector<float> w = m.decoder.params();
+  for (const auto& mesh : m.meshes) w.insert(w.end(), mesh.latents.values.begin(), mesh.latents.values.end());
+  return w;
+}
+
+bool same_sample(const bake::TransferSample& a, const bake::TransferSample& b) {
+  return std::memcmp(&a, &b, sizeof(a)) == 0;
+}
+
+}  // namespace
+
+// Every point is traced by exactly one rank, with the rays it gets in the
+// one-process bake: the shards together are that dataset, bit for bit, and
+// each global training sample is found on exactly one shard.
+TEST(BakeShards, TheRanksShardsTogetherAreTheOneProcessDataset) {
+  const auto assets = tiny_scene();
+  const auto s = small_data();
+  const auto one = bake::generate_dataset(assets, s);
+  ASSERT_EQ(one.all_training_samples, one.training_count);
+  constexpr int kRanks = 3;
+  std::vector<bake::TransferDataset> shards;
+  for (int r = 0; r < kRanks; ++r) shards.push_back(bake::generate_dataset(assets, s, {}, {r, kRanks}));
+
+  std::size_t samples = 0, training = 0;
+  for (const auto& d : shards) {
+    samples += d.samples.size();
+    training += d.training_count;
+    EXPECT_EQ(d.all_training_samples, one.training_count);
+    EXPECT_TRUE(std::is_sorted(d.training_points.begin(), d.training_points.end()));
+    // Balanced by the hash: 600 points, a third each, within 4 standard deviations.
+    const double points = static_cast<double>(d.samples.size()) / s.outgoing_per_point;
+    EXPECT_NEAR(points, 200.0, 4 * std::sqrt(600 * (1.0 / 3) * (2.0 / 3)));
+  }
+  EXPECT_EQ(samples, one.samples.size());
+  EXPECT_EQ(training, one.training_count);
+
+  for (std::uint64_t g = 0; g < one.training_count; ++g) {
+    int holders = 0;
+    for (const auto& d : shards) {
+      const std::int64_t local = d.local_training_sample(g);
+      if (local < 0) continue;
+      ++holders;
+      const auto i = static_cast<std::size_t>(local);
+      ASSERT_TRUE(same_sample(d.samples[i], one.samples[g])) << "global sample " << g;
+      ASSERT_EQ(std::memcmp(d.target(i), one.target(g), sizeof(float) * bake::kTransferValues), 0) << "global sample " << g;
+    }
+    ASSERT_EQ(holders, 1) << "global training sample " << g;
+  }
+  // The validation points too, each on one shard.
+  std::multimap<float, std::size_t> validation;  // keyed by the first target value
+  for (std::size_t i = one.training_count; i < one.samples.size(); ++i) validation.emplace(one.target(i)[0], i);
+  std::size_t found = 0;
+  for (const auto& d : shards)
+    for (std::size_t i = d.training_count; i < d.samples.size(); ++i) {
+      const auto [b, e] = validation.equal_range(d.target(i)[0]);
+      for (auto it = b; it != e; ++it)
+        if (same_sample(d.samples[i], one.samples[it->second])) {
+          ++found;
+          break;
+        }
+    }
+  EXPECT_EQ(found, one.validation_count());
+}
+
+// Two ranks draw the batches the one process draws and sum their halves'
+// gradients: the same steps up to the order of float sums. Both ranks end
+// with the same bits, and near the one-process model.
+TEST(DistributedTraining, TwoRanksTakeTheOneProcessStepsWithinRounding) {
+  const auto assets = tiny_scene();
+  const auto s = small_data();
+  bake::TrainSettings ts;
+  ts.iterations = 300;
+  ts.batch = 256;
+  const model::MlpLayout layout{.width = 16, .hidden_layers = 1};
+  constexpr int kSteps = 60;
+
+  const auto one_data = bake::generate_dataset(assets, s);
+  auto one = bake::make_untrained_model(assets, 7, layout, 3);
+  bake::Trainer solo_trainer(one_data, assets, one, ts);
+  std::vector<float> solo_loss;
+  for (int i = 0; i < kSteps; ++i) solo_loss.push_back(solo_trainer.step());
+  const auto solo_validation = solo_trainer.validate();
+
+  std::vector<model::TransferModel> models(2);
+  std::vector<std::vector<float>> losses(2);
+  std::vector<bake::BandErrors> validation(2);
+  std::vector<std::uint64_t> sent(2);
+  on_ranks(2, [&](int r, bake::Communicator& comm) {
+    const auto data = bake::generate_dataset(assets, s, {}, {r, 2});
+    models[r] = bake::make_untrained_model(assets, 7, layout, 3);
+    bake::Trainer trainer(data, assets, models[r], ts, comm);
+    for (int i = 0; i < kSteps; ++i) losses[r].push_back(trainer.step());
+    validation[r] = trainer.validate();
+    sent[r] = comm.bytes_sent();
+  });
+
+  EXPECT_EQ(weights(models[0]), weights(models[1])) << "the ranks' replicas differ";
+  EXPECT_EQ(losses[0], losses[1]);
+  EXPECT_EQ(validation[0].total, validation[1].total);
+  for (int i = 0; i < kSteps; ++i)
+    EXPECT_NEAR(losses[0][i], solo_loss[i], 1e-5 * solo_loss[i]) << "step " << i << ": the same batch's loss";
+  const auto a = weights(one), b = weights(models[0]);
+  double diff = 0, norm = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) diff += double(a[i] - b[i]) * (a[i] - b[i]), norm += double(a[i]) * a[i];
+  double worst_loss = 0;
+  for (int i = 0; i < kSteps; ++i) worst_loss = std::max(worst_loss, std::abs(double(losses[0][i]) - solo_loss[i]) / solo_loss[i]);
+  std::printf("[ measured ] after %d steps: weights %.2e apart (relative), losses at most %.2e, validation %.5f vs %.5f\n",
+              kSteps, std::sqrt(diff / norm), worst_loss, validation[0].total, solo_validation.total);
+  EXPECT_LT(std::sqrt(diff / norm), 1e-5) << "relative distance of the weights after " << kSteps << " steps";
+  EXPECT_NEAR(validation[0].total, solo_validation.total, 1e-4 * solo_validation.total);
+  // What a step exchanges: the decoder's gradients and the loss, then the
+  // latent rows the rank's half of the batch touched (index + 7 floats).
+  const double per_step = static_cast<double>(sent[0]) / kSteps;
+  const double decoder = static_cast<double>(one.decoder.params().size()) * sizeof(float) + sizeof(double);
+  EXPECT_GT(per_step, decoder);
+  EXPECT_LT(per_step, decoder + 3.0 * 256 * (8 + 7 * 4) + 4096) << "sparse latent rows, at most 3 per sample";
+}
+
+// A batch smaller than the ranks: a rank often holds none of it and still
+// joins every exchange; the replicas stay equal.
+TEST(DistributedTraining, ARankWithNoSampleOfTheBatchStillTakesTheStep) {
+  const auto assets = tiny_scene();
+  auto s = small_data();
+  s.points = 200;
+  bake::TrainSettings ts;
+  ts.batch = 1;
+  ts.iterations = 40;
+  std::vector<model::TransferModel> models(3);
+  on_ranks(3, [&](int r, bake::Communicator& comm) {
+    const auto data = bake::generate_dataset(assets, s, {}, {r, 3});
+    models[r] = bake::make_untrained_model(assets, 7, model::MlpLayout{.width = 8, .hidden_layers = 1}, 5);
+    bake::Trainer trainer(data, assets, models[r], ts, comm);
+    for (int i = 0; i < ts.iterations; ++i) EXPECT_TRUE(std::isfinite(trainer.step()));
+    EXPECT_EQ(trainer.iteration(), ts.iterations);
+  });
+  EXPECT_EQ(weights(models[0]), weights(models[1]));
+  EXPECT_EQ(weights(models[0]), weights(models[2]));
+  EXPECT_NE(weights(models[0]), weights(bake::make_untrained_model(assets, 7, model::MlpLayout{.width = 8, .hidden_layers = 1}, 5)));
+}
+
+// The whole bake on two ranks: one model, written by rank 0, as good as the
+// one-process bake's; each rank's dataset shard cached under its own name
+// and removed after success.
+TEST(BakeJob, TwoRanksBakeOneModelAsGoodAsOneProcess) {
+  TempDir dir("bake_distributed");
+  const auto assets = tiny_scene();
+  bake::BakeSettings s;
+  s.data = small_data();
+  s.train.iterations = 400;
+  s.train.batch = 256;
+  s.layout = {.width = 16, .hidden_layers = 1};
+  s.checkpoint_every = 100;
+  const auto solo = bake::run_bake(assets, dir.path / "one.tgm", s);
+
+  std::vector<bake::BakeReport> reports(2);
+  std::vector<int> sampling_calls(2), training_calls(2);
+  const fs::path out = dir.path / "two.tgm";
+  s.keep_dataset = true;
+  on_ranks(2, [&](int r, bake::Communicator& comm) {
+    bake::BakeCallbacks cb;
+    cb.sampling = [&](std::size_t, std::size_t, std::span<const double> rates) {
+      ++sampling_calls[r];
+      EXPECT_EQ(rates.size(), 2u);
+    };
+    cb.training = [&](int, int, float, std::span<const double>) { ++training_calls[r]; };
+    reports[r] = bake::run_bake(assets, out, s, cb, comm);
+  });
+  EXPECT_EQ(sampling_calls[0], bake::kSamplingRounds);
+  EXPECT_EQ(training_calls[0], 400);
+  EXPECT_EQ(sampling_calls[1] + training_calls[1], 0) << "progress is shown once, by rank 0";
+  for (const auto& r : reports) {
+    EXPECT_EQ(r.ranks, 2);
+    EXPECT_EQ(r.samples, solo.samples);
+    EXPECT_EQ(r.training_samples, solo.training_samples);
+    EXPECT_EQ(r.validation.total, reports[0].validation.total);
+    EXPECT_EQ(r.sampling_rates.size(), 2u);
+  }
+  EXPECT_NEAR(reports[0].validation.total, solo.validation.total, 0.02 * solo.validation.total);
+  const auto m = model::load_model(out);
+  EXPECT_NO_THROW(model::validate_model(m, assets, out));
+  EXPECT_FALSE(fs::exists(bake::checkpoint_path(out)));
+  EXPECT_TRUE(fs::exists(bake::dataset_cache_path(out, {0, 2})));
+  EXPECT_TRUE(fs::exists(bake::dataset_cache_path(out, {1, 2})));
+
+  // --resume with the shards cached: nothing is traced again.
+  s.resume = true;
+  on_ranks(2, [&](int r, bake::Communicator& comm) { reports[r] = bake::run_bake(assets, out, s, {}, comm); });
+  EXPECT_TRUE(reports[0].dataset_from_cache);
+  EXPECT_TRUE(reports[1].dataset_from_cache);
+}
+
+// A shard trained alone would draw batches from samples it does not hold.
+TEST(DistributedTraining, AShardTrainedByTheWrongRankIsRefused) {
+  const auto assets = tiny_scene();
+  auto s = small_data();
+  s.points = 100;
+  const auto shard = bake::generate_dataset(assets, s, {}, {1, 2});
+  auto m = bake::make_untrained_model(assets, 7, model::MlpLayout{.width = 8, .hidden_layers = 1}, 5);
+  try {
+    bake::Trainer trainer(shard, assets, m, {});
+    ADD_FAILURE() << "a shard of two ranks' dataset trained by one process";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("rank 1 of 2's shard, but this trainer is rank 0 of 1"), std::string::npos) << e.what();
+  }
+}
