@@ -76,6 +76,29 @@ void BM_TrainerStep(benchmark::State& state) {
   for (auto _ : state) trainer.step();
   state.counters["samples/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * kBatch, benchmark::Counter::kIsRate);
 }
+// A training step against the size of the level's latent table (docs/bake.md,
+// "Scaling"): the same batch of 2048 on a sphere of `range(0)` x 1000
+// vertices. Zeroing the gradients, the finiteness check and the dense Adam
+// update touch every latent every step, on every rank of a distributed bake;
+// the counter is that cost per latent float, beyond the step's own work.
+void BM_TrainerStepByLatentTable(benchmark::State& state) {
+  const int segments = static_cast<int>(std::lround(std::sqrt(static_cast<double>(state.range(0)) * 1000.0 / 2.0)));
+  engine::scene::SceneAssets a;
+  a.generation = engine::scene::next_scene_generation();
+  a.meshes = {std::make_shared<engine::scene::MeshAsset>(engine::scene::make_uv_sphere(1, 2 * segments, segments))};
+  a.materials.resize(1);
+  bake::DatasetSettings ds;
+  ds.points = 2000;
+  ds.rays = 16;
+  ds.max_points_per_vertex = 0;
+  const auto data = bake::generate_dataset(a, ds);
+  auto m = bake::make_untrained_model(a, 7, model::MlpLayout{}, 1);
+  bake::Trainer trainer(data, a, m, {});
+  for (auto _ : state) trainer.step();
+  state.counters["latent floats"] = static_cast<double>(m.meshes[0].latents.values.size());
+}
+BENCHMARK(BM_TrainerStepByLatentTable)->Arg(10)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
+
 // Per-pixel transfer: the batched path the renderer uses (arg 1) against the
 // scalar reference it is tested against (arg 0), on 8192 queries.
 void BM_InferTransfer(benchmark::State& state) {
