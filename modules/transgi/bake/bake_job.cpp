@@ -166,17 +166,6 @@ struct RankProgress {
   double done = 0, total = 0, seconds = 0;
 };
 
-// Every rank's progress on every rank (one small exchange).
-std::vector<RankProgress> exchange_progress(Communicator& comm, RankProgress mine) {
-  const auto all = comm.all_gather(std::as_bytes(std::span(&mine, 1)));
-  std::vector<RankProgress> out(all.size());
-  for (std::size_t r = 0; r < all.size(); ++r) {
-    if (all[r].size() != sizeof(RankProgress)) throw std::runtime_error("bake: a rank sent a malformed progress report");
-    std::memcpy(&out[r], all[r].data(), sizeof(RankProgress));
-  }
-  return out;
-}
-
 // Stage 1: this rank's shard of the dataset, from its cache or traced. Every
 // rank passes the same kSamplingRounds progress exchanges, a cached one with
 // nothing left to do, so the ranks' calls stay matched.
@@ -195,7 +184,7 @@ TransferDataset shard_dataset(const engine::scene::SceneAssets& assets, const fs
   const auto t0 = std::chrono::steady_clock::now();
   const auto round_done = [&](std::size_t done, std::size_t total) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const auto all = exchange_progress(comm, {double(done), double(total), seconds});
+    const auto all = gather_each(comm, RankProgress{double(done), double(total), seconds});
     if (comm.rank() != 0 || !cb.sampling) return;
     double all_done = 0, all_total = 0;
     std::vector<double> rates;
@@ -213,7 +202,7 @@ TransferDataset shard_dataset(const engine::scene::SceneAssets& assets, const fs
     save_dataset(dataset_cache_path(out, shard), key, data);
   }
   report.data_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const auto rates = exchange_progress(comm, {double(data.samples.size()) / std::max(1, s.data.outgoing_per_point), 0,
+  const auto rates = gather_each(comm, RankProgress{double(data.samples.size()) / std::max(1, s.data.outgoing_per_point), 0,
                                               cached ? 0.0 : report.data_seconds});
   for (const RankProgress& p : rates) report.sampling_rates.push_back(p.seconds > 0 ? p.done / p.seconds : 0.0);
   return data;

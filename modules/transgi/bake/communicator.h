@@ -9,8 +9,11 @@
 // updates from them (the model, the optimiser's moments) stays replicated.
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <span>
+#include <stdexcept>
+#include <type_traits>
 #include <vector>
 
 namespace transgi::bake {
@@ -42,8 +45,17 @@ class Communicator {
 // One process alone: sums are the values themselves, nothing is sent.
 Communicator& solo();
 
-// Helpers over all_gather for plain values.
-std::vector<double> gather_each(Communicator& comm, double mine);
-std::vector<std::uint64_t> gather_each(Communicator& comm, std::uint64_t mine);
+// Every rank's value of a plain type, in rank order, on every rank.
+template <class T>
+  requires std::is_trivially_copyable_v<T>
+std::vector<T> gather_each(Communicator& comm, const T& mine) {
+  const auto all = comm.all_gather(std::as_bytes(std::span(&mine, 1)));
+  std::vector<T> out(all.size());
+  for (std::size_t r = 0; r < all.size(); ++r) {
+    if (all[r].size() != sizeof(T)) throw std::runtime_error("bake: a rank sent a value of the wrong size");
+    std::memcpy(&out[r], all[r].data(), sizeof(T));
+  }
+  return out;
+}
 
 }  // namespace transgi::bake
