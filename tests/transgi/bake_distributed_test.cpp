@@ -226,6 +226,12 @@ TEST(BakeJob, TwoRanksBakeOneModelAsGoodAsOneProcess) {
   on_ranks(2, [&](int r, bake::Communicator& comm) { reports[r] = bake::run_bake(assets, out, s, {}, comm); });
   EXPECT_TRUE(reports[0].dataset_from_cache);
   EXPECT_TRUE(reports[1].dataset_from_cache);
+
+  // Baked again by one process: the model written, no cache of any rank count is left.
+  s.keep_dataset = false;
+  bake::run_bake(assets, out, s);
+  for (const auto& e : fs::directory_iterator(dir.path))
+    EXPECT_EQ(e.path().filename().string().find("two.tgm.dataset"), std::string::npos) << e.path() << " was left behind";
 }
 
 // A shard trained alone would draw batches from samples it does not hold.

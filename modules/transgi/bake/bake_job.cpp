@@ -222,6 +222,18 @@ void start_model(const engine::scene::SceneAssets& assets, const fs::path& out, 
   }
 }
 
+// Removes <out>.dataset.R-of-N for every R and N (not <out>.dataset itself,
+// which is removed by its one rank).
+void remove_other_dataset_caches(const fs::path& out) {
+  const std::string prefix = out.filename().string() + ".dataset.";
+  std::error_code ec;
+  const fs::path folder = out.has_parent_path() ? out.parent_path() : fs::path(".");
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind(prefix, 0) == 0 && name.find("-of-") != std::string::npos) fs::remove(it->path(), ec);
+  }
+}
+
 void write_model_metadata(model::TransferModel& m, const BakeSettings& s, const BakeReport& report) {
   const auto& l = m.decoder.layout();
   const auto bands = [](const BandErrors& e) { return nlohmann::json(std::vector<double>(e.rmse.begin(), e.rmse.end())); };
@@ -333,13 +345,16 @@ BakeReport run_bake(const engine::scene::SceneAssets& assets, const fs::path& ou
     throw std::runtime_error("bake: the ranks' copies of the model differ after training (the transport's sums "
                              "were not the same on every rank); no model was written");
 
-  // Stage 4: rank 0 writes the model; each rank cleans up after itself.
+  // Stage 4: rank 0 writes the model; each rank cleans up after itself, and
+  // rank 0 after bakes on other rank counts too (a bake resumed on another
+  // N traced its own shards): with the model written, no cache is needed.
   std::error_code ec;
   if (lead) {
     write_model_metadata(m, s, report);
     model::save_model(out, m);
     fs::remove(checkpoint_path(out), ec);
     fs::remove(checkpoint_path(out).string() + ".state", ec);  // the two-file checkpoint of earlier builds
+    if (!s.keep_dataset) remove_other_dataset_caches(out);
   }
   if (!s.keep_dataset) fs::remove(dataset_cache_path(out, {comm.rank(), comm.size()}), ec);
   return report;
