@@ -174,3 +174,28 @@ TEST_F(MpiBake, ARankKilledMidTrainingEndsTheJobWithoutATornFileAndResumeFinishe
               "before their kill; %d resumed from a checkpoint\n",
               killed, training_seconds, finished, resumed);
 }
+
+// A rank that fails alone (here: its shard cache cannot be written) says so
+// with its rank and the file, and ends the job instead of leaving the other
+// rank waiting in an exchange.
+TEST_F(MpiBake, ARankThatFailsAloneEndsTheJobNamingItselfAndTheFile) {
+  const fs::path out = dir_ / "model.tgm";
+  fs::create_directories(transgi::bake::dataset_cache_path(out, {1, 2}));  // a folder where rank 1 writes its shard
+  const fs::path log = dir_ / "fail.log";
+  const auto started = std::chrono::steady_clock::now();
+  const pid_t mpirun = spawn(on_ranks(2, bake_args(out, 400, false)), log);
+  int code = 0;
+  while (::waitpid(mpirun, &code, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() - started > std::chrono::seconds(60)) {
+      for (pid_t r : ranks_of(mpirun)) ::kill(r, SIGKILL);
+      ::kill(mpirun, SIGKILL);
+      ::waitpid(mpirun, nullptr, 0);
+      FAIL() << "the job hung:\n" << text_of(log);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  const std::string printed = text_of(log);
+  EXPECT_FALSE(WIFEXITED(code) && WEXITSTATUS(code) == 0) << printed;
+  EXPECT_NE(printed.find("rank 1 of 2: " + transgi::bake::dataset_cache_path(out, {1, 2}).string()), std::string::npos) << printed;
+  EXPECT_FALSE(fs::exists(out));
+}
