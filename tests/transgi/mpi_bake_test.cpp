@@ -150,7 +150,9 @@ TEST_F(MpiBake, ARankKilledMidTrainingEndsTheJobWithoutATornFileAndResumeFinishe
     const int code = wait_exit(mpirun);
     const std::string printed = text_of(log);
     resumed += printed.find("resuming from the checkpoint") != std::string::npos;
-    if (code == 0) {  // it finished before the kill (a resumed job had little left): a whole model
+    // It finished before the kill (a resumed job had little left), or the kill
+    // came after rank 0 had renamed the model into place: a whole model.
+    if (code == 0 || fs::exists(out)) {
       ++finished;
       EXPECT_NO_THROW(transgi::model::validate_model(transgi::model::load_model(out), scene_assets(), out));
       fs::remove(out);
@@ -164,7 +166,6 @@ TEST_F(MpiBake, ARankKilledMidTrainingEndsTheJobWithoutATornFileAndResumeFinishe
     if (fs::exists(transgi::bake::checkpoint_path(out))) {
       EXPECT_TRUE(transgi::bake::checkpoint_iteration(out, scene_assets()).has_value()) << "trial " << attempt << ": torn checkpoint";
     }
-    EXPECT_FALSE(fs::exists(out)) << "trial " << attempt << ": a model before training finished";
   }
   EXPECT_EQ(killed, trials);
   const fs::path last = dir_ / "resume.log";
