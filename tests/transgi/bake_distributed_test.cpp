@@ -248,3 +248,57 @@ TEST(DistributedTraining, AShardTrainedByTheWrongRankIsRefused) {
     EXPECT_NE(std::string(e.what()).find("rank 1 of 2's shard, but this trainer is rank 0 of 1"), std::string::npos) << e.what();
   }
 }
+
+// LatentUpdates::Touched: a step moves the latent rows its batch touched and
+// no other (their moments and values stay as they were).
+TEST(DistributedTraining, TouchedRowUpdatesMoveOnlyTheBatchsRows) {
+  const auto assets = tiny_scene();
+  auto s = small_data();
+  s.points = 200;
+  const auto data = bake::generate_dataset(assets, s);
+  bake::TrainSettings ts;
+  ts.batch = 8;
+  ts.latent_updates = bake::LatentUpdates::Touched;
+  auto m = bake::make_untrained_model(assets, 7, model::MlpLayout{.width = 8, .hidden_layers = 1}, 5);
+  bake::Trainer trainer(data, assets, m, ts);
+  for (int i = 0; i < 5; ++i) trainer.step();
+  const auto before = m.meshes;
+  trainer.step();
+  std::size_t moved = 0, rows = 0;
+  for (std::size_t mesh = 0; mesh < m.meshes.size(); ++mesh) {
+    const auto& a = before[mesh].latents;
+    const auto& b = m.meshes[mesh].latents;
+    for (std::uint32_t r = 0; r < a.rows(); ++r, ++rows)
+      moved += !std::equal(a.row(r), a.row(r) + 7, b.row(r));
+  }
+  EXPECT_GT(moved, 0u);
+  EXPECT_LE(moved, 3u * 8) << "a batch of 8 touches at most 24 rows; " << rows << " in the model";
+}
+
+// Touched-row updates on two ranks take the one process's steps too: every
+// rank moves the rows any rank's samples touched.
+TEST(DistributedTraining, TouchedRowUpdatesOnTwoRanksTakeTheOneProcessSteps) {
+  const auto assets = tiny_scene();
+  const auto s = small_data();
+  bake::TrainSettings ts;
+  ts.batch = 256;
+  ts.latent_updates = bake::LatentUpdates::Touched;
+  const model::MlpLayout layout{.width = 16, .hidden_layers = 1};
+  const auto one_data = bake::generate_dataset(assets, s);
+  auto one = bake::make_untrained_model(assets, 7, layout, 3);
+  bake::Trainer solo_trainer(one_data, assets, one, ts);
+  for (int i = 0; i < 40; ++i) solo_trainer.step();
+
+  std::vector<model::TransferModel> models(2);
+  on_ranks(2, [&](int r, bake::Communicator& comm) {
+    const auto data = bake::generate_dataset(assets, s, {}, {r, 2});
+    models[r] = bake::make_untrained_model(assets, 7, layout, 3);
+    bake::Trainer trainer(data, assets, models[r], ts, comm);
+    for (int i = 0; i < 40; ++i) trainer.step();
+  });
+  EXPECT_EQ(weights(models[0]), weights(models[1]));
+  const auto a = weights(one), b = weights(models[0]);
+  double diff = 0, norm = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) diff += double(a[i] - b[i]) * (a[i] - b[i]), norm += double(a[i]) * a[i];
+  EXPECT_LT(std::sqrt(diff / norm), 1e-5);
+}

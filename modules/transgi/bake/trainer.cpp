@@ -154,8 +154,15 @@ float Trainer::step() {
     }
   }
 
-  std::fill(grad_.begin(), grad_.end(), 0.0f);
   const std::size_t n_dec = model_.decoder.params().size();
+  const auto d = static_cast<std::size_t>(model_.latent_dim);
+  const bool lazy = settings_.latent_updates == LatentUpdates::Touched;
+  if (lazy) {  // only the last step's rows can hold gradients
+    std::fill(grad_.begin(), grad_.begin() + static_cast<std::ptrdiff_t>(n_dec), 0.0f);
+    for (std::uint64_t r : touched_rows_) std::fill_n(grad_.begin() + static_cast<std::ptrdiff_t>(n_dec + r * d), d, 0.0f);
+  } else {
+    std::fill(grad_.begin(), grad_.end(), 0.0f);
+  }
   const int in = model_.decoder.layout().inputs;
   if (rows > 0) {
     std::vector<float> dx(x.size());
@@ -168,14 +175,13 @@ float Trainer::step() {
     }
   }
   times_.samples += idx.size();
+  if (lazy || comm_.size() > 1) touched_rows_ = latent_rows_of(idx);
   const auto t1 = std::chrono::steady_clock::now();
-  if (comm_.size() > 1) exchange_gradients(idx, loss);
+  if (comm_.size() > 1) exchange_gradients(loss);
   const auto t2 = std::chrono::steady_clock::now();
   loss *= scale;
 
-  bool finite = std::isfinite(loss);
-  for (std::size_t i = 0; finite && i < grad_.size(); ++i) finite = std::isfinite(grad_[i]);
-  if (!finite) rollback();
+  if (!gradients_finite(loss)) rollback();
   else adam_step();
   const auto t3 = std::chrono::steady_clock::now();
   times_.compute_seconds += std::chrono::duration<double>((t1 - t0) + (t3 - t2)).count();
@@ -183,27 +189,50 @@ float Trainer::step() {
   return static_cast<float>(loss);
 }
 
+std::vector<std::uint64_t> Trainer::latent_rows_of(std::span<const std::size_t> batch) const {
+  const auto d = static_cast<std::size_t>(model_.latent_dim);
+  std::vector<std::uint64_t> rows;
+  if (d == 0) return rows;
+  for (std::size_t i : batch) {
+    const TransferSample& s = data_.samples[i];
+    const auto& table = model_.meshes[s.mesh].latents;
+    const glm::uvec3 t = assets_.meshes[s.mesh]->triangles[s.triangle];
+    for (std::uint32_t v : {t.x, t.y, t.z}) rows.push_back(latent_offset_[s.mesh] / d + table.vertex_to_latent[v]);
+  }
+  std::sort(rows.begin(), rows.end());
+  rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+  return rows;
+}
+
+bool Trainer::gradients_finite(double loss) const {
+  if (!std::isfinite(loss)) return false;
+  if (settings_.latent_updates == LatentUpdates::All) {
+    for (float g : grad_)
+      if (!std::isfinite(g)) return false;
+    return true;
+  }
+  const std::size_t n_dec = model_.decoder.params().size(), d = static_cast<std::size_t>(model_.latent_dim);
+  for (std::size_t i = 0; i < n_dec; ++i)
+    if (!std::isfinite(grad_[i])) return false;
+  for (std::uint64_t r : touched_rows_)
+    for (std::size_t k = 0; k < d; ++k)
+      if (!std::isfinite(grad_[n_dec + r * d + k])) return false;
+  return true;
+}
+
 // The decoder's gradients and the loss are summed densely. A latent row gets
 // gradients only from the samples on its triangles, at most 3 x batch rows a
 // step however large the level, so the ranks exchange only the rows they
 // touched (a row index and its values): for a 10 M-vertex level that is
 // about 200 KB a step where the dense table would be 280 MB (docs/bake.md).
-void Trainer::exchange_gradients(std::span<const std::size_t> batch, double& loss) {
+void Trainer::exchange_gradients(double& loss) {
   const std::size_t n_dec = model_.decoder.params().size();
   comm_.sum(std::span(grad_).first(n_dec));
   comm_.sum(std::span(&loss, 1));
   const auto d = static_cast<std::size_t>(model_.latent_dim);
   if (d == 0) return;
 
-  std::vector<std::uint64_t> touched;  // flat latent row indices over every mesh
-  for (std::size_t i : batch) {
-    const TransferSample& s = data_.samples[i];
-    const auto& table = model_.meshes[s.mesh].latents;
-    const glm::uvec3 t = assets_.meshes[s.mesh]->triangles[s.triangle];
-    for (std::uint32_t v : {t.x, t.y, t.z}) touched.push_back(latent_offset_[s.mesh] / d + table.vertex_to_latent[v]);
-  }
-  std::sort(touched.begin(), touched.end());
-  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+  const std::vector<std::uint64_t>& touched = touched_rows_;
   const std::size_t row_bytes = sizeof(std::uint64_t) + d * sizeof(float);
   std::vector<std::byte> mine(touched.size() * row_bytes);
   for (std::size_t r = 0; r < touched.size(); ++r) {
@@ -214,6 +243,7 @@ void Trainer::exchange_gradients(std::span<const std::size_t> batch, double& los
   // Every rank adds the same rows in rank order: the same sums on every rank.
   float* latent_grad = grad_.data() + n_dec;
   std::vector<float> row_values(d);
+  std::vector<std::uint64_t> every_rank_rows;
   for (int add = 0; add < 2; ++add)
     for (const auto& part : all)
       for (std::size_t at = 0; at + row_bytes <= part.size(); at += row_bytes) {
@@ -223,11 +253,15 @@ void Trainer::exchange_gradients(std::span<const std::size_t> batch, double& los
         float* g = latent_grad + row * d;
         if (add == 0) {
           std::fill_n(g, d, 0.0f);
+          every_rank_rows.push_back(row);
         } else {
           std::memcpy(row_values.data(), part.data() + at + sizeof(row), d * sizeof(float));
           for (std::size_t k = 0; k < d; ++k) g[k] += row_values[k];
         }
       }
+  std::sort(every_rank_rows.begin(), every_rank_rows.end());
+  every_rank_rows.erase(std::unique(every_rank_rows.begin(), every_rank_rows.end()), every_rank_rows.end());
+  touched_rows_ = std::move(every_rank_rows);
 }
 
 // Adam with bias correction; the latents get their own rate.
@@ -246,9 +280,17 @@ void Trainer::adam_step() {
   };
   auto& params = model_.decoder.params();
   for (std::size_t i = 0; i < n_dec; ++i) update(i, params[i], lr);
-  std::size_t flat = 0;
-  for (auto& mesh : model_.meshes)
-    for (float& p : mesh.latents.values) update(n_dec + flat++, p, lr_latent);
+  if (settings_.latent_updates == LatentUpdates::Touched) {
+    const auto d = static_cast<std::size_t>(model_.latent_dim);
+    for (std::uint64_t r : touched_rows_) {
+      float* row = latent_ptr(r * d);  // a row never spans two meshes
+      for (std::size_t k = 0; k < d; ++k) update(n_dec + r * d + k, row[k], lr_latent);
+    }
+  } else {
+    std::size_t flat = 0;
+    for (auto& mesh : model_.meshes)
+      for (float& p : mesh.latents.values) update(n_dec + flat++, p, lr_latent);
+  }
   if (iteration_ % kSnapshotEvery == 0) snapshot();
 }
 

@@ -14,6 +14,17 @@
 
 namespace transgi::bake {
 
+// Which latent rows a step's Adam update moves.
+enum class LatentUpdates {
+  // Every row, every step: the moments of rows without gradients decay and
+  // keep moving them. What every model so far was trained with.
+  All,
+  // Only the rows the step's batch touched, on every rank alike (lazy Adam,
+  // as embedding tables are trained): a step's cost follows the batch, not
+  // the level (docs/bake.md, "Scaling"), at the cost of other optimiser steps.
+  Touched,
+};
+
 struct TrainSettings {
   int iterations = 20000;  // higher = lower error, at the cost of time (the paper trains 200k on a GPU)
   int batch = 2048;
@@ -24,6 +35,7 @@ struct TrainSettings {
   std::vector<float> milestones = {0.5f, 0.75f, 0.9f};  // fractions of `iterations`
   float decay = 0.33f;                   // learning-rate factor at each milestone
   std::uint64_t seed = 7;
+  LatentUpdates latent_updates = LatentUpdates::All;
   model::GemmBackend backend = model::default_gemm_backend();
 };
 
@@ -81,7 +93,10 @@ class Trainer {
   std::size_t parameter_count() const;
   // This rank's share of a batch drawn over every rank's training samples.
   std::vector<std::size_t> draw_local_batch();
-  void exchange_gradients(std::span<const std::size_t> batch, double& loss);
+  // The flat latent rows (over every mesh) that these samples interpolate, sorted, once each.
+  std::vector<std::uint64_t> latent_rows_of(std::span<const std::size_t> batch) const;
+  void exchange_gradients(double& loss);
+  [[nodiscard]] bool gradients_finite(double loss) const;
   void adam_step();
   void snapshot();
   void rollback();
@@ -95,6 +110,9 @@ class Trainer {
   std::vector<std::size_t> latent_offset_;  // per mesh, into the flat latent index space
   std::size_t latent_count_ = 0;
   std::vector<float> m_, v_, grad_;
+  // This step's latent rows (LatentUpdates::Touched, or several ranks): this
+  // rank's before the exchange, every rank's after it.
+  std::vector<std::uint64_t> touched_rows_;
   int iteration_ = 0;
   float lr_scale_ = 1.0f;
   int rollbacks_ = 0;

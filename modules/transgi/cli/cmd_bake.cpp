@@ -65,6 +65,8 @@ BakeCommand parse_bake_command(const Args& args) {
   s.data.seed = static_cast<std::uint64_t>(args.integer("seed", 0, INT64_MAX, static_cast<std::int64_t>(s.data.seed)));
   s.resume = args.has("resume");
   s.keep_dataset = args.has("keep-dataset");
+  if (args.choice("latent-updates", {"all", "touched"}, std::string("all")) == "touched")
+    s.train.latent_updates = bake::LatentUpdates::Touched;
 
   return c;
 }
@@ -170,7 +172,7 @@ void bake_as_rank(const BakeCommand& c, const BakeProcesses& processes) {
 int run_bake(const std::vector<std::string>& argv) {
   const Args args("bake", argv,
                   {"scene", "out", "points", "dirs", "outgoing", "iters", "batch", "lr", "latent-dim", "width", "depth",
-                   "threads", "seed", "curve", "max-points-per-vertex"},
+                   "threads", "seed", "curve", "max-points-per-vertex", "latent-updates"},
                   {"resume", "keep-dataset"});
   const BakeCommand command = parse_bake_command(args);
   const BakeProcesses processes = join_bake_processes();
