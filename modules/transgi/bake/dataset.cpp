@@ -1,7 +1,6 @@
 #include "bake/dataset.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -120,16 +119,13 @@ TransferDataset generate_dataset(const engine::scene::SceneAssets& assets, const
   for (std::size_t p = 0; p < total_points; ++p)
     if (shard_of_point(s.seed, p, shard.count) == shard.rank) mine.push_back(p);
 
+  // A mesh's tracer lives from the first round that samples it to its last
+  // (points run mesh after mesh), so only a round's few meshes are held at once.
+  const auto mesh_of = [&](std::size_t p) {
+    return static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), p) - first.begin() - 1);
+  };
   std::vector<std::unique_ptr<engine::rt::RtScene>> tracers(mesh_count);
   std::vector<std::unique_ptr<MeshTransfer>> transfers(mesh_count);
-  for (std::size_t p : mine) {
-    const auto m = static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), p) - first.begin() - 1);
-    if (transfers[m]) continue;
-    tracers[m] = make_object_tracer(assets, static_cast<std::uint32_t>(m));
-    transfers[m] = std::make_unique<MeshTransfer>(
-        *tracers[m], *assets.meshes[m], assets,
-        s.visibility_fraction * glm::length(assets.meshes[m]->bounds_max - assets.meshes[m]->bounds_min));
-  }
 
   // Round r traces this shard's points among the scene's r-th hundredth, so
   // every rank passes its rounds at about the same time.
@@ -139,13 +135,23 @@ TransferDataset generate_dataset(const engine::scene::SceneAssets& assets, const
     const std::size_t hi = total_points * static_cast<std::size_t>(round + 1) / kSamplingRounds;
     const auto b = static_cast<int>(std::lower_bound(mine.begin(), mine.end(), lo) - mine.begin());
     const auto e = static_cast<int>(std::lower_bound(mine.begin(), mine.end(), hi) - mine.begin());
+    for (int i = b; i < e; ++i) {
+      const std::size_t m = mesh_of(mine[static_cast<std::size_t>(i)]);
+      if (transfers[m]) continue;
+      tracers[m] = make_object_tracer(assets, static_cast<std::uint32_t>(m));
+      transfers[m] = std::make_unique<MeshTransfer>(
+          *tracers[m], *assets.meshes[m], assets,
+          s.visibility_fraction * glm::length(assets.meshes[m]->bounds_max - assets.meshes[m]->bounds_min));
+    }
     engine::jobs::parallel_for(b, e, 4, [&](int pb, int pe) {
       for (int i = pb; i < pe; ++i) {
         const std::size_t p = mine[static_cast<std::size_t>(i)];
-        const auto m = static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), p) - first.begin() - 1);
+        const std::size_t m = mesh_of(p);
         results[static_cast<std::size_t>(i)] = sample_point(*transfers[m], static_cast<std::uint32_t>(m), p, s);
       }
     });
+    for (std::size_t m = 0; m < mesh_count; ++m)
+      if (transfers[m] && first[m + 1] <= hi) transfers[m].reset(), tracers[m].reset();  // its last point is traced
     if (progress) progress(static_cast<std::size_t>(e), mine.size());
   }
 
