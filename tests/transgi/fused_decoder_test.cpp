@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <vector>
 
 #include "engine/core/cpu_isa.h"
@@ -12,6 +13,7 @@
 #include "model/model_file.h"
 #include "shading/fused_decoder.h"
 #include "shading/sh_light.h"
+#include "shading/transfer_inference.h"
 
 using namespace transgi;
 using shading::FusedIsa;
@@ -199,4 +201,54 @@ TEST(FusedDecoder, SecondLightEqualsASeparateCall) {
       }
     }
   }
+}
+
+// decode_tile hands out the transfer that shade_tile dots with its light
+// (the real-time path keeps it across frames, gi_history.h): the same output
+// layer, so dotted with the light it is shade_tile's value up to the order of
+// the sum, and against the double oracle's transfer it is as close as
+// shade_tile's values are to the oracle's.
+TEST(FusedDecoder, DecodedTransferIsWhatShadeTileDotsWithTheLight) {
+  int tested = 0;
+  for (FusedIsa isa : {FusedIsa::Scalar, FusedIsa::Avx2, FusedIsa::Avx512Bf16, FusedIsa::Amx}) {
+    if (!shading::cpu_supports(isa)) {
+      std::printf("[ skipped  ] %s: not enabled on %s\n", shading::fused_isa_name(isa), engine::cpu::isa_summary().c_str());
+      continue;
+    }
+    const model::Mlp mlp = random_mlp({}, 13);
+    const model::MlpLayout& lay = mlp.layout();
+    const shading::FusedDecoder d(mlp, isa);
+    for (int n : {1, 7, 64}) {
+      const Batch b = random_batch(n, lay.inputs, 40u + static_cast<std::uint64_t>(n));
+      std::vector<float> transfer(static_cast<std::size_t>(n) * 75, std::numeric_limits<float>::quiet_NaN());
+      std::vector<float> rgb(static_cast<std::size_t>(n) * 3);
+      d.decode_tile(b.inputs.data(), n, transfer.data());
+      d.shade_tile(b.inputs.data(), b.light.data(), n, rgb.data());
+      double dot_se = 0, dot_ref = 0, oracle_se = 0, oracle_ref = 0;
+      for (int i = 0; i < n; ++i) {
+        const glm::vec3 dotted = shading::dot_transfer(transfer.data() + static_cast<std::size_t>(i) * 75, b.light.data() + static_cast<std::size_t>(i) * 75);
+        for (int c = 0; c < 3; ++c) {
+          const double want = rgb[static_cast<std::size_t>(i) * 3 + static_cast<std::size_t>(c)];
+          dot_se += (dotted[c] - want) * (dotted[c] - want);
+          dot_ref += want * want;
+        }
+        // The oracle's transfer: its value with a unit light on one coefficient.
+        for (int k = 0; k < 75; k += 11) {
+          std::vector<float> unit(75, 0.0f);
+          unit[static_cast<std::size_t>(k)] = 1.0f;
+          const double want = oracle(mlp, b.inputs.data() + static_cast<std::size_t>(i) * lay.inputs, unit.data())[k / 25];
+          const double got = transfer[static_cast<std::size_t>(i) * 75 + static_cast<std::size_t>(k)];
+          oracle_se += (got - want) * (got - want);
+          oracle_ref += want * want;
+        }
+      }
+      const double dot_error = std::sqrt(dot_se / dot_ref), oracle_error = std::sqrt(oracle_se / oracle_ref);
+      EXPECT_LE(dot_error, 1e-5) << shading::fused_isa_name(isa) << " n " << n
+                                 << ": the transfer dotted with the light must be shade_tile's value, relative RMS " << dot_error;
+      EXPECT_LE(oracle_error, tolerance(isa)) << shading::fused_isa_name(isa) << " n " << n << ": transfer against the oracle's, relative RMS "
+                                              << oracle_error;
+      ++tested;
+    }
+  }
+  EXPECT_GT(tested, 0);
 }

@@ -359,3 +359,53 @@ TEST(NanContainment, EachStageReplacesAndCountsWhatIsNotFinite) {
     EXPECT_GT(mean_luminance(f.full), 0.0) << "stage " << stage << ": the rest must still be lit";
   }
 }
+
+// Kept transfer (gi_history.h): a query whose transfer is kept is not
+// decoded (its 75 values, here a marker no decoder gives, are left as they
+// are and lit); the others are decoded into their slots as the scalar
+// reference decodes them; every value is its transfer dotted with its light.
+TEST(TransferInference, KeptTransferIsLitAndOnlyTheRestIsDecoded) {
+  const scene::SceneAssets assets = floor_and_cube();
+  math::Pcg32 rng(15, 6);
+  const model::TransferModel m = random_model(assets, 128, rng);
+  const std::vector<shading::TransferQuery> queries = random_queries(assets, 2 * shading::kFusedTile + 29, rng);
+  std::vector<float> light(queries.size() * 75), light2(queries.size() * 75);
+  for (std::size_t i = 0; i < light.size(); ++i) {
+    light[i] = rng.next_float();
+    light2[i] = rng.next_float() - 0.5f;
+  }
+  std::vector<float> slots(queries.size() * 75);
+  std::vector<float*> transfer(queries.size());
+  std::vector<std::uint8_t> decode(queries.size());
+  for (std::size_t i = 0; i < queries.size(); ++i) {
+    transfer[i] = slots.data() + i * 75;
+    decode[i] = i % 3 != 0;
+    for (int k = 0; k < 75; ++k) transfer[i][k] = decode[i] ? -1e30f : 0.01f * static_cast<float>(k + 1);  // the marker
+  }
+  const shading::FusedDecoder decoder(m.decoder, shading::best_fused_isa());
+  std::vector<glm::vec3> out(queries.size()), out2(queries.size());
+  std::vector<int> filled(queries.size(), 0);
+  jobs::JobSystem jobs({.threads = 2});
+  jobs.run([&] {
+    shading::shade_transfer_kept(decoder, m, assets, queries, transfer, decode, copying_fill(light, light2, filled), out.data(),
+                                 out2.data());
+  });
+  double worst = 0, scale = 0;
+  for (std::size_t i = 0; i < queries.size(); ++i) {
+    ASSERT_EQ(filled[i], 1) << "query " << i << " was filled " << filled[i] << " times";
+    ASSERT_EQ(out[i], shading::dot_transfer(transfer[i], light.data() + i * 75)) << "query " << i;
+    ASSERT_EQ(out2[i], shading::dot_transfer(transfer[i], light2.data() + i * 75)) << "query " << i;
+    if (!decode[i]) {
+      for (int k = 0; k < 75; ++k) ASSERT_EQ(transfer[i][k], 0.01f * static_cast<float>(k + 1)) << "kept query " << i << " was decoded";
+      continue;
+    }
+    float t[75];
+    shading::infer_transfer_reference(m, assets, queries[i], t);
+    for (int k = 0; k < 75; ++k) {
+      worst = std::max(worst, static_cast<double>(std::abs(transfer[i][k] - t[k])));
+      scale = std::max(scale, static_cast<double>(std::abs(t[k])));
+    }
+  }
+  // bf16 weights: within 1e-2 of the largest value, as the fused path.
+  EXPECT_LT(worst, 1e-2 * scale) << "worst absolute transfer difference " << worst << " against values up to " << scale;
+}

@@ -176,9 +176,9 @@ int run_bench_frame(const std::vector<std::string>& argv) {
     std::printf(" %s %.2f;", names[k], percentile(v, 0.5));
   }
   std::printf("\n");
-  std::printf("last frame: %zu pixels decoded (%zu grid, %zu edge), %zu grid cells reused from the frame before, %zu rotations, %zu reflection rays, %d probes traced\n",
+  std::printf("last frame: %zu pixels lit (%zu grid, %zu edge; %zu of them with a kept transfer, not decoded), %zu grid cells reused from the frame before, %zu rotations, %zu reflection rays, %d probes traced\n",
               frame.realtime.grid_samples + frame.realtime.edge_samples, frame.realtime.grid_samples,
-              frame.realtime.edge_samples, frame.realtime.reused_cells, frame.realtime.rotations, frame.realtime.reflection_rays,
+              frame.realtime.edge_samples, frame.realtime.kept_transfers, frame.realtime.reused_cells, frame.realtime.rotations, frame.realtime.reflection_rays,
               frame.probe_stats.traced);
   if (!inference_gflops.empty()) {
     const shading::FusedIsa isa = shading::best_fused_isa();

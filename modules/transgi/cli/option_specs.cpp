@@ -62,6 +62,13 @@ std::vector<OptionSpec> runtime_option_specs(const std::string& default_preset) 
               "probes traced a frame (0 = all): higher = light follows changes sooner, at the cost of probe time"),
       choice("gi-reuse", {"on", "off"}, on_off_by_preset(q.realtime.reuse_history, r.realtime.reuse_history),
              "real-time GI cells taken from the frame before where nothing changed: about half the decoding"),
+      integer("keep-transfer", "F", 0, 4096, by_preset(q.realtime.transfer_max_age, r.realtime.transfer_max_age),
+              "with gi-reuse, frames a cell keeps its decoded transfer (0 = none): higher = fewer decodes, at the cost of "
+              "transfer held at one sub-pixel position longer"),
+      number("keep-transfer-degrees", "D", 0.0, 90.0,
+             by_preset(q.realtime.transfer_view_degrees, r.realtime.transfer_view_degrees),
+             "view turn before a kept transfer is decoded again: higher = fewer decodes, at the cost of glossy transfer "
+             "seen from that far off"),
       choice("taa", {"on", "off"}, on_off_by_preset(q.taa.enabled, r.taa.enabled),
              "temporal antialiasing of the real-time frame (off shows one frame's samples)"),
       integer("probe-settle", "F", 0, 4096, by_preset(q.probes.settle_frames, r.probes.settle_frames),

@@ -13,6 +13,9 @@ runtime::TransGISettings runtime_settings_from(const Args& args, const char* def
   s.realtime.resolution_scale = static_cast<float>(args.number("gi-scale", 0.05, 1.0, s.realtime.resolution_scale));
   s.probes.update_budget = static_cast<int>(args.integer("probe-budget", 0, 1 << 20, s.probes.update_budget));
   if (args.has("gi-reuse")) s.realtime.reuse_history = args.choice("gi-reuse", {"on", "off"}, "on") == "on";
+  s.realtime.transfer_max_age = static_cast<int>(args.integer("keep-transfer", 0, 4096, s.realtime.transfer_max_age));
+  s.realtime.transfer_view_degrees =
+      static_cast<float>(args.number("keep-transfer-degrees", 0.0, 90.0, s.realtime.transfer_view_degrees));
   if (args.has("taa")) s.taa.enabled = args.choice("taa", {"on", "off"}, "on") == "on";
   s.probes.settle_frames = static_cast<int>(args.integer("probe-settle", 0, 4096, s.probes.settle_frames));
   s.probes.map.width = static_cast<int>(args.integer("map-width", 4, 4096, s.probes.map.width));

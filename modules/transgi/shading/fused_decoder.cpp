@@ -1,5 +1,6 @@
 #include "shading/fused_decoder.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdlib>
@@ -158,12 +159,23 @@ FusedDecoder::FusedDecoder(const model::Mlp& mlp, FusedIsa isa) : layout_(mlp.la
 void FusedDecoder::shade_tile(const float* inputs, const float* light, int n, float* rgb, const float* light2,
                               float* rgb2) const {
   if (!light2 || !rgb2) light2 = nullptr, rgb2 = nullptr;
+  run_tile(inputs, light, n, rgb, light2, rgb2, nullptr);
+}
+
+void FusedDecoder::decode_tile(const float* inputs, int n, float* transfer) const {
+  run_tile(inputs, nullptr, n, nullptr, nullptr, nullptr, transfer);
+}
+
+void FusedDecoder::run_tile(const float* inputs, const float* light, int n, float* rgb, const float* light2, float* rgb2,
+                            float* transfer) const {
   if (n <= 0) return;
-  if (n > kFusedTile) throw std::invalid_argument("FusedDecoder::shade_tile: more than kFusedTile points");
+  if (n > kFusedTile) throw std::invalid_argument("FusedDecoder: more than kFusedTile points in a tile");
   switch (isa_) {
-    case FusedIsa::Avx512Bf16: detail::shade_tile_avx512bf16(layers_, layout_.inputs, inputs, light, n, rgb, light2, rgb2); return;
-    case FusedIsa::Amx: detail::shade_tile_amx(layers_, layout_.inputs, inputs, light, n, rgb, light2, rgb2); return;
-    case FusedIsa::Avx2: detail::shade_tile_avx2(layers_, layout_.inputs, inputs, light, n, rgb, light2, rgb2); return;
+    case FusedIsa::Avx512Bf16:
+      detail::shade_tile_avx512bf16(layers_, layout_.inputs, inputs, light, n, rgb, light2, rgb2, transfer);
+      return;
+    case FusedIsa::Amx: detail::shade_tile_amx(layers_, layout_.inputs, inputs, light, n, rgb, light2, rgb2, transfer); return;
+    case FusedIsa::Avx2: detail::shade_tile_avx2(layers_, layout_.inputs, inputs, light, n, rgb, light2, rgb2, transfer); return;
     case FusedIsa::Scalar: break;
   }
   // Plain fp32 loops, one point at a time.
@@ -181,6 +193,10 @@ void FusedDecoder::shade_tile(const float* inputs, const float* light, int n, fl
         y[static_cast<std::size_t>(o)] = l < layout_.hidden_layers ? std::max(0.0f, s) : s;
       }
       x.swap(y);
+    }
+    if (transfer) {
+      std::copy_n(x.data(), 75, transfer + static_cast<std::size_t>(i) * 75);
+      continue;
     }
     for (int which = 0; which < (light2 ? 2 : 1); ++which) {
       const float* li = (which ? light2 : light) + static_cast<std::size_t>(i) * 75;

@@ -67,11 +67,19 @@ class FusedDecoder {
   void shade_tile(const float* inputs, const float* light, int n, float* rgb, const float* light2 = nullptr,
                   float* rgb2 = nullptr) const;
 
+  // The decoded transfer itself, for callers that keep it across frames and
+  // dot it with later lights (gi_history.h): transfer: n x 75, [c * 25 + k]
+  // per point, what shade_tile dots with its light. Single-threaded.
+  void decode_tile(const float* inputs, int n, float* transfer) const;
+
   [[nodiscard]] FusedIsa isa() const { return isa_; }
   [[nodiscard]] const model::MlpLayout& layout() const { return layout_; }
   [[nodiscard]] const std::vector<PackedLayer>& layers() const { return layers_; }
 
  private:
+  void run_tile(const float* inputs, const float* light, int n, float* rgb, const float* light2, float* rgb2,
+                float* transfer) const;
+
   model::MlpLayout layout_;
   FusedIsa isa_;
   std::vector<PackedLayer> layers_;

@@ -116,6 +116,15 @@ TRANSGI_AMX void dot_with_light(const PackedLayer& L, const float* acc, const fl
     }
 }
 
+// transfer[r][c * 25 + k] = acc[r][c * 32 + k] + bias: the output layer's
+// values out of the channel-blocked layout.
+TRANSGI_AMX void unblock_transfer(const PackedLayer& L, const float* acc, int n, float* transfer) {
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 25; ++k)
+        transfer[static_cast<std::size_t>(r) * 75 + c * 25 + k] = acc[r * kAmxOutputs + c * 32 + k] + L.bias[static_cast<std::size_t>(c * 32 + k)];
+}
+
 // 75 light values into the channel-blocked, zero-padded layout.
 void block_light(const float* src, float* dst) {
   for (int c = 0; c < 3; ++c) {
@@ -127,9 +136,10 @@ void block_light(const float* src, float* dst) {
 }  // namespace
 
 TRANSGI_AMX void shade_tile_amx(const std::vector<PackedLayer>& layers, int inputs, const float* x, const float* light,
-                                int n, float* rgb, const float* light2, float* rgb2) {
+                                int n, float* rgb, const float* light2, float* rgb2, float* transfer) {
   thread_local Scratch s;
-  const bool two_lights = light2 && rgb2;
+  const bool keep_transfer = transfer != nullptr;
+  const bool two_lights = !keep_transfer && light2 && rgb2;
   const int rows = (n + kRowBlock - 1) / kRowBlock * kRowBlock;
   // Padding rows past n get zero inputs, so they compute finite values that
   // are never read back.
@@ -137,7 +147,7 @@ TRANSGI_AMX void shade_tile_amx(const std::vector<PackedLayer>& layers, int inpu
     float* in = s.input + i * kMaxInputs;
     if (i < n) {
       std::copy_n(x + static_cast<std::size_t>(i) * inputs, inputs, in);
-      block_light(light + static_cast<std::size_t>(i) * 75, s.light + i * kAmxOutputs);
+      if (!keep_transfer) block_light(light + static_cast<std::size_t>(i) * 75, s.light + i * kAmxOutputs);
       if (two_lights) block_light(light2 + static_cast<std::size_t>(i) * 75, s.light2 + i * kAmxOutputs);
     } else {
       std::fill_n(in, inputs, 0.0f);
@@ -154,6 +164,10 @@ TRANSGI_AMX void shade_tile_amx(const std::vector<PackedLayer>& layers, int inpu
   const PackedLayer& out = layers.back();
   tile_product(out, s.act[src], out.in, s.acc, rows);
   _tile_release();
+  if (keep_transfer) {
+    unblock_transfer(out, s.acc, n, transfer);
+    return;
+  }
   dot_with_light(out, s.acc, s.light, n, rgb);
   if (two_lights) dot_with_light(out, s.acc, s.light2, n, rgb2);
 }

@@ -26,8 +26,10 @@ struct Tile {
   alignas(32) float act[2][kTileRows * kMaxWidth];  // act[0] also holds the inputs
   alignas(32) float light[kTileRows * kLightPadded];
   alignas(32) float light2[kTileRows * kLightPadded];
+  alignas(32) float transfer[kTileRows * kLightPadded];  // the output layer's values, when kept
   float rgb[kTileRows * 3], rgb2[kTileRows * 3];
   bool two_lights = false;
+  bool keep_transfer = false;  // store the output layer instead of dotting it with the light
 };
 
 TRANSGI_AVX2 inline void dot_light(__m256 y, const float* light, int o, float* rgb) {
@@ -65,7 +67,9 @@ TRANSGI_AVX2 void layer_group(const PackedLayer& L, int o0, Tile& t, int src, in
 #pragma GCC unroll 8
       for (int j = 0; j < NB; ++j) {
         const int o = o0 + j * kLanes;
-        if (output) {
+        if (output && t.keep_transfer) {
+          _mm256_store_ps(t.transfer + (r0 + p) * kLightPadded + o, acc[p][j]);
+        } else if (output) {
           dot_light(acc[p][j], t.light + (r0 + p) * kLightPadded, o, t.rgb + (r0 + p) * 3);
           if (t.two_lights) dot_light(acc[p][j], t.light2 + (r0 + p) * kLightPadded, o, t.rgb2 + (r0 + p) * 3);
         } else {
@@ -88,9 +92,10 @@ TRANSGI_AVX2 void run_layer(const PackedLayer& L, Tile& t, int src, int rows, bo
 }  // namespace
 
 TRANSGI_AVX2 void shade_tile_avx2(const std::vector<PackedLayer>& layers, int inputs, const float* x, const float* light,
-                                  int n, float* rgb, const float* light2, float* rgb2) {
+                                  int n, float* rgb, const float* light2, float* rgb2, float* transfer) {
   thread_local Tile t;
-  t.two_lights = light2 && rgb2;
+  t.keep_transfer = transfer != nullptr;
+  t.two_lights = !t.keep_transfer && light2 && rgb2;
   const int rows = (n + kRows - 1) / kRows * kRows;
   // Rows are independent: the padding rows past n are zeroed only so that
   // they compute finite values, which are dropped at the end.
@@ -102,7 +107,7 @@ TRANSGI_AVX2 void shade_tile_avx2(const std::vector<PackedLayer>& layers, int in
     float* l2 = t.light2 + i * kLightPadded;
     if (i < n) {
       std::copy_n(x + static_cast<std::size_t>(i) * inputs, inputs, in);
-      std::copy_n(light + static_cast<std::size_t>(i) * 75, 75, l);
+      if (!t.keep_transfer) std::copy_n(light + static_cast<std::size_t>(i) * 75, 75, l);
       if (t.two_lights) std::copy_n(light2 + static_cast<std::size_t>(i) * 75, 75, l2);
     } else {
       std::fill_n(in, inputs, 0.0f);
@@ -112,6 +117,10 @@ TRANSGI_AVX2 void shade_tile_avx2(const std::vector<PackedLayer>& layers, int in
   }
   int src = 0;
   for (std::size_t l = 0; l < layers.size(); ++l, src = 1 - src) run_layer(layers[l], t, src, rows, l + 1 == layers.size());
+  if (t.keep_transfer) {
+    for (int i = 0; i < n; ++i) std::copy_n(t.transfer + i * kLightPadded, 75, transfer + static_cast<std::size_t>(i) * 75);
+    return;
+  }
   std::copy_n(t.rgb, n * 3, rgb);
   if (t.two_lights) std::copy_n(t.rgb2, n * 3, rgb2);
 }

@@ -33,8 +33,10 @@ struct Tile {
   alignas(64) float light[kFusedTile * kLightPadded];
   alignas(64) float light2[kFusedTile * kLightPadded];
   alignas(64) std::uint16_t act[2][kFusedTile * kMaxWidth];
+  alignas(64) float transfer[kFusedTile * kLightPadded];  // the output layer's values, when kept
   float rgb[kFusedTile * 3], rgb2[kFusedTile * 3];
   bool two_lights = false;
+  bool keep_transfer = false;  // store the output layer instead of dotting it with the light
 };
 
 TRANSGI_AVX512BF16 inline __m512bh broadcast_pair(const std::uint16_t* p) {
@@ -123,7 +125,9 @@ TRANSGI_AVX512BF16 void bf16_layer_group(const PackedLayer& L, int o0, Tile& t, 
 #pragma GCC unroll 16
       for (int j = 0; j < NB; ++j) {
         const int o = o0 + j * kLanes;
-        if constexpr (kOutput) {
+        if (kOutput && t.keep_transfer) {
+          _mm512_store_ps(t.transfer + (r0 + p) * kLightPadded + o, acc[p][j]);
+        } else if constexpr (kOutput) {
           dot_light(acc[p][j], t.light + (r0 + p) * kLightPadded, o, t.rgb + (r0 + p) * 3);
           if (t.two_lights) dot_light(acc[p][j], t.light2 + (r0 + p) * kLightPadded, o, t.rgb2 + (r0 + p) * 3);
         } else {
@@ -175,9 +179,11 @@ TRANSGI_AVX512BF16 void first_layer_avx512(const PackedLayer& L, const float* in
 }
 
 TRANSGI_AVX512BF16 void shade_tile_avx512bf16(const std::vector<PackedLayer>& layers, int inputs, const float* x,
-                                              const float* light, int n, float* rgb, const float* light2, float* rgb2) {
+                                              const float* light, int n, float* rgb, const float* light2, float* rgb2,
+                                              float* transfer) {
   thread_local Tile t;
-  t.two_lights = light2 && rgb2;
+  t.keep_transfer = transfer != nullptr;
+  t.two_lights = !t.keep_transfer && light2 && rgb2;
   const int rows = (n + kRowMultiple - 1) / kRowMultiple * kRowMultiple;
   // Rows are independent: the padding rows past n are zeroed only so that
   // they compute finite values, which are dropped at the end.
@@ -186,7 +192,7 @@ TRANSGI_AVX512BF16 void shade_tile_avx512bf16(const std::vector<PackedLayer>& la
   std::fill_n(t.rgb2, rows * 3, 0.0f);
   for (int i = 0; i < rows; ++i) {
     float* l = t.light + i * kLightPadded;
-    if (i < n) std::copy_n(light + static_cast<std::size_t>(i) * 75, 75, l);
+    if (i < n && !t.keep_transfer) std::copy_n(light + static_cast<std::size_t>(i) * 75, 75, l);
     std::fill(l + (i < n ? 75 : 0), l + kLightPadded, 0.0f);
     if (t.two_lights) {
       float* l2 = t.light2 + i * kLightPadded;
@@ -199,6 +205,10 @@ TRANSGI_AVX512BF16 void shade_tile_avx512bf16(const std::vector<PackedLayer>& la
   int src = 0;
   for (std::size_t l = 1; l + 1 < layers.size(); ++l, src = 1 - src) for_each_group<HiddenLayer>(layers[l], t, src, rows);
   for_each_group<OutputLayer>(layers.back(), t, src, rows);
+  if (t.keep_transfer) {
+    for (int i = 0; i < n; ++i) std::copy_n(t.transfer + i * kLightPadded, 75, transfer + static_cast<std::size_t>(i) * 75);
+    return;
+  }
   std::copy_n(t.rgb, n * 3, rgb);
   if (t.two_lights) std::copy_n(t.rgb2, n * 3, rgb2);
 }

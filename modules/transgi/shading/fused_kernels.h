@@ -24,18 +24,19 @@ inline constexpr int kGroupAvx2 = 16;
 // kGroupAvx512 fp32 outputs.
 void first_layer_avx512(const PackedLayer& L, const float* input, std::uint16_t* act, int act_stride, int rows);
 
-// light2 / rgb2 may be null (one light).
+// light2 / rgb2 may be null (one light). With transfer, the output layer's
+// values go there (n x 75) instead, and the lights and rgb are not read.
 void shade_tile_avx512bf16(const std::vector<PackedLayer>& layers, int inputs, const float* x, const float* light, int n,
-                           float* rgb, const float* light2, float* rgb2);
+                           float* rgb, const float* light2, float* rgb2, float* transfer);
 // AMX: hidden and output layers as bf16 tile products; layers packed by
 // pack_layer_amx (outputs padded to 32, the output layer blocked by colour
 // channel: channel c's 25 values at columns c * 32 ..).
 void shade_tile_amx(const std::vector<PackedLayer>& layers, int inputs, const float* x, const float* light, int n,
-                    float* rgb, const float* light2, float* rgb2);
+                    float* rgb, const float* light2, float* rgb2, float* transfer);
 // The tile unit's peak: `reps` x 4 independent tile products of 16,384 FLOP
 // each, no memory traffic. Only where cpu_supports(FusedIsa::Amx).
 double amx_peak_loop(long long reps);
 void shade_tile_avx2(const std::vector<PackedLayer>& layers, int inputs, const float* x, const float* light, int n,
-                     float* rgb, const float* light2, float* rgb2);
+                     float* rgb, const float* light2, float* rgb2, float* transfer);
 
 }  // namespace transgi::shading::detail

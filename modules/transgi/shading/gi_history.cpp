@@ -13,16 +13,57 @@ namespace {
 // the previous cell it takes its value from.
 constexpr float kMinNormalCos = 0.9f;
 constexpr float kNormalScale = 32767.0f;
+
+// A kept transfer's lifetime in frames, between half and all of max_age,
+// spread over cells and frames so that a view decoded at once (a cut) does
+// not expire at once.
+std::uint64_t transfer_lifetime(int max_age, std::size_t cell, std::uint64_t frame) {
+  std::uint64_t h = (static_cast<std::uint64_t>(cell) << 20) ^ frame;
+  h ^= h >> 33;
+  h *= 0xff51afd7ed558ccdull;
+  h ^= h >> 33;
+  const std::uint64_t longest = static_cast<std::uint64_t>(max_age), shortest = (longest + 1) / 2;
+  return shortest + h % (longest - shortest + 1);
+}
+
 }  // namespace
 
 void GiHistory::clear() {
   prev_ = Cells{};
   cur_ = Cells{};
+  pool_ = TransferPool{};
+  keeping_ = TransferKeeping{};
   frame_ = 0;
 }
 
+std::uint32_t GiHistory::new_transfer_slot(std::size_t c) {
+  if (pool_.free.empty()) {
+    const std::size_t old = pool_.anchor.size(), grown = old + std::max<std::size_t>(4096, old / 2);
+    pool_.anchor.resize(grown);
+    pool_.values.resize(grown * 75);
+    for (std::size_t s = grown; s-- > old;) pool_.free.push_back(static_cast<std::uint32_t>(s));
+  }
+  const std::uint32_t slot = pool_.free.back();
+  pool_.free.pop_back();
+  Anchor& a = pool_.anchor[slot];
+  a.object_position = cur_.key[c].object_position;
+  for (int k = 0; k < 3; ++k) a.wo[k] = cur_.wo[c][static_cast<std::size_t>(k)];
+  a.expires = frame_ + transfer_lifetime(keeping_.max_age, c, frame_);
+  cur_.slot[c] = slot;
+  return slot;
+}
+
+void GiHistory::collect_free_slots() {
+  std::vector<std::uint8_t> held(pool_.anchor.size(), 0);
+  for (const std::uint32_t s : prev_.slot)
+    if (s != kNoSlot) held[s] = 1;
+  pool_.free.clear();
+  for (std::size_t s = held.size(); s-- > 0;)
+    if (!held[s]) pool_.free.push_back(static_cast<std::uint32_t>(s));
+}
+
 void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::rt::RtScene& scene, std::vector<std::int32_t>& source,
-                     std::vector<std::int32_t>* track, std::vector<std::uint8_t>* moved) {
+                     std::vector<std::int32_t>* track, std::vector<std::uint8_t>* moved, const TransferKeeping& keeping) {
   using engine::ecs::Entity;
   using engine::transform::Similarity;
   const std::size_t cells = up.cell_pixel.size();
@@ -34,6 +75,15 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
   cur_.sy = up.sy;
   cur_.camera = g.camera;
   cur_.key.resize(cells);
+  // Kept transfer: none is taken from another decoder or model, or once off.
+  const bool keeps = keeping.max_age > 0;
+  if (!keeps || keeping.decoder != keeping_.decoder || keeping.model != keeping_.model) {
+    pool_ = TransferPool{};
+    prev_.slot.clear();
+  }
+  keeping_ = keeping;
+  cur_.slot.assign(keeps ? cells : 0, kNoSlot);
+  cur_.wo.resize(keeps ? cells : 0);
   source.assign(cells, kDecode);
   if (track) track->assign(cells, kDecode);
   if (moved) moved->assign(cells, 0);
@@ -143,6 +193,64 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
   const float prev_u0 = comparable ? 0.5f * static_cast<float>(prev_.camera->width()) / prev_.sx - 0.5f : 0.0f;
   const float prev_v0 = comparable ? 0.5f * static_cast<float>(prev_.camera->height()) / prev_.sy - 0.5f : 0.0f;
   const std::size_t width = static_cast<std::size_t>(g.width);
+  // Among the (up to four) previous cells around where the point was seen,
+  // within `reach` in the object's frame, on the same object, normals alike:
+  // the nearest fresh one (a value to reuse; only for reuse_colour) and the
+  // nearest of any (the track, the kept transfer). Where nothing moved, the
+  // same cell is as good as the nearest.
+  const auto previous_cells = [&](std::size_t c, const Motion& m, const glm::vec3& p_obj, const glm::vec3& n_obj, float reach,
+                                  bool reuse_colour) -> std::pair<std::int32_t, std::int32_t> {
+    const auto matches = [&](const Key& k, float& d2) {
+      if (k.object != m.prev_object) return false;
+      const float cos_normal =
+          (static_cast<float>(k.normal[0]) * n_obj.x + static_cast<float>(k.normal[1]) * n_obj.y + static_cast<float>(k.normal[2]) * n_obj.z) /
+          kNormalScale;
+      if (cos_normal < kMinNormalCos) return false;
+      const glm::vec3 d = k.object_position - p_obj;
+      d2 = glm::dot(d, d);
+      return true;
+    };
+    float d2 = 0;
+    if (!reuse_colour && matches(prev_.key[c], d2) && d2 <= reach * reach) return {kDecode, static_cast<std::int32_t>(c)};
+    const glm::vec3 local = m.prev_m * p_obj + m.prev_t;
+    if (!(local.z < 0)) return {kDecode, kDecode};  // behind last frame's camera
+    // The previous cells around where the point was seen (cell centres at integers).
+    const float inv = -1.0f / local.z;
+    const float u = prev_u0 + prev_kx * local.x * inv, v = prev_v0 - prev_ky * local.y * inv;
+    if (!(u > -1.0f && v > -1.0f && u < static_cast<float>(prev_.grid_w) && v < static_cast<float>(prev_.grid_h))) return {kDecode, kDecode};
+    const int i0 = static_cast<int>(u + 1.0f) - 1, j0 = static_cast<int>(v + 1.0f) - 1;  // floor, as u, v > -1
+    float best = reach * reach, best_any = reach * reach;
+    std::int32_t pick = kDecode, pick_any = kDecode;
+    for (int dj = 0; dj < 2; ++dj)
+      for (int di = 0; di < 2; ++di) {
+        const int pi = i0 + di, pj = j0 + dj;
+        if (pi < 0 || pj < 0 || pi >= prev_.grid_w || pj >= prev_.grid_h) continue;
+        const std::size_t q = static_cast<std::size_t>(pj) * static_cast<std::size_t>(prev_.grid_w) + static_cast<std::size_t>(pi);
+        const Key& k = prev_.key[q];
+        if (!matches(k, d2)) continue;
+        if (reuse_colour && k.fresh && d2 <= best) {
+          best = d2;
+          pick = static_cast<std::int32_t>(q);
+        }
+        if (d2 <= best_any) {
+          best_any = d2;
+          pick_any = static_cast<std::int32_t>(q);
+        }
+      }
+    return {pick, pick_any};
+  };
+  // A kept transfer is taken while the point is within a footprint of where
+  // it was decoded (it does not creep cell by cell), the view direction
+  // within the threshold, and the transfer within its lifetime.
+  const auto transfer_still_holds = [&](const Anchor& a, const glm::vec3& p_obj, const glm::vec3& wo_obj, float reach) {
+    if (frame_ >= a.expires) return false;
+    const glm::vec3 d = a.object_position - p_obj;
+    if (glm::dot(d, d) > reach * reach) return false;
+    const float cos_view = (static_cast<float>(a.wo[0]) * wo_obj.x + static_cast<float>(a.wo[1]) * wo_obj.y +
+                            static_cast<float>(a.wo[2]) * wo_obj.z) /
+                           kNormalScale;
+    return cos_view >= keeping_.min_view_cos;
+  };
   auto body = [&](std::size_t b, std::size_t e_end) {
     for (std::size_t c = b; c < e_end; ++c) {
       Key& key = cur_.key[c];
@@ -165,59 +273,23 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
       key.object = object;
       for (int a = 0; a < 3; ++a) key.normal[a] = static_cast<std::int16_t>(std::clamp(n_obj[a], -1.0f, 1.0f) * kNormalScale);  // truncation: 3e-5 off at most
       key.fresh = 0;
+      glm::vec3 wo_obj(0.0f);
+      if (keeps) {
+        wo_obj = -glm::normalize(m.a * dir);
+        for (int a = 0; a < 3; ++a) cur_.wo[c][static_cast<std::size_t>(a)] = static_cast<std::int16_t>(std::clamp(wo_obj[a], -1.0f, 1.0f) * kNormalScale);
+      }
       const int i = static_cast<int>(c % static_cast<std::size_t>(up.grid_w)), j = static_cast<int>(c / static_cast<std::size_t>(up.grid_w));
       const bool reuse_colour = ((static_cast<unsigned>(i + j) + parity) & 1) != 0;  // else this frame's colour: decoded
-      if (m.prev_object == kNoObject || (!reuse_colour && !track)) continue;
+      if (m.prev_object == kNoObject || (!reuse_colour && !track && !keeps)) continue;
       // Within a cell's footprint at the point's depth, in object units.
       const float reach = depth * spread * cell_pixels * m.to_object_scale;
-      const auto matches = [&](const Key& k, float& d2) {
-        if (k.object != m.prev_object) return false;
-        const float cos_normal =
-            (static_cast<float>(k.normal[0]) * n_obj.x + static_cast<float>(k.normal[1]) * n_obj.y + static_cast<float>(k.normal[2]) * n_obj.z) /
-            kNormalScale;
-        if (cos_normal < kMinNormalCos) return false;
-        const glm::vec3 d = k.object_position - p_obj;
-        d2 = glm::dot(d, d);
-        return true;
-      };
-      if (!reuse_colour) {
-        // Only the track is asked: the same cell, where nothing moved there
-        // (a still camera, a still object), is as good as the nearest.
-        float d2 = 0;
-        if (matches(prev_.key[c], d2) && d2 <= reach * reach) {
-          (*track)[c] = static_cast<std::int32_t>(c);
-          continue;
-        }
-      }
-      const glm::vec3 local = m.prev_m * p_obj + m.prev_t;
-      if (!(local.z < 0)) continue;  // behind last frame's camera
-      // The previous cells around where the point was seen (cell centres at integers).
-      const float inv = -1.0f / local.z;
-      const float u = prev_u0 + prev_kx * local.x * inv, v = prev_v0 - prev_ky * local.y * inv;
-      if (!(u > -1.0f && v > -1.0f && u < static_cast<float>(prev_.grid_w) && v < static_cast<float>(prev_.grid_h))) continue;
-      const int i0 = static_cast<int>(u + 1.0f) - 1, j0 = static_cast<int>(v + 1.0f) - 1;  // floor, as u, v > -1
-      // The nearest fresh cell (a value to reuse) and the nearest of any (the track).
-      float best = reach * reach, best_any = reach * reach;
-      std::int32_t pick = kDecode, pick_any = kDecode;
-      for (int dj = 0; dj < 2; ++dj)
-        for (int di = 0; di < 2; ++di) {
-          const int pi = i0 + di, pj = j0 + dj;
-          if (pi < 0 || pj < 0 || pi >= prev_.grid_w || pj >= prev_.grid_h) continue;
-          const std::size_t q = static_cast<std::size_t>(pj) * static_cast<std::size_t>(prev_.grid_w) + static_cast<std::size_t>(pi);
-          const Key& k = prev_.key[q];
-          float d2 = 0;
-          if (!matches(k, d2)) continue;
-          if (k.fresh && d2 <= best) {
-            best = d2;
-            pick = static_cast<std::int32_t>(q);
-          }
-          if (d2 <= best_any) {
-            best_any = d2;
-            pick_any = static_cast<std::int32_t>(q);
-          }
-        }
+      const auto [pick, pick_any] = previous_cells(c, m, p_obj, n_obj, reach, reuse_colour);
       if (reuse_colour) source[c] = pick;
       if (track) (*track)[c] = pick_any;
+      if (keeps && pick_any != kDecode) {
+        const std::uint32_t slot = prev_.slot.empty() ? kNoSlot : prev_.slot[static_cast<std::size_t>(pick_any)];
+        if (slot != kNoSlot && transfer_still_holds(pool_.anchor[slot], p_obj, wo_obj, reach)) cur_.slot[c] = slot;
+      }
     }
   };
   engine::jobs::parallel_for<std::size_t>(0, cells, 1024, body);
@@ -231,6 +303,7 @@ void GiHistory::store(std::vector<glm::vec3>& value, std::vector<glm::vec3>& val
     for (std::size_t c = b; c < e; ++c) cur_.key[c].fresh = fresh[c];
   });
   std::swap(prev_, cur_);
+  if (keeping_.max_age > 0) collect_free_slots();
   ++frame_;
 }
 

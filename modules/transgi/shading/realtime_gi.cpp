@@ -69,6 +69,12 @@ struct RealtimeGiScratch::Impl {
   GiHistory history;
   std::vector<std::int32_t> source;
   std::vector<std::uint8_t> fresh;
+  // Kept transfer: per network sample, where its 75 values are and whether
+  // they are decoded this frame; the pixels decoded on their own keep none,
+  // theirs go to own_transfer.
+  std::vector<float*> net_transfer;
+  std::vector<std::uint8_t> net_decode;
+  std::vector<float> own_transfer;
   std::vector<glm::vec3> cell_value, cell_value_direct;
   engine::image::ImageRGB recycled;  // RealtimeGiScratch::recycle
   // The split of decoded samples into network and diffuse ones.
@@ -402,6 +408,7 @@ namespace {
 struct GiFrameInputs {
   const RealtimeGiRequest& request;
   bool reuse = false;        // cells may take the previous frame's value (GiHistory)
+  bool keep_transfer = false;  // cells keep their decoded transfer (RealtimeGiSettings::transfer_max_age)
   bool with_direct = false;  // the probes' direct SH goes to the direct image too
   // Glossy dielectrics (MirrorRay::dielectric_max_roughness) take their
   // diffuse light from the probes' irradiance and their specular from a ray.
@@ -442,9 +449,17 @@ void plan_decode(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc, RealtimeG
     std::fill(slot_of_pixel.begin() + static_cast<std::ptrdiff_t>(b), slot_of_pixel.begin() + static_cast<std::ptrdiff_t>(e), kNone);
   });
   // With reuse, the cells that take the previous frame's value are not decoded.
-  if (in.reuse)
+  if (in.reuse) {
+    TransferKeeping keeping;
+    if (in.keep_transfer) {
+      keeping.max_age = in.settings.transfer_max_age;
+      keeping.min_view_cos = std::cos(glm::radians(in.settings.transfer_view_degrees));
+      keeping.decoder = in.request.decoder;
+      keeping.model = in.request.model;
+    }
     sc.history.plan(up, g, in.scene, sc.source, in.near_field.rays > 0 ? &sc.contact.track : nullptr,
-                    in.near_field.rays > 0 ? &sc.contact.moved : nullptr);
+                    in.near_field.rays > 0 ? &sc.contact.moved : nullptr, keeping);
+  }
   else
     sc.history.clear();
   // The cells in cell order, their slots by a prefix sum over rows of cells
@@ -590,6 +605,57 @@ void light_diffuse_samples(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc)
   });
 }
 
+// The network samples' shaded light into their value slots, over the base
+// colour as every sample is upsampled (issue 37): a demodulated model's
+// already is; a format-1 model's is divided here.
+void store_network_values(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc) {
+  const std::vector<std::size_t>& net = sc.net;
+  const bool demodulated = in.request.model->demodulated;
+  engine::jobs::parallel_for<std::size_t>(0, net.size(), 1024, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      const glm::vec3 inv = demodulated ? glm::vec3(1.0f) : 1.0f / model::demodulation(in.g.albedo[sc.decode[net[k]]]);
+      sc.value[net[k]] = inv * sc.shaded[k];
+      if (in.with_direct) sc.value_direct[net[k]] = inv * sc.shaded_direct[k];
+    }
+  });
+}
+
+// Stage 4 with kept transfer: each network sample on a grid cell takes the
+// transfer its cell kept, or decodes into a new slot of the history's pool;
+// the pixels decoded on their own decode into own_transfer. Then all are lit.
+double decode_or_keep_transfer(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc, const TileLightFill& fill, RealtimeGiStats& stats) {
+  const std::vector<std::size_t>& net = sc.net;
+  const std::size_t grid = sc.decoded_cells.size();  // sc.decode lists the grid cells first
+  sc.net_decode.resize(net.size());
+  // Slots first (the pool may grow), then pointers into it.
+  std::vector<std::uint32_t> slot(net.size(), GiHistory::kNoSlot);
+  std::size_t own = 0, kept = 0;
+  for (std::size_t k = 0; k < net.size(); ++k) {
+    if (net[k] >= grid) {
+      sc.net_decode[k] = 1;
+      ++own;
+      continue;
+    }
+    const std::size_t cell = sc.decoded_cells[net[k]];
+    slot[k] = sc.history.kept_slot(cell);
+    sc.net_decode[k] = slot[k] == GiHistory::kNoSlot;
+    if (sc.net_decode[k])
+      slot[k] = sc.history.new_transfer_slot(cell);
+    else
+      ++kept;
+  }
+  sc.own_transfer.resize(own * 75);
+  sc.net_transfer.resize(net.size());
+  own = 0;
+  for (std::size_t k = 0; k < net.size(); ++k)
+    sc.net_transfer[k] = slot[k] != GiHistory::kNoSlot ? sc.history.transfer(slot[k]) : sc.own_transfer.data() + 75 * own++;
+  stats.kept_transfers = kept;
+  const double fill_seconds = shade_transfer_kept(*in.request.decoder, *in.request.model, in.assets, sc.queries, sc.net_transfer,
+                                                  sc.net_decode, fill, sc.shaded.data(), in.with_direct ? sc.shaded_direct.data() : nullptr);
+  store_network_values(in, sc);
+  return fill_seconds;
+}
+
 // Stage 4, decode. After it: sc.value (and sc.value_direct) hold each
 // network sample's light over its base colour. Returns the seconds the
 // decoder's threads spent interpolating light (for the stage times).
@@ -611,6 +677,7 @@ double decode_network_samples(const GiFrameInputs& in, RealtimeGiScratch::Impl& 
     }
   };
   double fill_seconds = 0;
+  if (in.keep_transfer) return decode_or_keep_transfer(in, sc, fill, stats);
   ProbeLightMaker* maker = in.request.batch_decoder && in.settings.device_lights ? in.request.batch_decoder->probe_lights() : nullptr;
   if (maker && !maker->set_probes(in.fields, static_cast<int>(rotated.count()),
                                   [&](int r, const probes::ProbeField* f, bool direct) { return rotated.sh(r, f, direct); }))
@@ -626,16 +693,7 @@ double decode_network_samples(const GiFrameInputs& in, RealtimeGiScratch::Impl& 
   else
     fill_seconds = shade_transfer_fused(*in.request.decoder, *in.request.model, in.assets, sc.queries, fill, shaded.data(),
                                         in.with_direct ? shaded_direct.data() : nullptr);
-  // Every sample's light is upsampled over its base colour (issue 37): a
-  // demodulated model's already is; a format-1 model's is divided here.
-  const bool demodulated = in.request.model->demodulated;
-  engine::jobs::parallel_for<std::size_t>(0, net.size(), 1024, [&](std::size_t b, std::size_t e) {
-    for (std::size_t k = b; k < e; ++k) {
-      const glm::vec3 inv = demodulated ? glm::vec3(1.0f) : 1.0f / model::demodulation(in.g.albedo[sc.decode[net[k]]]);
-      sc.value[net[k]] = inv * shaded[k];
-      if (in.with_direct) sc.value_direct[net[k]] = inv * shaded_direct[k];
-    }
-  });
+  store_network_values(in, sc);
   return fill_seconds;
 }
 
@@ -777,8 +835,10 @@ engine::image::ImageRGB shade_gi_realtime(const RealtimeGiRequest& request, cons
     throw std::invalid_argument("shade_gi_realtime: the G-buffer lacks its per-pixel arrays; make it with trace_gbuffer");
   RealtimeGiScratch local;
   RealtimeGiScratch::Impl& sc = *(scratch ? scratch : &local)->impl;
+  const bool reuse = request.settings.reuse_history && scratch != nullptr && g.camera.has_value();
   const GiFrameInputs in{request,
-                        request.settings.reuse_history && scratch != nullptr && g.camera.has_value(),
+                        reuse,
+                        reuse && request.settings.transfer_max_age > 0 && !request.batch_decoder && request.decoder && request.model,
                         direct_out != nullptr,
                         request.mirror.max_roughness >= 0,
                         request.mirror.max_roughness >= 0 && request.mirror.dielectric_max_roughness >= 0};
@@ -807,7 +867,7 @@ engine::image::ImageRGB shade_gi_realtime(const RealtimeGiRequest& request, cons
   const double fill_ms = std::min(fused_ms, 1e3 * fill_seconds / std::max(1, engine::jobs::current_thread_count()));
   stats.light_ms = diffuse_light_ms + fill_ms;
   stats.inference_ms = fused_ms - fill_ms;
-  stats.inferred = sc.net.size();
+  stats.inferred = sc.net.size() - stats.kept_transfers;
   stats.diffuse = sc.diffuse.size();
   stats.nonfinite_samples = zero_nonfinite_values(in, sc);
 

@@ -58,6 +58,22 @@ struct RealtimeGiSettings {
   // history from frame to frame; without it, or with the near field on,
   // every cell is decoded.
   bool reuse_history = false;
+  // With reuse_history and the CPU's fused decoder (not a batch decoder): a
+  // cell keeps the transfer it decoded (the network's 75 values, which
+  // depend on the surface point and the view direction in its object's
+  // frame, not on the light) for up to this many frames, and on the frames
+  // its colour comes round only dots it with this frame's light; it decodes
+  // again when its point leaves the footprint where the transfer was
+  // decoded, the view turns past transfer_view_degrees, or the transfer
+  // expires (gi_history.h). Higher = fewer decodes, at the cost of transfer
+  // held at one sub-pixel position (the antialiasing jitter does not refine
+  // it) for longer. 0 = every cell of the colour decoded.
+  int transfer_max_age = 0;
+  // How far the view direction at a point, in its object's frame, may turn
+  // before its kept transfer is decoded again. Higher = fewer decodes under
+  // a moving camera or object, at the cost of glossy transfer seen from up
+  // to this angle off.
+  float transfer_view_degrees = 2.0f;
   // With a batch decoder that can (a GPU's: ProbeLightMaker), the network
   // samples' lights are interpolated from the probes on its device, and only
   // a sample's position, normal and rotation cross the bus instead of 150
@@ -156,6 +172,7 @@ struct RealtimeGiStats {
   std::size_t grid_samples = 0, edge_samples = 0;  // decoded: on the grid, on their own
   std::size_t reused_cells = 0;                     // grid cells that took the previous frame's value
   std::size_t inferred = 0, diffuse = 0;           // of those: through the network, diffuse fallback
+  std::size_t kept_transfers = 0;                   // of the network's: lit with a kept transfer, not decoded
   std::size_t rotations = 0;                        // distinct object rotations this frame
   // Decoded samples whose GI came out non-finite (a NaN latent or weight, an
   // overflowing light) and were set to zero before upsampling.

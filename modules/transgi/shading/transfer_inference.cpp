@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <stdexcept>
 #include <vector>
 
 #include "engine/jobs/parallel_for.h"
@@ -77,6 +78,59 @@ double shade_transfer_fused(const FusedDecoder& decoder, const model::TransferMo
         network_input(model, assets, queries[i], z.data(), inputs.data() + (i - b) * static_cast<std::size_t>(in_size));
       decoder.shade_tile(inputs.data(), light.data(), static_cast<int>(e - b), &out[b].x, out2 ? light2.data() : nullptr,
                          out2 ? &out2[b].x : nullptr);
+    }
+    fill_ns.fetch_add(ns, std::memory_order_relaxed);
+  });
+  return static_cast<double>(fill_ns.load()) * 1e-9;
+}
+
+glm::vec3 dot_transfer(const float* transfer, const float* light) {
+  glm::vec3 rgb(0.0f);
+  for (int c = 0; c < 3; ++c) {
+    float sum = 0.0f;
+    for (int k = 0; k < 25; ++k) sum += transfer[c * 25 + k] * light[c * 25 + k];
+    rgb[c] = sum;
+  }
+  return rgb;
+}
+
+double shade_transfer_kept(const FusedDecoder& decoder, const model::TransferModel& model,
+                           const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
+                           std::span<float* const> transfer, std::span<const std::uint8_t> decode, const TileLightFill& fill,
+                           glm::vec3* out, glm::vec3* out2) {
+  if (transfer.size() != queries.size() || decode.size() != queries.size())
+    throw std::invalid_argument("shade_transfer_kept: one transfer pointer and one decode flag a query");
+  // The queries to decode, gathered so that the decoder's tiles are full.
+  std::vector<std::size_t> todo;
+  for (std::size_t i = 0; i < queries.size(); ++i)
+    if (decode[i]) todo.push_back(i);
+  const int in_size = decoder.layout().inputs;
+  const std::size_t decode_tiles = (todo.size() + kFusedTile - 1) / kFusedTile;
+  engine::jobs::parallel_for<std::size_t>(0, decode_tiles, 2, [&](std::size_t tb, std::size_t te) {
+    std::vector<float> inputs(static_cast<std::size_t>(kFusedTile) * static_cast<std::size_t>(in_size));
+    std::vector<float> z(static_cast<std::size_t>(model.latent_dim));
+    std::vector<float> decoded(static_cast<std::size_t>(kFusedTile) * 75);
+    for (std::size_t tile = tb; tile < te; ++tile) {
+      const std::size_t b = tile * kFusedTile, e = std::min(b + kFusedTile, todo.size());
+      for (std::size_t t = b; t < e; ++t)
+        network_input(model, assets, queries[todo[t]], z.data(), inputs.data() + (t - b) * static_cast<std::size_t>(in_size));
+      decoder.decode_tile(inputs.data(), static_cast<int>(e - b), decoded.data());
+      for (std::size_t t = b; t < e; ++t) std::copy_n(decoded.data() + (t - b) * 75, 75, transfer[todo[t]]);
+    }
+  });
+  // Every query lit, tile by tile, its light made just before its dot.
+  const std::size_t tiles = (queries.size() + kFusedTile - 1) / kFusedTile;
+  std::atomic<std::int64_t> fill_ns{0};
+  engine::jobs::parallel_for<std::size_t>(0, tiles, 4, [&](std::size_t tb, std::size_t te) {
+    std::vector<float> light(static_cast<std::size_t>(kFusedTile) * 75), light2(out2 ? light.size() : 0);
+    std::int64_t ns = 0;
+    for (std::size_t tile = tb; tile < te; ++tile) {
+      const std::size_t b = tile * kFusedTile, e = std::min(b + kFusedTile, queries.size());
+      timed_fill(fill, b, e, light.data(), out2 ? light2.data() : nullptr, ns);
+      for (std::size_t i = b; i < e; ++i) {
+        out[i] = dot_transfer(transfer[i], light.data() + (i - b) * 75);
+        if (out2) out2[i] = dot_transfer(transfer[i], light2.data() + (i - b) * 75);
+      }
     }
     fill_ns.fetch_add(ns, std::memory_order_relaxed);
   });

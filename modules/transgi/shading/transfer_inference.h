@@ -51,6 +51,21 @@ double shade_transfer_fused(const FusedDecoder& decoder, const model::TransferMo
                             const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
                             const TileLightFill& fill, glm::vec3* out, glm::vec3* out2 = nullptr);
 
+// The fused decoder with the transfer kept across frames (gi_history.h):
+// query i is decoded into transfer[i] (75 values) only where decode[i] is
+// set; elsewhere transfer[i] already holds what an earlier frame decoded.
+// Then out[i] = transfer[i] . light (dot_transfer), the light made by fill
+// tile by tile as above; out2 with the second light. The same transfer gives
+// the same out[i], decoded this frame or kept. Returns the seconds spent in
+// fill, summed over threads.
+double shade_transfer_kept(const FusedDecoder& decoder, const model::TransferModel& model,
+                           const engine::scene::SceneAssets& assets, std::span<const TransferQuery> queries,
+                           std::span<float* const> transfer, std::span<const std::uint8_t> decode, const TileLightFill& fill,
+                           glm::vec3* out, glm::vec3* out2 = nullptr);
+
+// sum over k of transfer[c * 25 + k] * light[c * 25 + k], channel c per component.
+glm::vec3 dot_transfer(const float* transfer, const float* light);
+
 // The same for one point: latent interpolation, input assembly and every
 // layer as scalar loops (no GEMM library, no threads).
 void infer_transfer_reference(const model::TransferModel& model, const engine::scene::SceneAssets& assets,
