@@ -38,14 +38,14 @@ void GiHistory::clear() {
 
 std::uint32_t GiHistory::new_transfer_slot(std::size_t c) {
   if (pool_.free.empty()) {
-    const std::size_t old = pool_.anchor.size(), grown = old + std::max<std::size_t>(4096, old / 2);
-    pool_.anchor.resize(grown);
+    const std::size_t old = pool_.slots, grown = old + std::max<std::size_t>(4096, old / 2);
+    pool_.slots = grown;
     pool_.values.resize(grown * 75);
     for (std::size_t s = grown; s-- > old;) pool_.free.push_back(static_cast<std::uint32_t>(s));
   }
   const std::uint32_t slot = pool_.free.back();
   pool_.free.pop_back();
-  Anchor& a = pool_.anchor[slot];
+  Anchor& a = cur_.anchor[c];
   a.object_position = cur_.key[c].object_position;
   for (int k = 0; k < 3; ++k) a.wo[k] = cur_.wo[c][static_cast<std::size_t>(k)];
   a.expires = frame_ + transfer_lifetime(keeping_.max_age, c, frame_);
@@ -54,7 +54,7 @@ std::uint32_t GiHistory::new_transfer_slot(std::size_t c) {
 }
 
 void GiHistory::collect_free_slots() {
-  std::vector<std::uint8_t> held(pool_.anchor.size(), 0);
+  std::vector<std::uint8_t> held(pool_.slots, 0);
   for (const std::uint32_t s : prev_.slot)
     if (s != kNoSlot) held[s] = 1;
   pool_.free.clear();
@@ -83,6 +83,7 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
   }
   keeping_ = keeping;
   cur_.slot.assign(keeps ? cells : 0, kNoSlot);
+  cur_.anchor.resize(keeps ? cells : 0);
   cur_.wo.resize(keeps ? cells : 0);
   source.assign(cells, kDecode);
   if (track) track->assign(cells, kDecode);
@@ -287,8 +288,12 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
       if (reuse_colour) source[c] = pick;
       if (track) (*track)[c] = pick_any;
       if (keeps && pick_any != kDecode) {
-        const std::uint32_t slot = prev_.slot.empty() ? kNoSlot : prev_.slot[static_cast<std::size_t>(pick_any)];
-        if (slot != kNoSlot && transfer_still_holds(pool_.anchor[slot], p_obj, wo_obj, reach)) cur_.slot[c] = slot;
+        const auto q = static_cast<std::size_t>(pick_any);
+        const std::uint32_t slot = prev_.slot.empty() ? kNoSlot : prev_.slot[q];
+        if (slot != kNoSlot && transfer_still_holds(prev_.anchor[q], p_obj, wo_obj, reach)) {
+          cur_.slot[c] = slot;
+          cur_.anchor[c] = prev_.anchor[q];
+        }
       }
     }
   };

@@ -104,7 +104,7 @@ class GiHistory {
   };
   struct TransferPool {
     std::vector<float> values;  // 75 a slot
-    std::vector<Anchor> anchor;
+    std::size_t slots = 0;
     std::vector<std::uint32_t> free;  // slots no cell holds, taken from the back
   };
   // Slots no cell of prev_ holds go back to the free list.
@@ -117,9 +117,12 @@ class GiHistory {
     std::vector<std::pair<engine::ecs::Entity, engine::transform::Similarity>> objects;  // in view, object to world
     std::vector<Key> key;
     std::vector<glm::vec3> value, value_direct;
-    // Kept transfer: each cell's pool slot (kNoSlot: none) and, for anchoring
-    // a new one, the object-space view direction it was seen along now.
+    // Kept transfer: each cell's pool slot (kNoSlot: none) and its anchor,
+    // carried with it from cell to cell (read beside the cell, not at a
+    // slot scattered through the pool); for anchoring a new one, the
+    // object-space view direction the cell is seen along now.
     std::vector<std::uint32_t> slot;
+    std::vector<Anchor> anchor;
     std::vector<std::array<std::int16_t, 3>> wo;
   };
   Cells prev_, cur_;
