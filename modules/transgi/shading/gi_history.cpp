@@ -243,10 +243,15 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
   // A kept transfer is taken while the point is within a footprint of where
   // it was decoded (it does not creep cell by cell), the view direction
   // within the threshold, and the transfer within its lifetime.
-  const auto transfer_still_holds = [&](const Anchor& a, const glm::vec3& p_obj, const glm::vec3& wo_obj, float reach) {
+  // The footprint is the cell's on its surface: wider by 1 / cos where the
+  // surface is seen at a grazing angle (to 4x), where the antialiasing's
+  // jitter moves a cell's point that much further along it.
+  const auto transfer_still_holds = [&](const Anchor& a, const glm::vec3& p_obj, const glm::vec3& n_obj, const glm::vec3& wo_obj,
+                                        float reach) {
     if (frame_ >= a.expires) return false;
     const glm::vec3 d = a.object_position - p_obj;
-    if (glm::dot(d, d) > reach * reach) return false;
+    const float on_surface = reach / std::max(std::abs(glm::dot(n_obj, wo_obj)), 0.25f);
+    if (glm::dot(d, d) > on_surface * on_surface) return false;
     const float cos_view = (static_cast<float>(a.wo[0]) * wo_obj.x + static_cast<float>(a.wo[1]) * wo_obj.y +
                             static_cast<float>(a.wo[2]) * wo_obj.z) /
                            kNormalScale;
@@ -290,7 +295,7 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
       if (keeps && pick_any != kDecode) {
         const auto q = static_cast<std::size_t>(pick_any);
         const std::uint32_t slot = prev_.slot.empty() ? kNoSlot : prev_.slot[q];
-        if (slot != kNoSlot && transfer_still_holds(prev_.anchor[q], p_obj, wo_obj, reach)) {
+        if (slot != kNoSlot && transfer_still_holds(prev_.anchor[q], p_obj, n_obj, wo_obj, reach)) {
           cur_.slot[c] = slot;
           cur_.anchor[c] = prev_.anchor[q];
         }
