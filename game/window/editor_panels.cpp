@@ -169,8 +169,8 @@ void EditorUi::gi_settings() {
   changed |= ImGui::Checkbox("edge-aware upsampling", &edit.realtime.edge_aware);
   changed |= ImGui::Checkbox("reuse last frame's GI (checkerboard)", &edit.realtime.reuse_history);
   // Frames a cell keeps its decoded transfer (0 = off), and the view turn that re-decodes it.
-  changed |= ImGui::SliderInt("keep transfer (frames)", &edit.realtime.transfer_max_age, 0, 128);
-  changed |= ImGui::SliderFloat("re-decode past view turn", &edit.realtime.transfer_view_degrees, 0.0f, 30.0f, "%.1f deg");
+  changed |= ImGui::SliderInt("keep transfer", &edit.realtime.transfer_max_age, 0, 128);
+  changed |= ImGui::SliderFloat("transfer view turn", &edit.realtime.transfer_view_degrees, 0.0f, 30.0f, "%.1f deg");
   changed |= ImGui::SliderInt("probe budget / frame", &edit.probes.update_budget, 0, 512);
   // Traced reflections (shading::MirrorRay); off is the paper's SH-4 transfer alone.
   bool reflections = edit.mirror.max_roughness >= 0;
