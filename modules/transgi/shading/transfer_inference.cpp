@@ -132,6 +132,10 @@ double shade_transfer_kept(const FusedDecoder& decoder, const model::TransferMod
     std::int64_t ns = 0;
     for (std::size_t tile = tb; tile < te; ++tile) {
       const std::size_t b = tile * kFusedTile, e = std::min(b + kFusedTile, queries.size());
+      // The tile's transfers lie anywhere in the pool: fetched while its
+      // light is made, not one miss at a time in the dots after.
+      for (std::size_t i = b; i < e; ++i)
+        for (std::size_t byte = 0; byte < 75 * sizeof(float); byte += 64) __builtin_prefetch(reinterpret_cast<const char*>(transfer[i]) + byte);
       timed_fill(fill, b, e, light.data(), out2 ? light2.data() : nullptr, ns);
       for (std::size_t i = b; i < e; ++i) {
         out[i] = dot_transfer(transfer[i], light.data() + (i - b) * 75);
