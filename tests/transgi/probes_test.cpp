@@ -520,6 +520,45 @@ TEST(Interpolation, VectorisedGeometryEqualsTheReferenceBitForBit) {
   EXPECT_GT(pruned, compared) << "the depth must prune some corners, or the visibility path went untested";
 }
 
+// interpolate_probes_many (batches of cages, their depth texels fetched
+// together) gives each point what interpolate_probes gives it, bit for bit,
+// over batches with ragged ends and some probes unusable.
+TEST(Interpolation, ManyPointsAtOnceEqualOneAtATime) {
+  ProbeGrid g{{-2, 0, -2}, {2, 3, 2}, {5, 4, 5}};
+  engine::math::Pcg32 rng(31, 3);
+  const MapLayout m{50, 25};
+  std::vector<ProbeMapState> states(static_cast<std::size_t>(g.count()));
+  for (auto& st : states) {
+    st.reset(m.texel_count());
+    for (int t = 0; t < m.texel_count(); ++t)
+      if (rng.next_float() < 0.7f) st.depth.set(static_cast<std::size_t>(t), 0.2f + 1.5f * rng.next_float(), 0.05f * rng.next_float());
+  }
+  std::vector<std::uint8_t> usable(static_cast<std::size_t>(g.count()), 1);
+  for (std::size_t q = 0; q < usable.size(); q += 7) usable[q] = 0;
+  const InterpolationSettings settings;
+  for (const std::size_t n : {std::size_t{1}, std::size_t{16}, std::size_t{37}, std::size_t{200}}) {
+    std::vector<glm::vec3> p(n), nrm(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      p[i] = g.min + (g.max - g.min) * glm::vec3(rng.next_float(), rng.next_float(), rng.next_float());
+      nrm[i] = engine::math::sample_uniform_sphere({rng.next_float(), rng.next_float()});
+    }
+    std::vector<InterpolationResult> many(n);
+    interpolate_probes_many(g, m, states, p, nrm, settings, usable, many);
+    int pruned = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const InterpolationResult one = interpolate_probes(g, m, states, p[i], nrm[i], settings, usable);
+      ASSERT_EQ(many[i].probes, one.probes) << n << " points, point " << i;
+      ASSERT_EQ(many[i].weights, one.weights) << n << " points, point " << i;
+      ASSERT_EQ(many[i].pruned, one.pruned) << n << " points, point " << i;
+      ASSERT_EQ(many[i].fallback, one.fallback) << n << " points, point " << i;
+      pruned += one.pruned;
+    }
+    if (n >= 37) {
+      EXPECT_GT(pruned, 0) << "the depth must prune some corners";
+    }
+  }
+}
+
 TEST(Interpolation, UnprunedWeightsAreTrilinear) {
   const ProbeGrid g{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}};
   const MapLayout m{32, 16};

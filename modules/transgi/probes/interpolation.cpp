@@ -90,6 +90,28 @@ InterpolationResult interpolate_probes(const ProbeGrid& grid, const MapLayout& l
   return weigh(cage, corners(cage, layout, p, n, biased, s.prune_occluded), states, s, usable);
 }
 
+void interpolate_probes_many(const ProbeGrid& grid, const MapLayout& layout, const std::vector<ProbeMapState>& states,
+                             std::span<const glm::vec3> position, std::span<const glm::vec3> normal,
+                             const InterpolationSettings& s, std::span<const std::uint8_t> usable,
+                             std::span<InterpolationResult> out) {
+  constexpr std::size_t kBatch = 16;
+  std::array<ProbeGrid::Cage, kBatch> cages;
+  std::array<Corners, kBatch> corner;
+  for (std::size_t b = 0; b < position.size(); b += kBatch) {
+    const std::size_t n = std::min(kBatch, position.size() - b);
+    for (std::size_t j = 0; j < n; ++j) {
+      const glm::vec3& p = position[b + j];
+      const glm::vec3& nrm = normal[b + j];
+      cages[j] = grid.cage(p);
+      corner[j] = corners(cages[j], layout, p, nrm, p + nrm * (s.normal_bias * grid.min_spacing()), s.prune_occluded);
+      for (std::size_t i = 0; i < 8; ++i)
+        if (corner[j].texel[i] >= 0)
+          __builtin_prefetch(states[static_cast<std::size_t>(cages[j].probes[i])].depth.texels.data() + corner[j].texel[i]);
+    }
+    for (std::size_t j = 0; j < n; ++j) out[b + j] = weigh(cages[j], corner[j], states, s, usable);
+  }
+}
+
 InterpolationResult interpolate_probes_reference(const ProbeGrid& grid, const MapLayout& layout,
                                                  const std::vector<ProbeMapState>& states, const glm::vec3& p,
                                                  const glm::vec3& n, const InterpolationSettings& s,

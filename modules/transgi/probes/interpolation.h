@@ -46,6 +46,15 @@ InterpolationResult interpolate_probes(const ProbeGrid& grid, const MapLayout& l
                                        const glm::vec3& normal, const InterpolationSettings& settings,
                                        std::span<const std::uint8_t> usable = {});
 
+// The same for many points: each batch of points' cages and corner geometry
+// first, their depth texels fetched together, then the weights, so the
+// depth maps' cache misses overlap instead of stalling point after point.
+// out[i] is interpolate_probes(..., position[i], normal[i], ...) exactly.
+void interpolate_probes_many(const ProbeGrid& grid, const MapLayout& layout, const std::vector<ProbeMapState>& states,
+                             std::span<const glm::vec3> position, std::span<const glm::vec3> normal,
+                             const InterpolationSettings& settings, std::span<const std::uint8_t> usable,
+                             std::span<InterpolationResult> out);
+
 // The same, one cage corner at a time: the plain statement that
 // interpolate_probes' vectorised corner geometry is tested against.
 InterpolationResult interpolate_probes_reference(const ProbeGrid& grid, const MapLayout& layout,

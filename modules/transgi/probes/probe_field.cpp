@@ -70,7 +70,16 @@ ENGINE_ISA_DISPATCH(void, blend_two, (const InterpolationResult& r, const float*
 
 bool ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float* sh_a, float* out_a, const float* sh_b,
                              float* out_b) const {
-  const InterpolationResult r = interpolate_probes(grid_, settings_.map, probes_.maps, p, n, settings_.interpolation, probes_.usable);
+  return blend(interpolate_probes(grid_, settings_.map, probes_.maps, p, n, settings_.interpolation, probes_.usable), sh_a, out_a,
+               sh_b, out_b);
+}
+
+void ProbeField::interpolation_weights(std::span<const glm::vec3> position, std::span<const glm::vec3> normal,
+                                       std::span<InterpolationResult> out) const {
+  interpolate_probes_many(grid_, settings_.map, probes_.maps, position, normal, settings_.interpolation, probes_.usable, out);
+}
+
+bool ProbeField::blend(const InterpolationResult& r, const float* sh_a, float* out_a, const float* sh_b, float* out_b) {
   blend_two(r, sh_a, out_a, sh_b, out_b);
   if (r.fallback) return false;
   for (float w : r.weights)

@@ -253,6 +253,12 @@ class ProbeField {
   // direct light, possibly rotated): half the cost of two calls.
   bool interpolate(const glm::vec3& position, const glm::vec3& normal, const float* sh_a, float* out_a, const float* sh_b,
                    float* out_b) const;
+  // The weights of interpolate() for many points at once (interpolate_probes_many),
+  // then one point's two blends with them: together exactly interpolate()
+  // with two SH arrays, returning the same.
+  void interpolation_weights(std::span<const glm::vec3> position, std::span<const glm::vec3> normal,
+                             std::span<InterpolationResult> out) const;
+  static bool blend(const InterpolationResult& weights, const float* sh_a, float* out_a, const float* sh_b, float* out_b);
   // The mean SH light (75, world space) of the probes that hold light, as of
   // the last update: the ambient term for points no probe lights (beyond the
   // coarsest cascade's reach, cascades.h). Zero before any update.

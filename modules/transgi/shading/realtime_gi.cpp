@@ -668,6 +668,25 @@ double decode_network_samples(const GiFrameInputs& in, RealtimeGiScratch::Impl& 
   shaded.resize(net.size());
   shaded_direct.resize(in.with_direct ? net.size() : 0);
   const auto fill = [&](std::size_t b, std::size_t e, float* light, float* light_direct) {
+    if (in.fields.size() == 1 && light_direct) {
+      // One field (no cascades): its weights for the tile's points at once,
+      // so their depth maps' misses overlap; then each point's blends. The
+      // same values as interpolate_fields_with gives a single field.
+      const probes::ProbeField* f = in.fields.front();
+      std::array<probes::InterpolationResult, kFusedTile> weights;
+      for (std::size_t c0 = b; c0 < e; c0 += kFusedTile) {
+        const std::size_t c1 = std::min(e, c0 + kFusedTile);
+        f->interpolation_weights(std::span<const glm::vec3>(sc.net_position).subspan(c0, c1 - c0),
+                                 std::span<const glm::vec3>(sc.net_normal).subspan(c0, c1 - c0),
+                                 std::span<probes::InterpolationResult>(weights).first(c1 - c0));
+        for (std::size_t k = c0; k < c1; ++k) {
+          const int r = sc.rotation_of[k];
+          probes::ProbeField::blend(weights[k - c0], rotated.sh(r, f), light + (k - b) * 75, rotated.sh(r, f, true),
+                                    light_direct + (k - b) * 75);
+        }
+      }
+      return;
+    }
     for (std::size_t k = b; k < e; ++k) {
       const int r = sc.rotation_of[k];
       probes::interpolate_fields_with(
