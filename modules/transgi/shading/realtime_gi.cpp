@@ -431,6 +431,33 @@ struct GiFrameInputs {
   }
 };
 
+// Light at n points (75 values each, and the direct light's where
+// light_direct is given): with one field, its weights for a batch of points
+// at once (ProbeField::interpolation_weights: the depth maps' cache misses
+// overlap), then each point's blends; with cascades, point by point. The
+// same values either way. indirect_of(k, f) and direct_of(k, f) name field
+// f's SH arrays for point k (world or rotated into its object's frame).
+template <class IndirectOf, class DirectOf>
+void interpolate_points(std::span<const probes::ProbeField* const> fields, const glm::vec3* position, const glm::vec3* normal,
+                        std::size_t n, IndirectOf indirect_of, DirectOf direct_of, float* light, float* light_direct) {
+  if (fields.size() == 1 && light_direct) {
+    const probes::ProbeField* f = fields.front();
+    std::array<probes::InterpolationResult, kFusedTile> weights;
+    for (std::size_t c0 = 0; c0 < n; c0 += kFusedTile) {
+      const std::size_t c1 = std::min(n, c0 + kFusedTile);
+      f->interpolation_weights(std::span<const glm::vec3>(position + c0, c1 - c0), std::span<const glm::vec3>(normal + c0, c1 - c0),
+                               std::span<probes::InterpolationResult>(weights).first(c1 - c0));
+      for (std::size_t k = c0; k < c1; ++k)
+        probes::ProbeField::blend(weights[k - c0], indirect_of(k, f), light + k * 75, direct_of(k, f), light_direct + k * 75);
+    }
+    return;
+  }
+  for (std::size_t k = 0; k < n; ++k)
+    probes::interpolate_fields_with(
+        fields, position[k], normal[k], [&](const probes::ProbeField* f) { return indirect_of(k, f); },
+        [&](const probes::ProbeField* f) { return direct_of(k, f); }, light + k * 75, light_direct ? light_direct + k * 75 : nullptr);
+}
+
 // Stage 1, plan. After it: sc.up is the upsampling plan; sc.decode lists the
 // pixels to decode (the grid cells that hit and are not reused, in cell
 // order, then the pixels decoded on their own), sc.decoded_cells the cell of
@@ -587,20 +614,34 @@ void light_diffuse_samples(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc)
     }
   });
   engine::jobs::parallel_for<std::size_t>(0, diffuse.size(), 256, [&](std::size_t b, std::size_t e) {
-    float world[75], world_direct[75];
-    for (std::size_t k = b; k < e; ++k) {
-      const GSample& s = g.samples[decode[diffuse[k]]];
-      probes::interpolate_fields_with(
-          in.fields, s.position, s.normal_world, [](const probes::ProbeField* f) { return f->light_sh_all().data(); },
-          [](const probes::ProbeField* f) { return f->direct_sh_all().data(); }, world, in.with_direct ? world_direct : nullptr);
-      // Over the base colour, as every sample is upsampled (below); a glossy
-      // dielectric's diffuse lobe less what its specular layer reflects.
-      glm::vec3 over = s.diffuse / model::demodulation(s.albedo) * engine::math::kInvPi;
-      // (1 - s E(wo): brdf.h's layer coupling averaged over the incoming light).
-      if (in.is_glossy_dielectric(decode[diffuse[k]])) over *= glm::vec3(1.0f) - specular_layer_albedo(s);
-      sc.value[diffuse[k]] = over * sh_irradiance(world, s.normal_world);
-      if (with_contact) sc.contact_gain[diffuse[k]] = over;
-      if (in.with_direct) sc.value_direct[diffuse[k]] = over * sh_irradiance(world_direct, s.normal_world);
+    // A tile of points' light at once (interpolate_points), then each one's.
+    std::array<glm::vec3, kFusedTile> position, normal;
+    std::vector<float> light(kFusedTile * 75), light_direct(in.with_direct ? kFusedTile * 75 : 0);
+    for (std::size_t t0 = b; t0 < e; t0 += kFusedTile) {
+      const std::size_t t1 = std::min(e, t0 + kFusedTile);
+      for (std::size_t k = t0; k < t1; ++k) {
+        const GSample& s = g.samples[decode[diffuse[k]]];
+        position[k - t0] = s.position;
+        normal[k - t0] = s.normal_world;
+      }
+      interpolate_points(
+          in.fields, position.data(), normal.data(), t1 - t0,
+          [](std::size_t, const probes::ProbeField* f) { return f->light_sh_all().data(); },
+          [](std::size_t, const probes::ProbeField* f) { return f->direct_sh_all().data(); }, light.data(),
+          in.with_direct ? light_direct.data() : nullptr);
+      for (std::size_t k = t0; k < t1; ++k) {
+        const GSample& s = g.samples[decode[diffuse[k]]];
+        const float* world = light.data() + (k - t0) * 75;
+        const float* world_direct = in.with_direct ? light_direct.data() + (k - t0) * 75 : nullptr;
+        // Over the base colour, as every sample is upsampled (below); a glossy
+        // dielectric's diffuse lobe less what its specular layer reflects.
+        glm::vec3 over = s.diffuse / model::demodulation(s.albedo) * engine::math::kInvPi;
+        // (1 - s E(wo): brdf.h's layer coupling averaged over the incoming light).
+        if (in.is_glossy_dielectric(decode[diffuse[k]])) over *= glm::vec3(1.0f) - specular_layer_albedo(s);
+        sc.value[diffuse[k]] = over * sh_irradiance(world, s.normal_world);
+        if (with_contact) sc.contact_gain[diffuse[k]] = over;
+        if (in.with_direct) sc.value_direct[diffuse[k]] = over * sh_irradiance(world_direct, s.normal_world);
+      }
     }
   });
 }
@@ -668,32 +709,10 @@ double decode_network_samples(const GiFrameInputs& in, RealtimeGiScratch::Impl& 
   shaded.resize(net.size());
   shaded_direct.resize(in.with_direct ? net.size() : 0);
   const auto fill = [&](std::size_t b, std::size_t e, float* light, float* light_direct) {
-    if (in.fields.size() == 1 && light_direct) {
-      // One field (no cascades): its weights for the tile's points at once,
-      // so their depth maps' misses overlap; then each point's blends. The
-      // same values as interpolate_fields_with gives a single field.
-      const probes::ProbeField* f = in.fields.front();
-      std::array<probes::InterpolationResult, kFusedTile> weights;
-      for (std::size_t c0 = b; c0 < e; c0 += kFusedTile) {
-        const std::size_t c1 = std::min(e, c0 + kFusedTile);
-        f->interpolation_weights(std::span<const glm::vec3>(sc.net_position).subspan(c0, c1 - c0),
-                                 std::span<const glm::vec3>(sc.net_normal).subspan(c0, c1 - c0),
-                                 std::span<probes::InterpolationResult>(weights).first(c1 - c0));
-        for (std::size_t k = c0; k < c1; ++k) {
-          const int r = sc.rotation_of[k];
-          probes::ProbeField::blend(weights[k - c0], rotated.sh(r, f), light + (k - b) * 75, rotated.sh(r, f, true),
-                                    light_direct + (k - b) * 75);
-        }
-      }
-      return;
-    }
-    for (std::size_t k = b; k < e; ++k) {
-      const int r = sc.rotation_of[k];
-      probes::interpolate_fields_with(
-          in.fields, sc.net_position[k], sc.net_normal[k], [&](const probes::ProbeField* f) { return rotated.sh(r, f); },
-          [&](const probes::ProbeField* f) { return rotated.sh(r, f, true); }, light + (k - b) * 75,
-          light_direct ? light_direct + (k - b) * 75 : nullptr);
-    }
+    interpolate_points(
+        in.fields, sc.net_position.data() + b, sc.net_normal.data() + b, e - b,
+        [&](std::size_t k, const probes::ProbeField* f) { return rotated.sh(sc.rotation_of[b + k], f); },
+        [&](std::size_t k, const probes::ProbeField* f) { return rotated.sh(sc.rotation_of[b + k], f, true); }, light, light_direct);
   };
   double fill_seconds = 0;
   if (in.keep_transfer) return decode_or_keep_transfer(in, sc, fill, stats);
