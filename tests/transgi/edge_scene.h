@@ -46,4 +46,10 @@ struct EdgeScene {
   }
 };
 
+// The real-time GI tests' camera: at `position`, looking down the -Z axis
+// tilted 0.2 rad down onto the box.
+inline engine::transform::Similarity camera_at(glm::vec3 position) {
+  return engine::transform::Similarity{.translation = position, .rotation = glm::angleAxis(-0.2f, glm::vec3(1, 0, 0))};
+}
+
 }  // namespace transgi_test

@@ -17,15 +17,12 @@
 
 using namespace transgi;
 using namespace engine;
+using transgi_test::camera_at;
 using transgi_test::EdgeScene;
 
 namespace {
 
 constexpr int kW = 96, kH = 64;
-
-transform::Similarity camera_at(glm::vec3 position) {
-  return transform::Similarity{.translation = position, .rotation = glm::angleAxis(-0.2f, glm::vec3(1, 0, 0))};
-}
 
 // The edge scene with a random network on every mesh, and two probe fields
 // that light it differently (a coarse and a fine grid under the same sky).
