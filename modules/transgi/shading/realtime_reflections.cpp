@@ -1,6 +1,7 @@
 #include "shading/realtime_reflections.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cmath>
@@ -221,15 +222,19 @@ void gather_rays(const GBuffer& g, DielectricRays& rays) {
       const float inv_2s2 = 0.5f / (sigma * sigma);
       const int x = static_cast<int>(p % width), y = static_cast<int>(p / width);
       const int bx0 = x / 2, by0 = y / 2;
+      // Every ray leaves its block's pixel on the same side (the jitter's),
+      // so rays lie whole blocks apart, 2 pixels each: the Gaussian is a
+      // product of one table per axis, not an exp per neighbour.
+      std::array<float, kReach + 1> gauss{};
+      for (int d = 0; d <= kReach; ++d) gauss[static_cast<std::size_t>(d)] = std::exp(-static_cast<float>(4 * d * d) * inv_2s2);
       glm::vec3 sum_direct(0.0f), sum_gi(0.0f), sum_weight(0.0f);
       for (int by = std::max(0, by0 - kReach); by <= std::min(rays.bh - 1, by0 + kReach); ++by)
         for (int bx = std::max(0, bx0 - kReach); bx <= std::min(rays.bw - 1, bx0 + kReach); ++bx) {
           const std::uint32_t j = rays.ray_of_block[static_cast<std::size_t>(by) * rays.bw + bx];
           if (j == kNoRay) continue;
           const std::size_t q = rays.ray_pixel[j];
-          const float dx = static_cast<float>(static_cast<int>(q % width) - x);
-          const float dy = static_cast<float>(static_cast<int>(q / width) - y);
-          const float w = same_plane_weight(g, p, q) * std::exp(-(dx * dx + dy * dy) * inv_2s2);
+          const float w = same_plane_weight(g, p, q) * gauss[static_cast<std::size_t>(std::abs(bx - bx0))] *
+                          gauss[static_cast<std::size_t>(std::abs(by - by0))];
           sum_direct += w * rays.direct[j];
           sum_gi += w * rays.gi[j];
           sum_weight += w * rays.weight[j];
