@@ -207,6 +207,34 @@ void interpolate_fields_with(std::span<const ProbeField* const> fields, const gl
     for (int k = 0; k < 75; ++k) out_direct[k] = m.weight[0] * out_direct[k] + m.weight[1] * b[k];
 }
 
+// The same at n points (75 values each into out, and the direct light's
+// into out_direct where given): with one field, its weights for a batch of
+// points at once (ProbeField::interpolation_weights: the depth maps' cache
+// misses overlap), then each point's blends; with several, point by point.
+// The same values either way. indirect_of(k, f) and direct_of(k, f) name
+// field f's SH arrays for point k (world or rotated into its object's frame).
+template <class IndirectOf, class DirectOf>
+void interpolate_fields_many(std::span<const ProbeField* const> fields, const glm::vec3* position, const glm::vec3* normal,
+                             std::size_t n, IndirectOf indirect_of, DirectOf direct_of, float* out, float* out_direct) {
+  if (fields.size() == 1 && out_direct) {
+    constexpr std::size_t kBatch = 64;
+    const ProbeField* f = fields.front();
+    std::array<InterpolationResult, kBatch> weights;
+    for (std::size_t c0 = 0; c0 < n; c0 += kBatch) {
+      const std::size_t c1 = std::min(n, c0 + kBatch);
+      f->interpolation_weights(std::span<const glm::vec3>(position + c0, c1 - c0), std::span<const glm::vec3>(normal + c0, c1 - c0),
+                               std::span<InterpolationResult>(weights).first(c1 - c0));
+      for (std::size_t k = c0; k < c1; ++k)
+        ProbeField::blend(weights[k - c0], indirect_of(k, f), out + k * 75, direct_of(k, f), out_direct + k * 75);
+    }
+    return;
+  }
+  for (std::size_t k = 0; k < n; ++k)
+    interpolate_fields_with(
+        fields, position[k], normal[k], [&](const ProbeField* f) { return indirect_of(k, f); },
+        [&](const ProbeField* f) { return direct_of(k, f); }, out + k * 75, out_direct ? out_direct + k * 75 : nullptr);
+}
+
 // The indirect light alone, from the fields' world-space SH.
 void interpolate_fields(std::span<const ProbeField* const> fields, const glm::vec3& p, const glm::vec3& n, float* out75);
 

@@ -431,33 +431,6 @@ struct GiFrameInputs {
   }
 };
 
-// Light at n points (75 values each, and the direct light's where
-// light_direct is given): with one field, its weights for a batch of points
-// at once (ProbeField::interpolation_weights: the depth maps' cache misses
-// overlap), then each point's blends; with cascades, point by point. The
-// same values either way. indirect_of(k, f) and direct_of(k, f) name field
-// f's SH arrays for point k (world or rotated into its object's frame).
-template <class IndirectOf, class DirectOf>
-void interpolate_points(std::span<const probes::ProbeField* const> fields, const glm::vec3* position, const glm::vec3* normal,
-                        std::size_t n, IndirectOf indirect_of, DirectOf direct_of, float* light, float* light_direct) {
-  if (fields.size() == 1 && light_direct) {
-    const probes::ProbeField* f = fields.front();
-    std::array<probes::InterpolationResult, kFusedTile> weights;
-    for (std::size_t c0 = 0; c0 < n; c0 += kFusedTile) {
-      const std::size_t c1 = std::min(n, c0 + kFusedTile);
-      f->interpolation_weights(std::span<const glm::vec3>(position + c0, c1 - c0), std::span<const glm::vec3>(normal + c0, c1 - c0),
-                               std::span<probes::InterpolationResult>(weights).first(c1 - c0));
-      for (std::size_t k = c0; k < c1; ++k)
-        probes::ProbeField::blend(weights[k - c0], indirect_of(k, f), light + k * 75, direct_of(k, f), light_direct + k * 75);
-    }
-    return;
-  }
-  for (std::size_t k = 0; k < n; ++k)
-    probes::interpolate_fields_with(
-        fields, position[k], normal[k], [&](const probes::ProbeField* f) { return indirect_of(k, f); },
-        [&](const probes::ProbeField* f) { return direct_of(k, f); }, light + k * 75, light_direct ? light_direct + k * 75 : nullptr);
-}
-
 // Stage 1, plan. After it: sc.up is the upsampling plan; sc.decode lists the
 // pixels to decode (the grid cells that hit and are not reused, in cell
 // order, then the pixels decoded on their own), sc.decoded_cells the cell of
@@ -624,7 +597,7 @@ void light_diffuse_samples(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc)
         position[k - t0] = s.position;
         normal[k - t0] = s.normal_world;
       }
-      interpolate_points(
+      probes::interpolate_fields_many(
           in.fields, position.data(), normal.data(), t1 - t0,
           [](std::size_t, const probes::ProbeField* f) { return f->light_sh_all().data(); },
           [](std::size_t, const probes::ProbeField* f) { return f->direct_sh_all().data(); }, light.data(),
@@ -709,7 +682,7 @@ double decode_network_samples(const GiFrameInputs& in, RealtimeGiScratch::Impl& 
   shaded.resize(net.size());
   shaded_direct.resize(in.with_direct ? net.size() : 0);
   const auto fill = [&](std::size_t b, std::size_t e, float* light, float* light_direct) {
-    interpolate_points(
+    probes::interpolate_fields_many(
         in.fields, sc.net_position.data() + b, sc.net_normal.data() + b, e - b,
         [&](std::size_t k, const probes::ProbeField* f) { return rotated.sh(sc.rotation_of[b + k], f); },
         [&](std::size_t k, const probes::ProbeField* f) { return rotated.sh(sc.rotation_of[b + k], f, true); }, light, light_direct);
