@@ -88,22 +88,6 @@ glm::vec3 punctual_irradiance(const engine::rt::RtScene& scene, const engine::re
   return irradiance;
 }
 
-// A reflection ray's hit in the real-time frame, lit by the probes'
-// indirect and direct SH and a shadow ray to each punctual light (not by
-// MirrorRay::light_samples samples of every light, as a mirror's hit is).
-HitIrradiance probe_hit_irradiance(const engine::rt::RtScene& scene, std::span<const probes::ProbeField* const> fields,
-                                   const engine::render::LightSet* lights) {
-  return [&scene, fields, lights](const engine::render::Surface& hit) {
-    using namespace engine;
-    float sh[75], sh_direct[75];
-    probes::interpolate_fields_with(
-        fields, hit.position, hit.shading_normal, [](const probes::ProbeField* f) { return f->light_sh_all().data(); },
-        [](const probes::ProbeField* f) { return f->direct_sh_all().data(); }, sh, sh_direct);
-    return sh_irradiance(sh, hit.shading_normal) + sh_irradiance(sh_direct, hit.shading_normal) +
-           punctual_irradiance(scene, lights, hit);
-  };
-}
-
 // The antialiasing's jitter phase as a number: the stream a reflection's
 // random choices follow, so each of the resolve's points sees other rays and
 // it averages them; no seed.
@@ -185,6 +169,68 @@ void choose_dielectric_rays(const GBuffer& g, float max_roughness, DielectricRay
   }
 }
 
+// Up to 16 reflection rays from G-buffer pixels at once: what
+// reflected_light gives each (light[i]), with one Embree packet for the rays
+// (a surface's neighbouring rays run alike) and the hits lit by the probes
+// in one batch (probes::interpolate_fields_many) and by a shadow ray to each
+// punctual light.
+constexpr int kPacket = 16;
+struct ReflectionPacket {
+  std::array<ReflectedLight, kPacket> light;
+
+  void reflect(const GBuffer& g, const engine::rt::RtScene& scene, std::span<const probes::ProbeField* const> fields,
+               const engine::render::LightSet* lights, const std::size_t* pixel, const glm::vec3* direction, int n) {
+    using namespace engine;
+    const scene::Environment* sky = lights ? lights->environment() : nullptr;
+    int lanes = 0;
+    for (int k = 0; k < n; ++k) {
+      const GSample& s = g.samples[pixel[k]];
+      light[static_cast<std::size_t>(k)] = {};
+      if (glm::dot(direction[k], s.geometric_normal) <= 0) continue;
+      rays_[static_cast<std::size_t>(lanes)] = rt::Ray{rt::offset_ray_origin(s.position, s.geometric_normal, scene.offset_scale()), direction[k]};
+      ray_of_[static_cast<std::size_t>(lanes++)] = k;
+    }
+    scene.intersect16(rays_.data(), lanes, hits_.data(), found_);
+    std::size_t count = 0;
+    for (int i = 0; i < lanes; ++i) {
+      const int k = ray_of_[static_cast<std::size_t>(i)];
+      ReflectedLight& out = light[static_cast<std::size_t>(k)];
+      if (!found_[i]) {
+        if (sky) out.direct = sky->radiance(direction[k]);
+        continue;
+      }
+      const render::Surface hit = render::make_surface(scene, hits_[static_cast<std::size_t>(i)], direction[k]);
+      if (hit.emission.r > 0 || hit.emission.g > 0 || hit.emission.b > 0) {
+        out.direct = hit.emission;
+        continue;
+      }
+      if (material::diffuse_albedo(hit.brdf) == glm::vec3(0.0f)) continue;
+      surface_[count] = hit;
+      position_[count] = hit.position;
+      normal_[count] = hit.shading_normal;
+      lit_[count++] = k;
+    }
+    probes::interpolate_fields_many(
+        fields, position_.data(), normal_.data(), count, [](std::size_t, const probes::ProbeField* f) { return f->light_sh_all().data(); },
+        [](std::size_t, const probes::ProbeField* f) { return f->direct_sh_all().data(); }, sh_, sh_direct_);
+    for (std::size_t j = 0; j < count; ++j) {
+      const render::Surface& hit = surface_[j];
+      const glm::vec3 irradiance = sh_irradiance(sh_ + j * 75, hit.shading_normal) + sh_irradiance(sh_direct_ + j * 75, hit.shading_normal) +
+                                   punctual_irradiance(scene, lights, hit);
+      light[static_cast<std::size_t>(lit_[j])].gi = material::diffuse_albedo(hit.brdf) * math::kInvPi * glm::max(irradiance, glm::vec3(0.0f));
+    }
+  }
+
+ private:
+  std::array<engine::rt::Ray, kPacket> rays_;
+  std::array<engine::rt::Hit, kPacket> hits_;
+  bool found_[kPacket] = {};
+  std::array<int, kPacket> ray_of_{}, lit_{};  // lane -> ray; lit hit -> ray
+  std::array<engine::render::Surface, kPacket> surface_;
+  std::array<glm::vec3, kPacket> position_, normal_;
+  float sh_[kPacket * 75], sh_direct_[kPacket * 75];
+};
+
 // Traces the rays choose_dielectric_rays picked: one per 2x2 block, from
 // its pixel on the jitter's side of the centre, so the antialiasing's phases
 // visit the four in turn; none where that pixel is no glossy dielectric or
@@ -198,65 +244,20 @@ void choose_dielectric_rays(const GBuffer& g, float max_roughness, DielectricRay
 void trace_dielectric_rays(const GBuffer& g, const engine::rt::RtScene& scene, std::span<const probes::ProbeField* const> fields,
                            const engine::render::LightSet* lights, DielectricRays& rays) {
   using namespace engine;
-  const scene::Environment* sky = lights ? lights->environment() : nullptr;
   const std::size_t n = rays.traced.size();
   rays.direct.resize(n);
   rays.gi.resize(n);
-  // What reflected_light does for one ray, for 16 at a time: one Embree
-  // packet (a floor's neighbouring rays run alike), then the hits' probe
-  // light in one batch (probes::interpolate_fields_many), the same values.
-  constexpr int kPacket = 16;
   const std::size_t packets = (n + kPacket - 1) / kPacket;
   jobs::parallel_for<std::size_t>(0, packets, 4, [&](std::size_t b, std::size_t e) {
-    std::array<rt::Ray, kPacket> packet;
-    std::array<rt::Hit, kPacket> hits;
-    bool found[kPacket];
-    std::array<std::size_t, kPacket> ray_of;  // packet lane -> ray
-    std::array<render::Surface, kPacket> surface;
-    std::array<glm::vec3, kPacket> position, normal;
-    std::array<std::size_t, kPacket> lit;  // lanes whose hits the probes light
-    float sh[kPacket * 75], sh_direct[kPacket * 75];
+    ReflectionPacket packet;
     for (std::size_t pk = b; pk < e; ++pk) {
       const std::size_t k0 = pk * kPacket, k1 = std::min(n, k0 + kPacket);
-      int lanes = 0;
+      for (std::size_t k = k0; k < k1; ++k)
+        rays.weight[k] /= glm::max(specular_layer_albedo(g.samples[rays.ray_pixel[k]]), glm::vec3(1e-6f));
+      packet.reflect(g, scene, fields, lights, rays.ray_pixel.data() + k0, rays.direction.data() + k0, static_cast<int>(k1 - k0));
       for (std::size_t k = k0; k < k1; ++k) {
-        const GSample& s = g.samples[rays.ray_pixel[k]];
-        rays.weight[k] /= glm::max(specular_layer_albedo(s), glm::vec3(1e-6f));
-        rays.direct[k] = rays.gi[k] = glm::vec3(0.0f);
-        if (glm::dot(rays.direction[k], s.geometric_normal) <= 0) continue;
-        packet[static_cast<std::size_t>(lanes)] =
-            rt::Ray{rt::offset_ray_origin(s.position, s.geometric_normal, scene.offset_scale()), rays.direction[k]};
-        ray_of[static_cast<std::size_t>(lanes++)] = k;
-      }
-      scene.intersect16(packet.data(), lanes, hits.data(), found);
-      std::size_t count = 0;
-      for (int i = 0; i < lanes; ++i) {
-        const std::size_t k = ray_of[static_cast<std::size_t>(i)];
-        if (!found[i]) {
-          if (sky) rays.direct[k] = rays.weight[k] * sky->radiance(rays.direction[k]);
-          continue;
-        }
-        const render::Surface hit = render::make_surface(scene, hits[static_cast<std::size_t>(i)], rays.direction[k]);
-        if (hit.emission.r > 0 || hit.emission.g > 0 || hit.emission.b > 0) {
-          rays.direct[k] = rays.weight[k] * hit.emission;
-          continue;
-        }
-        if (material::diffuse_albedo(hit.brdf) == glm::vec3(0.0f)) continue;
-        surface[count] = hit;
-        position[count] = hit.position;
-        normal[count] = hit.shading_normal;
-        lit[count++] = static_cast<std::size_t>(i);
-      }
-      probes::interpolate_fields_many(
-          fields, position.data(), normal.data(), count,
-          [](std::size_t, const probes::ProbeField* f) { return f->light_sh_all().data(); },
-          [](std::size_t, const probes::ProbeField* f) { return f->direct_sh_all().data(); }, sh, sh_direct);
-      for (std::size_t j = 0; j < count; ++j) {
-        const render::Surface& hit = surface[j];
-        const glm::vec3 irradiance = sh_irradiance(sh + j * 75, hit.shading_normal) + sh_irradiance(sh_direct + j * 75, hit.shading_normal) +
-                                     punctual_irradiance(scene, lights, hit);
-        const std::size_t k = ray_of[lit[j]];
-        rays.gi[k] = rays.weight[k] * (material::diffuse_albedo(hit.brdf) * math::kInvPi * glm::max(irradiance, glm::vec3(0.0f)));
+        rays.direct[k] = rays.weight[k] * packet.light[k - k0].direct;
+        rays.gi[k] = rays.weight[k] * packet.light[k - k0].gi;
       }
     }
   });
@@ -315,13 +316,28 @@ std::size_t shade_metal_reflections(const GBuffer& g, const engine::rt::RtScene&
                                    const engine::render::LightSet* lights, engine::image::ImageRGB& image,
                                    engine::image::ImageRGB* direct_out) {
   using namespace engine;
-  const scene::Environment* sky = lights ? lights->environment() : nullptr;
-  const HitIrradiance irradiance = probe_hit_irradiance(scene, fields, lights);
   const float metal_roughness = std::max(mirror.max_roughness, mirror.glossy_max_roughness);
   const std::uint64_t phase = jitter_phase(g);
   std::atomic<std::size_t> traced{0};
   jobs::parallel_for<std::size_t>(0, g.samples.size(), 1024, [&](std::size_t b, std::size_t e) {
+    ReflectionPacket packet;
+    std::array<std::size_t, kPacket> pixel;
+    std::array<glm::vec3, kPacket> direction, weight;
+    int lanes = 0;
     std::size_t n = 0;
+    // A packet's pixels' light, times each one's weight; no history here,
+    // unlike the glossy dielectrics': on the sample level's gold sphere a
+    // running mean smeared its glints over neighbouring points while the
+    // camera walked (docs/image-quality.md).
+    const auto flush = [&] {
+      packet.reflect(g, scene, fields, lights, pixel.data(), direction.data(), lanes);
+      for (int i = 0; i < lanes; ++i) {
+        const std::size_t p = pixel[static_cast<std::size_t>(i)];
+        image.pixels[p] = weight[static_cast<std::size_t>(i)] * packet.light[static_cast<std::size_t>(i)].gi;
+        if (direct_out) direct_out->pixels[p] += weight[static_cast<std::size_t>(i)] * packet.light[static_cast<std::size_t>(i)].direct;
+      }
+      lanes = 0;
+    };
     for (std::size_t p = b; p < e; ++p) {
       // metal_roughness <= max_roughness is is_mirror() on the pixel's material.
       if (!(g.metal_roughness[p] <= metal_roughness)) continue;
@@ -329,15 +345,17 @@ std::size_t shade_metal_reflections(const GBuffer& g, const engine::rt::RtScene&
       const bool mirror_direction = g.metal_roughness[p] <= mirror.max_roughness;
       math::Pcg32 rng = math::make_rng(0x6105ull, p, phase);
       const glm::vec2 u{rng.next_float(), rng.next_float()};
-      glm::vec3 wi, weight(0.0f);
-      ReflectedLight r;
-      if (sample_reflection(g.samples[p], mirror_direction, u, wi, weight)) r = reflected_light(scene, g.samples[p], wi, sky, irradiance);
-      // No history here, unlike the glossy dielectrics': on the sample
-      // level's gold sphere a running mean smeared its glints over
-      // neighbouring points while the camera walked (docs/image-quality.md).
-      image.pixels[p] = weight * r.gi;
-      if (direct_out) direct_out->pixels[p] += weight * r.direct;
+      glm::vec3 wi(0.0f, 0.0f, 1.0f), w(0.0f);
+      if (!sample_reflection(g.samples[p], mirror_direction, u, wi, w)) {
+        image.pixels[p] = glm::vec3(0.0f);  // no ray: black, as a zero weight gives
+        continue;
+      }
+      pixel[static_cast<std::size_t>(lanes)] = p;
+      direction[static_cast<std::size_t>(lanes)] = wi;
+      weight[static_cast<std::size_t>(lanes++)] = w;
+      if (lanes == kPacket) flush();
     }
+    if (lanes > 0) flush();
     traced.fetch_add(n, std::memory_order_relaxed);
   });
   return traced.load();
