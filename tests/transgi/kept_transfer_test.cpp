@@ -178,3 +178,24 @@ TEST(KeptTransfer, TransferIsRefreshedWithinItsLifetimeSpreadOverFrames) {
   EXPECT_LT(most, 0.6) << "the refreshes must not come at once";
   EXPECT_NEAR(sum / frames, 1.0 / 3.0, 0.1);
 }
+
+// A material edited in place (the editor bumps SceneAssets::edit_version):
+// the network reads each point's base colour, so nothing kept before the
+// edit is taken after it; once each colour has decoded again (two frames),
+// the cells keep again.
+TEST(KeptTransfer, AnEditedMaterialIsDecodedAgain) {
+  Net net;
+  shading::RealtimeGiScratch scratch;
+  const transform::Similarity cam = camera_at({0.3f, 1.2f, 3.5f});
+  for (int f = 0; f < 3; ++f) net.frame(cam, net.fine, scratch);
+  auto& assets = net.s.app.world().resource<scene::SceneAssets>();
+  assets.materials[0].base_color_factor = glm::vec4(0.2f, 0.5f, 0.3f, 1.0f);
+  ++assets.edit_version;
+  const Net::Frame edited = net.frame(cam, net.fine, scratch);
+  net.frame(cam, net.fine, scratch);
+  const Net::Frame after = net.frame(cam, net.fine, scratch);
+  std::printf("after the edit: %zu kept; two frames later: %zu of %zu\n", edited.stats.kept_transfers, after.stats.kept_transfers,
+              grid_network_samples(after.stats));
+  EXPECT_EQ(edited.stats.kept_transfers, 0u) << "a transfer decoded with the old colour was taken";
+  EXPECT_GE(after.stats.kept_transfers, grid_network_samples(after.stats) * 95 / 100) << "the cells must keep again";
+}

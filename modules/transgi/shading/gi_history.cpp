@@ -77,7 +77,8 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
   cur_.key.resize(cells);
   // Kept transfer: none is taken from another decoder or model, or once off.
   const bool keeps = keeping.max_age > 0;
-  if (!keeps || keeping.decoder != keeping_.decoder || keeping.model != keeping_.model) {
+  if (!keeps || keeping.decoder != keeping_.decoder || keeping.model != keeping_.model ||
+      keeping.assets_generation != keeping_.assets_generation || keeping.assets_edit != keeping_.assets_edit) {
     pool_ = TransferPool{};
     prev_.slot.clear();
   }

@@ -41,10 +41,13 @@ struct GBuffer;
 struct TransferKeeping {
   int max_age = 0;            // frames; 0 = no transfer is kept
   float min_view_cos = 1.0f;  // cosine of the largest change of view direction
-  // What decoded the kept transfers (the decoder, the model): when it
-  // changes, nothing kept before is taken.
+  // What decoded the kept transfers (the decoder, the model) and from which
+  // assets (their generation and edit_version: the network reads each
+  // point's base colour, which an edited material changes): when any of
+  // these changes, nothing kept before is taken.
   const void* decoder = nullptr;
   const void* model = nullptr;
+  std::uint64_t assets_generation = 0, assets_edit = 0;
 };
 
 class GiHistory {

@@ -456,6 +456,8 @@ void plan_decode(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc, RealtimeG
       keeping.min_view_cos = std::cos(glm::radians(in.settings.transfer_view_degrees));
       keeping.decoder = in.request.decoder;
       keeping.model = in.request.model;
+      keeping.assets_generation = in.assets.generation;
+      keeping.assets_edit = in.assets.edit_version;
     }
     sc.history.plan(up, g, in.scene, sc.source, in.near_field.rays > 0 ? &sc.contact.track : nullptr,
                     in.near_field.rays > 0 ? &sc.contact.moved : nullptr, keeping);
