@@ -73,6 +73,7 @@ struct RealtimeGiScratch::Impl {
   // they are decoded this frame; the pixels decoded on their own keep none,
   // theirs go to own_transfer.
   std::vector<float*> net_transfer;
+  std::vector<std::uint32_t> net_slot;
   std::vector<std::uint8_t> net_decode;
   std::vector<float> own_transfer;
   std::vector<glm::vec3> cell_value, cell_value_direct;
@@ -589,7 +590,7 @@ void light_diffuse_samples(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc)
     }
   });
   engine::jobs::parallel_for<std::size_t>(0, diffuse.size(), 256, [&](std::size_t b, std::size_t e) {
-    // A tile of points' light at once (interpolate_points), then each one's.
+    // A tile of points' light at once (probes::interpolate_fields_many), then each one's.
     std::array<glm::vec3, kFusedTile> position, normal;
     std::vector<float> light(kFusedTile * 75), light_direct(in.with_direct ? kFusedTile * 75 : 0);
     for (std::size_t t0 = b; t0 < e; t0 += kFusedTile) {
@@ -644,7 +645,8 @@ double decode_or_keep_transfer(const GiFrameInputs& in, RealtimeGiScratch::Impl&
   const std::size_t grid = sc.decoded_cells.size();  // sc.decode lists the grid cells first
   sc.net_decode.resize(net.size());
   // Slots first (the pool may grow), then pointers into it.
-  std::vector<std::uint32_t> slot(net.size(), GiHistory::kNoSlot);
+  std::vector<std::uint32_t>& slot = sc.net_slot;
+  slot.assign(net.size(), GiHistory::kNoSlot);
   std::size_t own = 0, kept = 0;
   for (std::size_t k = 0; k < net.size(); ++k) {
     if (net[k] >= grid) {
