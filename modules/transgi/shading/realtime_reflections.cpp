@@ -184,30 +184,25 @@ struct ReflectionPacket {
     const scene::Environment* sky = lights ? lights->environment() : nullptr;
     int lanes = 0;
     for (int k = 0; k < n; ++k) {
-      const GSample& s = g.samples[pixel[k]];
       light[static_cast<std::size_t>(k)] = {};
-      if (glm::dot(direction[k], s.geometric_normal) <= 0) continue;
-      rays_[static_cast<std::size_t>(lanes)] = rt::Ray{rt::offset_ray_origin(s.position, s.geometric_normal, scene.offset_scale()), direction[k]};
-      ray_of_[static_cast<std::size_t>(lanes++)] = k;
+      if (reflection_ray(scene, g.samples[pixel[k]], direction[k], rays_[static_cast<std::size_t>(lanes)]))
+        ray_of_[static_cast<std::size_t>(lanes++)] = k;
     }
     scene.intersect16(rays_.data(), lanes, hits_.data(), found_);
     std::size_t count = 0;
     for (int i = 0; i < lanes; ++i) {
       const int k = ray_of_[static_cast<std::size_t>(i)];
-      ReflectedLight& out = light[static_cast<std::size_t>(k)];
       if (!found_[i]) {
-        if (sky) out.direct = sky->radiance(direction[k]);
+        light[static_cast<std::size_t>(k)] = *reflected_without_irradiance(nullptr, direction[k], sky);
         continue;
       }
-      const render::Surface hit = render::make_surface(scene, hits_[static_cast<std::size_t>(i)], direction[k]);
-      if (hit.emission.r > 0 || hit.emission.g > 0 || hit.emission.b > 0) {
-        out.direct = hit.emission;
+      surface_[count] = render::make_surface(scene, hits_[static_cast<std::size_t>(i)], direction[k]);
+      if (const std::optional<ReflectedLight> r = reflected_without_irradiance(&surface_[count], direction[k], sky)) {
+        light[static_cast<std::size_t>(k)] = *r;
         continue;
       }
-      if (material::diffuse_albedo(hit.brdf) == glm::vec3(0.0f)) continue;
-      surface_[count] = hit;
-      position_[count] = hit.position;
-      normal_[count] = hit.shading_normal;
+      position_[count] = surface_[count].position;
+      normal_[count] = surface_[count].shading_normal;
       lit_[count++] = k;
     }
     probes::interpolate_fields_many(
@@ -217,7 +212,7 @@ struct ReflectionPacket {
       const render::Surface& hit = surface_[j];
       const glm::vec3 irradiance = sh_irradiance(sh_ + j * 75, hit.shading_normal) + sh_irradiance(sh_direct_ + j * 75, hit.shading_normal) +
                                    punctual_irradiance(scene, lights, hit);
-      light[static_cast<std::size_t>(lit_[j])].gi = material::diffuse_albedo(hit.brdf) * math::kInvPi * glm::max(irradiance, glm::vec3(0.0f));
+      light[static_cast<std::size_t>(lit_[j])].gi = reflected_gi(hit, irradiance);
     }
   }
 

@@ -70,18 +70,34 @@ HitIrradiance probe_and_sampled_irradiance(const engine::rt::RtScene& scene, con
 
 }  // namespace
 
+bool reflection_ray(const engine::rt::RtScene& scene, const GSample& smp, const glm::vec3& wi, engine::rt::Ray& ray) {
+  if (glm::dot(wi, smp.geometric_normal) <= 0) return false;
+  ray = engine::rt::Ray{engine::rt::offset_ray_origin(smp.position, smp.geometric_normal, scene.offset_scale()), wi};
+  return true;
+}
+
+std::optional<ReflectedLight> reflected_without_irradiance(const engine::render::Surface* hit, const glm::vec3& wi,
+                                                           const engine::scene::Environment* sky) {
+  if (!hit) return ReflectedLight{sky ? sky->radiance(wi) : glm::vec3(0.0f), glm::vec3(0.0f)};
+  if (hit->emission.r > 0 || hit->emission.g > 0 || hit->emission.b > 0) return ReflectedLight{hit->emission, glm::vec3(0.0f)};
+  if (engine::material::diffuse_albedo(hit->brdf) == glm::vec3(0.0f)) return ReflectedLight{};
+  return std::nullopt;
+}
+
+glm::vec3 reflected_gi(const engine::render::Surface& hit, const glm::vec3& irradiance) {
+  return engine::material::diffuse_albedo(hit.brdf) * engine::math::kInvPi * glm::max(irradiance, glm::vec3(0.0f));
+}
+
 ReflectedLight reflected_light(const engine::rt::RtScene& scene, const GSample& smp, const glm::vec3& wi,
                                const engine::scene::Environment* sky, const HitIrradiance& irradiance) {
   using namespace engine;
-  if (glm::dot(wi, smp.geometric_normal) <= 0) return {};
+  rt::Ray ray;
+  if (!reflection_ray(scene, smp, wi, ray)) return {};
   rt::Hit hit;
-  if (!scene.intersect(rt::Ray{rt::offset_ray_origin(smp.position, smp.geometric_normal, scene.offset_scale()), wi}, hit))
-    return {sky ? sky->radiance(wi) : glm::vec3(0.0f), glm::vec3(0.0f)};
+  if (!scene.intersect(ray, hit)) return *reflected_without_irradiance(nullptr, wi, sky);
   const render::Surface s = render::make_surface(scene, hit, wi);
-  if (s.emission.r > 0 || s.emission.g > 0 || s.emission.b > 0) return {s.emission, glm::vec3(0.0f)};
-  const glm::vec3 albedo = material::diffuse_albedo(s.brdf);
-  if (albedo == glm::vec3(0.0f)) return {};
-  return {glm::vec3(0.0f), albedo * math::kInvPi * glm::max(irradiance(s), glm::vec3(0.0f))};
+  if (const std::optional<ReflectedLight> r = reflected_without_irradiance(&s, wi, sky)) return *r;
+  return {glm::vec3(0.0f), reflected_gi(s, irradiance(s))};
 }
 
 bool sample_reflection(const GSample& smp, bool mirror, glm::vec2 u, glm::vec3& wi_world, glm::vec3& weight) {

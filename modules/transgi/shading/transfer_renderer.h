@@ -5,6 +5,7 @@
 // object show the environment, as in the reference.
 #include <array>
 #include <functional>
+#include <optional>
 #include <memory>
 #include <unordered_map>
 
@@ -115,6 +116,16 @@ using HitIrradiance = std::function<glm::vec3(const engine::render::Surface& hit
 // reflects its diffuse albedo / pi x irradiance(hit). Not weighted.
 ReflectedLight reflected_light(const engine::rt::RtScene& scene, const GSample& sample, const glm::vec3& wi,
                                const engine::scene::Environment* sky, const HitIrradiance& irradiance);
+// reflected_light in parts, for callers that trace many rays at once and
+// light their hits in a batch (realtime_reflections.cpp). The ray from the
+// sample along wi; false where wi points below its surface (no light).
+bool reflection_ray(const engine::rt::RtScene& scene, const GSample& sample, const glm::vec3& wi, engine::rt::Ray& ray);
+// What the traced ray brings back when that does not need the hit's
+// irradiance (a miss: the sky; an emitter; a black surface); else
+// std::nullopt, and reflected_gi(hit, irradiance at it) is its light.
+std::optional<ReflectedLight> reflected_without_irradiance(const engine::render::Surface* hit, const glm::vec3& wi,
+                                                           const engine::scene::Environment* sky);
+glm::vec3 reflected_gi(const engine::render::Surface& hit, const glm::vec3& irradiance);
 // The quality path's mirror: the light leaving a point of a near-mirror
 // towards the viewer, its Fresnel times what the reflection ray finds
 // (reflected_light above, no sky), its hit lit by the probes (light_at) and
