@@ -3,9 +3,11 @@
 // the world. Runs in PrepareRender after the Embree sync. What holds after
 // it: SceneLights::set holds this frame's emissive triangles (in world
 // space), enabled punctual lights and the environment; `version` increased
-// exactly when one of those changed this frame, and `geometry_version`
-// exactly when the Embree scene did, so per-frame caches (light probes) can
-// tell that their inputs moved.
+// exactly when the set was rebuilt this frame (a light, an emitter or the
+// environment changed, or the geometry moved), `lighting_version` exactly
+// when what lights the scene changed (not an object without emission that
+// moved), and `geometry_version` exactly when the Embree scene changed, so
+// per-frame caches (light probes) can tell which of their inputs moved.
 #include "engine/app/app.h"
 #include "engine/render/light_set.h"
 
@@ -24,7 +26,8 @@ struct LightSettings {
 
 struct SceneLights {
   LightSet set;
-  std::uint64_t version = 0;           // lighting changed (lights, emitters, environment)
+  std::uint64_t version = 0;           // the set was rebuilt (lighting or geometry changed)
+  std::uint64_t lighting_version = 0;  // lights, emitters (moved too), environment or materials changed
   std::uint64_t geometry_version = 0;  // the ray-traced geometry changed
   // The sun split of the current environment, computed once per map (a
   // moving object rebuilds the set every frame; the map does not change).

@@ -9,6 +9,19 @@ namespace {
 using namespace engine::schedule;
 using LightView = View<Get<const scene::PunctualLight, const transform::WorldTransform>>;
 
+// Whether two sets hold the same emissive triangles: a moved object that
+// emits nothing leaves them as they were.
+bool same_emitters(const LightSet& a, const LightSet& b) {
+  const std::vector<EmissiveTriangle>& x = a.emissive_triangles();
+  const std::vector<EmissiveTriangle>& y = b.emissive_triangles();
+  if (x.size() != y.size()) return false;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    if (x[i].p0 != y[i].p0 || x[i].p1 != y[i].p1 || x[i].p2 != y[i].p2 || x[i].material != y[i].material ||
+        x[i].emission != y[i].emission)
+      return false;
+  return true;
+}
+
 struct SeenState {
   std::uint64_t commits = UINT64_MAX;  // RtScene top-level commits at the last rebuild
   std::uint64_t assets_generation = UINT64_MAX;
@@ -41,7 +54,9 @@ void sync_lights(LightView lights, Removed<scene::PunctualLight> removed, Res<rt
     out->sun_split = std::make_shared<const scene::SunSplit>(scene::split_sun(*env, settings->extraction));
     out->sun_split_of = env;
   }
-  out->set = LightSet(*rt, std::move(punctual), env, out->sun_split);
+  LightSet set(*rt, std::move(punctual), env, out->sun_split);
+  if (lights_changed || assets_changed || !same_emitters(out->set, set)) ++out->lighting_version;
+  out->set = std::move(set);
   ++out->version;
   if (geometry_changed || assets_changed) ++out->geometry_version;
   seen->commits = rt->stats().top_level_commits;

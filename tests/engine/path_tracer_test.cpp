@@ -244,6 +244,40 @@ TEST(LightSync, SkyAndMaterialEditsRebuildTheLightSet) {
   EXPECT_EQ(lights.set.emissive_triangle_count(), 0u) << "the dark lamp is no longer an emitter";
 }
 
+// What lights the scene (lighting_version) against what was rebuilt
+// (version): a grey box that moves rebuilds the set (emitters are stored in
+// world space) but lights nothing differently; the lamp that moves does.
+TEST(LightSync, OnlyAMovedEmitterCountsAsALightingChange) {
+  using namespace engine;
+  app::App app(app::AppOptions{.jobs = {.threads = 1}});
+  auto& assets = app.world().insert_resource<scene::SceneAssets>();
+  assets.generation = scene::next_scene_generation();
+  assets.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({0.5f, 0.5f}, 0)),
+                   std::make_shared<scene::MeshAsset>(scene::make_box(glm::vec3(0.2f), false, 1))};
+  material::Material lamp;
+  lamp.emissive_factor = glm::vec3(1.0f);
+  lamp.emissive_strength = 5.0f;
+  assets.materials = {lamp, material::Material{}};
+  app.add_plugin<render::LightPlugin>();
+  const ecs::Entity light = app.world().spawn(), box = app.world().spawn();
+  app.world().emplace<transform::Transform>(light);
+  app.world().emplace<scene::MeshInstance>(light, scene::MeshInstance{0});
+  app.world().emplace<transform::Transform>(box, transform::Transform::from_translation({0, -1, 0}));
+  app.world().emplace<scene::MeshInstance>(box, scene::MeshInstance{1});
+  app.update();
+  const auto& lights = app.world().resource<render::SceneLights>();
+  const std::uint64_t v0 = lights.version, l0 = lights.lighting_version, g0 = lights.geometry_version;
+  app.world().get_mut<transform::Transform>(box).translation = {0.3f, -1, 0};
+  app.update();
+  EXPECT_EQ(lights.version, v0 + 1) << "the set is rebuilt when geometry moves";
+  EXPECT_EQ(lights.geometry_version, g0 + 1);
+  EXPECT_EQ(lights.lighting_version, l0) << "a grey box moved: no light changed";
+  app.world().get_mut<transform::Transform>(light).translation = {0, 0.5f, 0};
+  app.update();
+  EXPECT_EQ(lights.geometry_version, g0 + 2);
+  EXPECT_EQ(lights.lighting_version, l0 + 1) << "the lamp moved";
+}
+
 // Adaptive sampling (issue 14, item 1) against the furnace's known answer:
 // every pixel's gi is Le a^2 / (1 - a). Rendered to a target relative error
 // of 2 %, the pixels' RMS relative error is about the target (tolerance:
