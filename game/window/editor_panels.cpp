@@ -172,6 +172,8 @@ void EditorUi::gi_settings() {
   changed |= ImGui::SliderInt("keep transfer", &edit.realtime.transfer_max_age, 0, 128);
   changed |= ImGui::SliderFloat("transfer view turn", &edit.realtime.transfer_view_degrees, 0.0f, 30.0f, "%.1f deg");
   changed |= ImGui::SliderInt("probe budget / frame", &edit.probes.update_budget, 0, 512);
+  // The budget once the lights have held (objects may move); 0 = the one above.
+  changed |= ImGui::SliderInt("steady-light budget", &edit.probes.steady_light_budget, 0, 512);
   // Traced reflections (shading::MirrorRay); off is the paper's SH-4 transfer alone.
   bool reflections = edit.mirror.max_roughness >= 0;
   if (ImGui::Checkbox("traced reflections", &reflections)) {

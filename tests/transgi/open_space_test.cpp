@@ -278,7 +278,7 @@ TEST(OpenSpace, RelocatedProbesStayPutAcrossClassifications) {
   std::vector<ProbeFrameStats> stats;
   room.app.jobs().run([&] {
     for (int f = 0; f < 6; ++f) {
-      if (f > 0) field.notify_scene_changed(true);  // as a moving object does: classify again
+      if (f > 0) field.notify_scene_changed({.geometry_moved = true});  // as a moving object does: classify again
       stats.push_back(field.update(room.rt(), lights));
     }
   });

@@ -47,7 +47,7 @@ TEST(ProbeBudget, TracesAtMostTheBudgetAndRefreshesEveryProbeInTurn) {
       const ProbeFrameStats st = field.update(rt, lights);
       ASSERT_LE(st.traced, 5) << "frame " << f;
       ASSERT_EQ(st.traced, 5) << "frame " << f << ": 32 active probes, the budget must be spent";
-      if (f == 320) field.notify_scene_changed(true);  // queues classification, still within budget
+      if (f == 320) field.notify_scene_changed({.geometry_moved = true});  // queues classification, still within budget
     }
   });
   // 639 frames x 5 = 3195 updates over 32 probes: round-robin gives each
@@ -136,4 +136,33 @@ TEST(ProbeBudget, SettlingFramesTraceEveryProbeThenTheBudgetHolds) {
   floor.scene.app.jobs().run([&] {
     for (int f = 3; f < 8; ++f) EXPECT_EQ(settled.update(floor.rt(), floor.lights).traced, 5) << "frame " << f << " is past the settling";
   });
+}
+
+// steady_light_budget: while the lights hold, a field spends the smaller
+// budget; a light change gives the full budget back at once, for
+// skip.settle_frames frames; a moved object alone does not.
+TEST(ProbeBudget, TheFullBudgetReturnsWhileALightChangesAndForItsSettling) {
+  BudgetFloor floor(0.5f);
+  ProbeFieldSettings settings = floor.settings();
+  settings.skip.skip_converged = false;
+  settings.skip.settle_frames = 6;
+  settings.update_budget = 8;
+  settings.steady_light_budget = 3;
+  ProbeField field(settings);
+  std::vector<int> traced;
+  floor.scene.app.jobs().run([&] {
+    field.update(floor.rt(), floor.lights);  // the first frame classifies every probe
+    for (int f = 1; f < 30; ++f) {
+      if (f == 10) field.notify_scene_changed({.geometry_moved = true});
+      if (f == 15) field.notify_scene_changed({.light_changed = true});
+      traced.push_back(field.update(floor.rt(), floor.lights).traced);
+    }
+  });
+  // traced[i] is frame i + 1's. Frame 10 classifies (every probe traces).
+  for (int f = 1; f < 30; ++f) {
+    const int got = traced[static_cast<std::size_t>(f - 1)];
+    if (f == 10) continue;
+    const int want = f >= 15 && f < 15 + 6 ? 8 : 3;
+    EXPECT_EQ(got, want) << "frame " << f << (want == 8 ? ": a light changed at frame 15" : ": the lights hold");
+  }
 }

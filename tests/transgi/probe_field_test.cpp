@@ -132,7 +132,7 @@ ProbeFieldSettings switch_settings(float hysteresis, bool adaptive) {
 int frames_to_settle(TwoLights& scene, ProbeField& field, const std::vector<float>& settled) {
   scene.app.world().get_mut<scene::PunctualLight>(scene.light_a).enabled = false;
   const auto lights = scene.lights();
-  field.notify_scene_changed(false);  // what the ECS system does when a light changes
+  field.notify_scene_changed({.light_changed = true});  // what the ECS system does when a light changes
   for (int frame = 1; frame <= 400; ++frame) {
     scene.app.jobs().run([&] { field.update(scene.app.world().resource<rt::RtScene>(), lights); });
     bool all = true;

@@ -103,7 +103,7 @@ TEST(ProbeSkip, BuriedAndFarProbesAreClassifiedAndSkipped) {
   // again; both now see only the floor, 8.5 and 16.5 away (beyond 8): far.
   s.app.world().get_mut<transform::Transform>(box).translation = {50, 8.5f, 50};
   s.app.update();
-  field.notify_scene_changed(true);
+  field.notify_scene_changed({.geometry_moved = true});
   ProbeFrameStats third;
   s.app.jobs().run([&] { third = field.update(s.rt(), lights); });
   EXPECT_TRUE(third.classified);
@@ -144,7 +144,7 @@ TEST(ProbeSkip, ConvergedProbesStopUpdatingAndWakeOnChange) {
   for (int p = 0; p < settings.grid.count(); ++p)
     EXPECT_NEAR(field.light_sh(p)[0], expected, 0.04 * expected) << "probe " << p << " froze a wrong L00";
 
-  field.notify_scene_changed(false);
+  field.notify_scene_changed({.light_changed = true});
   ProbeFrameStats woken;
   s.app.jobs().run([&] { woken = field.update(s.rt(), lights); });
   EXPECT_EQ(woken.traced, settings.grid.count()) << "a scene change wakes every converged probe";

@@ -60,6 +60,10 @@ std::vector<OptionSpec> runtime_option_specs(const std::string& default_preset) 
              "real-time GI resolution over the image's: higher = finer GI, at the cost of more decoded points"),
       integer("probe-budget", "K", 0, 1 << 20, by_preset(q.probes.update_budget, r.probes.update_budget),
               "probes traced a frame (0 = all): higher = light follows changes sooner, at the cost of probe time"),
+      integer("probe-steady-budget", "K", 0, 1 << 20,
+              by_preset(q.probes.steady_light_budget, r.probes.steady_light_budget),
+              "probes traced a frame once the lights have held (0 = --probe-budget): higher = bounce light follows a "
+              "moved object sooner, at the cost of probe time"),
       choice("gi-reuse", {"on", "off"}, on_off_by_preset(q.realtime.reuse_history, r.realtime.reuse_history),
              "real-time GI cells taken from the frame before where nothing changed: about half the decoding"),
       integer("keep-transfer", "F", 0, 4096, by_preset(q.realtime.transfer_max_age, r.realtime.transfer_max_age),

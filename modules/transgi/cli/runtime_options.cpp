@@ -12,6 +12,8 @@ runtime::TransGISettings runtime_settings_from(const Args& args, const char* def
                                    : runtime::quality_preset();
   s.realtime.resolution_scale = static_cast<float>(args.number("gi-scale", 0.05, 1.0, s.realtime.resolution_scale));
   s.probes.update_budget = static_cast<int>(args.integer("probe-budget", 0, 1 << 20, s.probes.update_budget));
+  s.probes.steady_light_budget =
+      static_cast<int>(args.integer("probe-steady-budget", 0, 1 << 20, s.probes.steady_light_budget));
   if (args.has("gi-reuse")) s.realtime.reuse_history = args.choice("gi-reuse", {"on", "off"}, "on") == "on";
   s.realtime.transfer_max_age = static_cast<int>(args.integer("keep-transfer", 0, 4096, s.realtime.transfer_max_age));
   s.realtime.transfer_view_degrees =

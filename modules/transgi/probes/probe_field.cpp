@@ -106,7 +106,9 @@ std::size_t ProbeField::memory_bytes() const {
   return b;
 }
 
-void ProbeField::notify_scene_changed(bool geometry_moved) {
+void ProbeField::notify_scene_changed(SceneChange change) {
+  const bool geometry_moved = change.geometry_moved;
+  if (change.light_changed) light_changed_at_ = frame_;
   for (std::size_t q = 0; q < probes_.maps.size(); ++q) {
     if (probes_.state[q] == ProbeState::Converged) probes_.state[q] = ProbeState::Active;
     probes_.maps[q].stable_frames = 0;
@@ -136,7 +138,8 @@ void ProbeField::select_within_budget(std::vector<std::uint8_t>& traced) const {
   // Candidates: active probes and those queued for classification; those in
   // a changed region first, then the stalest, ties broken by a rotating
   // offset (round-robin).
-  const std::size_t n = traced.size(), offset = frame_ * static_cast<std::size_t>(settings_.update_budget) % n;
+  const int budget = budget_this_frame();
+  const std::size_t n = traced.size(), offset = frame_ * static_cast<std::size_t>(budget) % n;
   // With a focus (the camera), ties go nearest-first instead of by turn.
   // With changed_first, probes whose light just changed count as urgent.
   std::vector<std::tuple<int, std::uint64_t, float, std::size_t, std::size_t>> order;  // (not urgent, last traced, distance^2, turn, probe)
@@ -149,9 +152,16 @@ void ProbeField::select_within_budget(std::vector<std::uint8_t>& traced) const {
       order.emplace_back(not_urgent, probes_.last_traced[q], glm::dot(d, d), (q + n - offset) % n, q);
     }
   }
-  const std::size_t k = std::min(order.size(), static_cast<std::size_t>(settings_.update_budget));
+  const std::size_t k = std::min(order.size(), static_cast<std::size_t>(budget));
   std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(k), order.end());
   for (std::size_t i = 0; i < k; ++i) traced[std::get<4>(order[i])] = 1;
+}
+
+int ProbeField::budget_this_frame() const {
+  if (settings_.steady_light_budget <= 0) return settings_.update_budget;
+  const bool lights_held =
+      !light_changed_at_ || frame_ - *light_changed_at_ >= static_cast<std::uint64_t>(std::max(0, settings_.skip.settle_frames));
+  return lights_held ? settings_.steady_light_budget : settings_.update_budget;
 }
 
 void ProbeField::forget_light(int probe) {

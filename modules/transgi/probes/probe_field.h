@@ -23,6 +23,7 @@
 // scene changes again (notify_scene_changed).
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "engine/render/light_set.h"
@@ -94,6 +95,13 @@ struct ProbeFieldSettings {
   // frame, at the cost of each probe refreshing only every active/budget
   // frames, so lighting responds that many times slower.
   int update_budget = 0;
+  // With a budget: the probes updated a frame once no light has changed for
+  // skip.settle_frames frames (objects may still move: the probes by a moved
+  // object go first, notify_region_changed). A light that changes gets
+  // update_budget back at once. 0 = update_budget always. Lower = a shorter
+  // frame while only objects move, at the cost of the bounce light far from
+  // a moved object following it that much later.
+  int steady_light_budget = 0;
   // With a budget: the field's first settle_frames updates trace every
   // active probe, as a loading screen would, so a level starts with its
   // multi-bounce light converged (each update of a probe adds a bounce)
@@ -209,10 +217,16 @@ class ProbeField {
   ProbeFrameStats update(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
                          const ProbeField* outer = nullptr);
 
-  // The scene changed since the last update: converged probes wake up, and
-  // if the geometry moved the probes are classified again and their depth
-  // re-converges quickly.
-  void notify_scene_changed(bool geometry_moved);
+  // What changed since the last update.
+  struct SceneChange {
+    bool geometry_moved = false;  // an object moved, appeared or left
+    bool light_changed = false;   // a light, the sun or the sky changed
+  };
+  // The scene changed since the last update: converged probes wake up; if
+  // the geometry moved the probes are classified again and their depth
+  // re-converges quickly; if a light changed the full update_budget returns
+  // (steady_light_budget).
+  void notify_scene_changed(SceneChange change);
   // What changed lies in [min, max] (a moved object's old and new bounds):
   // with a budget, the probes within one cell of it are updated before any
   // other, so a moving object re-lights its neighbourhood first.
@@ -304,6 +318,9 @@ class ProbeField {
   void forget_light(int probe);
   // Marks the probes this frame's budget updates (update_budget > 0).
   void select_within_budget(std::vector<std::uint8_t>& traced) const;
+  // The probes this frame may update: update_budget, or steady_light_budget
+  // once the lights have held for skip.settle_frames.
+  [[nodiscard]] int budget_this_frame() const;
 
   // update()'s stages, in order, over one frame's scratch. After each:
   //  plan_update: which probes trace, this frame's ray set;
@@ -343,6 +360,9 @@ class ProbeField {
   std::vector<float> mean_sh_ = std::vector<float>(75, 0.0f), mean_direct_sh_ = std::vector<float>(75, 0.0f);
   std::vector<glm::vec3> fibonacci_;
   std::uint64_t frame_ = 0;
+  // The frame of the last light change; none yet = the lights have held
+  // since the field began (its own settle_frames cover the start).
+  std::optional<std::uint64_t> light_changed_at_;
   glm::vec3 focus_{0.0f};
   bool has_focus_ = false;
 };

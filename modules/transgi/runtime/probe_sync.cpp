@@ -19,14 +19,15 @@ SceneChanges changes_since(const SeenVersions& seen, const rt::RtScene& rt, cons
   static const std::vector<rt::WorldBounds> kNothing;
   SceneChanges c;
   c.geometry_moved = lights.geometry_version != seen.geometry;
-  c.lighting_changed = lights.version != seen.lights;
+  c.lighting_changed = lights.lighting_version != seen.lights;
   // Where it moved: probes there are updated first (RtScene keeps the list for its last commit).
   c.regions = c.geometry_moved ? &rt.changed_at_last_commit() : &kNothing;
   return c;
 }
 
 void tell(probes::ProbeField& field, const SceneChanges& c) {
-  if (c.geometry_moved || c.lighting_changed) field.notify_scene_changed(c.geometry_moved);
+  if (c.geometry_moved || c.lighting_changed)
+    field.notify_scene_changed({.geometry_moved = c.geometry_moved, .light_changed = c.lighting_changed});
   for (const rt::WorldBounds& b : *c.regions) field.notify_region_changed(b.min, b.max);
 }
 
@@ -51,7 +52,7 @@ void sync_probe_volumes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res
     tell(*v.field, changes);
   });
   seen->geometry = lights->geometry_version;
-  seen->lights = lights->version;
+  seen->lights = lights->lighting_version;
 }
 
 probes::ProbeFieldSettings cascade_field_settings(const probes::ProbeFieldSettings& base, const probes::CascadeSettings& c,
@@ -59,6 +60,7 @@ probes::ProbeFieldSettings cascade_field_settings(const probes::ProbeFieldSettin
   probes::ProbeFieldSettings s = base;
   s.grid = probes::cascade_grid(c, k, origin);
   s.update_budget = base.update_budget > 0 ? std::max(1, base.update_budget >> k) : 0;
+  s.steady_light_budget = base.steady_light_budget > 0 ? std::max(1, base.steady_light_budget >> k) : 0;
   s.blend_cells = c.blend_cells;
   if (c.map_width > 0 && path == GiPath::Realtime) s.map = probes::MapLayout{c.map_width, std::max(2, c.map_width / 2)};
   return s;
@@ -95,7 +97,7 @@ void sync_probe_cascades(View<Get<const scene::Camera, const transform::WorldTra
   });
   frame->cascade_probes_entered = entered;
   seen->geometry = lights->geometry_version;
-  seen->lights = lights->version;
+  seen->lights = lights->lighting_version;
 }
 
 }  // namespace transgi::runtime
