@@ -342,6 +342,13 @@ void fill16(Packet& out, const Ray* rays, int n, int* valid, std::atomic<std::ui
 }  // namespace
 
 void RtScene::intersect16(const Ray* rays, int n, Hit* hits, bool* found) const {
+  intersect16_with(rays, n, hits, found, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
+}
+void RtScene::intersect16_coherent(const Ray* rays, int n, Hit* hits, bool* found) const {
+  intersect16_with(rays, n, hits, found, RTC_INTERSECT_CONTEXT_FLAG_COHERENT);
+}
+
+void RtScene::intersect16_with(const Ray* rays, int n, Hit* hits, bool* found, int flags) const {
   alignas(64) int valid[16];
   alignas(64) RTCRayHit16 rh;
   fill16(rh.ray, rays, std::min(n, 16), valid, rejected_);
@@ -351,11 +358,7 @@ void RtScene::intersect16(const Ray* rays, int n, Hit* hits, bool* found) const 
   }
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  // Not the coherent kernel: Embree 3.13.5's coherent packet traversal
-  // looped forever on one shadow packet of the sample level (occluded16);
-  // camera rays never hit it, but a hang is worse than the 1 ms (of 10) the
-  // coherent kernel saved on the level's G-buffer.
-  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  ctx.flags = static_cast<RTCIntersectContextFlags>(flags);
   rtcIntersect16(valid, impl_->top, &ctx, &rh);
   for (int i = 0; i < std::min(n, 16); ++i) {
     found[i] = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
@@ -376,6 +379,9 @@ void RtScene::occluded16(const Ray* rays, int n, bool* blocked) const {
   fill16(r, rays, std::min(n, 16), valid, rejected_);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
+  // Not the coherent kernel: Embree 3.13.5's coherent packet traversal
+  // loops forever on some shadow packets (the sample level at frame ~23 on
+  // one machine; the daylit Breakfast Room with AVX-512 kernels, 2026-11-27).
   ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
   rtcOccluded16(valid, impl_->top, &ctx, &r);
   for (int i = 0; i < std::min(n, 16); ++i) blocked[i] = valid[i] && r.tfar[i] < 0.0f;

@@ -158,8 +158,8 @@ TEST(RtScene, OffsetOriginEscapesTheSurface) {
 }
 
 TEST(RtScene, PacketsAnswerAsSingleRays) {
-  // The 16-wide queries are a fast path; the single-ray queries are their
-  // reference. Rays of every kind: hits on two quads (one masked half), misses,
+  // The 16-wide queries (incoherent and coherent traversal) are fast paths;
+  // the single-ray queries are their reference. Rays of every kind: hits on two quads (one masked half), misses,
   // short tmax, a NaN ray and a short last packet.
   RtFixture f(/*masked=*/true);
   const Entity a = f.spawn_quad({0, 0, 0});
@@ -177,14 +177,16 @@ TEST(RtScene, PacketsAnswerAsSingleRays) {
   int hits = 0, blocked_count = 0;
   for (std::size_t p = 0; p < rays.size(); p += 16) {
     const int n = static_cast<int>(std::min<std::size_t>(16, rays.size() - p));
-    Hit packet[16];
-    bool found[16], blocked[16];
+    Hit packet[16], coherent[16];
+    bool found[16], found_coherent[16], blocked[16];
     f.rt().intersect16(rays.data() + p, n, packet, found);
+    f.rt().intersect16_coherent(rays.data() + p, n, coherent, found_coherent);
     f.rt().occluded16(rays.data() + p, n, blocked);
     for (int i = 0; i < n; ++i) {
       Hit single;
       const bool want = f.rt().intersect(rays[p + i], single);
       ASSERT_EQ(found[i], want) << "ray " << p + i;
+      ASSERT_EQ(found_coherent[i], want) << "ray " << p + i << ", coherent";
       EXPECT_EQ(blocked[i], f.rt().occluded(rays[p + i])) << "ray " << p + i;
       if (!want) continue;
       ++hits;
@@ -193,11 +195,15 @@ TEST(RtScene, PacketsAnswerAsSingleRays) {
       EXPECT_EQ(packet[i].primitive, single.primitive) << "ray " << p + i;
       EXPECT_NEAR(packet[i].t, single.t, 1e-5f * single.t) << "ray " << p + i;
       EXPECT_NEAR(packet[i].barycentric.x, single.barycentric.x, 1e-5f) << "ray " << p + i;
+      EXPECT_EQ(coherent[i].entity, single.entity) << "ray " << p + i << ", coherent";
+      EXPECT_EQ(coherent[i].primitive, single.primitive) << "ray " << p + i << ", coherent";
+      EXPECT_NEAR(coherent[i].t, single.t, 1e-5f * single.t) << "ray " << p + i << ", coherent";
+      EXPECT_NEAR(coherent[i].barycentric.x, single.barycentric.x, 1e-5f) << "ray " << p + i << ", coherent";
     }
   }
   EXPECT_GT(hits, 50) << "the rays must exercise hits";
   EXPECT_GT(static_cast<int>(rays.size()) - hits, 50) << "and misses";
-  EXPECT_EQ(f.rt().rejected_rays(), 4u) << "the NaN ray, counted by each of the four queries";
+  EXPECT_EQ(f.rt().rejected_rays(), 5u) << "the NaN ray, counted by each of the five queries";
   (void)a;
 }
 

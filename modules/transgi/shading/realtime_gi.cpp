@@ -228,7 +228,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
         __builtin_prefetch(reinterpret_cast<const char*>(&g.samples[pixel[i]] + 1) - 1, 1, 3);
       }
       if (tile_first.empty()) {
-        scene.intersect16(rays, n, hits, found);
+        scene.intersect16_coherent(rays, n, hits, found);
       } else {
         const std::size_t first = tile_first[static_cast<std::size_t>(t)];
         for (int i = 0; i < n; ++i) {
