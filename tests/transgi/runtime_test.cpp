@@ -409,3 +409,29 @@ TEST(TransferInference, KeptTransferIsLitAndOnlyTheRestIsDecoded) {
   // bf16 weights: within 1e-2 of the largest value, as the fused path.
   EXPECT_LT(worst, 1e-2 * scale) << "worst absolute transfer difference " << worst << " against values up to " << scale;
 }
+
+// The probe budget through the ECS (ProbeFieldSettings::steady_light_budget):
+// a cube that moves under a held sun leaves the field on its steady budget
+// (the light set is rebuilt, but lighting_version stays); turning the sun
+// gives the full budget back for skip.settle_frames frames.
+TEST(RuntimeDynamics, AMovingObjectSpendsTheSteadyBudgetAndATurnedSunTheFull) {
+  runtime::TransGISettings s = small_settings();
+  s.probes.update_budget = 40;
+  s.probes.steady_light_budget = 10;
+  s.probes.settle_frames = 2;
+  s.probes.skip.settle_frames = 5;
+  Level level(s);
+  level.run(3);  // the field's settling frames trace every probe
+  std::vector<int> traced;
+  for (int f = 0; f < 14; ++f) {
+    level.app.world().get_mut<transform::Transform>(level.cube).translation.x += 0.05f;
+    if (f == 4) level.app.world().get_mut<transform::Transform>(level.sun).rotation *= glm::angleAxis(0.2f, glm::vec3(0, 1, 0));
+    level.run(1);
+    traced.push_back(level.frame().probe_stats.traced);
+  }
+  for (int f = 0; f < 14; ++f) {
+    const bool after_turn = f >= 4 && f < 4 + 5;
+    EXPECT_EQ(traced[static_cast<std::size_t>(f)], after_turn ? 40 : 10)
+        << "frame " << f << (after_turn ? " follows the sun's turn" : ": only the cube moved");
+  }
+}
