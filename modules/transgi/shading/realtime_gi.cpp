@@ -592,7 +592,7 @@ void light_diffuse_samples(const GiFrameInputs& in, RealtimeGiScratch::Impl& sc)
   engine::jobs::parallel_for<std::size_t>(0, diffuse.size(), 256, [&](std::size_t b, std::size_t e) {
     // A tile of points' light at once (probes::interpolate_fields_many), then each one's.
     std::array<glm::vec3, kFusedTile> position, normal;
-    std::vector<float> light(kFusedTile * 75), light_direct(in.with_direct ? kFusedTile * 75 : 0);
+    std::array<float, kFusedTile * 75> light, light_direct;
     for (std::size_t t0 = b; t0 < e; t0 += kFusedTile) {
       const std::size_t t1 = std::min(e, t0 + kFusedTile);
       for (std::size_t k = t0; k < t1; ++k) {
