@@ -369,11 +369,12 @@ TransGISettings realtime_preset() {
   s.probes.map = probes::MapLayout{50, 25};
   s.probes.update_budget = 128;
   s.probes.settle_frames = 24;
-  // Half of it while the lights hold and only objects move: the probes by
-  // a moved object still go first, and the GI error of the level with an
-  // object moving did not rise (docs/performance.md, "Steady-light probe
-  // budget"); a light that changes gets the 128 back at once.
-  s.probes.steady_light_budget = 64;
+  // No smaller budget while the lights hold (steady_light_budget): 64 cut
+  // the sample level's frame by 3 ms at no cost in its GI error, but on the
+  // daylit Breakfast Room with an object moving it raised the GI error by a
+  // quarter, a glow on the back wall: fewer probes a frame move the probes'
+  // light level (docs/results.md, "the probe budget moves the mean";
+  // docs/performance.md, 2026-11-27 noon).
   s.realtime.reuse_history = true;
   // Cells keep their decoded transfer up to 32 frames and only take each
   // frame's light: a quarter of the cells decoded instead of half, at no
