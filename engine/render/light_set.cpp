@@ -88,31 +88,7 @@ bool LightSet::sample(const glm::vec3& p, float u_select, glm::vec2 u, LightSamp
     return pdf > 0;
   }
   if (!triangles_.empty() && group-- == 0) {
-    float tri_pdf = 0;
-    std::size_t i = 0;
-    // Reuse u.x for selection and stretch the remainder back to [0, 1).
-    const float x = triangle_distribution_.sample_continuous(u.x, &tri_pdf, &i);
-    const float n = static_cast<float>(triangles_.size());
-    const float ux = std::clamp(x * n - static_cast<float>(i), 0.0f, 0.99999994f);
-    const EmissiveTriangle& t = triangles_[i];
-    const glm::vec2 b = math::sample_uniform_triangle({ux, u.y});
-    const glm::vec3 q = (1 - b.x - b.y) * t.p0 + b.x * t.p1 + b.y * t.p2;
-    glm::vec3 d = q - p;
-    const float dist2 = glm::dot(d, d);
-    if (!(dist2 > 0)) return false;
-    const float dist = std::sqrt(dist2);
-    d /= dist;
-    const glm::vec3 n_light = glm::normalize(glm::cross(t.p1 - t.p0, t.p2 - t.p0));
-    const float cos_l = std::abs(glm::dot(n_light, d));
-    if (cos_l <= 1e-7f) return false;
-    // Selection pdf of the triangle (its share of the total power) / area, to solid angle.
-    const float p_tri = tri_pdf / n;
-    out.pdf = pg * p_tri / t.area * dist2 / cos_l;
-    out.radiance = evaluate_emission(*assets_, t.material, (1 - b.x - b.y) * t.uv0 + b.x * t.uv1 + b.y * t.uv2);
-    out.direction = d;
-    out.distance = dist;
-    out.delta = false;
-    return true;
+    return sample_area_light(p, u, pg, out);
   }
   if (!punctual_.empty()) {
     const float n = static_cast<float>(punctual_.size());
@@ -124,6 +100,39 @@ bool LightSet::sample(const glm::vec3& p, float u_select, glm::vec2 u, LightSamp
     return true;
   }
   return false;
+}
+
+bool LightSet::sample_area_light(const glm::vec3& p, glm::vec2 u, LightSample& out) const {
+  return sample_area_light(p, u, 1.0f, out);
+}
+
+bool LightSet::sample_area_light(const glm::vec3& p, glm::vec2 u, float group_pdf, LightSample& out) const {
+  if (triangles_.empty()) return false;
+  float tri_pdf = 0;
+  std::size_t i = 0;
+  // Reuse u.x for selection and stretch the remainder back to [0, 1).
+  const float x = triangle_distribution_.sample_continuous(u.x, &tri_pdf, &i);
+  const float n = static_cast<float>(triangles_.size());
+  const float ux = std::clamp(x * n - static_cast<float>(i), 0.0f, 0.99999994f);
+  const EmissiveTriangle& t = triangles_[i];
+  const glm::vec2 b = math::sample_uniform_triangle({ux, u.y});
+  const glm::vec3 q = (1 - b.x - b.y) * t.p0 + b.x * t.p1 + b.y * t.p2;
+  glm::vec3 d = q - p;
+  const float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0)) return false;
+  const float dist = std::sqrt(dist2);
+  d /= dist;
+  const glm::vec3 n_light = glm::normalize(glm::cross(t.p1 - t.p0, t.p2 - t.p0));
+  const float cos_l = std::abs(glm::dot(n_light, d));
+  if (cos_l <= 1e-7f) return false;
+  // Selection pdf of the triangle (its share of the total power) / area, to solid angle.
+  const float p_tri = tri_pdf / n;
+  out.pdf = group_pdf * p_tri / t.area * dist2 / cos_l;
+  out.radiance = evaluate_emission(*assets_, t.material, (1 - b.x - b.y) * t.uv0 + b.x * t.uv1 + b.y * t.uv2);
+  out.direction = d;
+  out.distance = dist;
+  out.delta = false;
+  return true;
 }
 
 bool LightSet::sample_punctual(std::size_t i, const glm::vec3& p, glm::vec2 u, LightSample& out) const {

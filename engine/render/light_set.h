@@ -57,6 +57,10 @@ class LightSet {
 
   // Samples one light as seen from point p (u3: selection, u: position/direction).
   bool sample(const glm::vec3& p, float u_select, glm::vec2 u, LightSample& out) const;
+  // Samples the area lights alone (a triangle by emitted power, then a point
+  // on it uniformly), as seen from p: out.pdf counts no group selection.
+  // False where there are none or the point is degenerate.
+  bool sample_area_light(const glm::vec3& p, glm::vec2 u, LightSample& out) const;
   // Solid-angle pdf that sample() would produce `dir` towards an emissive
   // triangle hit at distance `dist` with light normal `light_n` (from p).
   [[nodiscard]] float pdf_area_light(ecs::Entity entity, std::uint32_t primitive, const glm::vec3& dir, float dist,
@@ -84,6 +88,8 @@ class LightSet {
 
  private:
   float group_probability() const { return groups_ > 0 ? 1.0f / static_cast<float>(groups_) : 0.0f; }
+  // sample_area_light with the group's selection pdf folded in.
+  bool sample_area_light(const glm::vec3& p, glm::vec2 u, float group_pdf, LightSample& out) const;
 
   std::vector<EmissiveTriangle> triangles_;
   math::Distribution1D triangle_distribution_;
