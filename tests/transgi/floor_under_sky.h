@@ -4,16 +4,20 @@
 // ddgi_test.cpp).
 #include "engine/app/app.h"
 #include "engine/rt/rt_plugin.h"
+#include "engine/scene/components.h"
 #include "engine/scene/procedural.h"
 
 struct FloorUnderSky {
   engine::app::App app{engine::app::AppOptions{.jobs = {.threads = 2}}};
   // `extra`, if given, stands on the floor at `extra_at` (same material).
-  explicit FloorUnderSky(float albedo, const engine::scene::MeshAsset* extra = nullptr, glm::vec3 extra_at = glm::vec3(0.0f)) {
+  // `half`: the floor's half width (rays below the horizon steeper than
+  // height / half hit it; the rest pass its edge to the sky).
+  explicit FloorUnderSky(float albedo, const engine::scene::MeshAsset* extra = nullptr, glm::vec3 extra_at = glm::vec3(0.0f),
+                         float half = 100.0f) {
     using namespace engine;
     scene::SceneAssets a;
     a.generation = scene::next_scene_generation();
-    a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({100, 100}))};
+    a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({half, half}))};
     if (extra) a.meshes.push_back(std::make_shared<scene::MeshAsset>(*extra));
     material::Material m;
     m.base_color_factor = glm::vec4(albedo, albedo, albedo, 1);

@@ -29,7 +29,7 @@ double ms_since(Clock::time_point t) { return std::chrono::duration<double, std:
 
 ProbeField::ProbeField(ProbeFieldSettings s)
     : settings_(s), kernels_(cpu_probe_kernels()), grid_(s.grid), projector_(s.map), fibonacci_(spherical_fibonacci(s.rays_per_probe)) {
-  probes_.resize(static_cast<std::size_t>(s.grid.count()));
+  probes_.resize(static_cast<std::size_t>(s.grid.count()), static_cast<std::size_t>(s.sky.cells.count()));
   for (auto& st : probes_.maps) st.reset(s.map.texel_count(), depth_unit());
 }
 
@@ -99,7 +99,7 @@ void ProbeField::set_kernels(std::shared_ptr<ProbeKernels> kernels) {
 
 std::size_t ProbeField::memory_bytes() const {
   std::size_t b = (probes_.sh.size() + probes_.direct_mean.size() + probes_.direct_sh.size()) * sizeof(float) +
-                  probes_.direct_frames.size() * sizeof(std::uint32_t);
+                  probes_.direct_frames.size() * sizeof(std::uint32_t) + probes_.sky.size() * sizeof(SkyCell);
   for (const ProbeMapState& st : probes_.maps)
     b += st.radiance.size() * sizeof(HalfRgb) + st.sampled.size() * sizeof(std::uint8_t) +
          st.depth.texels.size() * sizeof(DepthMap::Texel);
@@ -113,8 +113,10 @@ void ProbeField::notify_scene_changed(SceneChange change) {
     if (probes_.state[q] == ProbeState::Converged) probes_.state[q] = ProbeState::Active;
     probes_.maps[q].stable_frames = 0;
     if (geometry_moved) probes_.maps[q].depth_frames = 0;
-    // The direct light may have changed: keep a short history so the mean follows.
-    probes_.direct_frames[q] = std::min<std::uint32_t>(probes_.direct_frames[q], 4);
+    // A changed lamp: keep a short history so the emitters' mean follows (a
+    // moved object restarts the probes near it, notify_region_changed; the
+    // sky needs no restart, sky_visibility.h).
+    if (change.light_changed) probes_.direct_frames[q] = std::min<std::uint32_t>(probes_.direct_frames[q], 4);
   }
   if (geometry_moved && settings_.skip.classify) {
     if (settings_.update_budget > 0 && !classify_pending_)
@@ -129,8 +131,13 @@ void ProbeField::notify_region_changed(const glm::vec3& lo, const glm::vec3& hi)
   const glm::vec3 margin = grid.spacing();
   for (int q = 0; q < grid.count(); ++q) {
     const glm::vec3 p = grid.position(q);
-    if (glm::all(glm::greaterThanEqual(p, lo - margin)) && glm::all(glm::lessThanEqual(p, hi + margin)))
+    if (glm::all(glm::greaterThanEqual(p, lo - margin)) && glm::all(glm::lessThanEqual(p, hi + margin))) {
       probes_.urgent[static_cast<std::size_t>(q)] = 1;
+      // Its view of the sky may have changed in part of a cell (a cell
+      // wholly covered or uncovered restarts by itself).
+      shorten_sky_history(probes_.sky_of(static_cast<std::size_t>(q)), settings_.sky, 4);
+      probes_.direct_frames[static_cast<std::size_t>(q)] = std::min<std::uint32_t>(probes_.direct_frames[static_cast<std::size_t>(q)], 4);
+    }
   }
 }
 
@@ -171,6 +178,14 @@ void ProbeField::forget_light(int probe) {
   std::fill_n(probes_.direct_mean.data() + q * 75, 75, 0.0f);
   std::fill_n(probes_.direct_sh.data() + q * 75, 75, 0.0f);
   probes_.direct_frames[q] = 0;
+  std::fill_n(probes_.sky_of(q), probes_.sky_cells, SkyCell{});
+}
+
+void ProbeField::finish_direct_sh(std::size_t q) {
+  float* out = probes_.direct_sh.data() + q * 75;
+  std::copy_n(probes_.direct_mean.data() + q * 75, 75, out);
+  sky_.add_sky_light(probes_.sky_of(q), out);
+  if (settings_.direct_window) apply_hanning_window(out);
 }
 
 int ProbeField::scroll(glm::ivec3 cells, const ProbeField* seed) {
@@ -275,11 +290,16 @@ void ProbeField::trace_and_shade(const engine::rt::RtScene& scene, const engine:
                                  const ProbeField* outer, UpdateWork& w) {
   using namespace engine;
   const int M = settings_.rays_per_probe;
+  // Emitters are light-sampled instead (sample_emitters).
+  const bool emitters_sampled = settings_.emitter_samples > 0 && lights.emissive_triangle_count() > 0;
   // What each ray found, kept by the probe that shot it.
   const auto consume = [&](int q, int i, const ProbeRayHit& h) {
     const auto qi = static_cast<std::size_t>(q);
     const glm::vec3& dir = w.directions[static_cast<std::size_t>(i)];
-    if (h.emitted != glm::vec3(0.0f)) {
+    // The sky: which way the probe sees out (its exact radiance is the sky
+    // projection's); emitters: a Monte Carlo projection, below.
+    if (sky_.has_sky()) record_sky_ray(probes_.sky_of(qi), settings_.sky, dir, !h.hit);
+    if (h.hit && h.emitted != glm::vec3(0.0f) && !emitters_sampled) {
       // Monte Carlo projection over a near-uniform set: 4 pi / M per ray.
       float* direct = w.direct_frame.data() + qi * 75;
       const math::ShBasis y = math::sh_eval(dir);
@@ -314,6 +334,68 @@ void ProbeField::trace_and_shade(const engine::rt::RtScene& scene, const engine:
   kernels_->shade_probe_rays(scene, lights, origins, w.tracing, w.directions, w.seed, frame_ + 1, self_source,
                              outer ? &outer_source : nullptr,
                              [&](int j, int i, const ProbeRayHit& h) { consume(w.tracing[static_cast<std::size_t>(j)], i, h); });
+}
+
+void ProbeField::sample_emitters(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, UpdateWork& w) {
+  using namespace engine;
+  const int K = settings_.emitter_samples;
+  if (K <= 0 || lights.emissive_triangle_count() == 0 || w.tracing.empty()) return;
+  const std::size_t k_per_probe = static_cast<std::size_t>(K), n = w.tracing.size() * k_per_probe;
+  std::vector<rt::Ray> rays(n);
+  std::vector<render::LightSample> samples(n);
+  // Probe j's K samples, stratified in the triangle-selection dimension;
+  // a failed sample gets pdf 0 and an empty segment.
+  const auto make_samples = [&](std::size_t j) {
+    const int q = w.tracing[j];
+    const glm::vec3 origin = grid_.position(q);
+    math::Pcg32 rng = math::make_rng(w.seed ^ 0xE317u, static_cast<std::uint64_t>(q), frame_);
+    for (std::size_t k = 0; k < k_per_probe; ++k) {
+      const std::size_t i = j * k_per_probe + k;
+      const glm::vec2 u{(static_cast<float>(k) + rng.next_float()) / static_cast<float>(K), rng.next_float()};
+      render::LightSample& ls = samples[i];
+      if (!lights.sample_area_light(origin, glm::min(u, glm::vec2(0.99999994f)), ls) || !(ls.pdf > 0) ||
+          ls.radiance == glm::vec3(0.0f)) {
+        ls.pdf = 0;
+        rays[i] = rt::Ray{origin, glm::vec3(0, 0, 1), 0.0f, 0.0f};
+        continue;
+      }
+      rays[i] = rt::Ray{origin, ls.direction, 0.0f, ls.distance * (1.0f - 1e-4f)};
+    }
+  };
+  // Probe j's unblocked samples into its direct SH.
+  const auto project = [&](std::size_t j, const std::uint8_t* blocked) {
+    float* direct = w.direct_frame.data() + static_cast<std::size_t>(w.tracing[j]) * 75;
+    for (std::size_t k = 0; k < k_per_probe; ++k) {
+      const render::LightSample& ls = samples[j * k_per_probe + k];
+      if (!(ls.pdf > 0) || blocked[k]) continue;
+      const glm::vec3 light = ls.radiance / (ls.pdf * static_cast<float>(K));
+      if (!std::isfinite(light.r + light.g + light.b)) continue;
+      const math::ShBasis y = math::sh_eval(ls.direction);
+      for (int c = 0; c < 3; ++c)
+        for (int t = 0; t < 25; ++t) direct[c * 25 + t] += light[c] * y[static_cast<std::size_t>(t)];
+    }
+  };
+  // A backend's tracer takes every shadow ray in one batch; else each
+  // probe's samples are made, traced and projected in one pass.
+  if (rt::RayBatchTracer* tracer = kernels_->tracer()) {
+    for (std::size_t j = 0; j < w.tracing.size(); ++j) make_samples(j);
+    std::vector<std::uint8_t> blocked(n, 1);
+    if (tracer->occluded(scene, rays, blocked)) {
+      for (std::size_t j = 0; j < w.tracing.size(); ++j) project(j, blocked.data() + j * k_per_probe);
+      return;
+    }
+  }
+  jobs::parallel_for<std::size_t>(0, w.tracing.size(), 8, [&](std::size_t b, std::size_t e) {
+    std::vector<std::uint8_t> blocked(k_per_probe);
+    for (std::size_t j = b; j < e; ++j) {
+      make_samples(j);
+      for (std::size_t k = 0; k < k_per_probe; ++k) {
+        const std::size_t i = j * k_per_probe + k;
+        blocked[k] = samples[i].pdf > 0 && scene.occluded(rays[i]) ? 1 : 0;
+      }
+      project(j, blocked.data());
+    }
+  });
 }
 
 void ProbeField::classify_traced(const engine::rt::RtScene& scene, UpdateWork& w) {
@@ -397,8 +479,7 @@ ProbeField::LightIntoProbes ProbeField::share_accumulate_project(UpdateWork& w) 
         std::min<std::uint32_t>(probes_.direct_frames[static_cast<std::size_t>(q)] + 1, static_cast<std::uint32_t>(std::max(1, settings_.direct_history)));
     for (int k = 0; k < 75; ++k)
       probes_.direct_mean[at + k] += (w.direct_frame[at + k] - probes_.direct_mean[at + k]) / static_cast<float>(frames);
-    std::copy_n(probes_.direct_mean.data() + at, 75, probes_.direct_sh.data() + at);
-    if (settings_.direct_window) apply_hanning_window(probes_.direct_sh.data() + at);
+    finish_direct_sh(static_cast<std::size_t>(q));
   };
   // After probe q's SH is projected into probes_.sh.
   auto finish_probe = [&](int q) {
@@ -459,6 +540,9 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
                                    const ProbeField* outer) {
   ProbeFrameStats stats;
   UpdateWork w;
+  // A changed sky (map, orientation or strength) re-lights every probe from
+  // what it knows of its view, now, whether or not it traces this frame.
+  const bool sky_changed = sky_.refresh(lights.environment(), settings_.sky);
   plan_update(w);
   stats.classified = w.classify;
 
@@ -466,6 +550,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   // bounce), then classify what traced.
   auto t0 = Clock::now();
   trace_and_shade(scene, lights, outer, w);
+  sample_emitters(scene, lights, w);
   for (std::uint8_t t : w.traced) stats.traced += t;
   stats.rays = static_cast<std::size_t>(stats.traced) * static_cast<std::size_t>(settings_.rays_per_probe);
   stats.hits = 0;
@@ -483,6 +568,11 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   // The own depth maps' update and the batch's set-up count as sharing.
   stats.project_ms = light.times.accumulate_ms;
   stats.raster_ms = ms_since(t0) - stats.project_ms;
+  if (sky_changed)
+    engine::jobs::parallel_for(0, grid_.count(), 64, [&](int b, int e) {
+      for (int q = b; q < e; ++q)
+        if (probes_.usable[static_cast<std::size_t>(q)] && !takes_frame(w, q)) finish_direct_sh(static_cast<std::size_t>(q));
+    });
   update_means_and_counts(stats);
   ++frame_;
   return stats;

@@ -8,10 +8,12 @@
 //     (their interpolated irradiance times the diffuse albedo, as DDGI does).
 //     Rays that hit an emitter or escape record zero: the probes hold
 //     indirect light only. What those rays saw (the environment, residual
-//     if the sun is split out, and emitters) is projected to a second SH per
-//     probe, the direct sky and emitter light (a running mean over
-//     `direct_history` frames): the real-time path's direct light from
-//     everything but punctual lights and the sun.
+//     if the sun is split out, and emitters) is a second SH per probe, the
+//     direct sky and emitter light: the real-time path's direct light from
+//     everything but punctual lights and the sun. The sky part is each
+//     direction cell's escaped fraction times the sky's exact projection
+//     (sky_visibility.h); emitters are a running mean over `direct_history`
+//     frames of the projection of what the rays hit.
 //  2. raster: radiance sharing across each probe's 26 neighbours.
 //  3. accumulate over frames (adaptive hysteresis), fill holes, project to
 //     SH (optionally windowed against ringing).
@@ -32,6 +34,7 @@
 #include "probes/open_space.h"
 #include "probes/probe_map.h"
 #include "probes/probe_kernels.h"
+#include "probes/sky_visibility.h"
 
 namespace transgi::probes {
 
@@ -113,10 +116,19 @@ struct ProbeFieldSettings {
   // budget follows the change. On = GI settles sooner after a light moves,
   // at the cost of unchanged probes refreshing less often meanwhile.
   bool changed_first = false;
-  // Frames the direct sky and emitter SH averages over (a running mean,
-  // restarted short when the scene changes). Higher = less noise from M rays
-  // a frame, at the cost of a slower response to a changed sky or lamp.
+  // Frames the direct emitter SH averages over (a running mean, restarted
+  // short when a light changes, or near a moved object). Higher = less
+  // noise, at the cost of a slower response to a changed lamp.
   int direct_history = 64;
+  // Light samples a traced probe takes of the emissive triangles a frame
+  // (a point by emitted power, one shadow ray each) for its direct emitter
+  // SH. A small lamp is one ray in hundreds of the probe's own, so without
+  // them each probe saw it a few times and neighbours disagreed: patches on
+  // every wall it lights. Higher = smoother lamp light, at the cost of that
+  // many shadow rays per probe. 0 = the probe rays that hit emitters.
+  int emitter_samples = 8;
+  // How the probes see the sky: escaped fractions per direction cell.
+  SkyVisibilitySettings sky;
   // Hanning window on the direct sky and emitter SH. On = no ringing around
   // small bright emitters, at the cost of a blurrier sky.
   bool direct_window = true;
@@ -187,12 +199,17 @@ struct ProbeSet {
   std::vector<std::uint8_t> urgent;          // in a changed region, not yet traced since
   std::vector<std::uint8_t> changed;         // its last update detected a lighting change (changed_first)
   std::vector<float> sh;                     // x 75: indirect light
-  std::vector<float> direct_mean, direct_sh;  // x 75: the sky and emitters' running mean, and that windowed
+  std::vector<float> direct_mean, direct_sh;  // x 75: the emitters' running mean, and that plus the sky, windowed
   std::vector<std::uint32_t> direct_frames;  // frames in each probe's running mean
+  std::vector<SkyCell> sky;                  // x sky cells: the escaped fractions (sky_visibility.h)
+  std::size_t sky_cells = 0;
+  [[nodiscard]] SkyCell* sky_of(std::size_t q) { return sky.data() + q * sky_cells; }
 
   // count probes, active and usable, holding nothing.
-  void resize(std::size_t count) {
+  void resize(std::size_t count, std::size_t cells_per_probe) {
     maps.resize(count);
+    sky_cells = cells_per_probe;
+    sky.assign(count * cells_per_probe, SkyCell{});
     state.assign(count, ProbeState::Active);
     usable.assign(count, 1);
     saw_light.assign(count, 0);
@@ -316,6 +333,8 @@ class ProbeField {
  private:
   // Clears probe q's maps, SH and direct-light history.
   void forget_light(int probe);
+  // Probe q's direct SH from its emitter mean and its view of the sky.
+  void finish_direct_sh(std::size_t q);
   // Marks the probes this frame's budget updates (update_budget > 0).
   void select_within_budget(std::vector<std::uint8_t>& traced) const;
   // The probes this frame may update: update_budget, or steady_light_budget
@@ -325,7 +344,9 @@ class ProbeField {
   // update()'s stages, in order, over one frame's scratch. After each:
   //  plan_update: which probes trace, this frame's ray set;
   //  trace_and_shade: every tracing probe's shaded points, hit counts and
-  //    the sky and emitters it saw;
+  //    the sky it saw (and the emitters, without emitter_samples);
+  //  sample_emitters: every tracing probe's light samples of the emitters
+  //    (emitter_samples), projected;
   //  classify_traced (classification and budgeted frames): buried, far and
   //    relocated probes marked, their light forgotten;
   //  share_accumulate_project: each updating probe's depth from its own
@@ -337,6 +358,7 @@ class ProbeField {
   void plan_update(UpdateWork& w);
   void trace_and_shade(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, const ProbeField* outer,
                        UpdateWork& w);
+  void sample_emitters(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, UpdateWork& w);
   void classify_traced(const engine::rt::RtScene& scene, UpdateWork& w);
   struct LightIntoProbes {
     SharingStats sharing;
@@ -356,6 +378,7 @@ class ProbeField {
   // The length probe depths are stored in units of (ProbeMapState::reset).
   [[nodiscard]] float depth_unit() const { return grid_.min_spacing() > 0 ? grid_.min_spacing() : 1.0f; }
   ProbeSet probes_;
+  SkyProjection sky_;
   bool classify_pending_ = true;
   std::vector<float> mean_sh_ = std::vector<float>(75, 0.0f), mean_direct_sh_ = std::vector<float>(75, 0.0f);
   std::vector<glm::vec3> fibonacci_;
