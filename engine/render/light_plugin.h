@@ -6,7 +6,9 @@
 // exactly when the set was rebuilt this frame (a light, an emitter or the
 // environment changed, or the geometry moved), `lighting_version` exactly
 // when what lights the scene changed (not an object without emission that
-// moved), and `geometry_version` exactly when the Embree scene changed, so
+// moved), `emitter_version` exactly when the emissive triangles changed (or
+// may have: a material edit or new assets; not a moved sun or a brighter
+// sky), and `geometry_version` exactly when the Embree scene changed, so
 // per-frame caches (light probes) can tell which of their inputs moved.
 #include "engine/app/app.h"
 #include "engine/render/light_set.h"
@@ -28,6 +30,7 @@ struct SceneLights {
   LightSet set;
   std::uint64_t version = 0;           // the set was rebuilt (lighting or geometry changed)
   std::uint64_t lighting_version = 0;  // lights, emitters (moved too), environment or materials changed
+  std::uint64_t emitter_version = 0;   // the emissive triangles (moved, edited, added or removed)
   std::uint64_t geometry_version = 0;  // the ray-traced geometry changed
   // The sun split of the current environment, computed once per map (a
   // moving object rebuilds the set every frame; the map does not change).

@@ -55,7 +55,9 @@ void sync_lights(LightView lights, Removed<scene::PunctualLight> removed, Res<rt
     out->sun_split_of = env;
   }
   LightSet set(*rt, std::move(punctual), env, out->sun_split);
-  if (lights_changed || assets_changed || !same_emitters(out->set, set)) ++out->lighting_version;
+  const bool emitters_changed = assets_changed || edited || !same_emitters(out->set, set);
+  if (lights_changed || emitters_changed) ++out->lighting_version;
+  if (emitters_changed) ++out->emitter_version;
   out->set = std::move(set);
   ++out->version;
   if (geometry_changed || assets_changed) ++out->geometry_version;

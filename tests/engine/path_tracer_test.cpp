@@ -266,16 +266,26 @@ TEST(LightSync, OnlyAMovedEmitterCountsAsALightingChange) {
   app.world().emplace<scene::MeshInstance>(box, scene::MeshInstance{1});
   app.update();
   const auto& lights = app.world().resource<render::SceneLights>();
-  const std::uint64_t v0 = lights.version, l0 = lights.lighting_version, g0 = lights.geometry_version;
+  const std::uint64_t v0 = lights.version, l0 = lights.lighting_version, g0 = lights.geometry_version,
+                      e0 = lights.emitter_version;
   app.world().get_mut<transform::Transform>(box).translation = {0.3f, -1, 0};
   app.update();
   EXPECT_EQ(lights.version, v0 + 1) << "the set is rebuilt when geometry moves";
   EXPECT_EQ(lights.geometry_version, g0 + 1);
   EXPECT_EQ(lights.lighting_version, l0) << "a grey box moved: no light changed";
+  EXPECT_EQ(lights.emitter_version, e0);
   app.world().get_mut<transform::Transform>(light).translation = {0, 0.5f, 0};
   app.update();
   EXPECT_EQ(lights.geometry_version, g0 + 2);
   EXPECT_EQ(lights.lighting_version, l0 + 1) << "the lamp moved";
+  EXPECT_EQ(lights.emitter_version, e0 + 1);
+  // A sun that turns lights the scene differently; the emitters stay.
+  const ecs::Entity sun = app.world().spawn();
+  app.world().emplace<transform::Transform>(sun);
+  app.world().emplace<scene::PunctualLight>(sun, scene::PunctualLight{.type = scene::PunctualLight::Type::Directional});
+  app.update();
+  EXPECT_EQ(lights.lighting_version, l0 + 2) << "a sun came up";
+  EXPECT_EQ(lights.emitter_version, e0 + 1) << "no emitter changed";
 }
 
 // Adaptive sampling (issue 14, item 1) against the furnace's known answer:

@@ -162,20 +162,37 @@ TEST(ProbeDirect, ProbesUnderASmallLampSeeItOverItsSolidAngle) {
   settings.grid = ProbeGrid{{-0.05f, 0.0f, -0.05f}, {0.05f, 0.0f, 0.05f}, {2, 1, 2}};  // four probes right under it
   settings.skip.classify = false;  // no surface nearby: the probes would be counted far
   ProbeField field(settings);
-  app.jobs().run([&] {
-    for (int f = 0; f < 64; ++f) field.update(app.world().resource<rt::RtScene>(), lights);
-  });
-  for (int p = 0; p < field.grid().count(); ++p) {
-    // The rectangle's solid angle from a point below it, offset (x, z) from its centre.
-    const glm::vec3 at = field.grid().position(p);
-    double omega = 0;
-    for (int i = 0; i < 4; ++i) {  // signed sum over the four quadrants (Van Oosterom-style corner formula)
-      const double x = (i & 1 ? half : -half) - at.x, z = (i & 2 ? half : -half) - at.z, h = height - at.y;
-      omega += ((i == 0 || i == 3) ? 1 : -1) * std::atan2(x * z, h * std::sqrt(x * x + z * z + h * h));
+  const auto run = [&](const render::LightSet& set, int frames) {
+    app.jobs().run([&] {
+      for (int f = 0; f < frames; ++f) field.update(app.world().resource<rt::RtScene>(), set);
+    });
+  };
+  // L00 = Le Y00 omega, omega the rectangle's solid angle from each probe, to `relative`.
+  const auto expect_lamp = [&](double relative, const char* when) {
+    for (int p = 0; p < field.grid().count(); ++p) {
+      const glm::vec3 at = field.grid().position(p);
+      double omega = 0;
+      for (int i = 0; i < 4; ++i) {  // signed sum over the rectangle's corners
+        const double x = (i & 1 ? half : -half) - at.x, z = (i & 2 ? half : -half) - at.z, h = height - at.y;
+        omega += ((i == 0 || i == 3) ? 1 : -1) * std::atan2(x * z, h * std::sqrt(x * x + z * z + h * h));
+      }
+      omega = std::abs(omega);
+      const float* L = field.direct_sh_all().data() + static_cast<std::size_t>(p) * 75;
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(L[c * 25], radiance[c] * kY00 * omega, relative * radiance[c] * kY00 * omega)
+            << when << ": probe " << p << " channel " << c;
     }
-    omega = std::abs(omega);
-    const float* L = field.direct_sh_all().data() + static_cast<std::size_t>(p) * 75;
-    for (int c = 0; c < 3; ++c)
-      EXPECT_NEAR(L[c * 25], radiance[c] * kY00 * omega, 0.01 * radiance[c] * kY00 * omega) << "probe " << p << " channel " << c;
-  }
+  };
+  run(lights, 64);
+  expect_lamp(0.01, "64 frames");
+  // Switched off (the set has no emitters), then on again: what the ECS tells
+  // the field when the emissive triangles change. One update follows each.
+  field.notify_scene_changed({.light_changed = true, .emitters_changed = true});
+  const render::LightSet dark;
+  run(dark, 1);
+  for (int p = 0; p < field.grid().count(); ++p)
+    EXPECT_EQ(field.direct_sh_all()[static_cast<std::size_t>(p) * 75], 0.0f) << "switched off: probe " << p;
+  field.notify_scene_changed({.light_changed = true, .emitters_changed = true});
+  run(lights, 1);
+  expect_lamp(0.03, "one frame after it came back on");
 }

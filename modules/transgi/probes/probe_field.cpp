@@ -113,10 +113,11 @@ void ProbeField::notify_scene_changed(SceneChange change) {
     if (probes_.state[q] == ProbeState::Converged) probes_.state[q] = ProbeState::Active;
     probes_.maps[q].stable_frames = 0;
     if (geometry_moved) probes_.maps[q].depth_frames = 0;
-    // A changed lamp: keep a short history so the emitters' mean follows (a
-    // moved object restarts the probes near it, notify_region_changed; the
+    // A changed lamp: the emitters' mean starts again from the next update's
+    // light samples, which alone are a fair estimate (a moved object only
+    // shortens the history of the probes near it, notify_region_changed; the
     // sky needs no restart, sky_visibility.h).
-    if (change.light_changed) probes_.direct_frames[q] = std::min<std::uint32_t>(probes_.direct_frames[q], 4);
+    if (change.emitters_changed) probes_.direct_frames[q] = 0;
   }
   if (geometry_moved && settings_.skip.classify) {
     if (settings_.update_budget > 0 && !classify_pending_)

@@ -117,8 +117,9 @@ struct ProbeFieldSettings {
   // at the cost of unchanged probes refreshing less often meanwhile.
   bool changed_first = false;
   // Frames the direct emitter SH averages over (a running mean, restarted
-  // short when a light changes, or near a moved object). Higher = less
-  // noise, at the cost of a slower response to a changed lamp.
+  // when an emitter changes, shortened near a moved object). Higher = less
+  // noise, at the cost of a slower response to geometry that moves near a
+  // lamp.
   int direct_history = 64;
   // Light samples a traced probe takes of the emissive triangles a frame
   // (a point by emitted power, one shadow ray each) for its direct emitter
@@ -238,11 +239,13 @@ class ProbeField {
   struct SceneChange {
     bool geometry_moved = false;  // an object moved, appeared or left
     bool light_changed = false;   // a light, the sun or the sky changed
+    bool emitters_changed = false;  // an emissive mesh moved, changed or came or went
   };
   // The scene changed since the last update: converged probes wake up; if
   // the geometry moved the probes are classified again and their depth
   // re-converges quickly; if a light changed the full update_budget returns
-  // (steady_light_budget).
+  // (steady_light_budget); if the emitters changed, their mean in the direct
+  // SH restarts short (the sky's part follows the sky by itself).
   void notify_scene_changed(SceneChange change);
   // What changed lies in [min, max] (a moved object's old and new bounds):
   // with a budget, the probes within one cell of it are updated before any

@@ -11,7 +11,7 @@ using namespace engine::schedule;
 namespace {
 
 struct SceneChanges {
-  bool geometry_moved = false, lighting_changed = false;
+  bool geometry_moved = false, lighting_changed = false, emitters_changed = false;
   const std::vector<rt::WorldBounds>* regions = nullptr;  // where geometry moved
 };
 
@@ -20,6 +20,7 @@ SceneChanges changes_since(const SeenVersions& seen, const rt::RtScene& rt, cons
   SceneChanges c;
   c.geometry_moved = lights.geometry_version != seen.geometry;
   c.lighting_changed = lights.lighting_version != seen.lights;
+  c.emitters_changed = lights.emitter_version != seen.emitters;
   // Where it moved: probes there are updated first (RtScene keeps the list for its last commit).
   c.regions = c.geometry_moved ? &rt.changed_at_last_commit() : &kNothing;
   return c;
@@ -27,7 +28,8 @@ SceneChanges changes_since(const SeenVersions& seen, const rt::RtScene& rt, cons
 
 void tell(probes::ProbeField& field, const SceneChanges& c) {
   if (c.geometry_moved || c.lighting_changed)
-    field.notify_scene_changed({.geometry_moved = c.geometry_moved, .light_changed = c.lighting_changed});
+    field.notify_scene_changed(
+        {.geometry_moved = c.geometry_moved, .light_changed = c.lighting_changed, .emitters_changed = c.emitters_changed});
   for (const rt::WorldBounds& b : *c.regions) field.notify_region_changed(b.min, b.max);
 }
 
@@ -53,6 +55,7 @@ void sync_probe_volumes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res
   });
   seen->geometry = lights->geometry_version;
   seen->lights = lights->lighting_version;
+  seen->emitters = lights->emitter_version;
 }
 
 probes::ProbeFieldSettings cascade_field_settings(const probes::ProbeFieldSettings& base, const probes::CascadeSettings& c,
@@ -98,6 +101,7 @@ void sync_probe_cascades(View<Get<const scene::Camera, const transform::WorldTra
   frame->cascade_probes_entered = entered;
   seen->geometry = lights->geometry_version;
   seen->lights = lights->lighting_version;
+  seen->emitters = lights->emitter_version;
 }
 
 }  // namespace transgi::runtime

@@ -17,7 +17,7 @@
 namespace transgi::runtime {
 
 struct SeenVersions {
-  std::uint64_t lights = 0, geometry = 0;
+  std::uint64_t lights = 0, geometry = 0, emitters = 0;
 };
 
 // After it: every ProbeVolume has a field for the current settings and
