@@ -101,6 +101,8 @@ std::vector<OptionSpec> runtime_option_specs(const std::string& default_preset) 
               "near-field filter radius in GI cells: higher = smoother, at the cost of detail"),
       integer("near-field-budget", "N", 0, 1 << 24, by_preset(q.near_field.cell_budget, r.near_field.cell_budget),
               "real-time path: GI cells that trace near-field rays a frame (0 = no limit): higher = less noise at high resolutions, at the cost of ray time"),
+      integer("near-field-history", "F", 1, 255, by_preset(q.near_field.history_frames, r.near_field.history_frames),
+              "real-time path: frames a cell's contact light is averaged over: higher = less noise, at the cost of lag after a change of light"),
   };
 }
 

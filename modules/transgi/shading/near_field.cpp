@@ -1,6 +1,7 @@
 #include "shading/near_field.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <stdexcept>
 
 #include "engine/jobs/parallel_for.h"
@@ -107,6 +108,12 @@ void filter_near_field_separable(std::span<const glm::vec4> guide, int width, in
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width && !row_has[static_cast<std::size_t>(y)]; ++x)
       row_has[static_cast<std::size_t>(y)] = valid[static_cast<std::size_t>(y) * width + x];
+  // A tent over the window, not a box: the sparse lattice's estimates then
+  // blend into their neighbours' like a bilinear reconstruction instead of
+  // each filling a square (a bright one-ray estimate showed as a block).
+  // Every tap within the radius keeps a positive weight, so the pixels an
+  // estimate reaches are the same.
+  const auto tent = [&](int d) { return static_cast<float>(radius + 1 - std::abs(d)); };
   // Pass 1 keeps, per pixel, the weighted sum and weight along its row; pass
   // 2 sums those down the column, each tap weighted against the centre.
   // Only rows with a valid pixel are written, and only they are read.
@@ -125,7 +132,7 @@ void filter_near_field_separable(std::span<const glm::vec4> guide, int width, in
         for (int nx = std::max(0, x - radius); nx <= std::min(width - 1, x + radius); ++nx) {
           const std::size_t i = static_cast<std::size_t>(y) * width + nx;
           if (!valid[i]) continue;
-          const float w = guide_similarity(c, guide[i], kDepthTolerance, kNormalPower);
+          const float w = guide_similarity(c, guide[i], kDepthTolerance, kNormalPower) * tent(nx - x);
           if (w > 0) acc += glm::vec4(w * values[i], w);
         }
         row[p] = acc;
@@ -145,7 +152,7 @@ void filter_near_field_separable(std::span<const glm::vec4> guide, int width, in
           if (!row_has[static_cast<std::size_t>(ny)]) continue;
           const std::size_t i = static_cast<std::size_t>(ny) * width + x;
           if (!(row[i].w > 0)) continue;
-          const float w = guide_similarity(c, guide[i], kDepthTolerance, kNormalPower);
+          const float w = guide_similarity(c, guide[i], kDepthTolerance, kNormalPower) * tent(ny - y);
           if (w > 0) acc += w * row[i];
         }
         if (acc.w > 0) {

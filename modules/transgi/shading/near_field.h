@@ -46,6 +46,10 @@ struct NearFieldRays {
   // which cells would have no estimate in reach: there the budget yields.
   // Higher = less noisy contact light, at the cost of ray time.
   int cell_budget = 0;
+  // Real-time path: frames a cell's contact light is averaged over (a
+  // running mean, restarted near a moved object). Higher = less noise, at
+  // the cost of contact light that lags a change of light as many frames.
+  int history_frames = 32;
   bool operator==(const NearFieldRays&) const = default;
 };
 

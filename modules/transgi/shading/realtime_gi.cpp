@@ -260,10 +260,6 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
 
 namespace {
 
-// Frames a cell's contact light is averaged over (ContactScratch::mean):
-// more = less noise, at the cost of contact light that lags a change as long.
-constexpr int kContactFrames = 8;
-
 // Contact light may darken a cell to this fraction of its probe light, no
 // further: it replaces what the probes hold for the near directions, and a
 // noisy estimate against an over-bright probe (one entering a cascade) had
@@ -361,7 +357,8 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
     });
   }
   if (tracked) {
-    // The running mean over the last kContactFrames frames of each surface
+    const int history = std::clamp(near_field.history_frames, 1, 255);  // counts are bytes
+    // The running mean over the last history_frames frames of each surface
     // point, followed through the GI history's track (a point seen anew, or
     // one near a moved object, starts from this frame's estimate).
     scratch.mean_next.resize(grid);
@@ -379,7 +376,7 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
           }
           continue;
         }
-        const int n = known ? std::min<int>(scratch.count[static_cast<std::size_t>(q)], kContactFrames - 1) : 0;
+        const int n = known ? std::min<int>(scratch.count[static_cast<std::size_t>(q)], history - 1) : 0;
         scratch.mean_next[c] = n > 0 ? (scratch.mean[static_cast<std::size_t>(q)] * static_cast<float>(n) + scratch.filtered[c]) /
                                            static_cast<float>(n + 1)
                                      : scratch.filtered[c];
