@@ -239,6 +239,7 @@ struct ProbeField::UpdateWork {
   std::vector<std::uint8_t> traced;                // per probe: it traces this frame
   std::vector<int> tracing;                        // the probes that trace
   std::vector<glm::vec3> directions;               // this frame's ray set
+  std::vector<int> sky_cells;                      // each direction's sky cell (sky_visibility.h)
   std::vector<std::vector<ShadedPoint>> points;    // per probe: what its rays found
   std::vector<int> backfaces, hits;                // per probe: of its rays
   std::vector<float> nearest;                      // per probe: its nearest hit
@@ -268,7 +269,11 @@ void ProbeField::plan_update(UpdateWork& w) {
   w.budgeted = settings_.update_budget > 0 && !w.classify && !settling;
   if (w.budgeted) select_within_budget(w.traced);
   w.directions.resize(static_cast<std::size_t>(M));
-  for (int i = 0; i < M; ++i) w.directions[static_cast<std::size_t>(i)] = glm::normalize(rotation * fibonacci_[static_cast<std::size_t>(i)]);
+  w.sky_cells.resize(static_cast<std::size_t>(M));
+  for (int i = 0; i < M; ++i) {
+    w.directions[static_cast<std::size_t>(i)] = glm::normalize(rotation * fibonacci_[static_cast<std::size_t>(i)]);
+    w.sky_cells[static_cast<std::size_t>(i)] = settings_.sky.cells.cell_of(w.directions[static_cast<std::size_t>(i)]);
+  }
   w.points.resize(static_cast<std::size_t>(probes));
   w.backfaces.assign(static_cast<std::size_t>(probes), 0);
   w.hits.assign(static_cast<std::size_t>(probes), 0);
@@ -293,13 +298,15 @@ void ProbeField::trace_and_shade(const engine::rt::RtScene& scene, const engine:
   const int M = settings_.rays_per_probe;
   // Emitters are light-sampled instead (sample_emitters).
   const bool emitters_sampled = settings_.emitter_samples > 0 && lights.emissive_triangle_count() > 0;
+  const bool with_sky = sky_.has_sky();
+  const int sky_history = std::clamp(settings_.sky.history_rays, 1, 255);
   // What each ray found, kept by the probe that shot it.
   const auto consume = [&](int q, int i, const ProbeRayHit& h) {
     const auto qi = static_cast<std::size_t>(q);
     const glm::vec3& dir = w.directions[static_cast<std::size_t>(i)];
     // The sky: which way the probe sees out (its exact radiance is the sky
     // projection's); emitters: a Monte Carlo projection, below.
-    if (sky_.has_sky()) record_sky_ray(probes_.sky_of(qi), settings_.sky, dir, !h.hit);
+    if (with_sky) record_sky_ray(probes_.sky_of(qi)[w.sky_cells[static_cast<std::size_t>(i)]], !h.hit, sky_history);
     if (h.hit && h.emitted != glm::vec3(0.0f) && !emitters_sampled) {
       // Monte Carlo projection over a near-uniform set: 4 pi / M per ray.
       float* direct = w.direct_frame.data() + qi * 75;

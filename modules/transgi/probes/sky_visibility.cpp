@@ -11,26 +11,8 @@
 
 namespace transgi::probes {
 
-namespace {
-constexpr int kCertainRays = 8;
-}  // namespace
-
 void record_sky_ray(SkyCell* cells, const SkyVisibilitySettings& settings, const glm::vec3& direction, bool escaped) {
-  SkyCell& c = cells[settings.cells.cell_of(direction)];
-  const std::uint16_t x = escaped ? 65535 : 0;
-  // A cell whose last several rays all agreed (wall or open sky) and now
-  // sees otherwise: the geometry moved across it, so its history no longer
-  // holds. (A few agreeing rays are common on a window's outline.)
-  const bool certain = c.rays >= kCertainRays && (c.escaped == 0 || c.escaped == 65535);
-  if (c.rays == 0 || (certain && c.escaped != x)) {
-    c.escaped = x;
-    c.rays = 1;
-    return;
-  }
-  const int cap = std::clamp(settings.history_rays, 1, 255);
-  c.rays = static_cast<std::uint8_t>(std::min(cap, c.rays + 1));
-  const float mean = static_cast<float>(c.escaped) + (static_cast<float>(x) - static_cast<float>(c.escaped)) / static_cast<float>(c.rays);
-  c.escaped = static_cast<std::uint16_t>(std::clamp(std::lround(mean), 0L, 65535L));
+  record_sky_ray(cells[settings.cells.cell_of(direction)], escaped, std::clamp(settings.history_rays, 1, 255));
 }
 
 void shorten_sky_history(SkyCell* cells, const SkyVisibilitySettings& settings, int rays) {

@@ -73,7 +73,26 @@ struct SkyVisibilitySettings {
   bool operator==(const SkyVisibilitySettings&) const = default;
 };
 
-// Records one ray of a probe in its cells.
+// A cell whose last this many rays all agreed (wall or open sky) and whose
+// next ray disagrees restarts: the geometry moved across it. (A few
+// agreeing rays in a row are common on a window's outline.)
+inline constexpr int kSkyCertainRays = 8;
+
+// Records one ray in its cell (`history_rays` in [1, 255]). Integer
+// arithmetic, rounded: it runs once per probe ray.
+inline void record_sky_ray(SkyCell& c, bool escaped, int history_rays) {
+  const int x = escaped ? 65535 : 0, e = c.escaped;
+  const bool certain = c.rays >= kSkyCertainRays && (e == 0 || e == 65535);
+  if (c.rays == 0 || (certain && e != x)) {
+    c.escaped = static_cast<std::uint16_t>(x);
+    c.rays = 1;
+    return;
+  }
+  const int rays = std::min(history_rays, c.rays + 1), d = x - e;
+  c.rays = static_cast<std::uint8_t>(rays);
+  c.escaped = static_cast<std::uint16_t>(e + (d >= 0 ? d + rays / 2 : d - rays / 2) / rays);
+}
+// Records one ray of a probe in its cells, by direction.
 void record_sky_ray(SkyCell* cells, const SkyVisibilitySettings& settings, const glm::vec3& direction, bool escaped);
 // Every cell seen by at most `rays` rays, so the next ones count more (the
 // geometry near the probe moved).
