@@ -114,6 +114,10 @@ glm::vec2 TemporalAntialiasing::next_jitter(const TemporalAaSettings& settings) 
   return settings.enabled ? taa_jitter(frame_, settings.jitter_phases) : glm::vec2(0.0f);
 }
 
+int TemporalAntialiasing::next_phase(const TemporalAaSettings& settings) const {
+  return settings.enabled ? static_cast<int>(frame_ % static_cast<std::uint64_t>(std::max(settings.jitter_phases, 1))) : 0;
+}
+
 void TemporalAntialiasing::clear() {
   prev_ = Previous{};
   stats_ = Stats{};

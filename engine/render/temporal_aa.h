@@ -97,6 +97,10 @@ class TemporalAntialiasing {
   // The sub-pixel offset, in [-0.5, 0.5)^2 pixels, of the next frame's camera
   // rays (film = pixel + 0.5 + jitter); 0 when disabled.
   [[nodiscard]] glm::vec2 next_jitter(const TemporalAaSettings& settings) const;
+  // The next frame's phase in the jitter cycle, 0..jitter_phases - 1 (0
+  // when disabled): what else varies over the cycle (a shadow pattern's
+  // shift) takes it, so a still pixel's cycle mean averages that too.
+  [[nodiscard]] int next_phase(const TemporalAaSettings& settings) const;
   // Blends each of `layers` (same size as the camera's image, traced with
   // next_jitter()'s offset) with its history, in place, and keeps the
   // result and the surfaces as the next frame's history. Every layer shares

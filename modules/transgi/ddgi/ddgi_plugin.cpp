@@ -150,7 +150,9 @@ void render_realtime(const rt::RtScene& rt, const scene::SceneAssets& assets, co
   const render::LightSet& lights = scene_lights.set;
   shading::GBuffer& g = scratch.gbuffer;
   auto t0 = Clock::now();
-  shading::DirectTileShader direct(rt, lights, rays, frame.width, frame.height);
+  // The sun's disk pattern shifts with the jitter phase, as TransGI's frame does (realtime_direct.h).
+  const int pattern_phase = options.taa.enabled ? scratch.taa.next_phase(options.taa) : 0;
+  shading::DirectTileShader direct(rt, lights, rays, frame.width, frame.height, {}, pattern_phase);
   const glm::vec2 jitter = options.taa.enabled ? scratch.taa.next_jitter(options.taa) : glm::vec2(0.0f);
   shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, g, &direct, kernels.tracer(),
                          jitter, options.taa.texture_lod_bias_in_use());

@@ -187,14 +187,19 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   // G-buffer, not tile by tile inside it.
   // Last frame's images lend their storage to this frame's (nothing reads
   // them once a new frame starts).
-  if (deterministic && !tracer) direct.emplace(rt, lights, rays, frame.width, frame.height, std::move(frame.direct));
+  // The sun's disk pattern shifts with the jitter phase: a still pixel's
+  // cycle mean then averages 16 points of the disk where the penumbra is too
+  // narrow for the filter (realtime_direct.h, disk_pattern_shift).
+  const int pattern_phase = settings.taa.enabled ? packed.taa.next_phase(settings.taa) : 0;
+  if (deterministic && !tracer)
+    direct.emplace(rt, lights, rays, frame.width, frame.height, std::move(frame.direct), pattern_phase);
   packed.scratch.recycle(std::move(frame.gi));
   const glm::vec2 jitter = settings.taa.enabled ? packed.taa.next_jitter(settings.taa) : glm::vec2(0.0f);
   shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, packed.gbuffer, direct ? &*direct : nullptr, tracer,
                          jitter, settings.taa.texture_lod_bias_in_use());
   std::optional<engine::image::ImageRGB> batched_direct;
   if (deterministic && tracer)
-    batched_direct = shading::shade_direct_realtime(packed.gbuffer, rt, lights, rays, &frame.direct_stats, tracer);
+    batched_direct = shading::shade_direct_realtime(packed.gbuffer, rt, lights, rays, &frame.direct_stats, tracer, pattern_phase);
   // The device's time for the camera and shadow rays just traced; the probe
   // update takes the rest (device_stage::kOtherRays).
   if (tracer) frame.set_device_stage(device_stage::kGbufferRays, tracer->take_device_ms());

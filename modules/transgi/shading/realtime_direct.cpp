@@ -29,14 +29,22 @@ glm::vec2 disk_pattern(int x, int y) {
   return engine::math::r2_point(r);
 }
 
+glm::ivec2 disk_pattern_shift(int phase) {
+  // A 4x4 grid of even offsets, visited in bit-reversed order.
+  const unsigned k = static_cast<unsigned>(((phase % kDiskPatternPhases) + kDiskPatternPhases) % kDiskPatternPhases);
+  const unsigned r = ((k & 1u) << 3) | ((k & 2u) << 1) | ((k & 4u) >> 1) | ((k & 8u) >> 3);
+  return {2 * static_cast<int>(r & 3u), 2 * static_cast<int>(r >> 2)};
+}
+
 DirectTileShader::DirectTileShader(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
                                    const engine::render::CameraRays& camera, int width, int height,
-                                   engine::image::ImageRGB recycled)
+                                   engine::image::ImageRGB recycled, int pattern_phase)
     : scene_(scene),
       lights_(lights),
       camera_(camera),
       out_(recycled.width == width && recycled.height == height ? std::move(recycled) : engine::image::ImageRGB(width, height)),
       n_lights_(lights.punctual_count()),
+      pattern_shift_(disk_pattern_shift(pattern_phase)),
       rays_per_tile_(static_cast<std::size_t>((width + 3) / 4) * static_cast<std::size_t>((height + 3) / 4), 0) {
   using namespace engine;
   // A directional light's sample does not depend on the point: its 64
@@ -103,8 +111,8 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty, Scratch& scr
         if (!s.hit) continue;
         render::LightSample ls;
         if (is_directional_[l])
-          ls = directional_[l][static_cast<std::size_t>((x & 7) | ((y & 7) << 3))];
-        else if (!lights_.sample_punctual(l, s.position, disk_pattern(x, y), ls))
+          ls = directional_[l][static_cast<std::size_t>(((x + pattern_shift_.x) & 7) | (((y + pattern_shift_.y) & 7) << 3))];
+        else if (!lights_.sample_punctual(l, s.position, disk_pattern(x + pattern_shift_.x, y + pattern_shift_.y), ls))
           continue;
         const math::Frame frame = math::Frame::from_normal(s.normal_world);
         const glm::vec3 wo = frame.to_local(s.wo_world);
@@ -425,8 +433,8 @@ engine::image::ImageRGB DirectTileShader::take(const GBuffer& g, RealtimeDirectS
 engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
                                               const engine::render::LightSet& lights,
                                               const engine::render::CameraRays& camera, RealtimeDirectStats* stats,
-                                              engine::rt::RayBatchTracer* tracer) {
-  DirectTileShader shader(scene, lights, camera, g.width, g.height);
+                                              engine::rt::RayBatchTracer* tracer, int pattern_phase) {
+  DirectTileShader shader(scene, lights, camera, g.width, g.height, {}, pattern_phase);
   const int tiles_x = (g.width + 3) / 4, tiles_y = (g.height + 3) / 4;
   auto each_tile = [&] {
     engine::jobs::parallel_for(0, tiles_x * tiles_y, 16, [&](int t0, int t1) {

@@ -45,9 +45,14 @@ struct RealtimeDirectStats {
 // threads at once for different tiles.
 class DirectTileShader {
  public:
+  // `pattern_phase`: which of kDiskPatternPhases shifts of the disk pattern
+  // this frame uses (disk_pattern_shift): the temporal antialiasing's jitter
+  // phase, so that a still pixel's cycle mean averages 16 points of the disk
+  // where its penumbra is too narrow for the filter to hold the whole
+  // pattern (a contact shadow's serrated edge). 0 = the unshifted pattern.
   DirectTileShader(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
                    const engine::render::CameraRays& camera, int width, int height,
-                   engine::image::ImageRGB recycled = {});
+                   engine::image::ImageRGB recycled = {}, int pattern_phase = 0);
   // `recycled`: last frame's image, whose storage this one reuses where the
   // size matches (tiles write every pixel, so nothing is cleared: clearing
   // a 640x360 image was serial time in the frame).
@@ -92,6 +97,7 @@ class DirectTileShader {
   const engine::render::CameraRays& camera_;
   engine::image::ImageRGB out_;
   std::size_t n_lights_ = 0;
+  glm::ivec2 pattern_shift_{0};  // disk_pattern_shift(pattern_phase)
   std::vector<std::array<engine::render::LightSample, 64>> directional_;
   std::vector<std::uint8_t> is_directional_;
   // A directional light with a disk: per pixel, how far along the pixel's
@@ -122,11 +128,19 @@ engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt
                                               const engine::render::LightSet& lights,
                                               const engine::render::CameraRays& camera,
                                               RealtimeDirectStats* stats = nullptr,
-                                              engine::rt::RayBatchTracer* tracer = nullptr);
+                                              engine::rt::RayBatchTracer* tracer = nullptr, int pattern_phase = 0);
 
 // The fixed point on [0, 1)^2 that pixel (x, y) uses for disk lights: an
 // R2 low-discrepancy sequence over each 8x8 block.
 glm::vec2 disk_pattern(int x, int y);
+// Phases of the pattern's shift: pixel (x, y) takes disk_pattern(x + s.x,
+// y + s.y) in phase k, s = disk_pattern_shift(k). The 16 shifts are the
+// even offsets of the 8x8 block, in an order that spreads each run of
+// phases, so a pixel visits 16 points of the disk over a cycle. A shift
+// moves the pattern as a whole: a filter window 8 or 16 pixels wide still
+// holds every point once, so the widest penumbrae do not change with it.
+inline constexpr int kDiskPatternPhases = 16;
+glm::ivec2 disk_pattern_shift(int phase);
 
 // The soft shadow's filter. blocker: per pixel of `g`, the distance to what
 // blocks its pattern ray (infinity: lit; NaN: not a receiver). Returns per
