@@ -6,6 +6,7 @@
 #include "engine/rt/rt_plugin.h"
 #include "engine/scene/components.h"
 #include "engine/scene/procedural.h"
+#include "probes/probe_field.h"
 
 struct FloorUnderSky {
   engine::app::App app{engine::app::AppOptions{.jobs = {.threads = 2}}};
@@ -38,3 +39,12 @@ struct FloorUnderSky {
     app.update();
   }
 };
+
+// Eight probes above the floor (heights 0.5 and 1.5), maps small enough to
+// converge fast.
+inline transgi::probes::ProbeFieldSettings floor_probe_settings() {
+  transgi::probes::ProbeFieldSettings settings;
+  settings.grid = transgi::probes::ProbeGrid{{-1, 0.5f, -1}, {1, 1.5f, 1}, {2, 2, 2}};
+  settings.map = transgi::probes::MapLayout{32, 16};
+  return settings;
+}

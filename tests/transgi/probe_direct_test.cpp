@@ -26,9 +26,7 @@ constexpr double kY00 = 0.28209479177387814;  // 1 / (2 sqrt(pi))
 constexpr double kY1 = 0.4886025119029199;    // sqrt(3 / (4 pi))
 
 ProbeFieldSettings raw_direct_probes() {
-  ProbeFieldSettings settings;
-  settings.grid = ProbeGrid{{-1, 0.5f, -1}, {1, 1.5f, 1}, {2, 2, 2}};
-  settings.map = MapLayout{32, 16};
+  ProbeFieldSettings settings = floor_probe_settings();
   settings.direct_window = false;  // compare the raw projection with the analytic one
   return settings;
 }

@@ -22,11 +22,8 @@ using namespace engine;
 
 namespace {
 
-// Eight probes above the floor, maps small enough to converge fast.
 ProbeFieldSettings floor_probes() {
-  ProbeFieldSettings settings;
-  settings.grid = ProbeGrid{{-1, 0.5f, -1}, {1, 1.5f, 1}, {2, 2, 2}};
-  settings.map = MapLayout{32, 16};
+  ProbeFieldSettings settings = floor_probe_settings();
   settings.window = false;  // compare the raw projection with the analytic one
   return settings;
 }
