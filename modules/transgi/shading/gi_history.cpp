@@ -180,7 +180,7 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
     engine::jobs::parallel_for<std::size_t>(0, cells, 4096, [&](std::size_t b, std::size_t e) {
       for (std::size_t c = b; c < e; ++c) {
         const std::uint32_t now = object_of_cell_[c], was = prev_.key[c].object;
-        (*moved)[c] = (now != kNoObject && motion[now].moved) || (was < prev_moved.size() && prev_moved[was]);
+        (*moved)[c] = now != kNoObject && motion[now].moved ? kMovedHere : (was < prev_moved.size() && prev_moved[was]) ? kMovedFrom : 0;
       }
     });
   }

@@ -53,6 +53,7 @@ struct TransferKeeping {
 class GiHistory {
  public:
   static constexpr std::int32_t kDecode = -1;
+  static constexpr std::uint8_t kMovedFrom = 1, kMovedHere = 2;
   static constexpr std::uint32_t kNoSlot = 0xffffffffu;
 
   // For every cell of this frame's grid: the previous frame's cell whose
@@ -62,7 +63,8 @@ class GiHistory {
   // surface point, fresh or not (kDecode where none did): what a per-cell
   // running estimate follows from frame to frame. With `moved`, per cell
   // whether an object whose transform changed since the previous frame is
-  // there now or was there then (the previous frame's cell at that index).
+  // there now (kMovedHere: the cell's own surface moved) or was there then
+  // (kMovedFrom: the previous frame's cell at that index), else 0.
   void plan(const UpsamplingPlan& up, const GBuffer& g, const engine::rt::RtScene& scene, std::vector<std::int32_t>& source,
             std::vector<std::int32_t>* track = nullptr, std::vector<std::uint8_t>* moved = nullptr,
             const TransferKeeping& keeping = {});

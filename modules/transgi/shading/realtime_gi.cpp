@@ -266,6 +266,13 @@ namespace {
 // taken cells to black.
 constexpr float kContactFloor = 0.25f;
 
+// Frames a moving object's own surface averages its contact light over
+// while it moves (followed through the history's track; its surroundings
+// restart instead, kContactResetCells): a restart every frame left a moving
+// ball or a dragged cube mottled with one frame's noise, and the object's
+// own points are the same points from frame to frame.
+constexpr int kMovingContactFrames = 4;
+
 // How far, in GI cells, from where a moved object is or was a cell's contact
 // light restarts: about twice the filter's reach.
 constexpr int kContactResetCells = 8;
@@ -336,7 +343,8 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
   // Cells within kContactResetCells of where a moved object is or was: the
   // contact light there changed with the move, so their means restart (else
   // the floor beside a moved object keeps its old light for frames: a ghost).
-  const bool reset_near_moved = tracked && moved.size() == grid && std::find(moved.begin(), moved.end(), 1) != moved.end();
+  const bool reset_near_moved =
+      tracked && moved.size() == grid && std::any_of(moved.begin(), moved.end(), [](std::uint8_t m) { return m != 0; });
   if (reset_near_moved) {
     const int radius = kContactResetCells;
     scratch.near_moved_row.assign(grid, 0);
@@ -360,15 +368,17 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
     const int history = std::clamp(near_field.history_frames, 1, 255);  // counts are bytes
     // The running mean over the last history_frames frames of each surface
     // point, followed through the GI history's track (a point seen anew, or
-    // one near a moved object, starts from this frame's estimate).
+    // one near a moved object, starts from this frame's estimate; a moved
+    // object's own point keeps kMovingContactFrames).
     scratch.mean_next.resize(grid);
     scratch.count_next.assign(grid, 0);
     // A cell that no estimate reached carries its point's mean unchanged.
     engine::jobs::parallel_for<std::size_t>(0, grid, 4096, [&](std::size_t b, std::size_t e) {
       for (std::size_t c = b; c < e; ++c) {
         const std::int32_t q = track[c];
+        const bool on_moved = reset_near_moved && moved[c] == GiHistory::kMovedHere;
         const bool known = q >= 0 && static_cast<std::size_t>(q) < scratch.count.size() && scratch.count[static_cast<std::size_t>(q)] > 0 &&
-                           !(reset_near_moved && scratch.near_moved[c]);
+                           (on_moved || !(reset_near_moved && scratch.near_moved[c]));
         if (!scratch.estimated[c]) {
           if (known) {
             scratch.mean_next[c] = scratch.mean[static_cast<std::size_t>(q)];
@@ -376,7 +386,7 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
           }
           continue;
         }
-        const int n = known ? std::min<int>(scratch.count[static_cast<std::size_t>(q)], history - 1) : 0;
+        const int n = known ? std::min<int>(scratch.count[static_cast<std::size_t>(q)], (on_moved ? std::min(history, kMovingContactFrames) : history) - 1) : 0;
         scratch.mean_next[c] = n > 0 ? (scratch.mean[static_cast<std::size_t>(q)] * static_cast<float>(n) + scratch.filtered[c]) /
                                            static_cast<float>(n + 1)
                                      : scratch.filtered[c];
