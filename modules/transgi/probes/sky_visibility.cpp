@@ -22,8 +22,8 @@ void shorten_sky_history(SkyCell* cells, const SkyVisibilitySettings& settings, 
 
 namespace {
 
-// FNV-1a over every pixel's bits (a 2048 x 1024 map in about a millisecond;
-// maps are not edited in place, so it runs when the map object is new).
+// FNV-1a over every pixel's bits: one pass over the map, so it runs only
+// when the map object or its storage is new (maps are not edited in place).
 std::uint64_t fingerprint_of(const engine::image::ImageRGB& image) {
   std::uint64_t h = 1469598103934665603ull;
   const auto* bytes = reinterpret_cast<const std::uint32_t*>(image.pixels.data());
