@@ -4,6 +4,8 @@
 // u = atan2(l.x, -l.z) / (2 pi) wrapped to [0, 1), v = acos(l.y) / pi with
 // v = 0 the top row. Radiance = strength * pixel. Importance sampled by
 // pixel luminance times sin(theta).
+#include <algorithm>
+#include <cmath>
 #include <memory>
 
 #include <glm/glm.hpp>
@@ -59,5 +61,32 @@ class Environment {
 
 // A constant-radiance environment (for furnace tests) is just a 1x1 map.
 Environment uniform_environment(glm::vec3 radiance);
+
+// The integration rule that projections of a map share (its SH over the
+// sphere, or per cell of directions): lookups are nearest-texel, so each
+// texel is constant radiance over its patch of the sphere, and each patch
+// is visited in sub-cells with their exact solid angle, fine enough that
+// even a tiny map integrates exactly enough (at least 1024 x 512 over the
+// sphere). fn(x, y, world_direction, solid_angle) for every sub-cell of
+// texel rows [y0, y1); the texel's radiance is strength x image.at(x, y).
+template <class Fn>
+void for_each_patch_sample(const Environment& env, int y0, int y1, Fn&& fn) {
+  const image::ImageRGB& img = env.image();
+  const int w = img.width, h = img.height;
+  const int sub_x = std::max(1, (1024 + w - 1) / w), sub_y = std::max(1, (512 + h - 1) / h);
+  const double pi = 3.14159265358979323846;
+  for (int y = y0; y < y1; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int sy = 0; sy < sub_y; ++sy) {
+        const double v0 = (y + static_cast<double>(sy) / sub_y) / h, v1 = (y + (sy + 1.0) / sub_y) / h;
+        const double d_omega = (2.0 * pi / (static_cast<double>(w) * sub_x)) * (std::cos(pi * v0) - std::cos(pi * v1));
+        const double v = 0.5 * (v0 + v1);
+        for (int sx = 0; sx < sub_x; ++sx) {
+          const double u = (x + (sx + 0.5) / sub_x) / w;
+          const glm::vec3 local = Environment::uv_to_direction({static_cast<float>(u), static_cast<float>(v)});
+          fn(x, y, glm::normalize(env.to_world(local)), d_omega);
+        }
+      }
+}
 
 }  // namespace engine::scene

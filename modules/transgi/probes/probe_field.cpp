@@ -24,6 +24,14 @@ namespace transgi::probes {
 namespace {
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+// sh75 += the SH projection of radiance arriving from direction dir
+// (already weighted by its estimator: solid angle, or 1 / pdf).
+void add_radiance_sh(float* sh75, const glm::vec3& dir, const glm::vec3& weighted) {
+  const engine::math::ShBasis y = engine::math::sh_eval(dir);
+  for (int c = 0; c < 3; ++c)
+    for (int k = 0; k < 25; ++k) sh75[c * 25 + k] += weighted[c] * y[static_cast<std::size_t>(k)];
+}
 }  // namespace
 
 
@@ -309,11 +317,7 @@ void ProbeField::trace_and_shade(const engine::rt::RtScene& scene, const engine:
     if (with_sky) record_sky_ray(probes_.sky_of(qi)[w.sky_cells[static_cast<std::size_t>(i)]], !h.hit, sky_history);
     if (h.hit && h.emitted != glm::vec3(0.0f) && !emitters_sampled) {
       // Monte Carlo projection over a near-uniform set: 4 pi / M per ray.
-      float* direct = w.direct_frame.data() + qi * 75;
-      const math::ShBasis y = math::sh_eval(dir);
-      const glm::vec3 e4 = h.emitted * (4.0f * math::kPi / static_cast<float>(M));
-      for (int c = 0; c < 3; ++c)
-        for (int k = 0; k < 25; ++k) direct[c * 25 + k] += e4[c] * y[static_cast<std::size_t>(k)];
+      add_radiance_sh(w.direct_frame.data() + qi * 75, dir, h.emitted * (4.0f * math::kPi / static_cast<float>(M)));
     }
     ShadedPoint sp;
     sp.direction = dir;
@@ -377,10 +381,7 @@ void ProbeField::sample_emitters(const engine::rt::RtScene& scene, const engine:
       const render::LightSample& ls = samples[j * k_per_probe + k];
       if (!(ls.pdf > 0) || blocked[k]) continue;
       const glm::vec3 light = ls.radiance / (ls.pdf * static_cast<float>(K));
-      if (!std::isfinite(light.r + light.g + light.b)) continue;
-      const math::ShBasis y = math::sh_eval(ls.direction);
-      for (int c = 0; c < 3; ++c)
-        for (int t = 0; t < 25; ++t) direct[c * 25 + t] += light[c] * y[static_cast<std::size_t>(t)];
+      if (std::isfinite(light.r + light.g + light.b)) add_radiance_sh(direct, ls.direction, light);
     }
   };
   // A backend's tracer takes every shadow ray in one batch; else each

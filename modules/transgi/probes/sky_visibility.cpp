@@ -32,37 +32,38 @@ std::uint64_t fingerprint_of(const engine::image::ImageRGB& image) {
   return h;
 }
 
-std::vector<float> project_cells(const engine::scene::Environment& env, const SkyCells& cells, int sub) {
+// Every map texel's patch binned into the cell holding each of its
+// sub-cells (engine::scene::for_each_patch_sample: the rule of the whole
+// map's projection, so the cells sum to it). Bands of rows in parallel, each
+// into its own sums, added in band order: the same whatever the threads.
+std::vector<float> project_cells(const engine::scene::Environment& env, const SkyCells& cells) {
   using namespace engine;
   const image::ImageRGB& image = env.image();
-  const int count = cells.count();
-  std::vector<float> per_cell(static_cast<std::size_t>(count) * 75, 0.0f);
-  const glm::mat3 to_local = env.to_local_matrix();
-  // Equal-area cells: every sub-sample holds the same solid angle.
-  const double d_omega = 4.0 * math::kPi / (static_cast<double>(count) * sub * sub);
-  jobs::parallel_for(0, count, 16, [&](int b, int e) {
-    for (int t = b; t < e; ++t) {
-      const int x = t % cells.width, y = t / cells.width;
-      std::array<double, 75> acc{};
-      for (int sy = 0; sy < sub; ++sy)
-        for (int sx = 0; sx < sub; ++sx) {
-          const glm::vec3 world = SkyCells::direction(
-              (static_cast<float>(x) + (static_cast<float>(sx) + 0.5f) / static_cast<float>(sub)) / static_cast<float>(cells.width),
-              (static_cast<float>(y) + (static_cast<float>(sy) + 0.5f) / static_cast<float>(sub)) / static_cast<float>(cells.height));
-          // The map's pixel at unit strength (Environment::radiance without its strength).
-          const glm::vec2 uv = scene::Environment::direction_to_uv(glm::normalize(to_local * world));
-          const int px = std::min(image.width - 1, static_cast<int>(uv.x * static_cast<float>(image.width)));
-          const int py = std::min(image.height - 1, static_cast<int>(uv.y * static_cast<float>(image.height)));
-          const glm::vec3 L = image.at(px, py);
-          const math::ShBasis Y = math::sh_eval(world);
-          for (int k = 0; k < 25; ++k)
-            for (int c = 0; c < 3; ++c)
-              acc[static_cast<std::size_t>(c * 25 + k)] += static_cast<double>(L[c] * Y[static_cast<std::size_t>(k)]) * d_omega;
+  const std::size_t count = static_cast<std::size_t>(cells.count());
+  constexpr int kBands = 8;
+  std::vector<std::vector<double>> band_sums(kBands);
+  jobs::parallel_for(0, kBands, 1, [&](int b0, int b1) {
+    for (int b = b0; b < b1; ++b) {
+      std::vector<double>& acc = band_sums[static_cast<std::size_t>(b)];
+      acc.assign(count * 75, 0.0);
+      const int y0 = image.height * b / kBands, y1 = image.height * (b + 1) / kBands;
+      scene::for_each_patch_sample(env, y0, y1, [&](int x, int y, const glm::vec3& dir, double d_omega) {
+        const glm::vec3 L = image.at(x, y);  // at unit strength
+        const math::ShBasis Y = math::sh_eval(dir);
+        double* cell = acc.data() + static_cast<std::size_t>(cells.cell_of(dir)) * 75;
+        for (int c = 0; c < 3; ++c) {
+          const double l = static_cast<double>(L[c]) * d_omega;
+          for (int k = 0; k < 25; ++k) cell[c * 25 + k] += l * static_cast<double>(Y[static_cast<std::size_t>(k)]);
         }
-      for (int i = 0; i < 75; ++i)
-        per_cell[static_cast<std::size_t>(t) * 75 + static_cast<std::size_t>(i)] = static_cast<float>(acc[static_cast<std::size_t>(i)]);
+      });
     }
   });
+  std::vector<float> per_cell(count * 75);
+  for (std::size_t i = 0; i < per_cell.size(); ++i) {
+    double sum = 0;
+    for (const std::vector<double>& band : band_sums) sum += band[i];
+    per_cell[i] = static_cast<float>(sum);
+  }
   return per_cell;
 }
 
@@ -106,13 +107,12 @@ bool SkyProjection::refresh(const engine::scene::Environment* env, const SkyVisi
     shared.fingerprinted = env;
     shared.fingerprinted_pixels = image.pixels.data();
   }
-  const Key key{image.width, image.height, shared.fingerprint, env->to_world_matrix(), settings.cells,
-                std::max(1, settings.projection_subsamples)};
+  const Key key{image.width, image.height, shared.fingerprint, env->to_world_matrix(), settings.cells};
   if (key == key_ && per_cell_) return strength_changed;
   if (!(key == shared.key) || !shared.per_cell) {
     // Projected outside the lock (it runs parallel jobs).
     lock.unlock();
-    auto made = std::make_shared<const std::vector<float>>(project_cells(*env, key.cells, key.subsamples));
+    auto made = std::make_shared<const std::vector<float>>(project_cells(*env, key.cells));
     lock.lock();
     shared.per_cell = std::move(made);
     shared.key = key;

@@ -65,11 +65,6 @@ struct SkyVisibilitySettings {
   // cell (a cell whose rays all agreed restarts at the first ray that
   // disagrees, so a door that closes a whole cell is seen at once).
   int history_rays = 32;
-  // Sub-samples per cell side for the environment's projection. Higher = a
-  // more exact integral of a detailed sky, at the cost of time whenever the
-  // map or its rotation changes (its strength only rescales).
-  int projection_subsamples = 8;
-
   bool operator==(const SkyVisibilitySettings&) const = default;
 };
 
@@ -99,7 +94,9 @@ void record_sky_ray(SkyCell* cells, const SkyVisibilitySettings& settings, const
 void shorten_sky_history(SkyCell* cells, const SkyVisibilitySettings& settings, int rays);
 
 // The environment's SH projection per cell (cells x 75, [c * 25 + k]) at unit
-// strength, recomputed only when the map or its orientation changes.
+// strength, integrated texel by texel as the whole map's projection is
+// (engine::scene::for_each_patch_sample), recomputed only when the map or
+// its orientation changes (its strength only rescales).
 class SkyProjection {
  public:
   // Returns whether the projection or the strength changed since the last
@@ -121,7 +118,6 @@ class SkyProjection {
     std::uint64_t fingerprint = 0;
     glm::mat3 to_world{0.0f};
     SkyCells cells{0, 0};
-    int subsamples = 0;
     bool operator==(const Key&) const = default;
   };
 

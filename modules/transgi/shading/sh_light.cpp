@@ -12,34 +12,29 @@ namespace transgi::shading {
 using engine::math::kShCount;
 
 ShRgb project_environment(const engine::scene::Environment& env) {
-  // Lookups are nearest-texel, so each texel is constant radiance over its
-  // patch of the sphere: integrate Y_k over every patch with enough
-  // sub-samples that even a tiny map (a few texels) projects exactly enough
-  // (a constant sky must give zero above band 0). Sub-cells use their exact
-  // solid angle; accumulation is in double.
+  // Each texel's integral of Y_k over its patch, then times its radiance;
+  // accumulation in double (engine::scene::for_each_patch_sample's rule).
   std::array<double, 3 * kShCount> acc{};
   const auto& img = env.image();
-  const int w = img.width, h = img.height;
-  const int sub_x = std::max(1, (1024 + w - 1) / w), sub_y = std::max(1, (512 + h - 1) / h);
-  const double pi = engine::math::kPi;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const glm::vec3 L = env.strength() * img.at(x, y);
-      std::array<double, kShCount> yint{};
-      for (int sy = 0; sy < sub_y; ++sy) {
-        const double v0 = (y + static_cast<double>(sy) / sub_y) / h, v1 = (y + (sy + 1.0) / sub_y) / h;
-        const double d_omega = (2.0 * pi / (static_cast<double>(w) * sub_x)) * (std::cos(pi * v0) - std::cos(pi * v1));
-        const double v = 0.5 * (v0 + v1);
-        for (int sx = 0; sx < sub_x; ++sx) {
-          const double u = (x + (sx + 0.5) / sub_x) / w;
-          const glm::vec3 local = engine::scene::Environment::uv_to_direction({static_cast<float>(u), static_cast<float>(v)});
-          const engine::math::ShBasis b = engine::math::sh_eval(glm::normalize(env.to_world(local)));
-          for (int k = 0; k < kShCount; ++k) yint[static_cast<std::size_t>(k)] += b[static_cast<std::size_t>(k)] * d_omega;
-        }
-      }
-      for (int c = 0; c < 3; ++c)
-        for (int k = 0; k < kShCount; ++k) acc[static_cast<std::size_t>(c * kShCount + k)] += L[c] * yint[static_cast<std::size_t>(k)];
+  std::array<double, kShCount> yint{};
+  int at_x = -1, at_y = -1;
+  const auto flush = [&] {
+    if (at_x < 0) return;
+    const glm::vec3 L = env.strength() * img.at(at_x, at_y);
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < kShCount; ++k) acc[static_cast<std::size_t>(c * kShCount + k)] += L[c] * yint[static_cast<std::size_t>(k)];
+    yint.fill(0.0);
+  };
+  engine::scene::for_each_patch_sample(env, 0, img.height, [&](int x, int y, const glm::vec3& dir, double d_omega) {
+    if (x != at_x || y != at_y) {
+      flush();
+      at_x = x;
+      at_y = y;
     }
+    const engine::math::ShBasis b = engine::math::sh_eval(dir);
+    for (int k = 0; k < kShCount; ++k) yint[static_cast<std::size_t>(k)] += b[static_cast<std::size_t>(k)] * d_omega;
+  });
+  flush();
   ShRgb out;
   for (std::size_t i = 0; i < out.size(); ++i) out[i] = static_cast<float>(acc[i]);
   return out;
