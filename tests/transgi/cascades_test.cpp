@@ -213,12 +213,14 @@ struct Room {
   app::App app{app::AppOptions{.jobs = {.threads = 2}}};
   ecs::Entity camera;
 
-  explicit Room(const CascadeSettings& cascades, bool ddgi = false) {
+  // ground_half > 0: the room stands on a flat ground plane that far each way.
+  explicit Room(const CascadeSettings& cascades, bool ddgi = false, float ground_half = 0.0f) {
     auto& w = app.world();
     scene::SceneAssets a;
     a.generation = scene::next_scene_generation();
     a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_box({6.0f, 2.0f, 6.0f}, true, 0)),
-                std::make_shared<scene::MeshAsset>(scene::make_box(glm::vec3(0.6f), false, 1))};
+                std::make_shared<scene::MeshAsset>(scene::make_box(glm::vec3(0.6f), false, 1)),
+                std::make_shared<scene::MeshAsset>(scene::make_quad(glm::vec2(std::max(ground_half, 1.0f)), 0))};
     a.materials = {lambert(glm::vec3(0.6f)), lambert({0.8f, 0.4f, 0.2f})};
     w.insert_resource<scene::SceneAssets>(std::move(a));
     if (ddgi) {
@@ -239,6 +241,11 @@ struct Room {
     const ecs::Entity box = w.spawn();
     w.emplace<transform::Transform>(box, transform::Transform::from_translation({1.5f, 0.6f, -2.0f}));
     w.emplace<scene::MeshInstance>(box, scene::MeshInstance{1});
+    if (ground_half > 0) {
+      const ecs::Entity ground = w.spawn();
+      w.emplace<transform::Transform>(ground, transform::Transform::from_translation({0.0f, -0.001f, 0.0f}));
+      w.emplace<scene::MeshInstance>(ground, scene::MeshInstance{2});
+    }
     const ecs::Entity lamp = w.spawn();
     w.emplace<transform::Transform>(lamp, transform::Transform::from_translation({-2.0f, 3.2f, 1.0f}));
     w.emplace<scene::PunctualLight>(lamp, scene::PunctualLight{.type = scene::PunctualLight::Type::Point, .intensity = 40.0f});
@@ -382,6 +389,80 @@ TEST(CascadeFit, PastTheCoarsestCascadeAFarFieldCoversTheScene) {
         EXPECT_EQ(set->state.fields.back()->settings().grid, ProbeGrid::centred_in(rt.bounds_min(), rt.bounds_max(), cs.dims));
       }
     }
+}
+
+TEST(GeometryCore, AGroundPlaneIsLeftOutAndARoomsOwnQuadsAreNot) {
+  const auto box = [](glm::vec3 lo, glm::vec3 hi) { return SceneBox{lo, hi}; };
+  // A 12 x 4 x 12 m building and a box in it on a 200 m ground plane: the plane goes.
+  const SceneBox building = box({-6, 0, -6}, {6, 4, 6}), table = box({1, 0, -2}, {2, 1, -1});
+  const SceneBox ground = box({-100, -0.001f, -100}, {100, -0.001f, 100});
+  const std::vector<SceneBox> on_ground{building, table, ground};
+  EXPECT_EQ(geometry_core(on_ground), building);
+  // A room of six single quads (each flat, none larger than the others make): all stay.
+  const std::vector<SceneBox> quads{box({-6, 0, -6}, {6, 0, 6}), box({-6, 4, -6}, {6, 4, 6}), box({-6, 0, -6}, {-6, 4, 6}),
+                                    box({6, 0, -6}, {6, 4, 6}),  box({-6, 0, -6}, {6, 4, -6}), box({-6, 0, 6}, {6, 4, 6})};
+  EXPECT_EQ(geometry_core(quads), box({-6, 0, -6}, {6, 4, 6}));
+  // A plane only 3x the building (a courtyard) stays, and so does a hilly
+  // 1 km terrain (50 m of relief is not flat).
+  const std::vector<SceneBox> courtyard{building, box({-18, -0.001f, -18}, {18, -0.001f, 18})};
+  EXPECT_EQ(geometry_core(courtyard), box({-18, -0.001f, -18}, {18, 4, 18}));
+  const std::vector<SceneBox> terrain{building, box({-500, -20, -500}, {500, 30, 500})};
+  EXPECT_EQ(geometry_core(terrain), box({-500, -20, -500}, {500, 30, 500}));
+  // A lone plane is the scene; nothing at all is empty.
+  const std::vector<SceneBox> lone{ground};
+  EXPECT_EQ(geometry_core(lone), ground);
+  EXPECT_TRUE(geometry_core(std::span<const SceneBox>{}).empty());
+}
+
+// A building on a ground plane far past the fitted grid's cells gets the grid
+// over itself (as it would alone) and the far field over the plane, which
+// lights only what the grid does not hold: the building's own walls, half a
+// cell outside its outermost probes, stay the grid's (the far field's probes
+// stand outside in the sky, and lit the rooms when they took those walls).
+TEST(CascadeFit, ABuildingOnAGroundPlaneGetsOneGridOverItselfAndTheFarFieldBeyond) {
+  for (const bool ddgi : {false, true}) {
+    CascadeSettings cs;
+    cs.dims = glm::ivec3(6);
+    cs.fit_scene_cell = 2.5f;  // the room is 12 m: 2 m cells; the plane's 200 m is not
+    Room room(cs, ddgi, 100.0f);
+    room.app.jobs().run([&] { room.app.update(); });
+    const auto& rt = room.app.world().resource<rt::RtScene>();
+    const SceneBox building{{-6.0f, 0.0f, -6.0f}, {6.0f, 4.0f, 6.0f}};
+    const auto check = [&](const auto& state, const auto& fields) {
+      ASSERT_TRUE(state.fitted_to_scene) << "ddgi " << ddgi;
+      ASSERT_TRUE(state.far_field) << "ddgi " << ddgi;
+      ASSERT_EQ(fields.size(), 2u);
+      const ProbeGrid fitted = ProbeGrid::centred_in(building.lo, building.hi, cs.dims);
+      EXPECT_LT(glm::length(fields[0]->placement().min - fitted.min), 1e-4f);
+      EXPECT_LT(glm::length(fields[0]->placement().max - fitted.max), 1e-4f);
+      EXPECT_EQ(fields[1]->placement(), ProbeGrid::centred_in(rt.bounds_min(), rt.bounds_max(), cs.dims));
+      EXPECT_EQ(fields[1]->settings().blend_cells, kFallbackBlendCells);
+      // A point on a wall (outside the probes' box, inside the building),
+      // one in a corner, and one on the ground outside.
+      using F = std::remove_cvref_t<decltype(*fields[0])>;
+      std::vector<const F*> view;
+      for (const auto& f : fields) view.push_back(f.get());
+      const std::span<const F* const> all(view);
+      for (const glm::vec3 p : {glm::vec3(5.99f, 1.0f, 0.3f), glm::vec3(-5.99f, 3.99f, -5.99f), glm::vec3(0.0f, 0.01f, 5.99f)}) {
+        const auto m = mix_at(all, p);
+        EXPECT_EQ(m.field[0], view[0]) << p.x << " " << p.y << " " << p.z;
+        EXPECT_EQ(m.count, 1);
+      }
+      EXPECT_EQ(mix_at(all, glm::vec3(30.0f, 0.0f, 10.0f)).field[0], view[1]);
+    };
+    if (ddgi) {
+      room.app.world().view<const ddgi::DdgiCascades>().each([&](const ddgi::DdgiCascades& c) { check(c.state, c.state.fields); });
+    } else {
+      const runtime::ProbeCascades* set = nullptr;
+      room.app.world().view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& c) { set = &c; });
+      ASSERT_NE(set, nullptr);
+      check(set->state, set->state.fields);
+      // A probe ray's hit on the wall takes the fitted grid's bounce, not the far field's.
+      const ProbeFeedbackSource src = set->state.fields[0]->feedback_source();
+      EXPECT_LE(src.held_min().x, -6.0f + 1e-4f);
+      EXPECT_GE(src.held_max().y, 4.0f - 1e-4f);
+    }
+  }
 }
 
 TEST(AuthoredVolumes, AMarkedNodeGetsAVolumeOverItsRotatedBoxAndAFlatOneIsRefusedByName) {

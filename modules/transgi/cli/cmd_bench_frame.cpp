@@ -196,7 +196,9 @@ int run_bench_frame(const std::vector<std::string>& argv) {
     std::printf("\n");
   }
   world.view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& set) {
-    if (set.state.fitted_to_scene) std::printf("cascades: the scene is small enough for one grid over its bounds (--cascade-fit-scene)\n");
+    if (set.state.fitted_to_scene)
+      std::printf("cascades: the scene is small enough for one grid over its %s (--cascade-fit-scene)\n",
+                  set.state.far_field ? "geometry less its ground plane, with the far field beyond" : "bounds");
     for (std::size_t k = 0; k < set.state.fields.size() && k < frame.cascade_stats.size(); ++k) {
       const probes::ProbeFrameStats& c = frame.cascade_stats[k];
       const glm::vec3 cell = set.state.fields[k]->grid().spacing();

@@ -41,10 +41,12 @@ void sync_volumes(View<Get<DdgiProbeVolume>> volumes, View<Get<DdgiCascades>> ca
     const auto settings_for = [&](int k) {
       DdgiSettings s = *settings;
       s.blend_cells = k >= std::max(1, set.cascades.count) ? probes::kFallbackBlendCells : set.cascades.blend_cells;
+      // The fitted grid holds the region it was fitted to, up to its faces.
+      if (k < 0) s.hold_cells = 0.5f;
       return s;
     };
     probes::follow_camera(
-        set.state, set.cascades, viewer, rt->bounds_min(), rt->bounds_max(),
+        set.state, set.cascades, viewer, rt->bounds_min(), rt->bounds_max(), [&] { return probes::geometry_core(*rt); },
         [&](const probes::ProbeGrid& grid, int k) { return std::make_shared<DdgiVolume>(grid, settings_for(k)); },
         [&](const DdgiVolume& v, const probes::ProbeGrid&, int k) { return v.settings() == settings_for(k); },
         [&](DdgiVolume& v, glm::ivec3 cells, const DdgiVolume* coarser) { return v.scroll(cells, coarser); },

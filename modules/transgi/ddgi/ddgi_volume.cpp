@@ -124,7 +124,8 @@ DdgiVolume::UpdateRays DdgiVolume::trace(const engine::rt::RtScene& scene, const
   // The bounce light from the last update's maps: the next coarser
   // cascade's outside this grid's box.
   const ProbeRayBounce bounce = [&](const glm::vec3& p, const glm::vec3& n, const glm::vec3& towards_probe) {
-    if (outer && (glm::any(glm::lessThan(p, grid_.min)) || glm::any(glm::greaterThan(p, grid_.max))))
+    if (outer && (glm::any(glm::lessThan(p, grid_.held_min(settings_.hold_cells))) ||
+                  glm::any(glm::greaterThan(p, grid_.held_max(settings_.hold_cells)))))
       return outer->irradiance(p, n, -towards_probe);
     return frame_ > 0 ? irradiance(p, n, -towards_probe) : glm::vec3(0.0f);
   };

@@ -99,6 +99,9 @@ struct DdgiSettings {
   // hands the point over to the next, in cells. Higher = smoother seams, at
   // the cost of two lookups there. 0 = a hard edge.
   float blend_cells = 0.0f;
+  // How far past its outermost probes this volume holds points, in cells
+  // (probes::ProbeFieldSettings::hold_cells): 0.5 for a fitted grid.
+  float hold_cells = 0.0f;
 
   bool operator==(const DdgiSettings&) const = default;
 };

@@ -145,8 +145,11 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
     for (const auto& f : c.state.fields)
       if (f) r.probe_bytes += f->memory_bytes();
   });
-  bool fitted_to_scene = false;
-  world.view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& c) { fitted_to_scene = fitted_to_scene || c.state.fitted_to_scene; });
+  bool fitted_to_scene = false, with_far_field = false;
+  world.view<const runtime::ProbeCascades>().each([&](const runtime::ProbeCascades& c) {
+    fitted_to_scene = fitted_to_scene || c.state.fitted_to_scene;
+    with_far_field = with_far_field || (c.state.fitted_to_scene && c.state.far_field);
+  });
   const auto& st = frame.probe_stats;
   char line[256];
   if (o.placement.mode == runtime::ProbeVolumeMode::Scene)
@@ -154,8 +157,9 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
   else if (o.placement.mode == runtime::ProbeVolumeMode::Authored)
     std::snprintf(line, sizeof(line), "the scene's authored probe volumes");
   else if (fitted_to_scene)
-    std::snprintf(line, sizeof(line), "cascades: the scene fits one %dx%dx%d grid over its bounds (--cascade-fit-scene)",
-                  o.placement.cascades.dims.x, o.placement.cascades.dims.y, o.placement.cascades.dims.z);
+    std::snprintf(line, sizeof(line), "cascades: the scene fits one %dx%dx%d grid over its %s (--cascade-fit-scene)",
+                  o.placement.cascades.dims.x, o.placement.cascades.dims.y, o.placement.cascades.dims.z,
+                  with_far_field ? "geometry less its ground plane, the far field beyond" : "bounds");
   else
     std::snprintf(line, sizeof(line), "%d cascades of %dx%dx%d probes, %.2f m finest cells", o.placement.cascades.count,
                   o.placement.cascades.dims.x, o.placement.cascades.dims.y, o.placement.cascades.dims.z,

@@ -56,6 +56,9 @@ bool VulkanProbeLights::set_probes(std::span<const probes::ProbeField* const> fi
                                       fallback ? 0.0f : field.settings().blend_cells * grid.min_spacing(), static_cast<uint>(probe_base),
                                       static_cast<uint>(depth_base));
     r.fallback = fallback ? 1u : 0u;
+    const glm::vec3 held_min = grid.held_min(field.settings().hold_cells), held_max = grid.held_max(field.settings().hold_cells);
+    r.box_min_x = held_min.x, r.box_min_y = held_min.y, r.box_min_z = held_min.z;
+    r.box_max_x = held_max.x, r.box_max_y = held_max.y, r.box_max_z = held_max.z;
     r.mean_at = static_cast<uint>(mean_base + f * 2 * kTransferOutputs);
     records[f] = r;
     write_probe_field(grid, field.states(), field.usable(), texels, probe_base, depth_base, depth, probe_info);

@@ -119,9 +119,13 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
     if (!f) continue;
     const auto count = static_cast<std::size_t>(f->grid->count());
     const auto texels = static_cast<std::size_t>(f->layout.texel_count());
-    (which == 0 ? feedback.self : feedback.outer) =
-        probe_field_gpu(*f->grid, f->layout, f->interpolation, 0.0f, static_cast<std::uint32_t>(probe_base),
-                        static_cast<std::uint32_t>(depth_base));
+    ProbeFieldGpu& record = which == 0 ? feedback.self : feedback.outer;
+    record = probe_field_gpu(*f->grid, f->layout, f->interpolation, 0.0f, static_cast<std::uint32_t>(probe_base),
+                             static_cast<std::uint32_t>(depth_base));
+    // The points it holds: past them a hit takes the outer field's light.
+    const glm::vec3 held_min = f->held_min(), held_max = f->held_max();
+    record.box_min_x = held_min.x, record.box_min_y = held_min.y, record.box_min_z = held_min.z;
+    record.box_max_x = held_max.x, record.box_max_y = held_max.y, record.box_max_z = held_max.z;
     write_probe_field(*f->grid, *f->states, f->usable, texels, probe_base, depth_base, depth, probe_info);
     std::memcpy(probe_sh.data() + probe_base * kTransferOutputs, f->sh.data(), f->sh.size() * sizeof(float));
     probe_base += count;

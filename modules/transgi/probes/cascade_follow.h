@@ -56,30 +56,46 @@ CascadeViewer viewer_of(const CameraView& cameras, Entity requested, const glm::
 
 // After it, `state` holds one field per cascade placed on the viewer (and the
 // far field after them where the scene reaches beyond the coarsest), or the
-// one fitted grid. Fields are made by make(grid, k) (k = -1 for the fitted
-// grid, k = count for the far field); a field for which same_but_place(field, grid, k) is false is made
-// anew; one whose origin moved is scrolled by scroll(field, cells, coarser),
-// coarsest first, so a finer cascade's entered probes are seeded from a
-// coarser one that has already moved; scroll returns how many probes
-// entered, and so does follow_camera, summed. kept(field) is called on each
-// field that was neither made nor rebuilt this frame (to tell it of scene
-// changes) and on every field with the viewer (to aim budgets).
-template <class Field, class Make, class SameButPlace, class Scroll, class Kept>
+// one fitted grid (over the scene's geometry less its ground planes,
+// core_of() = geometry_core, asked once when the choice is made; with the far
+// field after it over the whole scene when a ground plane was left out).
+// Fields are made by make(grid, k) (k = -1 for the fitted grid, k = count
+// for the far field); a field for which same_but_place(field, grid, k) is
+// false is made anew; one whose origin moved is scrolled by scroll(field,
+// cells, coarser), coarsest first, so a finer cascade's entered probes are
+// seeded from a coarser one that has already moved; scroll returns how many
+// probes entered, and so does follow_camera, summed. kept(field) is called on
+// each field that was neither made nor rebuilt this frame (to tell it of
+// scene changes) and on every field with the viewer (to aim budgets).
+template <class Field, class CoreOf, class Make, class SameButPlace, class Scroll, class Kept>
 int follow_camera(CascadeState<Field>& state, const CascadeSettings& c, const CascadeViewer& viewer, const glm::vec3& scene_lo,
-                  const glm::vec3& scene_hi, Make make, SameButPlace same_but_place, Scroll scroll, Kept kept) {
-  if (state.fields.empty() && fits_one_grid(c, scene_lo, scene_hi)) {
-    state.fields = {make(ProbeGrid::centred_in(scene_lo, scene_hi, c.dims), -1)};
-    state.origins = {glm::ivec3(0)};
-    state.fitted_to_scene = true;
-    return 0;
+                  const glm::vec3& scene_hi, CoreOf core_of, Make make, SameButPlace same_but_place, Scroll scroll, Kept kept) {
+  const int far_k = std::max(1, c.count);
+  if (state.fields.empty()) {
+    const SceneBox core = core_of();
+    const glm::vec3 lo = core.empty() ? scene_lo : core.lo, hi = core.empty() ? scene_hi : core.hi;
+    if (fits_one_grid(c, lo, hi)) {
+      state.fields = {make(ProbeGrid::centred_in(lo, hi, c.dims), -1)};
+      state.origins = {glm::ivec3(0)};
+      state.fitted_to_scene = true;
+      state.far_field = c.far_field && (glm::any(glm::lessThan(scene_lo, lo)) || glm::any(glm::greaterThan(scene_hi, hi)));
+      if (state.far_field) {
+        state.fields.push_back(make(ProbeGrid::centred_in(scene_lo, scene_hi, c.dims), far_k));
+        state.origins.push_back(glm::ivec3(0));
+      }
+      return 0;
+    }
   }
   if (state.fitted_to_scene) {
-    auto& f = state.fields.front();
-    const ProbeGrid grid = f->placement();
-    if (!same_but_place(*f, grid, -1))
-      f = make(grid, -1);
-    else
-      kept(*f, false);
+    for (std::size_t i = 0; i < state.fields.size(); ++i) {
+      auto& f = state.fields[i];
+      const int k = state.far_field && i + 1 == state.fields.size() ? far_k : -1;
+      const ProbeGrid grid = f->placement();
+      if (!same_but_place(*f, grid, k))
+        f = make(grid, k);
+      else
+        kept(*f, false);
+    }
     return 0;
   }
   const CascadeViewer v = viewer.sanitised();

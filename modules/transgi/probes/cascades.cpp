@@ -50,6 +50,41 @@ bool needs_far_field(const CascadeSettings& s, const glm::vec3& lo, const glm::v
   return std::isfinite(extent.x + extent.y + extent.z) && std::max({extent.x, extent.y, extent.z}) > reach;
 }
 
+SceneBox geometry_core(std::span<const SceneBox> boxes) {
+  const auto join = [](SceneBox a, const SceneBox& b) {
+    if (b.empty()) return a;
+    if (a.empty()) return b;
+    a.lo = glm::min(a.lo, b.lo);
+    a.hi = glm::max(a.hi, b.hi);
+    return a;
+  };
+  const auto largest_side = [](const SceneBox& b) { return b.empty() ? 0.0f : std::max({b.hi.x - b.lo.x, b.hi.y - b.lo.y, b.hi.z - b.lo.z}); };
+  const auto flat = [&](const SceneBox& b) {
+    const glm::vec3 e = b.hi - b.lo;
+    return !b.empty() && std::min({e.x, e.y, e.z}) < kFlatRatio * largest_side(b);
+  };
+  // Every box but box i, from the unions before and after it.
+  const std::size_t n = boxes.size();
+  std::vector<SceneBox> after(n + 1);
+  for (std::size_t i = n; i-- > 0;) after[i] = join(after[i + 1], boxes[i]);
+  SceneBox before, core;
+  for (std::size_t i = 0; i < n; ++i) {
+    const SceneBox others = join(before, after[i + 1]);
+    const bool ground = flat(boxes[i]) && !others.empty() && largest_side(boxes[i]) > kGroundReach * largest_side(others);
+    if (!ground) core = join(core, boxes[i]);
+    before = join(before, boxes[i]);
+  }
+  return core.empty() ? before : core;
+}
+
+SceneBox geometry_core(const engine::rt::RtScene& rt) {
+  std::vector<SceneBox> boxes;
+  rt.for_each_instance([&](const engine::rt::InstanceRecord& r) {
+    if (r.active) boxes.push_back(SceneBox{r.bounds.min, r.bounds.max});
+  });
+  return geometry_core(boxes);
+}
+
 namespace {
 // How far p lies inside [lo, hi] (its nearest face), negative outside.
 float depth_inside(const BlendBox& b, const glm::vec3& p) {

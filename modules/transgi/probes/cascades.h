@@ -79,6 +79,28 @@ struct CascadeSettings {
 // Whether the scene's bounds reach beyond the coarsest cascade's extent on
 // some axis (then a far field is added, if asked).
 [[nodiscard]] bool needs_far_field(const CascadeSettings& s, const glm::vec3& lo, const glm::vec3& hi);
+
+// An axis-aligned box of world space; empty when lo > hi.
+struct SceneBox {
+  glm::vec3 lo{1.0f}, hi{-1.0f};
+  [[nodiscard]] bool empty() const { return glm::any(glm::greaterThan(lo, hi)); }
+  bool operator==(const SceneBox&) const = default;
+};
+// The box of the scene's geometry less its ground planes: a box (one per
+// instance) that is flat (smallest side under kFlatRatio of its largest) and
+// whose largest side is more than kGroundReach times that of all the other
+// boxes together. Why: a building on a 200 m ground plane has the plane's
+// bounds, so the fitted grid's rule (CascadeSettings::fit_scene_cell) sent it
+// to the camera's cascades, whose coarse cells put probes outside its thin
+// walls and lit its rooms with the sky (docs/image-quality.md, 2026-11-27,
+// evening). A room's walls and floor, even as single quads, are each no
+// larger than the room the others make, so they stay. Returns the union of
+// every box when nothing is left out; empty when there are no boxes.
+inline constexpr float kFlatRatio = 0.01f;
+inline constexpr float kGroundReach = 4.0f;
+[[nodiscard]] SceneBox geometry_core(std::span<const SceneBox> instance_boxes);
+// The same over the scene's live instances.
+[[nodiscard]] SceneBox geometry_core(const engine::rt::RtScene& rt);
 // Cell size of cascade k.
 [[nodiscard]] float cascade_cell(const CascadeSettings& s, int k);
 // Grid coordinates (in cascade k's cells, world-anchored) of probe (0,0,0)
@@ -141,7 +163,8 @@ template <class Field>
   for (std::size_t i = 0; i < fields.size(); ++i) {
     const ProbeGrid& g = fields[i]->placement();
     const float cells = fields[i]->settings().blend_cells;
-    boxes[i] = {g.min, g.max, cells == kFallbackBlendCells ? 0.0f : cells * g.min_spacing(), cells == kFallbackBlendCells};
+    const float hold = fields[i]->settings().hold_cells;
+    boxes[i] = {g.held_min(hold), g.held_max(hold), cells == kFallbackBlendCells ? 0.0f : cells * g.min_spacing(), cells == kFallbackBlendCells};
   }
   const BoxMix b = blend_boxes(std::span<const BlendBox>(boxes, fields.size()), p);
   m.count = b.count;
@@ -160,7 +183,8 @@ template <class Field>
   if (i + 1 >= fields.size()) return nullptr;
   for (std::size_t j = i + 1; j < fields.size(); ++j) {
     const ProbeGrid& g = fields[j]->placement();
-    if (glm::all(glm::greaterThanEqual(p, g.min)) && glm::all(glm::lessThanEqual(p, g.max))) return fields[j];
+    const float hold = fields[j]->settings().hold_cells;
+    if (glm::all(glm::greaterThanEqual(p, g.held_min(hold))) && glm::all(glm::lessThanEqual(p, g.held_max(hold)))) return fields[j];
   }
   return fields.back();
 }

@@ -33,8 +33,7 @@ glm::vec3 probe_irradiance(const ProbeFeedbackSource& s, const glm::vec3& p, con
 
 glm::vec3 bounce_irradiance(const ProbeFeedbackSource& self, const ProbeFeedbackSource* outer, const glm::vec3& p,
                             const glm::vec3& n) {
-  const ProbeGrid& box = *self.grid;
-  if (outer && (glm::any(glm::lessThan(p, box.min)) || glm::any(glm::greaterThan(p, box.max))))
+  if (outer && (glm::any(glm::lessThan(p, self.held_min())) || glm::any(glm::greaterThan(p, self.held_max()))))
     return outer->lit ? probe_irradiance(*outer, p, n) : glm::vec3(0.0f);
   return self.lit ? probe_irradiance(self, p, n) : glm::vec3(0.0f);
 }

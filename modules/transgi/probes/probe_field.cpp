@@ -297,7 +297,14 @@ void ProbeField::plan_update(UpdateWork& w) {
 }
 
 ProbeFeedbackSource ProbeField::feedback_source() const {
-  return ProbeFeedbackSource{&grid_, settings_.map, &probes_.maps, probes_.sh, probes_.usable, settings_.interpolation, frame_ > 0};
+  return ProbeFeedbackSource{&grid_,
+                             settings_.map,
+                             &probes_.maps,
+                             probes_.sh,
+                             probes_.usable,
+                             settings_.interpolation,
+                             frame_ > 0,
+                             settings_.hold_cells};
 }
 
 void ProbeField::trace_and_shade(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,

@@ -146,6 +146,12 @@ struct ProbeFieldSettings {
   // the point over to the next field, in cells. Higher = smoother seams, at
   // the cost of two interpolations over more of the screen. 0 = a hard edge.
   float blend_cells = 0.0f;
+  // How far past its outermost probes this field holds points before the
+  // next field takes them, in cells. A grid fitted to a region stands half a
+  // cell inside its faces (ProbeGrid::centred_in) and holds all of it: 0.5,
+  // so the far field beyond a fitted building does not light the building's
+  // own walls. Cascades: 0.
+  float hold_cells = 0.0f;
 
   bool operator==(const ProbeFieldSettings&) const = default;
 };

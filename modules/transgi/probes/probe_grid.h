@@ -63,6 +63,10 @@ struct ProbeGrid {
   // Distance between neighbouring probes per axis; an axis with a single
   // probe has no spacing (0) and is ignored by cage() and min_spacing().
   [[nodiscard]] glm::vec3 spacing() const { return (max - min) / glm::vec3(glm::max(dims - 1, glm::ivec3(1))); }
+  // The probes' box grown by `cells` of its spacing on every face: the
+  // points a field holds (ProbeFieldSettings::hold_cells).
+  [[nodiscard]] glm::vec3 held_min(float cells) const { return min - cells * spacing(); }
+  [[nodiscard]] glm::vec3 held_max(float cells) const { return max + cells * spacing(); }
   [[nodiscard]] float min_spacing() const;
   [[nodiscard]] glm::vec3 grid_point(int i) const { return min + glm::vec3(coords(i)) * spacing(); }
   [[nodiscard]] glm::vec3 position(int i) const {

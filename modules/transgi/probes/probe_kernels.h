@@ -35,6 +35,12 @@ struct ProbeFeedbackSource {
   InterpolationSettings interpolation;
   // Whether the SH hold light yet (a field's first frame has none to give).
   bool lit = true;
+  // How far past its outermost probes it holds points, in cells
+  // (ProbeFieldSettings::hold_cells); past them a probe ray's hit takes the
+  // outer field's light.
+  float hold_cells = 0.0f;
+  [[nodiscard]] glm::vec3 held_min() const { return grid->held_min(hold_cells); }
+  [[nodiscard]] glm::vec3 held_max() const { return grid->held_max(hold_cells); }
 };
 
 // ProbeField::irradiance of the field `source` describes: the pruned

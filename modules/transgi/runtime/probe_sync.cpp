@@ -82,10 +82,12 @@ void sync_probe_cascades(View<Get<const scene::Camera, const transform::WorldTra
       s.grid = grid;
       // The far field (k = count) lights only what no cascade holds.
       s.blend_cells = k >= std::max(1, c.count) ? probes::kFallbackBlendCells : c.blend_cells;
+      // The fitted grid holds the region it was fitted to, up to its faces.
+      if (k < 0) s.hold_cells = 0.5f;
       return s;
     };
     entered += probes::follow_camera(
-        set.state, c, viewer, rt->bounds_min(), rt->bounds_max(),
+        set.state, c, viewer, rt->bounds_min(), rt->bounds_max(), [&] { return probes::geometry_core(*rt); },
         [&](const probes::ProbeGrid& grid, int k) {
           auto f = std::make_shared<probes::ProbeField>(wanted(grid, k));
           if (k >= 0) f->set_focus(viewer.sanitised().eye);
