@@ -79,9 +79,7 @@ SceneBox geometry_core(std::span<const SceneBox> boxes) {
 
 SceneBox geometry_core(const engine::rt::RtScene& rt) {
   std::vector<SceneBox> boxes;
-  rt.for_each_instance([&](const engine::rt::InstanceRecord& r) {
-    if (r.active) boxes.push_back(SceneBox{r.bounds.min, r.bounds.max});
-  });
+  rt.for_each_instance([&](const engine::rt::InstanceRecord& r) { boxes.push_back(SceneBox{r.bounds.min, r.bounds.max}); });
   return geometry_core(boxes);
 }
 
