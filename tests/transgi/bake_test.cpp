@@ -130,6 +130,36 @@ TEST(ModelFile, RoundTripsExactly) {
   EXPECT_NO_THROW(model::validate_model(back, assets, d.path / "m.tgm"));
 }
 
+// The transfer masks a mesh's own surfaces within the bake's visibility
+// distance; shading adds their light back out to the same distance, so the
+// fraction travels with the model (in its bake settings). A model whose
+// settings do not say was baked with the default; a value that is not a
+// distance fraction is an error naming it.
+TEST(ModelFile, TheVisibilityFractionTravelsWithTheModel) {
+  TempDir d;
+  const auto assets = tiny_scene();
+  auto m = bake::make_untrained_model(assets, 7, model::MlpLayout{.width = 16, .hidden_layers = 1}, 9);
+  const auto reload = [&](const std::string& settings) {
+    m.bake_settings_json = settings;
+    model::save_model(d.path / "m.tgm", m);
+    return model::load_model(d.path / "m.tgm");
+  };
+  EXPECT_FLOAT_EQ(reload(R"({"points": 600, "visibility_fraction": 0.25})").visibility_fraction, 0.25f);
+  EXPECT_FLOAT_EQ(reload(R"({"points": 600})").visibility_fraction, model::kDefaultVisibilityFraction);
+  EXPECT_FLOAT_EQ(reload("not json").visibility_fraction, model::kDefaultVisibilityFraction);
+  const auto back = reload(R"({"visibility_fraction": 0.25})");
+  const engine::scene::MeshAsset& mesh = *assets.meshes[0];
+  EXPECT_FLOAT_EQ(back.self_masked_within(mesh), 0.25f * glm::length(mesh.bounds_max - mesh.bounds_min));
+  for (const char* bad : {R"({"visibility_fraction": "half"})", R"({"visibility_fraction": -1})"}) {
+    try {
+      reload(bad);
+      ADD_FAILURE() << bad << " loaded";
+    } catch (const model::ModelFileError& e) {
+      EXPECT_NE(std::string(e.what()).find("visibility_fraction"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(ModelFile, AFormatOneFileLoadsAsNotDemodulated) {
   // Format 1 (before issue 37) ends at the metrics, with no flags word: its
   // decoder predicts the transfer with the albedo in it.

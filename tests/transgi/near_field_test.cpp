@@ -76,12 +76,13 @@ std::array<float, 75> uniform_sh(float l0) {
   return sh;
 }
 
-glm::vec3 estimate(SunlitFloor& scene, const shading::GSample& s, float l0, float reach, bool skip_self, int rays) {
+// own_masked_within: where the sample's transfer masks its own object (0: no transfer).
+glm::vec3 estimate(SunlitFloor& scene, const shading::GSample& s, float l0, float reach, float own_masked_within, int rays) {
   const render::LightSet lights(scene.rt(), render::gather_punctual_lights(scene.app.world()), nullptr);
   const std::array<float, 75> sh = uniform_sh(l0);
   const shading::NearLightAt light_at = [&](const glm::vec3&, const glm::vec3&, float* out) { std::copy(sh.begin(), sh.end(), out); };
   math::Pcg32 rng = math::make_rng(7, 0, 0);
-  return shading::near_field_irradiance(scene.rt(), &lights, s, sh.data(), reach, skip_self, rays, light_at, rng);
+  return shading::near_field_irradiance(scene.rt(), &lights, s, sh.data(), reach, own_masked_within, rays, light_at, rng);
 }
 
 // The filter's guide: normal and depth per sample, 0 depth for a miss.
@@ -101,7 +102,7 @@ TEST(NearField, APointOverASunlitFloorGetsTheFloorsLightInsideItsReach) {
     const float floor_radiance = a * e / pi + a * l0;
     const float c = h / reach;
     const float expected = pi * (1 - c * c) * (floor_radiance - l0);
-    const glm::vec3 got = estimate(scene, facing_down(h), l0, reach, false, 4096);
+    const glm::vec3 got = estimate(scene, facing_down(h), l0, reach, 0.0f, 4096);
     std::printf("h %.2f reach %.1f L0 %.2f: dE expected pi (1 - (h/R)^2) (L - L0) = %.5f, got %.5f %.5f %.5f\n", h, reach,
                 l0, expected, got.r, got.g, got.b);
     // 64 x 64 stratified cosine rays: the cone's edge crosses about 64 strata,
@@ -122,9 +123,9 @@ TEST(NearField, AGlintOnAMetalIsNotContactLight) {
   gold.roughness_factor = 0.2f;
   gold.specular_factor = 1.0f;
   SunlitFloor metal(gold);
-  EXPECT_EQ(estimate(metal, facing_down(0.3f), 0.0f, 1.0f, false, 256), glm::vec3(0.0f));
+  EXPECT_EQ(estimate(metal, facing_down(0.3f), 0.0f, 1.0f, 0.0f, 256), glm::vec3(0.0f));
   SunlitFloor matte;
-  EXPECT_GT(estimate(matte, facing_down(0.3f), 0.0f, 1.0f, false, 256).g, 0.1f);
+  EXPECT_GT(estimate(matte, facing_down(0.3f), 0.0f, 1.0f, 0.0f, 256).g, 0.1f);
   // The BRDF's diffuse lobe alone: all of a metal's f is glossy, all of a
   // Lambertian's diffuse.
   material::BrdfParams metal_brdf{.base_color = glm::vec3(1.0f, 0.8f, 0.3f), .metallic = 1.0f, .roughness = 0.2f};
@@ -135,19 +136,41 @@ TEST(NearField, AGlintOnAMetalIsNotContactLight) {
   EXPECT_EQ(material::brdf_eval_diffuse(matte_brdf, up, up), material::brdf_eval(matte_brdf, up, up));
 }
 
-TEST(NearField, TheSamplesOwnObjectAndWhatLiesBeyondReachAddNothing) {
+// A sample's transfer masks its own object within the bake's visibility
+// distance t (model::TransferModel::self_masked_within): neither the probes'
+// light nor the object's own comes through those directions, so the near
+// field adds the object's whole radiance there, out to t, not the difference
+// from the probes. Known answer as above with the floor as the sample's own
+// object: dE = pi (1 - (h / t)^2) L for t past the reach; the difference
+// within the reach where the floor lies past t (no masking).
+TEST(NearField, WhereTheTransferMasksItsOwnObjectThatObjectsWholeLightIsAdded) {
+  SunlitFloor scene;
+  const float a = SunlitFloor::kAlbedo, e = SunlitFloor::kLux, pi = glm::pi<float>();
+  const float h = 0.2f, l0 = 0.3f, reach = 0.5f, floor_radiance = a * e / pi + a * l0;
+  shading::GSample s = facing_down(h);
+  s.entity = scene.floor;
+  for (const auto& [masked_within, expected] :
+       {std::pair{1.0f, pi * (1 - (h / 1.0f) * (h / 1.0f)) * floor_radiance},
+        // the reach's cone gets the difference, and its masked inner cone the L0 back
+        std::pair{0.4f, pi * (1 - (h / reach) * (h / reach)) * (floor_radiance - l0) + pi * (1 - (h / 0.4f) * (h / 0.4f)) * l0},
+        std::pair{0.1f, pi * (1 - (h / reach) * (h / reach)) * (floor_radiance - l0)},
+        std::pair{0.0f, pi * (1 - (h / reach) * (h / reach)) * (floor_radiance - l0)}}) {
+    const glm::vec3 got = estimate(scene, s, l0, reach, masked_within, 4096);
+    std::printf("masked within %.1f (reach %.1f): expected %.5f, got %.5f\n", masked_within, reach, expected, got.g);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], expected, 0.02f * std::abs(expected) + 1e-6f) << "channel " << k;
+  }
+}
+
+TEST(NearField, WhatLiesBeyondReachAddsNothing) {
   SunlitFloor scene;
   shading::GSample s = facing_down(0.2f);
-  const glm::vec3 near = estimate(scene, s, 0.0f, 1.0f, true, 64);
-  EXPECT_GT(near.g, 0.5f) << "another object's floor is contact light";
-  s.entity = scene.floor;  // the floor's own point: its transfer holds it
-  EXPECT_EQ(estimate(scene, s, 0.0f, 1.0f, true, 64), glm::vec3(0.0f));
-  s.entity = {};
-  EXPECT_EQ(estimate(scene, s, 0.0f, 0.19f, false, 64), glm::vec3(0.0f)) << "the floor is 0.2 away, the reach 0.19";
-  EXPECT_EQ(estimate(scene, s, 0.0f, 1.0f, false, 0), glm::vec3(0.0f)) << "no rays: off";
+  EXPECT_GT(estimate(scene, s, 0.0f, 1.0f, 0.0f, 64).g, 0.5f) << "another object's floor is contact light";
+  EXPECT_EQ(estimate(scene, s, 0.0f, 0.19f, 0.0f, 64), glm::vec3(0.0f)) << "the floor is 0.2 away, the reach 0.19";
+  EXPECT_EQ(estimate(scene, s, 0.0f, 0.19f, 5.0f, 64), glm::vec3(0.0f)) << "another object's, masked or not";
+  EXPECT_EQ(estimate(scene, s, 0.0f, 1.0f, 0.0f, 0), glm::vec3(0.0f)) << "no rays: off";
   // Facing up, away from the floor, no ray can meet it.
   s.normal_world = s.geometric_normal = glm::vec3(0, 1, 0);
-  EXPECT_EQ(estimate(scene, s, 0.0f, 1.0f, false, 64), glm::vec3(0.0f));
+  EXPECT_EQ(estimate(scene, s, 0.0f, 1.0f, 0.0f, 64), glm::vec3(0.0f));
 }
 
 TEST(NearField, TheFilterKeepsAConstantAndNeverCrossesADepthStep) {

@@ -237,6 +237,7 @@ void remove_other_dataset_caches(const fs::path& out) {
 void write_model_metadata(model::TransferModel& m, const BakeSettings& s, const BakeReport& report) {
   const auto& l = m.decoder.layout();
   const auto bands = [](const BandErrors& e) { return nlohmann::json(std::vector<double>(e.rmse.begin(), e.rmse.end())); };
+  m.visibility_fraction = s.data.visibility_fraction;
   m.bake_settings_json = nlohmann::json{{"points", s.data.points},
                                         {"outgoing_per_point", s.data.outgoing_per_point},
                                         {"rays", s.data.rays},

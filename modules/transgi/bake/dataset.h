@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 
 #include "bake/transfer.h"
+#include "model/transfer_model.h"
 
 namespace transgi::bake {
 
@@ -33,7 +34,7 @@ struct DatasetSettings {
   // Rays per point (the paper uses 2000). Higher = less noisy targets, at the cost of time.
   int rays = 2000;
   // Visibility distance t as a fraction of each mesh's bounding-box diagonal.
-  float visibility_fraction = 0.5f;
+  float visibility_fraction = model::kDefaultVisibilityFraction;
   float validation_fraction = 0.05f;
   std::uint64_t seed = 1;
   // Targets divided by each point's base colour (model::demodulation): the

@@ -5,6 +5,7 @@
 
 #include "engine/math/sampling.h"
 #include "engine/render/surface.h"
+#include "model/transfer_model.h"
 
 namespace transgi::bake {
 
@@ -19,7 +20,7 @@ std::unique_ptr<engine::rt::RtScene> make_object_tracer(const engine::scene::Sce
 }
 
 float default_visibility_distance(const engine::scene::MeshAsset& mesh) {
-  return 0.5f * glm::length(mesh.bounds_max - mesh.bounds_min);
+  return model::kDefaultVisibilityFraction * glm::length(mesh.bounds_max - mesh.bounds_min);
 }
 
 MeshTransfer::MeshTransfer(const engine::rt::RtScene& tracer, const engine::scene::MeshAsset& mesh,

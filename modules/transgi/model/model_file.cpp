@@ -6,6 +6,8 @@
 #include <fstream>
 #include <span>
 
+#include <nlohmann/json.hpp>
+
 #include "engine/io/atomic_file.h"
 #include "engine/core/fnv1a.h"
 
@@ -81,6 +83,18 @@ struct Reader {
     return s;
   }
 };
+
+// The bake's visibility fraction, from its free-form settings: models from
+// before it was recorded, or from tools that write other settings, were
+// baked with the default.
+float visibility_fraction_of(const std::string& bake_settings, const Reader& r) {
+  const nlohmann::json j = nlohmann::json::parse(bake_settings, nullptr, false);
+  if (!j.is_object() || !j.contains("visibility_fraction")) return kDefaultVisibilityFraction;
+  const nlohmann::json& v = j["visibility_fraction"];
+  if (!v.is_number() || !(v.get<double>() >= 0.0) || !(v.get<double>() <= 1e6))
+    r.fail("bake settings' visibility_fraction " + v.dump() + " is not a number in [0, 1e6]");
+  return v.get<float>();
+}
 
 }  // namespace
 
@@ -189,6 +203,7 @@ TransferModel decode_model(std::span<const std::byte> bytes, const std::string& 
     model.meshes.push_back(std::move(m));
   }
   model.bake_settings_json = r.string("bake settings");
+  model.visibility_fraction = visibility_fraction_of(model.bake_settings_json, r);
   model.metrics_json = r.string("metrics");
   if (version >= 2) {
     const auto flags = r.value<std::uint32_t>("flags");

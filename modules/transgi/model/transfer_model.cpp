@@ -6,11 +6,14 @@
 
 namespace transgi::model {
 
-
 std::size_t TransferModel::latent_bytes() const {
   std::size_t n = 0;
   for (const auto& m : meshes) n += m.latents.values.size() * sizeof(float);
   return n;
+}
+
+float TransferModel::self_masked_within(const engine::scene::MeshAsset& mesh) const {
+  return visibility_fraction * glm::length(mesh.bounds_max - mesh.bounds_min);
 }
 
 void assemble_input(const float* latent, int latent_dim, const glm::vec3& albedo, const glm::vec3& normal,

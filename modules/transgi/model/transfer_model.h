@@ -17,6 +17,11 @@ struct MeshLatents {
   LatentTable latents;
 };
 
+// The transfer's visibility V tests the object itself and counts hits closer
+// than this fraction of its mesh's bounding-box diagonal (paper Section 4.2;
+// bake::DatasetSettings::visibility_fraction), the default of a bake.
+inline constexpr float kDefaultVisibilityFraction = 0.5f;
+
 struct TransferModel {
   Mlp decoder;
   int latent_dim = 7;
@@ -26,11 +31,19 @@ struct TransferModel {
   // so a texture's detail and hue in the GI are exact whatever the network
   // smooths (issue 37). False for models baked before format 2.
   bool demodulated = false;
+  // What the bake's V used (kDefaultVisibilityFraction). Within that distance
+  // of a point, its own object's surfaces are masked by its transfer: their
+  // light is not in the decoded transfer, and shading must add it
+  // (shading/near_field.h). Read from bake_settings_json on load.
+  float visibility_fraction = kDefaultVisibilityFraction;
   std::string bake_settings_json;   // what produced it (free-form JSON)
   std::string metrics_json;         // training and validation results (free-form JSON)
 
   [[nodiscard]] std::size_t decoder_bytes() const { return decoder.params().size() * sizeof(float); }
   [[nodiscard]] std::size_t latent_bytes() const;
+  // The distance, in the mesh's own units, within which a point's transfer
+  // masks the mesh's own surfaces.
+  [[nodiscard]] float self_masked_within(const engine::scene::MeshAsset& mesh) const;
 };
 
 // Base colours are floored here before transfer or light is divided by

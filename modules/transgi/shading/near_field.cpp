@@ -1,5 +1,6 @@
 #include "shading/near_field.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
@@ -15,10 +16,11 @@
 namespace transgi::shading {
 
 glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::render::LightSet* lights,
-                                const GSample& s, const float* light_sh, float reach, bool skip_self, int rays,
+                                const GSample& s, const float* light_sh, float reach, float own_masked_within, int rays,
                                 const NearLightAt& light_at, engine::math::Pcg32& rng) {
   using namespace engine;
   if (!s.hit || rays <= 0 || !(reach > 0)) return glm::vec3(0.0f);
+  const float own_reach = std::isfinite(own_masked_within) ? std::max(own_masked_within, 0.0f) : 0.0f;
   static const render::LightSet kNoLights;
   const render::LightSet& light_set = lights ? *lights : kNoLights;
   const math::Frame frame = math::Frame::from_normal(s.normal_world);
@@ -41,12 +43,17 @@ glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::
     const glm::vec3 dir = frame.to_world(math::sample_cosine_hemisphere(u));
     if (glm::dot(dir, s.geometric_normal) <= 0) continue;
     rt::Hit hit;
-    if (!scene.intersect(rt::Ray{origin, dir, 0.0f, reach}, hit)) continue;
-    if (skip_self && hit.entity == s.entity) continue;
+    if (!scene.intersect(rt::Ray{origin, dir, 0.0f, std::max(reach, own_reach)}, hit)) continue;
+    const bool masked = hit.entity == s.entity && hit.t < own_reach;
+    if (!masked && !(hit.t < reach)) continue;
     // The hit's diffuse lobe only: the near field carries contact light, and
     // a glint (the sun in a metal) met by one ray would be spread into a
     // bright box by the filter; the probes keep what the glossy lobes reflect.
     const probes::ProbeRayHit h = probes::shade_probe_ray(scene, light_set, dir, &hit, rng, feedback, probes::HitLobes::Diffuse);
+    if (masked) {
+      sum += h.radiance;
+      continue;
+    }
     if (!probes_sh) {
       light_at(s.position, s.normal_world, own_sh);
       probes_sh = own_sh;

@@ -56,17 +56,24 @@ struct NearFieldRays {
 // World SH light (75 values) at a point with a normal, as the probes give it.
 using NearLightAt = std::function<void(const glm::vec3& position, const glm::vec3& normal, float* out75)>;
 
-// The irradiance to add at `s` (world space, about its shading normal): for
-// each of `rays` cosine-distributed directions that hit another surface
-// within `reach`, pi / rays x (that hit's radiance towards s, minus the
-// probes' SH radiance `light_sh` in that direction). Hits on the sample's
-// own entity are skipped where `skip_self` (its transfer already holds
-// them). Zero where nothing is near. May be negative per channel: the
-// caller clamps the shaded total. A null `light_sh` is interpolated with
-// `light_at` at s only once a ray hits: most rays from an open floor or wall
-// meet nothing within reach, and the interpolation costs more than the ray.
+// The irradiance to add at `s` (world space, about its shading normal), from
+// `rays` cosine-distributed directions, pi / rays x the sum of, per ray:
+// - a hit on another surface within `reach`: that hit's radiance towards s,
+//   minus the probes' SH radiance `light_sh` in that direction (the probes'
+//   parallax replaced);
+// - a hit on the sample's own entity within `own_masked_within` (the
+//   distance within which its transfer's visibility masks its own object,
+//   model::TransferModel::self_masked_within, in world units; 0 for samples
+//   shaded without a transfer): that hit's radiance alone. The transfer
+//   holds nothing from those directions, neither the probes' light nor the
+//   object's own: the light a concave object (a chair's shell, a room's
+//   walls and ceiling baked as one mesh) reflects onto itself.
+// Zero where nothing is near. May be negative per channel: the caller
+// clamps the shaded total. A null `light_sh` is interpolated with
+// `light_at` at s only once a ray needs it: most rays from an open floor or
+// wall meet nothing within reach, and the interpolation costs more than the ray.
 glm::vec3 near_field_irradiance(const engine::rt::RtScene& scene, const engine::render::LightSet* lights,
-                                const GSample& s, const float* light_sh, float reach, bool skip_self, int rays,
+                                const GSample& s, const float* light_sh, float reach, float own_masked_within, int rays,
                                 const NearLightAt& light_at, engine::math::Pcg32& rng);
 
 // Joint-bilateral average of per-sample values over the samples of the

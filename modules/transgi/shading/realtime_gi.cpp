@@ -284,11 +284,12 @@ constexpr int kContactResetCells = 8;
 // checkerboard, alternating, and rays from its own colour's cells gave each
 // colour its own noise, a frozen checkerboard in a still view. The
 // lattice's estimates are filtered (a horizontal then a vertical bilateral
-// pass) into every cell, so both colours read one field. `skips_own(p)`: the sample at pixel p is
-// shaded by the network, whose transfer holds its own object's light.
+// pass) into every cell, so both colours read one field. `own_masked_within(p)`: where the
+// transfer of the sample at pixel p masks its own object (near_field_irradiance; 0 where no
+// transfer shades it).
 void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::span<const probes::ProbeField* const> fields,
                        const engine::render::LightSet* lights, const NearFieldRays& near_field, const UpsamplingPlan& up,
-                       std::span<const std::size_t> cells, const std::function<bool(std::size_t)>& skips_own, std::span<const glm::vec3> contact_gain,
+                       std::span<const std::size_t> cells, const std::function<float(std::size_t)>& own_masked_within, std::span<const glm::vec3> contact_gain,
                        std::span<const std::int32_t> track, std::span<const std::uint8_t> moved, ContactScratch& scratch,
                        std::vector<glm::vec3>& value) {
   const NearLightAt light_at = [&](const glm::vec3& p, const glm::vec3& n, float* out) { probes::interpolate_fields(fields, p, n, out); };
@@ -334,7 +335,7 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
       engine::math::Pcg32 rng = engine::math::make_rng(0x4EA2F1ull, p, stream);  // no seed: by frame, not by run
       const float reach = near_field.reach_cells * probes::fields_at(fields, s.position).field[0]->placement().min_spacing();
       scratch.contact[c] =
-          near_field_irradiance(scene, lights, s, nullptr, reach, skips_own(p), near_field.rays, light_at, rng);
+          near_field_irradiance(scene, lights, s, nullptr, reach, own_masked_within(p), near_field.rays, light_at, rng);
       scratch.valid[c] = 1;
     }
   });
@@ -899,10 +900,12 @@ engine::image::ImageRGB shade_gi_realtime(const RealtimeGiRequest& request, cons
   if (in.near_field.rays > 0) {
     t0 = Clock::now();
     // The lattice's cells need not be decoded this frame: their route as route_samples decides it.
-    const std::function<bool(std::size_t)> skips_own = [&](std::size_t p) {
-      return in.network_decodes(g.entity[p]) && !in.is_glossy_dielectric(p);
+    const std::function<float(std::size_t)> own_masked_within = [&](std::size_t p) {
+      if (!in.network_decodes(g.entity[p]) || in.is_glossy_dielectric(p)) return 0.0f;
+      const GSample& s = g.samples[p];
+      return in.request.model->self_masked_within(*in.assets.meshes[s.mesh]) * in.scene.instance_of(s.entity)->to_world.scale;
     };
-    add_contact_light(g, in.scene, fields, request.mirror_lights, in.near_field, sc.up, sc.decoded_cells, skips_own, sc.contact_gain,
+    add_contact_light(g, in.scene, fields, request.mirror_lights, in.near_field, sc.up, sc.decoded_cells, own_masked_within, sc.contact_gain,
                       in.reuse ? std::span<const std::int32_t>(sc.contact.track) : std::span<const std::int32_t>(),
                       in.reuse ? std::span<const std::uint8_t>(sc.contact.moved) : std::span<const std::uint8_t>(), sc.contact,
                       sc.value);

@@ -229,7 +229,7 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
       if (!transfers[m]) {
         tracers[m] = bake::make_object_tracer(assets, m);
         transfers[m] = std::make_unique<bake::MeshTransfer>(*tracers[m], *assets.meshes[m], assets,
-                                                            bake::default_visibility_distance(*assets.meshes[m]));
+                                                            model.self_masked_within(*assets.meshes[m]));
       }
     }
     jobs::parallel_for<std::size_t>(0, hits.size(), 16, [&](std::size_t b, std::size_t e) {
@@ -256,6 +256,13 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
     if (!to_object.contains(samples[i].entity))
       to_object.emplace(samples[i].entity,
                         math::ShRotation(glm::transpose(glm::mat3_cast(scene.instance_of(samples[i].entity)->to_world.rotation))));
+  // Where each sample's transfer masks its own object, in world units.
+  std::unordered_map<engine::ecs::Entity, float> masked_within;
+  for (std::size_t i : hits)
+    if (!masked_within.contains(samples[i].entity))
+      masked_within.emplace(samples[i].entity, model.self_masked_within(*assets.meshes[samples[i].mesh]) *
+                                                   scene.instance_of(samples[i].entity)->to_world.scale);
+  const auto self_masked_within = [&](const Sample& smp) { return masked_within.at(smp.entity); };
   std::vector<glm::vec3> shaded(n, glm::vec3(0.0f));
   // The contact light the probes miss (near_field.h), estimated from the
   // same world light as the shading, filtered across similar neighbours,
@@ -263,12 +270,13 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
   // at zero, as sh_irradiance is.
   const bool with_near = s.near_field.rays > 0 && s.probe_spacing_at;
   std::vector<glm::vec3> near(with_near ? n : 0, glm::vec3(0.0f));
-  const auto estimate_near = [&](std::size_t i, const float* world, bool skip_self) {
+  // own_masked_within: where a sample's transfer masks its own object (0: shaded without one).
+  const auto estimate_near = [&](std::size_t i, const float* world, float own_masked_within) {
     if (!with_near) return;
     const Sample& smp = samples[i];
     math::Pcg32 rng = math::make_rng(s.seed ^ 0x4EA2F1ull, i, 0);
     const float reach = s.near_field.reach_cells * s.probe_spacing_at(smp.position);
-    near[i] = near_field_irradiance(scene, s.lights, smp, world, reach, skip_self, s.near_field.rays, light_at, rng);
+    near[i] = near_field_irradiance(scene, s.lights, smp, world, reach, own_masked_within, s.near_field.rays, light_at, rng);
   };
   const std::size_t grain = with_near ? 16 : 256;
   jobs::parallel_for<std::size_t>(0, hits.size(), grain, [&](std::size_t b, std::size_t e) {
@@ -281,7 +289,7 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
       ShRgb light;
       std::copy(object, object + 75, light.begin());
       shaded[hits[j]] = shade(light, transfer.data() + j * bake::kTransferValues);
-      estimate_near(hits[j], world, true);  // its transfer already holds its own object
+      estimate_near(hits[j], world, self_masked_within(smp));
     }
   });
   jobs::parallel_for<std::size_t>(0, diffuse_only.size(), grain, [&](std::size_t b, std::size_t e) {
@@ -290,7 +298,7 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
       const Sample& smp = samples[diffuse_only[j]];
       light_at(smp.position, smp.normal_world, world);
       shaded[diffuse_only[j]] = smp.diffuse * math::kInvPi * sh_irradiance(world, smp.normal_world);
-      estimate_near(diffuse_only[j], world, false);
+      estimate_near(diffuse_only[j], world, 0.0f);
     }
   });
   if (with_near) {
