@@ -128,6 +128,19 @@ glm::vec3 directional_albedo(const BrdfParams& p, float cos_o) {
   return (1.0f - p.metallic) * dielectric + p.metallic * metal;
 }
 
+glm::vec3 dielectric_layer_albedo(const BrdfParams& p, float cos_o) {
+  if (!(cos_o > 0) || p.specular <= 0) return glm::vec3(0.0f);
+  const SpecularAlbedo e = ggx_albedo(cos_o, alpha_of(p));
+  const glm::vec3 f0 = dielectric_f0(p);
+  return {layer_albedo(p, e, f0.r), layer_albedo(p, e, f0.g), layer_albedo(p, e, f0.b)};
+}
+
+glm::vec3 metal_albedo(const BrdfParams& p, float cos_o) {
+  if (!(cos_o > 0)) return glm::vec3(0.0f);
+  const SpecularAlbedo e = ggx_albedo(cos_o, alpha_of(p));
+  return {e.with_f0(p.base_color.r), e.with_f0(p.base_color.g), e.with_f0(p.base_color.b)};
+}
+
 glm::vec3 brdf_eval(const BrdfParams& p, const glm::vec3& wo, const glm::vec3& wi) {
   const float cos_o = wo.z, cos_i = wi.z;
   if (cos_o <= 0 || cos_i <= 0) return glm::vec3(0.0f);

@@ -58,6 +58,14 @@ inline glm::vec3 diffuse_albedo(const BrdfParams& p) { return p.base_color * (1.
 // pi): a varnished floor's specular layer and a metal reflect the room's
 // light too, where diffuse_albedo leaves them black.
 glm::vec3 directional_albedo(const BrdfParams& p, float cos_o);
+// Its parts, for shading that splits light known as averages by lobe (the
+// diffuse lobe's about the normal, the glossy lobes' about the mirror
+// direction): the non-metal part's specular layer albedo towards wo (per
+// channel, at most 1; its diffuse lobe reflects base_color x (1 - this)), and
+// the metal part's. directional_albedo = (1 - metallic) (base (1 - layer) +
+// layer) + metallic metal (where the layer is below 1).
+glm::vec3 dielectric_layer_albedo(const BrdfParams& p, float cos_o);
+glm::vec3 metal_albedo(const BrdfParams& p, float cos_o);
 
 // f(wo, wi). Zero when either direction is below the surface.
 glm::vec3 brdf_eval(const BrdfParams& p, const glm::vec3& wo, const glm::vec3& wi);

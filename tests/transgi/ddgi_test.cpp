@@ -6,10 +6,15 @@
 #include <cmath>
 #include <cstdio>
 
+#include <glm/gtc/quaternion.hpp>
+
+#include "ddgi/ddgi_renderer.h"
 #include "ddgi/ddgi_volume.h"
 #include "engine/app/app.h"
+#include "engine/material/brdf.h"
 #include "engine/math/rng.h"
 #include "engine/math/sampling.h"
+#include "engine/render/camera_rays.h"
 #include "engine/rt/rt_plugin.h"
 #include "engine/scene/procedural.h"
 #include "floor_under_sky.h"
@@ -89,6 +94,58 @@ TEST(Ddgi, FurnaceConvergesToTheAnalyticIrradiance) {
     EXPECT_NEAR(e.g, c.expected, 0.04 * c.expected) << "normal " << c.n.x << " " << c.n.y << " " << c.n.z;
     EXPECT_NEAR(e.r, e.g, 1e-4) << "grey";
   }
+}
+
+// A varnished floor reflects the room through its specular layer; DDGI has
+// no reflection probes, so its GI takes that light as the layer's albedo /
+// pi x the irradiance about the mirror direction (ddgi_renderer.h), and it is
+// not lost. The furnace above, converged, then the floor turned into a black
+// varnish (no diffuse lobe: what DDGI shows of it is the layer alone),
+// rendered from a camera looking down at it. About a direction at elevation
+// phi the furnace's irradiance is pi ((1 + sin phi) / 2 + a (1 - sin phi) / 2);
+// each pixel must read the layer's albedo / pi x that, within the furnace's 4 %
+// and 2 % for the maps' interpolation. (0 before DDGI had the layer.)
+TEST(Ddgi, AVarnishedFloorReflectsTheIrradianceAboutItsMirrorDirection) {
+  const float a = 0.5f;
+  FloorUnderSky s(a);
+  auto& assets = s.app.world().resource<scene::SceneAssets>();
+  DdgiSettings settings;
+  settings.escaped = EscapedRays::Environment;
+  DdgiVolume volume(transgi::probes::ProbeGrid{{-1, 0.5f, -1}, {1, 1.5f, 1}, {2, 2, 2}}, settings);
+  const render::LightSet no_lights;
+  const auto& rt_scene = s.app.world().resource<rt::RtScene>();
+  s.app.jobs().run([&] {
+    for (int f = 0; f < 800; ++f) volume.update(rt_scene, no_lights, &*assets.environment);
+  });
+  material::Material varnish;
+  varnish.base_color_factor = glm::vec4(0, 0, 0, 1);
+  varnish.metallic_factor = 0;
+  varnish.roughness_factor = 0.3f;
+  varnish.specular_factor = 1;
+  assets.materials[0] = varnish;
+  transform::Similarity eye;
+  eye.translation = glm::vec3(0.0f, 1.0f, 0.5f);
+  eye.rotation = glm::angleAxis(-0.7f, glm::vec3(1, 0, 0));  // looking down the -z way
+  // Pixels narrow enough (3 mrad) that the layer's albedo is one value over each.
+  const int w = 16, h = 16;
+  const render::CameraRays camera(scene::Camera{.yfov_radians = 0.05f}, eye, w, h);
+  const DdgiVolume* volumes[] = {&volume};
+  image::ImageRGB gi;
+  s.app.jobs().run([&] { gi = render_ddgi_gi(rt_scene, volumes, camera, w, h, DdgiRenderSettings{.spp = 1}); });
+  const material::BrdfParams brdf{.base_color = glm::vec3(0.0f), .metallic = 0, .roughness = 0.3f, .specular = 1};
+  for (int y = 0; y < h; y += 5)
+    for (int x = 0; x < w; x += 5) {
+      const rt::Ray ray = camera.generate_filtered(x, y, glm::vec2(0.5f), 0.0f);
+      ASSERT_LT(ray.direction.y, -0.1f) << "the pixel sees the floor";
+      const glm::vec3 mirror = glm::reflect(ray.direction, glm::vec3(0, 1, 0));
+      const double sin_phi = mirror.y, pi = 3.14159265358979323846;
+      const double e = pi * ((1 + sin_phi) / 2 + a * (1 - sin_phi) / 2);
+      const double expected = material::dielectric_layer_albedo(brdf, -ray.direction.y).g / pi * e;
+      const glm::vec3 got = gi.pixels[static_cast<std::size_t>(y * w + x)];
+      std::printf("pixel (%d, %d): mirror elevation sin %.3f, expected %.5f, got %.5f\n", x, y, sin_phi, expected, got.g);
+      EXPECT_GT(expected, 0.01) << "a layer that reflects";
+      EXPECT_NEAR(got.g, expected, 0.06 * expected) << "pixel " << x << " " << y;
+    }
 }
 
 // The same furnace with the sky sampled at the floor's hits (EscapedRays::

@@ -5,7 +5,7 @@
 
 #include "engine/gpu/gpu_error.h"
 #include "engine/jobs/parallel_for.h"
-#include "engine/material/specular_albedo.h"
+#include "engine/material/brdf.h"
 #include "engine/math/rng.h"
 #include "engine/math/sampling.h"
 #include "engine/render/surface.h"
@@ -14,6 +14,23 @@
 namespace transgi::ddgi {
 
 namespace {
+
+// What a surface reflects of irradiance known about two directions, each
+// weight / pi: its diffuse lobe takes the irradiance about its normal, its
+// glossy lobes (a dielectric's specular layer, a metal) the irradiance about
+// its mirror direction, a blurred reflection (engines use reflection probes
+// there; DDGI has none). Together they reflect the surface's directional
+// albedo: a varnished floor's layer and a metal reflect the room, where the
+// diffuse albedo alone leaves them out.
+struct LobeWeights {
+  glm::vec3 about_normal{0.0f}, about_mirror{0.0f};
+};
+LobeWeights lobe_weights(const engine::material::BrdfParams& brdf, const glm::vec3& diffuse, float cos_o) {
+  using namespace engine;
+  const glm::vec3 layer = (1.0f - brdf.metallic) * material::dielectric_layer_albedo(brdf, cos_o);
+  const glm::vec3 metal = brdf.metallic * material::metal_albedo(brdf, cos_o);
+  return {diffuse * (glm::vec3(1.0f) - layer) * math::kInvPi, (layer + metal) * math::kInvPi};
+}
 
 // The volumes' irradiance at p, blended as mix_at says; a volume with no
 // active probe weighing in hands its weight to the next holding p.
@@ -88,24 +105,28 @@ engine::image::ImageRGB render_ddgi_gi_batched(const engine::rt::RtScene& scene,
   std::vector<std::uint8_t> found(rays.size());
   if (!tracer.intersect(scene, rays, hits, found))
     throw gpu::GpuError("render_ddgi_gi_batched: the device traces only scenes built with their assets (RtScene::assets())");
-  std::vector<glm::vec3> position(rays.size()), normal(rays.size()), view(rays.size()), albedo(rays.size(), glm::vec3(0.0f));
+  // Two lookups a sample: about its normal (2k), about its mirror direction (2k + 1).
+  std::vector<glm::vec3> position(2 * rays.size()), normal(2 * rays.size()), view(2 * rays.size());
+  std::vector<LobeWeights> weights(rays.size());
   jobs::parallel_for<std::size_t>(0, rays.size(), 256, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       if (!found[k]) continue;
       const render::Surface surf = render::make_surface(scene, hits[k], rays[k].direction);
-      position[k] = surf.position;
-      normal[k] = surf.shading_normal;
-      view[k] = rays[k].direction;
-      albedo[k] = material::diffuse_albedo(surf.brdf) * math::kInvPi;
+      const glm::vec3 wo = -rays[k].direction;
+      position[2 * k] = position[2 * k + 1] = surf.position;
+      normal[2 * k] = surf.shading_normal;
+      normal[2 * k + 1] = glm::reflect(rays[k].direction, surf.shading_normal);
+      view[2 * k] = view[2 * k + 1] = rays[k].direction;
+      weights[k] = lobe_weights(surf.brdf, material::diffuse_albedo(surf.brdf), glm::dot(surf.shading_normal, wo));
     }
   });
-  std::vector<glm::mat2x3> e(rays.size());
+  std::vector<glm::mat2x3> e(position.size());
   kernels.irradiance(volumes, position, normal, view, e);
   for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
     glm::vec3 sum(0.0f);
     for (std::size_t si = 0; si < spp; ++si) {
       const std::size_t k = pixel * spp + si;
-      if (found[k]) sum += albedo[k] * e[k][0];
+      if (found[k]) sum += weights[k].about_normal * e[2 * k][0] + weights[k].about_mirror * e[2 * k + 1][0];
     }
     img.pixels[pixel] = sum / static_cast<float>(s.spp);
   }
@@ -129,7 +150,11 @@ engine::image::ImageRGB render_ddgi_gi(const engine::rt::RtScene& scene, std::sp
           rt::Hit hit;
           if (!scene.intersect(ray, hit)) continue;
           const render::Surface surf = render::make_surface(scene, hit, ray.direction);
-          sum += material::diffuse_albedo(surf.brdf) * math::kInvPi * irradiance_from(volumes, surf.position, surf.shading_normal, ray.direction);
+          const LobeWeights w = lobe_weights(surf.brdf, material::diffuse_albedo(surf.brdf), glm::dot(surf.shading_normal, -ray.direction));
+          sum += w.about_normal * irradiance_from(volumes, surf.position, surf.shading_normal, ray.direction);
+          if (w.about_mirror != glm::vec3(0.0f))
+            sum += w.about_mirror *
+                   irradiance_from(volumes, surf.position, glm::reflect(ray.direction, surf.shading_normal), ray.direction);
         }
         img.pixels[pixel] = sum / static_cast<float>(s.spp);
       }
@@ -162,13 +187,9 @@ std::vector<glm::mat2x3> look_up(const shading::GBuffer& g, std::span<const Look
   return e;
 }
 
-// A metal's specular albedo (GGX with Schlick's Fresnel) at its view angle.
+// A metal's specular albedo (GGX with Schlick's Fresnel) at its view angle, times its metallic.
 glm::vec3 metal_albedo(const shading::GSample& s) {
-  using namespace engine;
-  const float mu = std::max(glm::dot(s.normal_world, s.wo_world), 1e-4f);
-  const float alpha = std::max(s.brdf.roughness * s.brdf.roughness, material::kMinAlpha);
-  const material::SpecularAlbedo a = material::ggx_albedo(mu, alpha);
-  return s.brdf.metallic * (s.brdf.base_color * a.a + glm::vec3(a.b));
+  return s.brdf.metallic * engine::material::metal_albedo(s.brdf, std::max(glm::dot(s.normal_world, s.wo_world), 1e-4f));
 }
 
 }  // namespace
@@ -180,14 +201,22 @@ DdgiPixels shade_ddgi_gbuffer(const shading::GBuffer& g, std::span<const DdgiVol
   DdgiPixels out{image::ImageRGB(g.width, g.height), image::ImageRGB(g.width, g.height)};
   if (volumes.empty()) return out;
   shading::plan_upsampling(g.guide, g.width, g.height, upsampling, plan);
-  // The lookups: each grid cell's pixel, each pixel decoded on its own, and
-  // each metal pixel's mirror direction, in that order.
+  // The lookups: each grid cell's pixel about its normal and about its
+  // mirror direction, each pixel decoded on its own alike, and each metal
+  // pixel's mirror direction, in that order.
   std::vector<Lookup> lookups;
   for (std::size_t c = 0; c < plan.cell_pixel.size(); ++c)
-    if (plan.cell_guide[c].w > 0) lookups.push_back({plan.cell_pixel[c], g.samples[plan.cell_pixel[c]].normal_world});
+    if (plan.cell_guide[c].w > 0) {
+      const shading::GSample& s = g.samples[plan.cell_pixel[c]];
+      lookups.push_back({plan.cell_pixel[c], s.normal_world});
+      lookups.push_back({plan.cell_pixel[c], glm::reflect(-s.wo_world, s.normal_world)});
+    }
   const std::size_t cells_end = lookups.size();
   for (std::size_t p = 0; p < g.samples.size(); ++p)
-    if (plan.kind[p] == UpsamplingPlan::kOwn) lookups.push_back({p, g.samples[p].normal_world});
+    if (plan.kind[p] == UpsamplingPlan::kOwn) {
+      lookups.push_back({p, g.samples[p].normal_world});
+      lookups.push_back({p, glm::reflect(-g.samples[p].wo_world, g.samples[p].normal_world)});
+    }
   const std::size_t own_end = lookups.size();
   // Metals as the G-buffer marks them (metallic >= 0.5), as TransGI's mirror pass finds them.
   for (std::size_t p = 0; p < g.samples.size(); ++p)
@@ -195,30 +224,41 @@ DdgiPixels shade_ddgi_gbuffer(const shading::GBuffer& g, std::span<const DdgiVol
       lookups.push_back({p, glm::reflect(-g.samples[p].wo_world, g.samples[p].normal_world)});
   const std::vector<glm::mat2x3> e = look_up(g, lookups, volumes, kernels);
 
-  // Irradiance per grid cell (a miss stays 0).
-  std::vector<glm::mat2x3> cell_e(plan.cell_pixel.size(), glm::mat2x3(0.0f));
+  // Irradiance per grid cell about its normal and its mirror direction (a miss stays 0).
+  std::vector<glm::mat2x3> cell_e(plan.cell_pixel.size(), glm::mat2x3(0.0f)), cell_mirror(plan.cell_pixel.size(), glm::mat2x3(0.0f));
   std::size_t k = 0;
   for (std::size_t c = 0; c < plan.cell_pixel.size(); ++c)
-    if (plan.cell_guide[c].w > 0) cell_e[c] = e[k++];
-  // Upsampled irradiance x the pixel's own diffuse albedo / pi: textures keep
-  // their full resolution. Pixels decoded on their own are written after.
+    if (plan.cell_guide[c].w > 0) {
+      cell_e[c] = e[k++];
+      cell_mirror[c] = e[k++];
+    }
+  // A pixel's light: lobe_weights of the irradiance about its normal and about its mirror direction.
+  // (A metal the G-buffer marks takes its metal lobe's light at its own pixel, below.)
+  const auto shade = [&](std::size_t p, const glm::mat2x3& about_normal, const glm::mat2x3& about_mirror) {
+    const shading::GSample& s = g.samples[p];
+    const float cos_o = glm::dot(s.normal_world, s.wo_world);
+    LobeWeights w = lobe_weights(s.brdf, s.diffuse, cos_o);
+    if (g.metal_roughness[p] < std::numeric_limits<float>::infinity())
+      w.about_mirror -= s.brdf.metallic * material::metal_albedo(s.brdf, cos_o) * math::kInvPi;
+    out.gi.pixels[p] = w.about_normal * about_normal[0] + w.about_mirror * about_mirror[0];
+    out.emitted.pixels[p] = w.about_normal * about_normal[1] + w.about_mirror * about_mirror[1];
+  };
   jobs::parallel_for(0, g.height, 4, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < g.width; ++x) {
         const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(g.width) + static_cast<std::size_t>(x);
         if (plan.kind[p] != UpsamplingPlan::kUpsampled) continue;
-        glm::mat2x3 irradiance(0.0f);
-        for (int tap = 0; tap < 4; ++tap) irradiance += plan.weight[static_cast<std::size_t>(tap)][p] * cell_e[plan.cell(tap, x, y)];
-        const glm::vec3 albedo = g.samples[p].diffuse * math::kInvPi;
-        out.gi.pixels[p] = albedo * irradiance[0];
-        out.emitted.pixels[p] = albedo * irradiance[1];
+        glm::mat2x3 about_normal(0.0f), about_mirror(0.0f);
+        for (int tap = 0; tap < 4; ++tap) {
+          const float w = plan.weight[static_cast<std::size_t>(tap)][p];
+          const std::size_t c = plan.cell(tap, x, y);
+          about_normal += w * cell_e[c];
+          about_mirror += w * cell_mirror[c];
+        }
+        shade(p, about_normal, about_mirror);
       }
   });
-  for (k = cells_end; k < own_end; ++k) {
-    const glm::vec3 albedo = g.samples[lookups[k].pixel].diffuse * math::kInvPi;
-    out.gi.pixels[lookups[k].pixel] = albedo * e[k][0];
-    out.emitted.pixels[lookups[k].pixel] = albedo * e[k][1];
-  }
+  for (k = cells_end; k < own_end; k += 2) shade(lookups[k].pixel, e[k], e[k + 1]);
   for (k = own_end; k < lookups.size(); ++k) {
     const glm::vec3 albedo = metal_albedo(g.samples[lookups[k].pixel]) * math::kInvPi;
     out.gi.pixels[lookups[k].pixel] += albedo * e[k][0];

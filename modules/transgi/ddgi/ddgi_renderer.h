@@ -46,19 +46,23 @@ engine::image::ImageRGB render_ddgi_gi_batched(const engine::rt::RtScene& scene,
                                                DdgiKernels& kernels);
 
 // DDGI's light on a real-time G-buffer (one sample per pixel, as TransGI's
-// real-time frame traces it): diffuse albedo / pi x the volumes' irradiance,
-// looked up on a grid at `upsampling.resolution_scale` of the image (and at
-// every pixel no cell represents) and upsampled to each pixel exactly as
-// TransGI's GI is (shading/upsampling.h: bilinear x depth x normal weights),
-// then multiplied by the pixel's own albedo. The emitted maps
-// (DdgiSettings::emitted_maps) are looked up and upsampled with it: the sky's
-// and the emitters' direct light; the punctual lights' is the caller's
-// (shading::DirectTileShader). A metal (metallic >= 0.5, as the G-buffer
-// marks it) has little diffuse albedo and would be black: it gets its GGX
-// specular albedo x the irradiance about its mirror direction / pi at its
-// own pixel, a blurred reflection (engines use reflection probes there; DDGI
-// has none). Every lookup goes to kernels.irradiance in one batch. `plan` is
-// scratch kept between frames.
+// real-time frame traces it): the volumes' irradiance about each surface's
+// normal and about its mirror direction, looked up on a grid at
+// `upsampling.resolution_scale` of the image (and at every pixel no cell
+// represents) and upsampled to each pixel exactly as TransGI's GI is
+// (shading/upsampling.h: bilinear x depth x normal weights), then reflected
+// by the pixel's own material: its diffuse albedo x (1 - its dielectric
+// specular layer's albedo) / pi x the first, the layer's albedo / pi x the
+// second (a varnished floor reflects the room, blurred: engines use
+// reflection probes there; DDGI has none, and without it the layer's light
+// was missing from DDGI's GI). The emitted maps (DdgiSettings::emitted_maps)
+// are looked up and upsampled with it: the sky's and the emitters' direct
+// light; the punctual lights' is the caller's (shading::DirectTileShader). A
+// metal (metallic >= 0.5, as the G-buffer marks it) has little diffuse
+// albedo and would be black: it gets its GGX specular albedo x the
+// irradiance about its mirror direction / pi at its own pixel. Every lookup
+// goes to kernels.irradiance in one batch. `plan` is scratch kept between
+// frames.
 struct DdgiPixels {
   engine::image::ImageRGB gi;       // from the irradiance maps: indirect light
   engine::image::ImageRGB emitted;  // from the emitted maps (DdgiSettings::emitted_maps): direct light, else 0
