@@ -28,6 +28,12 @@ vec3 texel_direction(uint x, uint y, uint n) {
 
 float max_component(vec3 v) { return max(v.x, max(v.y, v.z)); }
 
+// ddgi::to_change_encoding: a texel stored with the maps' gamma, re-encoded with RTXGI's 5.
+const float kRtxgiGamma = 5.0;
+vec3 to_change_encoding(vec3 stored) {
+  return p.irradiance_gamma == kRtxgiGamma ? stored : pow(max(stored, vec3(0.0)), vec3(p.irradiance_gamma / kRtxgiGamma));
+}
+
 uint irr_at(uint probe, uint x, uint y) {
   const uint size = p.irradiance_interior + 2u;
   return (probe * size * size + y * size + x) * 3u;
@@ -82,13 +88,15 @@ void main() {
       const vec3 previous = vec3(irradiance[at], irradiance[at + 1u], irradiance[at + 2u]);
       float h = p.hysteresis;
       vec3 delta = result - previous;
-      if (max_component(previous - result) > p.irradiance_threshold) h = max(0.0, h - 0.75);
-      if (p.clamp_brightness != 0u && length(delta) > p.brightness_threshold) {
+      // RTXGI's change tests, judged in its gamma-5 encoding whatever the maps' (ddgi_blend.cpp).
+      const vec3 old_judged = to_change_encoding(previous), new_judged = to_change_encoding(result);
+      if (max_component(old_judged - new_judged) > p.irradiance_threshold) h = max(0.0, h - 0.75);
+      if (p.clamp_brightness != 0u && length(new_judged - old_judged) > p.brightness_threshold) {
         result = previous + delta * 0.25;
         delta = result - previous;
       }
       vec3 lerp_delta = (1.0 - h) * delta;
-      if (max_component(result) < max_component(previous)) {
+      if (p.irradiance_gamma == kRtxgiGamma && max_component(result) < max_component(previous)) {
         const float threshold = 1.0 / 1024.0;
         for (int c = 0; c < 3; ++c)
           lerp_delta[c] = min(max(threshold, abs(lerp_delta[c])), abs(delta[c])) * sign(lerp_delta[c]);

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include <glm/gtc/quaternion.hpp>
 
@@ -152,20 +153,32 @@ TEST(Ddgi, AVarnishedFloorReflectsTheIrradianceAboutItsMirrorDirection) {
 // Zero, the light set holds the sky) and emitted maps on: the irradiance is
 // the indirect light alone (0 looking up, a pi down, a pi / 2 sideways) and
 // the emitted maps hold the sky's direct light (pi up, 0 down, pi / 2
-// sideways), which sum to the furnace above.
+// sideways), which sum to the furnace above. Each hit's one next-event
+// sample of the sky makes every update noisy: the maps' running mean of the
+// irradiance itself (the default) stays within 2 % of pi of the answer;
+// RTXGI's running mean of gamma-5 texels with its brightness clamp reads
+// low (Jensen's inequality, and bright updates clamped, dark ones not),
+// measured 6-9 % low; it must read lower than the default where the light
+// is indirect, or this test could not tell the two apart.
 TEST(Ddgi, EmittedMapsHoldTheSkysDirectLightAndTheIrradianceTheRest) {
   const float a = 0.5f;
   FloorUnderSky s(a);
   const auto& assets = s.app.world().resource<scene::SceneAssets>();
   const auto& rt_scene = s.app.world().resource<rt::RtScene>();
-  DdgiSettings settings;
-  settings.emitted_maps = true;
-  DdgiVolume volume(transgi::probes::ProbeGrid{{-1, 0.5f, -1}, {1, 1.5f, 1}, {2, 2, 2}}, settings);
-  const render::LightSet sky(rt_scene, {}, &*assets.environment);
-  s.app.jobs().run([&] {
-    for (int f = 0; f < 800; ++f) volume.update(rt_scene, sky);
-  });
-  ASSERT_TRUE(volume.has_emitted_maps());
+  const auto converged = [&](DdgiSettings settings) {
+    settings.emitted_maps = true;
+    auto volume = std::make_unique<DdgiVolume>(transgi::probes::ProbeGrid{{-1, 0.5f, -1}, {1, 1.5f, 1}, {2, 2, 2}}, settings);
+    const render::LightSet sky(rt_scene, {}, &*assets.environment);
+    s.app.jobs().run([&] {
+      for (int f = 0; f < 800; ++f) volume->update(rt_scene, sky);
+    });
+    return volume;
+  };
+  DdgiSettings rtxgi;
+  rtxgi.irradiance_gamma = kRtxgiGamma;
+  rtxgi.brightness_threshold = 0.1f;
+  const auto volume = converged(DdgiSettings{}), rtxgi_volume = converged(rtxgi);
+  ASSERT_TRUE(volume->has_emitted_maps());
   const double pi = 3.14159265358979323846;
   const glm::vec3 p(0.1f, 1.0f, -0.2f), view = glm::normalize(glm::vec3(0.3f, -0.2f, -1.0f));
   const struct {
@@ -174,15 +187,15 @@ TEST(Ddgi, EmittedMapsHoldTheSkysDirectLightAndTheIrradianceTheRest) {
   } cases[] = {{{0, 1, 0}, 0.0, pi}, {{0, -1, 0}, a * pi, 0.0}, {{1, 0, 0}, a * pi / 2, pi / 2}, {{0, 0, -1}, a * pi / 2, pi / 2}};
   for (const auto& c : cases) {
     glm::vec3 emitted(-1.0f);
-    const glm::vec3 e = volume.irradiance(p, c.n, view, nullptr, &emitted);
-    std::printf("normal (%g, %g, %g): indirect %.4f (analytic %.4f), emitted %.4f (analytic %.4f)\n", c.n.x, c.n.y, c.n.z, e.g,
-                c.indirect, emitted.g, c.emitted);
-    // The emitted maps' linear running mean is within 1.2 % of pi (measured).
-    // The irradiance reads 6-9 % low (measured): RTXGI's running mean of
-    // gamma-encoded texels is biased low when each update's radiance is
-    // noisy, as one next-event sample of the sky at each hit makes it.
+    const glm::vec3 e = volume->irradiance(p, c.n, view, nullptr, &emitted);
+    const glm::vec3 e_rtxgi = rtxgi_volume->irradiance(p, c.n, view);
+    std::printf("normal (%g, %g, %g): indirect %.4f (RTXGI's encoding and clamp %.4f, analytic %.4f), emitted %.4f (analytic %.4f)\n",
+                c.n.x, c.n.y, c.n.z, e.g, e_rtxgi.g, c.indirect, emitted.g, c.emitted);
     EXPECT_NEAR(emitted.g, c.emitted, 0.02 * pi) << "normal " << c.n.x << " " << c.n.y << " " << c.n.z;
-    EXPECT_NEAR(e.g, c.indirect, 0.1 * a * pi) << "normal " << c.n.x << " " << c.n.y << " " << c.n.z;
+    EXPECT_NEAR(e.g, c.indirect, 0.02 * pi) << "normal " << c.n.x << " " << c.n.y << " " << c.n.z;
+    if (c.indirect > 0) {
+      EXPECT_LT(e_rtxgi.g, e.g - 0.02 * c.indirect) << "normal " << c.n.x << " " << c.n.y << " " << c.n.z;
+    }
   }
 }
 

@@ -1,6 +1,7 @@
 #include "cli/option_specs.h"
 
 #include <climits>
+#include <cmath>
 #include <cstdio>
 #include <utility>
 
@@ -175,9 +176,12 @@ std::vector<OptionSpec> render_option_specs() {
       choice("probe-skip", {"on", "off"}, "on", "transgi: skip probes in walls and probes whose light has converged"),
       choice("sharing", {"depth-guard", "paper"}, "depth-guard", "transgi: radiance sharing across probes, guarded by depth or as the paper"),
       number("hysteresis", "H", 0.0, 1.0, number_text(d.hysteresis), "ddgi: weight of the old irradiance: higher = steadier, at the cost of lag"),
-      number("brightness-threshold", "B", 0.0, 1e30, number_text(d.brightness_threshold), "ddgi: largest change a frame before hysteresis is lowered"),
+      number("brightness-threshold", "B", 0.0, 1e30, std::isfinite(d.brightness_threshold) ? number_text(d.brightness_threshold) : "off",
+             "ddgi: a texel's largest change an update (in RTXGI's gamma-5 units; RTXGI's is 0.1) before it moves only a quarter of "
+             "the way: lower = steadier under fireflies, at the cost of a darker mean under daylight"),
       integer("warmup-frames", "W", 0, 100000, "64", "ddgi: first frames blended without hysteresis"),
-      number("irradiance-gamma", "G", 0.1, 20.0, number_text(d.irradiance_gamma), "ddgi: the irradiance maps' encoding gamma"),
+      number("irradiance-gamma", "G", 0.1, 20.0, number_text(d.irradiance_gamma),
+             "ddgi: the irradiance maps' encoding gamma: 1 averages the irradiance, RTXGI's 5 its fifth root (lower under noise)"),
   };
   append(o, runtime_option_specs("quality"));
   append(o, placement_option_specs(runtime::ProbeVolumeMode::Cascades));

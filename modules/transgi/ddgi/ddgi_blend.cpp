@@ -7,6 +7,10 @@ namespace transgi::ddgi {
 
 namespace {
 float max_component(const glm::vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
+// A texel stored with the maps' gamma, re-encoded with RTXGI's 5.
+glm::vec3 to_change_encoding(const glm::vec3& stored, float gamma) {
+  return gamma == kRtxgiGamma ? stored : glm::pow(glm::max(stored, glm::vec3(0.0f)), glm::vec3(gamma / kRtxgiGamma));
+}
 }  // namespace
 
 void blend_irradiance(OctahedralMap<glm::vec3>& map, const std::vector<RayRecord>& rays, const DdgiSettings& s, float hysteresis,
@@ -39,15 +43,22 @@ void blend_irradiance(OctahedralMap<glm::vec3>& map, const std::vector<RayRecord
       const glm::vec3 previous = texel;
       float h = hysteresis;
       glm::vec3 delta = result - previous;
-      if (max_component(previous - result) > s.irradiance_threshold) h = std::max(0.0f, h - 0.75f);
-      if (clamp_brightness && glm::length(delta) > s.brightness_threshold) {
+      // RTXGI's change tests, judged in its gamma-5 encoding whatever the
+      // maps' (to_change_encoding), so their thresholds mean what RTXGI's do
+      // and do not depend on how bright the scene is.
+      const glm::vec3 old_judged = to_change_encoding(previous, s.irradiance_gamma);
+      const glm::vec3 new_judged = to_change_encoding(result, s.irradiance_gamma);
+      if (max_component(old_judged - new_judged) > s.irradiance_threshold) h = std::max(0.0f, h - 0.75f);
+      if (clamp_brightness && glm::length(new_judged - old_judged) > s.brightness_threshold) {
         result = previous + delta * 0.25f;
         delta = result - previous;
       }
       glm::vec3 lerp_delta = (1.0f - h) * delta;
-      if (max_component(result) < max_component(previous)) {
-        // Darkening steps at least 1/1024 per frame so low-precision
-        // formats (and this one) reach the target.
+      if (s.irradiance_gamma == kRtxgiGamma && max_component(result) < max_component(previous)) {
+        // RTXGI's maps: darkening steps at least 1/1024 per frame so its
+        // 10-bit formats reach the target. Not on other maps: in linear
+        // units the floor is a large step for a dim texel, and every noisy
+        // darker update taking it pulled the mean down.
         constexpr float kThreshold = 1.0f / 1024.0f;
         for (int c = 0; c < 3; ++c)
           lerp_delta[c] = std::min(std::max(kThreshold, std::abs(lerp_delta[c])), std::abs(delta[c])) *

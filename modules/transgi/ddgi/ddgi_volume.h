@@ -7,6 +7,7 @@
 // power-cosine blending with hysteresis, and Chebyshev + wrap-shading
 // interpolation of irradiance at a shading point.
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -32,6 +33,9 @@ enum class EscapedRays {
   Environment,  // the sky's radiance, as RTXGI does; the light set must then leave the sky out
 };
 
+// RTXGI's irradiance encoding gamma: its change thresholds are in these units.
+inline constexpr float kRtxgiGamma = 5.0f;
+
 struct DdgiSettings {
   // Rays per probe per update. Higher = less noise, at the cost of tracing and blending time.
   int rays_per_probe = 256;
@@ -41,12 +45,23 @@ struct DdgiSettings {
   int distance_texels = 14;
   // Weight of history. Higher = less flicker, at the cost of slower reaction.
   float hysteresis = 0.97f;
-  // A texel darkening by more than this (in gamma-encoded units) lowers its
-  // hysteresis by 0.75 for the frame.
+  // A texel darkening by more than this (in RTXGI's gamma-5 encoding,
+  // kRtxgiGamma, whatever irradiance_gamma is) lowers its hysteresis by 0.75
+  // for the frame. Lower = light that goes out fades sooner, at the cost of
+  // a darker mean where a texel's light is noisy (a dark update pulls it down
+  // fast, a bright one slowly).
   float irradiance_threshold = 0.25f;
-  // A texel changing by more than this moves only a quarter of the way.
-  float brightness_threshold = 0.10f;
-  float irradiance_gamma = 5.0f;
+  // A texel changing by more than this (in the same encoding) moves only a
+  // quarter of the way. RTXGI's is 0.1; off here (infinity): under daylight
+  // most of a room's light comes from sunlit patches that a few rays meet
+  // now and then, and clamping those rays' updates kept much of it out
+  // (docs/ddgi.md). Lower = steadier under fireflies, at the cost of that bias.
+  float brightness_threshold = std::numeric_limits<float>::infinity();
+  // The maps hold irradiance^(1 / gamma) and blend it with the hysteresis.
+  // 1 here: a running mean of the irradiance itself. RTXGI's 5 suits its
+  // 10-bit maps (ours are float) and averages a perceptual encoding, whose
+  // mean under noise is biased low (Jensen's inequality; docs/ddgi.md).
+  float irradiance_gamma = 1.0f;
   // Sharpness of the distance filter (cosine power). Higher = crisper
   // visibility edges, at the cost of banding.
   float distance_exponent = 50.0f;
