@@ -57,6 +57,37 @@ TEST(Brdf, LambertAlbedoIsTheBaseColourExactly) {
   EXPECT_NEAR(brdf_eval(p, wo, dir_from_cos(0.2f, 2.0f)).g, 0.5f / kPi, 1e-7);
 }
 
+namespace {
+
+enum class Lobes { All, Glossy };
+struct RgbEstimate {
+  glm::dvec3 mean{0.0}, err{0.0};  // per channel: the estimate and its standard error
+};
+// Per channel, the integral over wi of f(wo, wi) cos(wi) (Lobes::All), or of
+// f less its diffuse lobe (Lobes::Glossy), by importance sampling with
+// brdf_sample over 256 x 256 strata.
+RgbEstimate integral_with_cos(const BrdfParams& p, const glm::vec3& wo, Lobes lobes, std::uint64_t seed, std::uint64_t stream) {
+  Pcg32 rng(seed, stream);
+  const int sqrt_n = 256, n = sqrt_n * sqrt_n;
+  glm::dvec3 sum(0.0), sum2(0.0);
+  for (int i = 0; i < sqrt_n; ++i)
+    for (int j = 0; j < sqrt_n; ++j) {
+      const glm::vec2 u((static_cast<float>(i) + rng.next_float()) / sqrt_n, (static_cast<float>(j) + rng.next_float()) / sqrt_n);
+      BrdfSample s;
+      if (!brdf_sample(p, wo, u, rng.next_float(), s)) continue;
+      const glm::vec3 f = lobes == Lobes::All ? s.f : s.f - brdf_eval_diffuse(p, wo, s.wi);
+      const glm::dvec3 v = glm::dvec3(f) * static_cast<double>(s.wi.z / s.pdf);
+      sum += v;
+      sum2 += v * v;
+    }
+  RgbEstimate e;
+  e.mean = sum / static_cast<double>(n);
+  for (int k = 0; k < 3; ++k) e.err[k] = std::sqrt(std::max(0.0, sum2[k] / n - e.mean[k] * e.mean[k]) / n);
+  return e;
+}
+
+}  // namespace
+
 TEST(Brdf, DirectionalAlbedoIsTheIntegralOfEveryLobe) {
   // directional_albedo (tables, no sampling) against the integral of
   // f(wo, wi) cos(wi) over the hemisphere, estimated per channel by
@@ -75,22 +106,10 @@ TEST(Brdf, DirectionalAlbedoIsTheIntegralOfEveryLobe) {
   for (const BrdfParams& p : materials)
     for (const float cos_o : {0.15f, 0.5f, 0.95f}) {
       const glm::vec3 wo = dir_from_cos(cos_o, 0.7f);
-      Pcg32 rng(3, 11);
-      const int sqrt_n = 256, n = sqrt_n * sqrt_n;
-      glm::dvec3 sum(0.0), sum2(0.0);
-      for (int i = 0; i < sqrt_n; ++i)
-        for (int j = 0; j < sqrt_n; ++j) {
-          const glm::vec2 u((static_cast<float>(i) + rng.next_float()) / sqrt_n, (static_cast<float>(j) + rng.next_float()) / sqrt_n);
-          BrdfSample s;
-          if (!brdf_sample(p, wo, u, rng.next_float(), s)) continue;
-          const glm::dvec3 v = glm::dvec3(s.f) * static_cast<double>(s.wi.z / s.pdf);
-          sum += v;
-          sum2 += v * v;
-        }
+      const RgbEstimate e = integral_with_cos(p, wo, Lobes::All, 3, 11);
       const glm::vec3 table = directional_albedo(p, cos_o);
       for (int k = 0; k < 3; ++k) {
-        const double mean = sum[k] / n, err = std::sqrt(std::max(0.0, sum2[k] / n - mean * mean) / n);
-        EXPECT_NEAR(table[k], mean, 4 * err + 0.005)
+        EXPECT_NEAR(table[k], e.mean[k], 4 * e.err[k] + 0.005)
             << "base " << p.base_color[k] << " metallic " << p.metallic << " roughness " << p.roughness << " cos_o " << cos_o;
       }
       EXPECT_GE(table.r + 1e-6f, diffuse_albedo(p).r) << "the specular layer only adds";
@@ -113,23 +132,11 @@ TEST(Brdf, TheLayerAndMetalAlbedosAreTheGlossyLobesIntegrals) {
   for (const BrdfParams& p : materials)
     for (const float cos_o : {0.15f, 0.5f, 0.95f}) {
       const glm::vec3 wo = dir_from_cos(cos_o, 0.7f);
-      Pcg32 rng(5, 13);
-      const int sqrt_n = 256, n = sqrt_n * sqrt_n;
-      glm::dvec3 sum(0.0), sum2(0.0);
-      for (int i = 0; i < sqrt_n; ++i)
-        for (int j = 0; j < sqrt_n; ++j) {
-          const glm::vec2 u((static_cast<float>(i) + rng.next_float()) / sqrt_n, (static_cast<float>(j) + rng.next_float()) / sqrt_n);
-          BrdfSample s;
-          if (!brdf_sample(p, wo, u, rng.next_float(), s)) continue;
-          const glm::dvec3 v = glm::dvec3(s.f - brdf_eval_diffuse(p, wo, s.wi)) * static_cast<double>(s.wi.z / s.pdf);
-          sum += v;
-          sum2 += v * v;
-        }
+      const RgbEstimate e = integral_with_cos(p, wo, Lobes::Glossy, 5, 13);
       const glm::vec3 layer = dielectric_layer_albedo(p, cos_o), metal = metal_albedo(p, cos_o);
       const glm::vec3 glossy = (1.0f - p.metallic) * layer + p.metallic * metal;
       for (int k = 0; k < 3; ++k) {
-        const double mean = sum[k] / n, err = std::sqrt(std::max(0.0, sum2[k] / n - mean * mean) / n);
-        EXPECT_NEAR(glossy[k], mean, 4 * err + 0.005)
+        EXPECT_NEAR(glossy[k], e.mean[k], 4 * e.err[k] + 0.005)
             << "base " << p.base_color[k] << " metallic " << p.metallic << " roughness " << p.roughness << " cos_o " << cos_o;
       }
       const glm::vec3 parts = (1.0f - p.metallic) * (p.base_color * (1.0f - layer) + layer) + p.metallic * metal;
