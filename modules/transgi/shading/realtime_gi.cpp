@@ -901,9 +901,10 @@ engine::image::ImageRGB shade_gi_realtime(const RealtimeGiRequest& request, cons
     t0 = Clock::now();
     // The lattice's cells need not be decoded this frame: their route as route_samples decides it.
     const std::function<float(std::size_t)> own_masked_within = [&](std::size_t p) {
-      if (!in.network_decodes(g.entity[p]) || in.is_glossy_dielectric(p)) return 0.0f;
       const GSample& s = g.samples[p];
-      return in.request.model->self_masked_within(*in.assets.meshes[s.mesh]) * in.scene.instance_of(s.entity)->to_world.scale;
+      if (!s.hit || !in.network_decodes(g.entity[p]) || in.is_glossy_dielectric(p)) return 0.0f;
+      const engine::rt::InstanceRecord* instance = in.scene.instance_of(s.entity);
+      return instance ? in.request.model->self_masked_within(*in.assets.meshes[s.mesh]) * instance->to_world.scale : 0.0f;
     };
     add_contact_light(g, in.scene, fields, request.mirror_lights, in.near_field, sc.up, sc.decoded_cells, own_masked_within, sc.contact_gain,
                       in.reuse ? std::span<const std::int32_t>(sc.contact.track) : std::span<const std::int32_t>(),
