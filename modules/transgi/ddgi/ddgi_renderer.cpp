@@ -21,14 +21,15 @@ namespace {
 // its mirror direction, a blurred reflection (engines use reflection probes
 // there; DDGI has none). Together they reflect the surface's directional
 // albedo: a varnished floor's layer and a metal reflect the room, where the
-// diffuse albedo alone leaves them out.
+// diffuse albedo alone leaves them out. `with_metal` false leaves the metal
+// lobe out (the real-time path reflects a marked metal at its own pixel).
 struct LobeWeights {
   glm::vec3 about_normal{0.0f}, about_mirror{0.0f};
 };
-LobeWeights lobe_weights(const engine::material::BrdfParams& brdf, const glm::vec3& diffuse, float cos_o) {
+LobeWeights lobe_weights(const engine::material::BrdfParams& brdf, const glm::vec3& diffuse, float cos_o, bool with_metal = true) {
   using namespace engine;
   const glm::vec3 layer = (1.0f - brdf.metallic) * material::dielectric_layer_albedo(brdf, cos_o);
-  const glm::vec3 metal = brdf.metallic * material::metal_albedo(brdf, cos_o);
+  const glm::vec3 metal = with_metal ? brdf.metallic * material::metal_albedo(brdf, cos_o) : glm::vec3(0.0f);
   return {diffuse * (glm::vec3(1.0f) - layer) * math::kInvPi, (layer + metal) * math::kInvPi};
 }
 
@@ -236,10 +237,8 @@ DdgiPixels shade_ddgi_gbuffer(const shading::GBuffer& g, std::span<const DdgiVol
   // (A metal the G-buffer marks takes its metal lobe's light at its own pixel, below.)
   const auto shade = [&](std::size_t p, const glm::mat2x3& about_normal, const glm::mat2x3& about_mirror) {
     const shading::GSample& s = g.samples[p];
-    const float cos_o = glm::dot(s.normal_world, s.wo_world);
-    LobeWeights w = lobe_weights(s.brdf, s.diffuse, cos_o);
-    if (g.metal_roughness[p] < std::numeric_limits<float>::infinity())
-      w.about_mirror -= s.brdf.metallic * material::metal_albedo(s.brdf, cos_o) * math::kInvPi;
+    const bool marked_metal = g.metal_roughness[p] < std::numeric_limits<float>::infinity();
+    const LobeWeights w = lobe_weights(s.brdf, s.diffuse, glm::dot(s.normal_world, s.wo_world), !marked_metal);
     out.gi.pixels[p] = w.about_normal * about_normal[0] + w.about_mirror * about_mirror[0];
     out.emitted.pixels[p] = w.about_normal * about_normal[1] + w.about_mirror * about_mirror[1];
   };

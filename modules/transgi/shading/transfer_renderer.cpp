@@ -251,18 +251,19 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
 
   // 4. Light at each sample (world SH), rotated into its object's frame, dotted with the transfer.
   t0 = Clock::now();
-  std::unordered_map<engine::ecs::Entity, math::ShRotation> to_object;
+  // Per object: the rotation of world SH into its frame, and where its
+  // transfer masks the object itself, in world units.
+  struct ObjectFrame {
+    math::ShRotation to_object;
+    float masked_within = 0.0f;
+  };
+  std::unordered_map<engine::ecs::Entity, ObjectFrame> objects;
   for (std::size_t i : hits)
-    if (!to_object.contains(samples[i].entity))
-      to_object.emplace(samples[i].entity,
-                        math::ShRotation(glm::transpose(glm::mat3_cast(scene.instance_of(samples[i].entity)->to_world.rotation))));
-  // Where each sample's transfer masks its own object, in world units.
-  std::unordered_map<engine::ecs::Entity, float> masked_within;
-  for (std::size_t i : hits)
-    if (!masked_within.contains(samples[i].entity))
-      masked_within.emplace(samples[i].entity, model.self_masked_within(*assets.meshes[samples[i].mesh]) *
-                                                   scene.instance_of(samples[i].entity)->to_world.scale);
-  const auto self_masked_within = [&](const Sample& smp) { return masked_within.at(smp.entity); };
+    if (!objects.contains(samples[i].entity)) {
+      const engine::transform::Similarity& to_world = scene.instance_of(samples[i].entity)->to_world;
+      objects.emplace(samples[i].entity, ObjectFrame{math::ShRotation(glm::transpose(glm::mat3_cast(to_world.rotation))),
+                                                     model.self_masked_within(*assets.meshes[samples[i].mesh]) * to_world.scale});
+    }
   std::vector<glm::vec3> shaded(n, glm::vec3(0.0f));
   // The contact light the probes miss (near_field.h), estimated from the
   // same world light as the shading, filtered across similar neighbours,
@@ -284,12 +285,13 @@ TransferRenderResult render_transfer(const engine::rt::RtScene& scene, const eng
     for (std::size_t j = b; j < e; ++j) {
       const Sample& smp = samples[hits[j]];
       light_at(smp.position, smp.normal_world, world);
-      const math::ShRotation& rot = to_object.at(smp.entity);
+      const ObjectFrame& frame = objects.at(smp.entity);
+      const math::ShRotation& rot = frame.to_object;
       for (int c = 0; c < 3; ++c) rot.apply(world + c * 25, object + c * 25);
       ShRgb light;
       std::copy(object, object + 75, light.begin());
       shaded[hits[j]] = shade(light, transfer.data() + j * bake::kTransferValues);
-      estimate_near(hits[j], world, self_masked_within(smp));
+      estimate_near(hits[j], world, frame.masked_within);
     }
   });
   jobs::parallel_for<std::size_t>(0, diffuse_only.size(), grain, [&](std::size_t b, std::size_t e) {
