@@ -28,8 +28,9 @@ struct LobeWeights {
 };
 LobeWeights lobe_weights(const engine::material::BrdfParams& brdf, const glm::vec3& diffuse, float cos_o, bool with_metal = true) {
   using namespace engine;
-  const glm::vec3 layer = (1.0f - brdf.metallic) * material::dielectric_layer_albedo(brdf, cos_o);
-  const glm::vec3 metal = with_metal ? brdf.metallic * material::metal_albedo(brdf, cos_o) : glm::vec3(0.0f);
+  // (Each albedo is a table lookup; a lobe that weighs nothing skips it.)
+  const glm::vec3 layer = brdf.metallic < 1.0f ? (1.0f - brdf.metallic) * material::dielectric_layer_albedo(brdf, cos_o) : glm::vec3(0.0f);
+  const glm::vec3 metal = with_metal && brdf.metallic > 0.0f ? brdf.metallic * material::metal_albedo(brdf, cos_o) : glm::vec3(0.0f);
   return {diffuse * (glm::vec3(1.0f) - layer) * math::kInvPi, (layer + metal) * math::kInvPi};
 }
 
@@ -204,20 +205,40 @@ DdgiPixels shade_ddgi_gbuffer(const shading::GBuffer& g, std::span<const DdgiVol
   shading::plan_upsampling(g.guide, g.width, g.height, upsampling, plan);
   // The lookups: each grid cell's pixel about its normal and about its
   // mirror direction, each pixel decoded on its own alike, and each metal
-  // pixel's mirror direction, in that order.
+  // pixel's mirror direction, in that order. A surface with no glossy lobe
+  // (no specular layer, no metal) gets no lookup about its mirror direction:
+  // it would weigh nothing, and the lookups are the stage's cost (its cell
+  // lends its neighbours its irradiance about the normal instead). A metal
+  // the G-buffer marks takes its metal lobe's light at its own pixel.
   std::vector<Lookup> lookups;
+  const auto weights_of = [&](std::size_t p) {
+    const shading::GSample& s = g.samples[p];
+    // Most of a frame is plain diffuse: no view angle to read for it.
+    if (s.brdf.metallic <= 0.0f && s.brdf.specular <= 0.0f) return LobeWeights{s.diffuse * math::kInvPi, glm::vec3(0.0f)};
+    const bool marked_metal = g.metal_roughness[p] < std::numeric_limits<float>::infinity();
+    return lobe_weights(s.brdf, s.diffuse, glm::dot(s.normal_world, s.wo_world), !marked_metal);
+  };
+  // Each pixel that gets lookups (a cell's, or one decoded on its own): the
+  // index of its lookup about its normal, and of its mirror one (kNoMirror: none).
+  constexpr std::size_t kNoMirror = std::numeric_limits<std::size_t>::max();
+  struct Looked {
+    std::size_t pixel = 0, normal = 0, mirror = kNoMirror;
+  };
+  const auto look = [&](std::size_t p) {
+    const shading::GSample& s = g.samples[p];
+    Looked l{p, lookups.size(), kNoMirror};
+    lookups.push_back({p, s.normal_world});
+    if (weights_of(p).about_mirror != glm::vec3(0.0f)) {
+      l.mirror = lookups.size();
+      lookups.push_back({p, glm::reflect(-s.wo_world, s.normal_world)});
+    }
+    return l;
+  };
+  std::vector<Looked> cells(plan.cell_pixel.size()), own;
   for (std::size_t c = 0; c < plan.cell_pixel.size(); ++c)
-    if (plan.cell_guide[c].w > 0) {
-      const shading::GSample& s = g.samples[plan.cell_pixel[c]];
-      lookups.push_back({plan.cell_pixel[c], s.normal_world});
-      lookups.push_back({plan.cell_pixel[c], glm::reflect(-s.wo_world, s.normal_world)});
-    }
-  const std::size_t cells_end = lookups.size();
+    if (plan.cell_guide[c].w > 0) cells[c] = look(plan.cell_pixel[c]);
   for (std::size_t p = 0; p < g.samples.size(); ++p)
-    if (plan.kind[p] == UpsamplingPlan::kOwn) {
-      lookups.push_back({p, g.samples[p].normal_world});
-      lookups.push_back({p, glm::reflect(-g.samples[p].wo_world, g.samples[p].normal_world)});
-    }
+    if (plan.kind[p] == UpsamplingPlan::kOwn) own.push_back(look(p));
   const std::size_t own_end = lookups.size();
   // Metals as the G-buffer marks them (metallic >= 0.5), as TransGI's mirror pass finds them.
   for (std::size_t p = 0; p < g.samples.size(); ++p)
@@ -227,18 +248,13 @@ DdgiPixels shade_ddgi_gbuffer(const shading::GBuffer& g, std::span<const DdgiVol
 
   // Irradiance per grid cell about its normal and its mirror direction (a miss stays 0).
   std::vector<glm::mat2x3> cell_e(plan.cell_pixel.size(), glm::mat2x3(0.0f)), cell_mirror(plan.cell_pixel.size(), glm::mat2x3(0.0f));
-  std::size_t k = 0;
   for (std::size_t c = 0; c < plan.cell_pixel.size(); ++c)
     if (plan.cell_guide[c].w > 0) {
-      cell_e[c] = e[k++];
-      cell_mirror[c] = e[k++];
+      cell_e[c] = e[cells[c].normal];
+      cell_mirror[c] = cells[c].mirror == kNoMirror ? cell_e[c] : e[cells[c].mirror];
     }
   // A pixel's light: lobe_weights of the irradiance about its normal and about its mirror direction.
-  // (A metal the G-buffer marks takes its metal lobe's light at its own pixel, below.)
-  const auto shade = [&](std::size_t p, const glm::mat2x3& about_normal, const glm::mat2x3& about_mirror) {
-    const shading::GSample& s = g.samples[p];
-    const bool marked_metal = g.metal_roughness[p] < std::numeric_limits<float>::infinity();
-    const LobeWeights w = lobe_weights(s.brdf, s.diffuse, glm::dot(s.normal_world, s.wo_world), !marked_metal);
+  const auto shade = [&](std::size_t p, const LobeWeights& w, const glm::mat2x3& about_normal, const glm::mat2x3& about_mirror) {
     out.gi.pixels[p] = w.about_normal * about_normal[0] + w.about_mirror * about_mirror[0];
     out.emitted.pixels[p] = w.about_normal * about_normal[1] + w.about_mirror * about_mirror[1];
   };
@@ -247,18 +263,20 @@ DdgiPixels shade_ddgi_gbuffer(const shading::GBuffer& g, std::span<const DdgiVol
       for (int x = 0; x < g.width; ++x) {
         const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(g.width) + static_cast<std::size_t>(x);
         if (plan.kind[p] != UpsamplingPlan::kUpsampled) continue;
+        const LobeWeights lobes = weights_of(p);
+        const bool mirrored = lobes.about_mirror != glm::vec3(0.0f);
         glm::mat2x3 about_normal(0.0f), about_mirror(0.0f);
         for (int tap = 0; tap < 4; ++tap) {
           const float w = plan.weight[static_cast<std::size_t>(tap)][p];
           const std::size_t c = plan.cell(tap, x, y);
           about_normal += w * cell_e[c];
-          about_mirror += w * cell_mirror[c];
+          if (mirrored) about_mirror += w * cell_mirror[c];
         }
-        shade(p, about_normal, about_mirror);
+        shade(p, lobes, about_normal, about_mirror);
       }
   });
-  for (k = cells_end; k < own_end; k += 2) shade(lookups[k].pixel, e[k], e[k + 1]);
-  for (k = own_end; k < lookups.size(); ++k) {
+  for (const Looked& l : own) shade(l.pixel, weights_of(l.pixel), e[l.normal], l.mirror == kNoMirror ? e[l.normal] : e[l.mirror]);
+  for (std::size_t k = own_end; k < lookups.size(); ++k) {
     const glm::vec3 albedo = metal_albedo(g.samples[lookups[k].pixel]) * math::kInvPi;
     out.gi.pixels[lookups[k].pixel] += albedo * e[k][0];
     out.emitted.pixels[lookups[k].pixel] += albedo * e[k][1];
