@@ -19,10 +19,16 @@ float fast_acos(float x) {
   return x < 0.0 ? 3.14159265 - r : r;
 }
 
-int map_texel_of(vec3 d, uint width, uint height) {
+// Where a direction falls on the map, in texels (MapLayout::texel_position).
+vec2 map_texel_position(vec3 d, uint width, uint height) {
   const float u = fast_atan2(d.x, -d.z) * 0.15915494, v = fast_acos(d.y) * 0.31830989;
   const float uw = u < 0.0 ? u + 1.0 : u;
-  const int x = min(int(width) - 1, max(0, int(uw * float(width))));
-  const int y = min(int(height) - 1, max(0, int(v * float(height))));
+  return vec2(uw * float(width), v * float(height));
+}
+
+int map_texel_of(vec3 d, uint width, uint height) {
+  const vec2 at = map_texel_position(d, width, height);
+  const int x = min(int(width) - 1, max(0, int(at.x)));
+  const int y = min(int(height) - 1, max(0, int(at.y)));
   return y * int(width) + x;
 }

@@ -1,9 +1,9 @@
 // Probe interpolation with pruning (the GPU twin of
 // probes::interpolate_probes, paper Section 5.3): the 8 probes of a point's
-// cage with trilinear weights, minus back-facing probes and probes whose
-// Chebyshev visibility bound (on their own hit-distance moments toward the
-// point) is below the threshold; a distance-and-cosine average when all are
-// pruned. The includer declares `depth` (probes x texels, half2(mean,
+// cage with trilinear weights, minus back-facing probes, each weighed by a
+// ramp on its Chebyshev visibility bound (on its own hit-distance moments
+// toward the point, read bilinearly); a distance-and-cosine average when all
+// are pruned. The includer declares `depth` (probes x texels, half2(mean,
 // variance)) and `probes` (ProbeGpu) buffers; a field's probes start at
 // probe_base and its depth texels at depth_base in them, so one kernel can
 // read several fields.
@@ -15,6 +15,40 @@ float chebyshev_visibility(float mean, float variance_in, float distance) {
   const float variance = max(variance_in, 1e-6 * mean * mean + 1e-8);
   const float d = distance - mean;
   return variance / (variance + d * d);
+}
+
+// probes::visibility_weight.
+float visibility_weight(float visibility, float threshold, float ramp) {
+  if (!(ramp > 0.0)) return visibility < threshold ? 0.0 : 1.0;
+  return clamp((visibility - threshold) / ramp, 0.0, 1.0);
+}
+
+// probes::filtered_visibility for the probe whose depth texels start at
+// `first` (depth in units of `unit`): the moments of the four texel centres
+// around `at`, bilinearly, leaving out texels never hit (1 if all are).
+float filtered_visibility(uint first, vec2 at, uint width, uint height, float unit, float distance) {
+  const float px = at.x - 0.5;
+  const float py = clamp(at.y - 0.5, 0.0, float(height - 1u));
+  const float fx = floor(px);
+  const int y0 = min(int(py), int(height) - 1), y1 = min(y0 + 1, int(height) - 1);
+  int x0 = int(fx) % int(width);
+  if (x0 < 0) x0 += int(width);
+  const int x1 = x0 + 1 == int(width) ? 0 : x0 + 1;
+  const float ax = px - fx, ay = py - float(y0);
+  const int texel[4] = int[4](y0 * int(width) + x0, y0 * int(width) + x1, y1 * int(width) + x0, y1 * int(width) + x1);
+  const float weight[4] = float[4]((1.0 - ax) * (1.0 - ay), ax * (1.0 - ay), (1.0 - ax) * ay, ax * ay);
+  float m1 = 0.0, m2 = 0.0, sum = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    const vec2 m = unpackHalf2x16(depth[first + uint(texel[k])]);
+    if (isnan(m.x) || isinf(m.x) || !(weight[k] > 0.0)) continue;
+    m1 += weight[k] * m.x;
+    m2 += weight[k] * (m.y + m.x * m.x);
+    sum += weight[k];
+  }
+  if (!(sum > 0.0)) return 1.0;
+  m1 /= sum;
+  m2 /= sum;
+  return chebyshev_visibility(m1 * unit, max(m2 - m1 * m1, 0.0) * unit * unit, distance);
 }
 
 // Probe indices in the result are the field's own (add probe_base to read).
@@ -49,21 +83,23 @@ InterpolationGpu interpolate_probes_at(InterpolatePush p, uint probe_base, uint 
     const vec3 from_probe = biased - pos;
     const float from_dist = length(from_probe);
     const bool occlusion = (p.flags & kInterpolatePruneOccluded) != 0u;
-    const int texel = occlusion && from_dist > 1e-6 ? map_texel_of(from_probe / from_dist, p.map_width, p.map_height) : -1;
+    const bool tested = occlusion && from_dist > 1e-6;
 
     const bool holds_light = probe.usable != 0u;
     fallback[c] = holds_light ? max(0.05, 0.5 * (facing + 1.0)) / (dist * dist + 1e-4) : 0.0;
     bool keep = w > 0.0 && holds_light;
     if (keep && (p.flags & kInterpolatePruneBackFacing) != 0u && facing < 0.0) keep = false;
-    if (keep && texel >= 0) {
-      const vec2 m = unpackHalf2x16(depth[depth_base + uint(at) * p.texels + uint(texel)]);
-      if (chebyshev_visibility(m.x * probe.depth_unit, m.y * probe.depth_unit * probe.depth_unit, from_dist) <
-          p.visibility_threshold)
-        keep = false;
+    float seen = 1.0;
+    if (keep && tested) {
+      const float visibility =
+          filtered_visibility(depth_base + uint(at) * p.texels, map_texel_position(from_probe / from_dist, p.map_width, p.map_height),
+                              p.map_width, p.map_height, probe.depth_unit, from_dist);
+      seen = visibility_weight(visibility, p.visibility_threshold, p.visibility_ramp);
+      if (seen <= 0.0) keep = false;
     }
     if (!keep && w > 0.0) ++pruned;
     r.probes[c] = at;
-    r.weights[c] = keep ? w : 0.0;
+    r.weights[c] = keep ? w * seen : 0.0;
     sum += r.weights[c];
   }
   r.pruned = pruned;

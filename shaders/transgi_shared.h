@@ -77,7 +77,8 @@ struct InterpolatePush {
   float visibility_threshold;
   int points;
   uint flags;
-  uint map_width, map_height, texels, pad0;
+  uint map_width, map_height, texels;
+  float visibility_ramp;
 };
 
 // A probe field among several that a kernel reads from shared buffers (the

@@ -608,6 +608,72 @@ TEST(Interpolation, OccludedProbeIsPrunedByChebyshev) {
   EXPECT_EQ(chebyshev_visibility(0.2f, 0.0f, 0.1f), 1.0f) << "closer than the wall: visible";
 }
 
+// Known answers: at a texel's centre its own moments; half-way between two
+// texels at depths 1 and 2 the mean 1.5 and the variance 0.25 (so a point
+// at 2 is seen with bound 0.5), also across the map's u seam; texels no ray
+// hit are left out, and a footprint of them alone sees everything.
+TEST(Interpolation, FilteredVisibilityReadsTheBilinearMomentsOfTheFourNearestTexels) {
+  const MapLayout m{8, 4};
+  DepthMap depth;
+  depth.reset(m.texel_count(), 0.5f);
+  const auto at = [&](int x, int y) { return static_cast<std::size_t>(y * m.width + x); };
+  depth.set(at(2, 1), 1.0f, 0.01f);
+  const float seen = filtered_visibility(depth, m, {2.5f, 1.5f}, 1.5f);
+  EXPECT_NEAR(seen, chebyshev_visibility(depth.mean(at(2, 1)), depth.variance(at(2, 1)), 1.5f), 1e-6f);
+  EXPECT_LT(seen, 0.1f);
+
+  depth.set(at(3, 2), 1.0f, 0.0f);
+  depth.set(at(4, 2), 2.0f, 0.0f);
+  EXPECT_NEAR(filtered_visibility(depth, m, {4.0f, 2.5f}, 2.0f), 0.5f, 1e-5f);
+  depth.set(at(7, 3), 1.0f, 0.0f);
+  depth.set(at(0, 3), 2.0f, 0.0f);
+  EXPECT_NEAR(filtered_visibility(depth, m, {0.0f, 3.5f}, 2.0f), 0.5f, 1e-5f) << "across the u seam";
+  EXPECT_NEAR(filtered_visibility(depth, m, {8.0f, 3.5f}, 2.0f), 0.5f, 1e-5f) << "across the u seam, from the right";
+
+  // Row 0: texel 5 hit at 1, texel 4 never hit.
+  depth.set(at(5, 0), 1.0f, 0.0f);
+  EXPECT_EQ(filtered_visibility(depth, m, {4.5f, 0.5f}, 2.5f), 1.0f) << "no hit: nothing hides the point";
+  for (const float x : {4.6f, 5.0f, 5.5f})
+    EXPECT_NEAR(filtered_visibility(depth, m, {x, 0.5f}, 2.5f), chebyshev_visibility(1.0f, 0.0f, 2.5f), 1e-6f)
+        << "the hit decides wherever it weighs";
+}
+
+// A probe beyond a wall's edge: points sliding past the edge see it fade in
+// with the ramp; the paper's cut (softness 0) flips it from nothing to its
+// whole trilinear weight between two points a tenth of a millimetre apart.
+TEST(Interpolation, AProbeBeyondAWallsEdgeFadesInInsteadOfFlipping) {
+  const ProbeGrid g{{0, 0, 0}, {1, 0, 0}, {2, 1, 1}};
+  const MapLayout m{32, 16};
+  auto states = open_space_states(g, m);
+  // Probe 1 at x = 1: a wall at x = 0.8 below y = 0; above it, the room's
+  // far wall at x = -1.
+  std::vector<ShadedPoint> wall_hits;
+  for (int t = 0; t < m.texel_count(); ++t) {
+    const glm::vec3 d = m.direction_of(t);
+    if (d.x > -0.1f) continue;
+    const float along = d.y < 0 ? 0.2f / -d.x : 2.0f / -d.x;
+    wall_hits.push_back({glm::vec3(1, 0, 0) + d * along, glm::vec3(0), d, along});
+  }
+  update_own_depth(states[1], m, wall_hits, {});
+  const auto probe1_weight = [&](float y, const InterpolationSettings& s) {
+    const InterpolationResult r = interpolate_probes(g, m, states, {0.4f, y, 0.0f}, {0, 0, 1}, s);
+    float w = 0;
+    for (std::size_t i = 0; i < 8; ++i) w += r.probes[i] == 1 ? r.weights[i] : 0.0f;
+    return w;
+  };
+  const InterpolationSettings ramp, cut{.visibility_ramp = 0.0f};
+  EXPECT_EQ(probe1_weight(-0.1f, ramp), 0.0f) << "behind the wall";
+  EXPECT_NEAR(probe1_weight(0.1f, ramp), 0.4f, 1e-5f) << "in the open: its trilinear weight";
+  float ramp_step = 0, cut_step = 0;
+  for (int i = 1; i <= 2000; ++i) {
+    const float y0 = -0.1f + 1e-4f * static_cast<float>(i - 1), y1 = y0 + 1e-4f;
+    ramp_step = std::max(ramp_step, std::abs(probe1_weight(y1, ramp) - probe1_weight(y0, ramp)));
+    cut_step = std::max(cut_step, std::abs(probe1_weight(y1, cut) - probe1_weight(y0, cut)));
+  }
+  EXPECT_LT(ramp_step, 0.05f);
+  EXPECT_GT(cut_step, 0.2f) << "the cut flips (what the ramp is for)";
+}
+
 TEST(Interpolation, AllPrunedFallsBackToDistanceAndCosineWeights) {
   const ProbeGrid g{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}};
   const MapLayout m{32, 16};

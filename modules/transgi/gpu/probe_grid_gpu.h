@@ -28,6 +28,7 @@ inline ProbeFieldGpu probe_field_gpu(const probes::ProbeGrid& grid, const probes
   r.field.grid = probe_grid_gpu(grid);
   r.field.bias_length = interpolation.normal_bias * grid.min_spacing();
   r.field.visibility_threshold = interpolation.visibility_threshold;
+  r.field.visibility_ramp = interpolation.visibility_ramp;
   r.field.flags = (interpolation.prune_back_facing ? kInterpolatePruneBackFacing : 0u) |
                   (interpolation.prune_occluded ? kInterpolatePruneOccluded : 0u) |
                   (grid.offsets.empty() ? 0u : kInterpolateHasOffsets);

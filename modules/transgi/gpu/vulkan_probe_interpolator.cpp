@@ -53,6 +53,7 @@ GpuInterpolation VulkanProbeInterpolator::interpolate(const probes::ProbeGrid& g
   push.grid = probe_grid_gpu(grid);
   push.bias_length = settings.normal_bias * grid.min_spacing();
   push.visibility_threshold = settings.visibility_threshold;
+  push.visibility_ramp = settings.visibility_ramp;
   push.points = static_cast<int>(n);
   push.flags = (settings.prune_back_facing ? kInterpolatePruneBackFacing : 0u) |
                (settings.prune_occluded ? kInterpolatePruneOccluded : 0u) |

@@ -1,6 +1,7 @@
 #include "probes/interpolation.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "engine/core/cpu_isa.h"
@@ -14,6 +15,61 @@ float chebyshev_visibility(float mean, float variance_in, float distance) {
   return variance / (variance + d * d);
 }
 
+float visibility_weight(float visibility, const InterpolationSettings& s) {
+  if (!(s.visibility_ramp > 0)) return visibility < s.visibility_threshold ? 0.0f : 1.0f;
+  return std::clamp((visibility - s.visibility_threshold) / s.visibility_ramp, 0.0f, 1.0f);
+}
+
+namespace {
+// The four texels around `at` and their bilinear weights (filtered_visibility).
+struct Footprint {
+  std::array<int, 4> texel{};
+  std::array<float, 4> weight{};
+};
+
+Footprint footprint(const MapLayout& layout, glm::vec2 at) {
+  const float px = at.x - 0.5f;
+  const float py = std::clamp(at.y - 0.5f, 0.0f, static_cast<float>(layout.height - 1));
+  const float fx = std::floor(px);
+  const int y0 = std::min(static_cast<int>(py), layout.height - 1), y1 = std::min(y0 + 1, layout.height - 1);
+  int x0 = static_cast<int>(fx) % layout.width;
+  if (x0 < 0) x0 += layout.width;
+  const int x1 = x0 + 1 == layout.width ? 0 : x0 + 1;
+  const float ax = px - fx, ay = py - static_cast<float>(y0);
+  Footprint f;
+  f.texel = {y0 * layout.width + x0, y0 * layout.width + x1, y1 * layout.width + x0, y1 * layout.width + x1};
+  f.weight = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
+  return f;
+}
+
+// binary16 to float: one vcvtph2ps where the body is built for x86-64-v3 or
+// v4, a library call in the scalar build; exact either way.
+ENGINE_INLINE_BODY float half_to_float(std::uint16_t h) { return static_cast<float>(std::bit_cast<_Float16>(h)); }
+
+ENGINE_INLINE_BODY float visibility_of(const std::array<DepthMap::Texel, 4>& texels, const Footprint& f, float unit,
+                                       float distance) {
+  float m1 = 0, m2 = 0, sum = 0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    const float m = half_to_float(texels[k].mean);
+    if (!std::isfinite(m) || !(f.weight[k] > 0)) continue;  // never hit
+    m1 += f.weight[k] * m;
+    m2 += f.weight[k] * (half_to_float(texels[k].variance) + m * m);
+    sum += f.weight[k];
+  }
+  if (!(sum > 0)) return 1.0f;
+  m1 /= sum;
+  m2 /= sum;
+  return chebyshev_visibility(m1 * unit, std::max(m2 - m1 * m1, 0.0f) * unit * unit, distance);
+}
+}  // namespace
+
+float filtered_visibility(const DepthMap& depth, const MapLayout& layout, glm::vec2 at, float distance) {
+  const Footprint f = footprint(layout, at);
+  std::array<DepthMap::Texel, 4> texels;
+  for (std::size_t k = 0; k < 4; ++k) texels[k] = depth.texels[static_cast<std::size_t>(f.texel[k])];
+  return visibility_of(texels, f, depth.unit, distance);
+}
+
 namespace {
 
 // What the weights need from each corner of the cage.
@@ -22,6 +78,7 @@ struct Corners {
   std::array<float, 8> dist{};       // point to probe
   std::array<float, 8> from_dist{};  // probe to the biased point
   std::array<int, 8> texel{};        // the probe's depth texel towards the biased point; -1 = none
+  std::array<glm::vec2, 8> at{};     // where on its map (MapLayout::texel_position), where texel >= 0
 };
 
 // The plain statement: one corner at a time through MapLayout::texel_of.
@@ -34,7 +91,12 @@ Corners corners_reference(const ProbeGrid::Cage& cage, const MapLayout& layout, 
     c.facing[i] = c.dist[i] > 1e-6f ? glm::dot(to_probe / c.dist[i], n) : 1.0f;  // dir = n when the point is at the probe
     const glm::vec3 from_probe = biased - cage.positions[i];
     c.from_dist[i] = glm::length(from_probe);
-    c.texel[i] = occlusion && c.from_dist[i] > 1e-6f ? layout.texel_of(from_probe / c.from_dist[i]) : -1;
+    if (occlusion && c.from_dist[i] > 1e-6f) {
+      c.at[i] = layout.texel_position(from_probe / c.from_dist[i]);
+      c.texel[i] = layout.texel_of(from_probe / c.from_dist[i]);
+    } else {
+      c.texel[i] = -1;
+    }
   }
   return c;
 }
@@ -70,6 +132,7 @@ ENGINE_INLINE_BODY Corners corners_body(
     const int x = std::min(layout.width - 1, std::max(0, static_cast<int>(uw * w)));
     const int y = std::min(layout.height - 1, std::max(0, static_cast<int>(v * h)));
     c.texel[static_cast<std::size_t>(i)] = occlusion && from > 1e-6f ? y * layout.width + x : -1;
+    c.at[static_cast<std::size_t>(i)] = glm::vec2(uw * w, v * h);
   }
   return c;
 }
@@ -77,8 +140,9 @@ ENGINE_ISA_DISPATCH(Corners, corners, (const ProbeGrid::Cage& cage, const MapLay
                    const glm::vec3& biased, bool occlusion),
                    (cage, layout, p, n, biased, occlusion))
 
-InterpolationResult weigh(const ProbeGrid::Cage& cage, const Corners& c, const std::vector<ProbeMapState>& states,
-                          const InterpolationSettings& s, std::span<const std::uint8_t> usable);
+InterpolationResult weigh(const ProbeGrid::Cage& cage, const Corners& c, const MapLayout& layout,
+                          const std::vector<ProbeMapState>& states, const InterpolationSettings& s,
+                          std::span<const std::uint8_t> usable);
 
 }  // namespace
 
@@ -87,7 +151,7 @@ InterpolationResult interpolate_probes(const ProbeGrid& grid, const MapLayout& l
                                        const InterpolationSettings& s, std::span<const std::uint8_t> usable) {
   const ProbeGrid::Cage cage = grid.cage(p);
   const glm::vec3 biased = p + n * (s.normal_bias * grid.min_spacing());
-  return weigh(cage, corners(cage, layout, p, n, biased, s.prune_occluded), states, s, usable);
+  return weigh(cage, corners(cage, layout, p, n, biased, s.prune_occluded), layout, states, s, usable);
 }
 
 void interpolate_probes_many(const ProbeGrid& grid, const MapLayout& layout, const std::vector<ProbeMapState>& states,
@@ -105,10 +169,14 @@ void interpolate_probes_many(const ProbeGrid& grid, const MapLayout& layout, con
       cages[j] = grid.cage(p);
       corner[j] = corners(cages[j], layout, p, nrm, p + nrm * (s.normal_bias * grid.min_spacing()), s.prune_occluded);
       for (std::size_t i = 0; i < 8; ++i)
-        if (corner[j].texel[i] >= 0)
-          __builtin_prefetch(states[static_cast<std::size_t>(cages[j].probes[i])].depth.texels.data() + corner[j].texel[i]);
+        if (corner[j].texel[i] >= 0 && cages[j].weights[i] > 0 && !(s.prune_back_facing && corner[j].facing[i] < 0)) {
+          // The filtered read takes this texel's row and the next.
+          const DepthMap::Texel* texels = states[static_cast<std::size_t>(cages[j].probes[i])].depth.texels.data();
+          __builtin_prefetch(texels + corner[j].texel[i]);
+          if (corner[j].texel[i] + layout.width < layout.texel_count()) __builtin_prefetch(texels + corner[j].texel[i] + layout.width);
+        }
     }
-    for (std::size_t j = 0; j < n; ++j) out[b + j] = weigh(cages[j], corner[j], states, s, usable);
+    for (std::size_t j = 0; j < n; ++j) out[b + j] = weigh(cages[j], corner[j], layout, states, s, usable);
   }
 }
 
@@ -118,41 +186,48 @@ InterpolationResult interpolate_probes_reference(const ProbeGrid& grid, const Ma
                                                  std::span<const std::uint8_t> usable) {
   const ProbeGrid::Cage cage = grid.cage(p);
   const glm::vec3 biased = p + n * (s.normal_bias * grid.min_spacing());
-  return weigh(cage, corners_reference(cage, layout, p, n, biased, s.prune_occluded), states, s, usable);
+  return weigh(cage, corners_reference(cage, layout, p, n, biased, s.prune_occluded), layout, states, s, usable);
 }
 
 namespace {
 
-InterpolationResult weigh(const ProbeGrid::Cage& cage, const Corners& c, const std::vector<ProbeMapState>& states,
-                          const InterpolationSettings& s, std::span<const std::uint8_t> usable) {
+ENGINE_INLINE_BODY InterpolationResult weigh_body(const ProbeGrid::Cage& cage, const Corners& c, const MapLayout& layout,
+                                                  const std::vector<ProbeMapState>& states, const InterpolationSettings& s,
+                                                  std::span<const std::uint8_t> usable) {
   InterpolationResult r;
   r.probes = cage.probes;
-  // The eight depth reads (often cache misses) are issued together, after
-  // the geometry, so they overlap.
-  std::array<DepthMap::Texel, 8> depth{};
-  for (std::size_t i = 0; i < 8; ++i)
-    if (c.texel[i] >= 0 && (usable.empty() || usable[static_cast<std::size_t>(cage.probes[i])]))  // unusable: maps released
-      depth[i] = states[static_cast<std::size_t>(cage.probes[i])].depth.texels[static_cast<std::size_t>(c.texel[i])];
   const auto& facing = c.facing;
   const auto& dist = c.dist;
   const auto& from_dist = c.from_dist;
-  float sum = 0;
+  // Which corners the geometry keeps; only theirs need the depth test.
+  std::array<bool, 8> keep{};
   std::array<float, 8> fallback{};
   for (std::size_t i = 0; i < 8; ++i) {
-    const int q = cage.probes[i];
     // Fallback weight: nearer and more in front of the surface counts more.
-    const bool holds_light = usable.empty() || usable[static_cast<std::size_t>(q)] != 0;
+    const bool holds_light = usable.empty() || usable[static_cast<std::size_t>(cage.probes[i])] != 0;
     fallback[i] = holds_light ? std::max(0.05f, 0.5f * (facing[i] + 1.0f)) / (dist[i] * dist[i] + 1e-4f) : 0.0f;
-    bool keep = cage.weights[i] > 0 && holds_light;
-    if (keep && s.prune_back_facing && facing[i] < 0) keep = false;
-    if (keep && s.prune_occluded && c.texel[i] >= 0) {
-      const DepthMap& dm = states[static_cast<std::size_t>(q)].depth;
-      const float mean = engine::math::from_half(depth[i].mean) * dm.unit;
-      const float variance = engine::math::from_half(depth[i].variance) * dm.unit * dm.unit;
-      if (chebyshev_visibility(mean, variance, from_dist[i]) < s.visibility_threshold) keep = false;
+    keep[i] = cage.weights[i] > 0 && holds_light && !(s.prune_back_facing && facing[i] < 0);
+  }
+  // The depth reads (often cache misses) are issued together, so they overlap.
+  std::array<Footprint, 8> foot{};
+  std::array<std::array<DepthMap::Texel, 4>, 8> depth{};
+  const bool test_depth = s.prune_occluded;
+  for (std::size_t i = 0; i < 8; ++i)
+    if (keep[i] && test_depth && c.texel[i] >= 0) {
+      foot[i] = footprint(layout, c.at[i]);
+      const std::vector<DepthMap::Texel>& texels = states[static_cast<std::size_t>(cage.probes[i])].depth.texels;
+      for (std::size_t k = 0; k < 4; ++k) depth[i][k] = texels[static_cast<std::size_t>(foot[i].texel[k])];
     }
-    if (!keep && cage.weights[i] > 0) ++r.pruned;
-    r.weights[i] = keep ? cage.weights[i] : 0.0f;
+  float sum = 0;
+  for (std::size_t i = 0; i < 8; ++i) {
+    float seen = 1.0f;
+    if (keep[i] && test_depth && c.texel[i] >= 0) {
+      seen = visibility_weight(
+          visibility_of(depth[i], foot[i], states[static_cast<std::size_t>(cage.probes[i])].depth.unit, from_dist[i]), s);
+      if (seen <= 0) keep[i] = false;
+    }
+    if (!keep[i] && cage.weights[i] > 0) ++r.pruned;
+    r.weights[i] = keep[i] ? cage.weights[i] * seen : 0.0f;
     sum += r.weights[i];
   }
   if (sum > 1e-6f) {
@@ -165,6 +240,9 @@ InterpolationResult weigh(const ProbeGrid::Cage& cage, const Corners& c, const s
   for (std::size_t i = 0; i < 8; ++i) r.weights[i] = fsum > 0 ? fallback[i] / fsum : 0.0f;
   return r;
 }
+ENGINE_ISA_DISPATCH(InterpolationResult, weigh, (const ProbeGrid::Cage& cage, const Corners& c, const MapLayout& layout,
+                   const std::vector<ProbeMapState>& states, const InterpolationSettings& s, std::span<const std::uint8_t> usable),
+                   (cage, c, layout, states, s, usable))
 
 }  // namespace
 

@@ -5,6 +5,11 @@
 // Chebyshev test on its own hit-distance moments in the point's direction).
 // When all 8 are pruned, the probes are averaged with distance and cosine
 // weights instead, as the paper says.
+//
+// The moments are read bilinearly and the test is a ramp, not a cut (as
+// DDGI reads its depth): read from the one nearest texel and cut at the
+// threshold, a probe beyond a thin wall or a window's edge was kept or
+// dropped texel by texel, and moldings and frames near it sparkled.
 #include <array>
 #include <cstdint>
 #include <span>
@@ -24,6 +29,11 @@ struct InterpolationSettings {
   float normal_bias = 0.1f;
   // A probe whose Chebyshev visibility bound is below this is occluded.
   float visibility_threshold = 0.2f;
+  // Above the threshold a probe's weight rises along a ramp, to full at
+  // threshold + ramp, instead of all at once. Higher = smoother where probes
+  // are half hidden, at the cost of less light from probes partly seen;
+  // 0 = the paper's cut.
+  float visibility_ramp = 0.3f;
   bool prune_back_facing = true;
   bool prune_occluded = true;
 
@@ -65,5 +75,18 @@ InterpolationResult interpolate_probes_reference(const ProbeGrid& grid, const Ma
 // Chebyshev upper bound on the probability that the probe sees a point at
 // `distance`, from the mean and variance of its hit distance in that direction.
 float chebyshev_visibility(float mean, float variance, float distance);
+
+// What a visibility bound leaves of a probe's weight (0 = pruned).
+float visibility_weight(float visibility, const InterpolationSettings& settings);
+
+// The Chebyshev bound that a probe sees a point `distance` away in the
+// direction that falls at `at` on its depth map (MapLayout::texel_position):
+// from the first and second moments of the four nearest texel centres,
+// bilinearly (wrapping around in u, clamped in v). Texels no ray has hit
+// are left out (1 if all four are): a point lies on a surface, so the
+// texels towards it hold hits unless it is on a silhouette, where the hits
+// beside it say more than the escapes. Counted as open instead, they let a
+// probe outside a closed room see its cornices past the roof's edge.
+float filtered_visibility(const DepthMap& depth, const MapLayout& layout, glm::vec2 at, float distance);
 
 }  // namespace transgi::probes

@@ -46,12 +46,18 @@ struct MapLayout {
   // through Environment::direction_to_uv, is texel_of_reference; they differ
   // only for directions that close to a texel border (tested).
   [[nodiscard]] int texel_of(const glm::vec3& unit_dir) const {
+    const glm::vec2 at = texel_position(unit_dir);
+    const int x = std::min(width - 1, std::max(0, static_cast<int>(at.x)));
+    const int y = std::min(height - 1, std::max(0, static_cast<int>(at.y)));
+    return y * width + x;
+  }
+  // Where a direction falls on the map, in texels (texel x spans [x, x + 1)):
+  // what a filtered read interpolates at.
+  [[nodiscard]] glm::vec2 texel_position(const glm::vec3& unit_dir) const {
     const float u = fast_atan2(unit_dir.x, -unit_dir.z) * 0.15915494f;  // / 2 pi
     const float v = fast_acos(unit_dir.y) * 0.31830989f;                 // / pi
     const float uw = u < 0 ? u + 1.0f : u;
-    const int x = std::min(width - 1, std::max(0, static_cast<int>(uw * static_cast<float>(width))));
-    const int y = std::min(height - 1, std::max(0, static_cast<int>(v * static_cast<float>(height))));
-    return y * width + x;
+    return {uw * static_cast<float>(width), v * static_cast<float>(height)};
   }
   [[nodiscard]] int texel_of_reference(const glm::vec3& unit_dir) const;
   [[nodiscard]] glm::vec3 direction_of(int texel) const;  // texel centre
