@@ -62,7 +62,13 @@ InterpolationGpu interpolate_probes_at(InterpolatePush p, uint probe_base, uint 
     if (dims[a] > 1 && s[a] > 0.0) g[a] = clamp((x[a] - lo[a]) / s[a], 0.0, float(dims[a] - 1));
   const ivec3 base = min(ivec3(floor(g)), max(dims - 2, ivec3(0)));
   const vec3 f = clamp(g - vec3(base), vec3(0.0), vec3(1.0));
-  const vec3 biased = x + n * p.bias_length;
+  // probes::visibility_test_point.
+  vec3 biased = x + n * p.bias_length;
+  if (p.view_bias_length > 0.0) {
+    const vec3 to_viewer = vec3(p.viewer_x, p.viewer_y, p.viewer_z) - x;
+    const float d = length(to_viewer);
+    if (d > 1e-6) biased += to_viewer * (p.view_bias_length / d);
+  }
 
   InterpolationGpu r;
   float fallback[8];

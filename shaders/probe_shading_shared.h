@@ -66,7 +66,7 @@ static_assert(sizeof(PendingProbeRayGpu) == 96 && offsetof(PendingProbeRayGpu, f
               offsetof(PendingProbeRayGpu, sx) == 80, "PendingProbeRayGpu layout");
 static_assert(sizeof(ProbeRayHitGpu) == 64 && offsetof(ProbeRayHitGpu, flags) == 28 && offsetof(ProbeRayHitGpu, er) == 48,
               "ProbeRayHitGpu layout");
-static_assert(sizeof(ProbeFeedbackGpu) == 288, "ProbeFeedbackGpu layout");
+static_assert(sizeof(ProbeFeedbackGpu) == 320, "ProbeFeedbackGpu layout");
 }  // namespace transgi::gpu
 #endif
 

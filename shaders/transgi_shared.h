@@ -79,6 +79,9 @@ struct InterpolatePush {
   uint flags;
   uint map_width, map_height, texels;
   float visibility_ramp;
+  // The points' viewer (the camera) and the view bias's length in metres
+  // (view_bias x the grid's smallest spacing); 0 = no viewer.
+  float viewer_x, viewer_y, viewer_z, view_bias_length;
 };
 
 // A probe field among several that a kernel reads from shared buffers (the
@@ -181,13 +184,14 @@ static_assert(sizeof(ShadedPointGpu) == 64 && offsetof(ShadedPointGpu, rx) == 16
               "ShadedPointGpu layout");
 static_assert(sizeof(ProbeGridGpu) == 64 && offsetof(ProbeGridGpu, spacing_x) == 16 &&
               offsetof(ProbeGridGpu, dims_x) == 32 && offsetof(ProbeGridGpu, scroll_x) == 48, "ProbeGridGpu layout");
-static_assert(sizeof(InterpolatePush) == 96 && offsetof(InterpolatePush, bias_length) == 64 &&
-              offsetof(InterpolatePush, flags) == 76 && offsetof(InterpolatePush, map_width) == 80,
+static_assert(sizeof(InterpolatePush) == 112 && offsetof(InterpolatePush, bias_length) == 64 &&
+              offsetof(InterpolatePush, flags) == 76 && offsetof(InterpolatePush, map_width) == 80 &&
+              offsetof(InterpolatePush, viewer_x) == 96,
               "InterpolatePush layout");
 static_assert(sizeof(ProbeGpu) == 32 && offsetof(ProbeGpu, usable) == 16, "ProbeGpu layout");
-static_assert(sizeof(ProbeFieldGpu) == 144 && offsetof(ProbeFieldGpu, probe_base) == 96 && offsetof(ProbeFieldGpu, enabled) == 108 &&
-              offsetof(ProbeFieldGpu, band) == 124 && offsetof(ProbeFieldGpu, box_max_x) == 128 &&
-              offsetof(ProbeFieldGpu, fallback) == 140,
+static_assert(sizeof(ProbeFieldGpu) == 160 && offsetof(ProbeFieldGpu, probe_base) == 112 && offsetof(ProbeFieldGpu, enabled) == 124 &&
+              offsetof(ProbeFieldGpu, band) == 140 && offsetof(ProbeFieldGpu, box_max_x) == 144 &&
+              offsetof(ProbeFieldGpu, fallback) == 156,
               "ProbeFieldGpu layout");
 static_assert(sizeof(InterpolationGpu) == 80 && offsetof(InterpolationGpu, weights) == 32 &&
               offsetof(InterpolationGpu, pruned) == 64, "InterpolationGpu layout");

@@ -58,6 +58,7 @@ Scene random_scene(std::uint64_t seed) {
 // border or of the visibility threshold can fall the other way. So: at most
 // 0.5 % of the points may prune differently (measured 0); every other point
 // has the same probes, fallback flag, and weights and blended SH to 1e-4.
+// Once without a viewer and once with one inside the box (the view bias).
 TEST(VulkanProbeInterpolation, EqualsTheCpuStageOnAScrolledRelocatedGrid) {
   GPU_TEST_CONTEXT_OR_SKIP(ctx);
   const Scene s = random_scene(17);
@@ -71,41 +72,45 @@ TEST(VulkanProbeInterpolation, EqualsTheCpuStageOnAScrolledRelocatedGrid) {
     nrm[static_cast<std::size_t>(i)] = glm::normalize(d + glm::vec3(1e-3f));
   }
   gpu::VulkanProbeInterpolator interpolator(*ctx, s.layout);
-  const gpu::GpuInterpolation got = interpolator.interpolate(s.grid, s.states, s.sh, s.usable, settings, pos, nrm);
-  ASSERT_EQ(got.results.size(), static_cast<std::size_t>(n));
+  const glm::vec3 eye = glm::mix(s.grid.min, s.grid.max, glm::vec3(0.3f, 0.6f, 0.2f));
+  for (const glm::vec3* viewer : {static_cast<const glm::vec3*>(nullptr), &eye}) {
+    SCOPED_TRACE(viewer ? "with a viewer (the view bias)" : "without a viewer");
+    const gpu::GpuInterpolation got = interpolator.interpolate(s.grid, s.states, s.sh, s.usable, settings, pos, nrm, viewer);
+    ASSERT_EQ(got.results.size(), static_cast<std::size_t>(n));
 
-  int flipped = 0, pruned_total = 0, fallbacks = 0, bad = 0;
-  for (int i = 0; i < n; ++i) {
-    const auto want = probes::interpolate_probes_reference(s.grid, s.layout, s.states, pos[static_cast<std::size_t>(i)],
-                                                           nrm[static_cast<std::size_t>(i)], settings, s.usable);
-    const auto& g = got.results[static_cast<std::size_t>(i)];
-    pruned_total += want.pruned;
-    fallbacks += want.fallback;
-    if (want.probes != g.probes) {
-      if (bad++ < 5) ADD_FAILURE() << "point " << i << ": the cage's probes differ (corner 0: expected " << want.probes[0] << ", got " << g.probes[0] << ")";
-      continue;
+    int flipped = 0, pruned_total = 0, fallbacks = 0, bad = 0;
+    for (int i = 0; i < n; ++i) {
+      const auto want = probes::interpolate_probes_reference(s.grid, s.layout, s.states, pos[static_cast<std::size_t>(i)],
+                                                             nrm[static_cast<std::size_t>(i)], settings, s.usable, viewer);
+      const auto& g = got.results[static_cast<std::size_t>(i)];
+      pruned_total += want.pruned;
+      fallbacks += want.fallback;
+      if (want.probes != g.probes) {
+        if (bad++ < 5) ADD_FAILURE() << "point " << i << ": the cage's probes differ (corner 0: expected " << want.probes[0] << ", got " << g.probes[0] << ")";
+        continue;
+      }
+      if (want.pruned != g.pruned || want.fallback != g.fallback) {
+        ++flipped;
+        continue;
+      }
+      for (std::size_t c = 0; c < 8; ++c)
+        if (!(std::abs(want.weights[c] - g.weights[c]) <= 1e-4f) && bad++ < 5)
+          ADD_FAILURE() << "point " << i << " corner " << c << ": expected weight " << want.weights[c] << ", got " << g.weights[c];
+      for (int k = 0; k < 75; ++k) {
+        double l = 0;
+        for (std::size_t c = 0; c < 8; ++c) l += want.weights[c] * s.sh[static_cast<std::size_t>(want.probes[c]) * 75 + k];
+        const float gk = got.light_sh[static_cast<std::size_t>(i) * 75 + k];
+        if (!(std::abs(gk - l) <= 1e-4) && bad++ < 5)
+          ADD_FAILURE() << "point " << i << " SH " << k << ": expected " << l << ", got " << gk;
+      }
     }
-    if (want.pruned != g.pruned || want.fallback != g.fallback) {
-      ++flipped;
-      continue;
-    }
-    for (std::size_t c = 0; c < 8; ++c)
-      if (!(std::abs(want.weights[c] - g.weights[c]) <= 1e-4f) && bad++ < 5)
-        ADD_FAILURE() << "point " << i << " corner " << c << ": expected weight " << want.weights[c] << ", got " << g.weights[c];
-    for (int k = 0; k < 75; ++k) {
-      double l = 0;
-      for (std::size_t c = 0; c < 8; ++c) l += want.weights[c] * s.sh[static_cast<std::size_t>(want.probes[c]) * 75 + k];
-      const float gk = got.light_sh[static_cast<std::size_t>(i) * 75 + k];
-      if (!(std::abs(gk - l) <= 1e-4) && bad++ < 5)
-        ADD_FAILURE() << "point " << i << " SH " << k << ": expected " << l << ", got " << gk;
-    }
+    std::printf("interpolation %s: %d points, %d corners pruned, %d fallbacks, %d decisions flipped\n",
+                viewer ? "with a viewer" : "without a viewer", n, pruned_total, fallbacks, flipped);
+    EXPECT_EQ(bad, 0);
+    EXPECT_LE(flipped, n / 200) << "pruning decisions that differ from the CPU";
+    EXPECT_GT(pruned_total, n) << "the scene should exercise pruning";
+    EXPECT_GT(fallbacks, 0) << "the scene should exercise the fallback";
   }
-  std::printf("interpolation: %d points, %d corners pruned, %d fallbacks, %d decisions flipped\n", n, pruned_total,
-              fallbacks, flipped);
-  EXPECT_EQ(bad, 0);
-  EXPECT_LE(flipped, n / 200) << "pruning decisions that differ from the CPU";
-  EXPECT_GT(pruned_total, n) << "the scene should exercise pruning";
-  EXPECT_GT(fallbacks, 0) << "the scene should exercise the fallback";
   EXPECT_EQ(ctx->validation_errors(), 0);
 }
 

@@ -674,6 +674,40 @@ TEST(Interpolation, AProbeBeyondAWallsEdgeFadesInInsteadOfFlipping) {
   EXPECT_GT(cut_step, 0.2f) << "the cut flips (what the ramp is for)";
 }
 
+// A cornice facet facing down, 5 mm inside a single-sheet wall (z = 0):
+// the probes beyond the wall see the wall a centimetre before the point, well
+// inside their texels' spread of distances (a grazing texel's), so the
+// Chebyshev test keeps them. Moved towards the viewer in the room, the test
+// point lies a tenth of a cell off the wall and they are pruned; without a
+// viewer they are not (the leak the view bias is for).
+TEST(Interpolation, TheViewBiasKeepsProbesBeyondAThinWallFromAPointBesideIt) {
+  const ProbeGrid g{{-0.5f, -0.5f, -0.5f}, {0.5f, 0.5f, 0.5f}, {2, 2, 2}};
+  const MapLayout m{50, 25};  // the real-time preset's maps
+  auto states = open_space_states(g, m);
+  for (int q = 0; q < g.count(); ++q) {
+    const glm::vec3 probe = g.position(q);
+    if (probe.z < 0) continue;  // inside the room: nothing in the way
+    for (int t = 0; t < m.texel_count(); ++t) {
+      const glm::vec3 d = m.direction_of(t);
+      if (d.z >= -0.05f) continue;
+      const float to_wall = probe.z / -d.z;
+      states[static_cast<std::size_t>(q)].depth.set(static_cast<std::size_t>(t), to_wall, 0.0025f * to_wall * to_wall);
+    }
+  }
+  const glm::vec3 p(0.1f, 0.1f, -0.005f), n(0.0f, -1.0f, 0.0f), camera(0.1f, -0.3f, -2.0f);
+  const auto beyond_the_wall = [&](const glm::vec3* viewer) {
+    const InterpolationResult r = interpolate_probes(g, m, states, p, n, {}, {}, viewer);
+    float w = 0;
+    for (std::size_t i = 0; i < 8; ++i) w += g.position(r.probes[i]).z > 0 ? r.weights[i] : 0.0f;
+    EXPECT_FALSE(r.fallback);
+    return w;
+  };
+  EXPECT_GT(beyond_the_wall(nullptr), 0.3f) << "without a viewer the outside probes leak in";
+  EXPECT_EQ(beyond_the_wall(&camera), 0.0f);
+  EXPECT_EQ(visibility_test_point(g, p, n, InterpolationSettings{}, nullptr), p + n * 0.1f);
+  EXPECT_NEAR(glm::length(visibility_test_point(g, p, n, InterpolationSettings{}, &camera) - (p + n * 0.1f)), 0.1f, 1e-6f);
+}
+
 TEST(Interpolation, AllPrunedFallsBackToDistanceAndCosineWeights) {
   const ProbeGrid g{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}};
   const MapLayout m{32, 16};

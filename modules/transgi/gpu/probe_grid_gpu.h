@@ -18,23 +18,38 @@ inline ProbeGridGpu probe_grid_gpu(const probes::ProbeGrid& grid) {
           grid.dims.x,      grid.dims.y, grid.dims.z, 0,             grid.scroll.x, grid.scroll.y, grid.scroll.z, 0};
 }
 
+// The interpolation's parameters for `grid` (points: 0; the caller sets it
+// where the kernel counts them). viewer: the points' viewer (the camera),
+// or null for none (probes::interpolate_probes).
+inline InterpolatePush interpolate_push(const probes::ProbeGrid& grid, const probes::MapLayout& layout,
+                                        const probes::InterpolationSettings& interpolation, const glm::vec3* viewer) {
+  InterpolatePush r{};
+  r.grid = probe_grid_gpu(grid);
+  r.bias_length = interpolation.normal_bias * grid.min_spacing();
+  r.visibility_threshold = interpolation.visibility_threshold;
+  r.visibility_ramp = interpolation.visibility_ramp;
+  r.flags = (interpolation.prune_back_facing ? kInterpolatePruneBackFacing : 0u) |
+            (interpolation.prune_occluded ? kInterpolatePruneOccluded : 0u) |
+            (grid.offsets.empty() ? 0u : kInterpolateHasOffsets);
+  r.map_width = static_cast<uint>(layout.width);
+  r.map_height = static_cast<uint>(layout.height);
+  r.texels = static_cast<uint>(layout.texel_count());
+  if (viewer && interpolation.view_bias > 0) {
+    r.viewer_x = viewer->x, r.viewer_y = viewer->y, r.viewer_z = viewer->z;
+    r.view_bias_length = interpolation.view_bias * grid.min_spacing();
+  }
+  return r;
+}
+
 // A field whose probes start at probe_base and depth texels at depth_base
 // in a kernel's shared buffers: `grid` as relocated (interpolation reads
-// the probes where they stand), its box, and the hand-over band (in metres).
+// the probes where they stand), its box, the hand-over band (in metres) and
+// its points' viewer (null: none).
 inline ProbeFieldGpu probe_field_gpu(const probes::ProbeGrid& grid, const probes::MapLayout& layout,
-                                     const probes::InterpolationSettings& interpolation, float band, std::uint32_t probe_base,
-                                     std::uint32_t depth_base) {
+                                     const probes::InterpolationSettings& interpolation, const glm::vec3* viewer, float band,
+                                     std::uint32_t probe_base, std::uint32_t depth_base) {
   ProbeFieldGpu r{};
-  r.field.grid = probe_grid_gpu(grid);
-  r.field.bias_length = interpolation.normal_bias * grid.min_spacing();
-  r.field.visibility_threshold = interpolation.visibility_threshold;
-  r.field.visibility_ramp = interpolation.visibility_ramp;
-  r.field.flags = (interpolation.prune_back_facing ? kInterpolatePruneBackFacing : 0u) |
-                  (interpolation.prune_occluded ? kInterpolatePruneOccluded : 0u) |
-                  (grid.offsets.empty() ? 0u : kInterpolateHasOffsets);
-  r.field.map_width = static_cast<uint>(layout.width);
-  r.field.map_height = static_cast<uint>(layout.height);
-  r.field.texels = static_cast<uint>(layout.texel_count());
+  r.field = interpolate_push(grid, layout, interpolation, viewer);
   r.probe_base = probe_base;
   r.depth_base = depth_base;
   r.enabled = 1u;

@@ -21,7 +21,7 @@ GpuInterpolation VulkanProbeInterpolator::interpolate(const probes::ProbeGrid& g
                                                       std::span<const float> probe_sh, std::span<const std::uint8_t> usable,
                                                       const probes::InterpolationSettings& settings,
                                                       std::span<const glm::vec3> positions,
-                                                      std::span<const glm::vec3> normals) {
+                                                      std::span<const glm::vec3> normals, const glm::vec3* viewer) {
   const auto count = static_cast<std::size_t>(grid.count());
   const auto texels = static_cast<std::size_t>(layout_.texel_count());
   if (states.size() != count || probe_sh.size() != count * kTransferOutputs || (!usable.empty() && usable.size() != count) ||
@@ -49,18 +49,8 @@ GpuInterpolation VulkanProbeInterpolator::interpolate(const probes::ProbeGrid& g
   engine::gpu::bind_at_least(ctx_, *pipeline_, 4, results_, n * sizeof(InterpolationGpu));
   engine::gpu::bind_at_least(ctx_, *pipeline_, 5, point_sh_, n * kTransferOutputs * sizeof(float));
 
-  InterpolatePush push{};
-  push.grid = probe_grid_gpu(grid);
-  push.bias_length = settings.normal_bias * grid.min_spacing();
-  push.visibility_threshold = settings.visibility_threshold;
-  push.visibility_ramp = settings.visibility_ramp;
+  InterpolatePush push = interpolate_push(grid, layout_, settings, viewer);
   push.points = static_cast<int>(n);
-  push.flags = (settings.prune_back_facing ? kInterpolatePruneBackFacing : 0u) |
-               (settings.prune_occluded ? kInterpolatePruneOccluded : 0u) |
-               (grid.offsets.empty() ? 0u : kInterpolateHasOffsets);
-  push.map_width = static_cast<uint>(layout_.width);
-  push.map_height = static_cast<uint>(layout_.height);
-  push.texels = static_cast<uint>(texels);
   const auto groups = static_cast<std::uint32_t>((n + kInterpolateGroupSize - 1) / kInterpolateGroupSize);
   out.gpu_ms = ctx_.submit_and_wait([&](VkCommandBuffer cmd) { pipeline_->record_dispatch(cmd, groups, 1, 1, &push); });
 

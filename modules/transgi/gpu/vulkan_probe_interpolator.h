@@ -31,11 +31,11 @@ class VulkanProbeInterpolator {
   VulkanProbeInterpolator(engine::gpu::VulkanContext& ctx, probes::MapLayout layout);
 
   // probe_sh: grid.count() x 75; usable: empty (all) or grid.count() flags;
-  // positions and normals: one per point.
+  // positions and normals: one per point; viewer: theirs, or null.
   GpuInterpolation interpolate(const probes::ProbeGrid& grid, const std::vector<probes::ProbeMapState>& states,
                                std::span<const float> probe_sh, std::span<const std::uint8_t> usable,
                                const probes::InterpolationSettings& settings, std::span<const glm::vec3> positions,
-                               std::span<const glm::vec3> normals);
+                               std::span<const glm::vec3> normals, const glm::vec3* viewer = nullptr);
 
  private:
   engine::gpu::VulkanContext& ctx_;

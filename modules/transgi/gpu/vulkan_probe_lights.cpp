@@ -52,7 +52,7 @@ bool VulkanProbeLights::set_probes(std::span<const probes::ProbeField* const> fi
     // Relocation moves probes, not the box, so the grid's box is the placed
     // one that mix_at and next_holding hand points over by.
     const bool fallback = field.settings().blend_cells == probes::kFallbackBlendCells;
-    ProbeFieldGpu r = probe_field_gpu(grid, field.settings().map, field.settings().interpolation,
+    ProbeFieldGpu r = probe_field_gpu(grid, field.settings().map, field.settings().interpolation, field.viewer(),
                                       fallback ? 0.0f : field.settings().blend_cells * grid.min_spacing(), static_cast<uint>(probe_base),
                                       static_cast<uint>(depth_base));
     r.fallback = fallback ? 1u : 0u;

@@ -120,7 +120,7 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
     const auto count = static_cast<std::size_t>(f->grid->count());
     const auto texels = static_cast<std::size_t>(f->layout.texel_count());
     ProbeFieldGpu& record = which == 0 ? feedback.self : feedback.outer;
-    record = probe_field_gpu(*f->grid, f->layout, f->interpolation, 0.0f, static_cast<std::uint32_t>(probe_base),
+    record = probe_field_gpu(*f->grid, f->layout, f->interpolation, nullptr, 0.0f, static_cast<std::uint32_t>(probe_base),
                              static_cast<std::uint32_t>(depth_base));
     // The points it holds: past them a hit takes the outer field's light.
     const glm::vec3 held_min = f->held_min(), held_max = f->held_max();

@@ -146,18 +146,30 @@ InterpolationResult weigh(const ProbeGrid::Cage& cage, const Corners& c, const M
 
 }  // namespace
 
+glm::vec3 visibility_test_point(const ProbeGrid& grid, const glm::vec3& p, const glm::vec3& n, const InterpolationSettings& s,
+                                const glm::vec3* viewer) {
+  glm::vec3 biased = p + n * (s.normal_bias * grid.min_spacing());
+  if (viewer && s.view_bias > 0) {
+    const glm::vec3 to_viewer = *viewer - p;
+    const float d = glm::length(to_viewer);
+    if (d > 1e-6f) biased += to_viewer * (s.view_bias * grid.min_spacing() / d);
+  }
+  return biased;
+}
+
 InterpolationResult interpolate_probes(const ProbeGrid& grid, const MapLayout& layout,
                                        const std::vector<ProbeMapState>& states, const glm::vec3& p, const glm::vec3& n,
-                                       const InterpolationSettings& s, std::span<const std::uint8_t> usable) {
+                                       const InterpolationSettings& s, std::span<const std::uint8_t> usable,
+                                       const glm::vec3* viewer) {
   const ProbeGrid::Cage cage = grid.cage(p);
-  const glm::vec3 biased = p + n * (s.normal_bias * grid.min_spacing());
+  const glm::vec3 biased = visibility_test_point(grid, p, n, s, viewer);
   return weigh(cage, corners(cage, layout, p, n, biased, s.prune_occluded), layout, states, s, usable);
 }
 
 void interpolate_probes_many(const ProbeGrid& grid, const MapLayout& layout, const std::vector<ProbeMapState>& states,
                              std::span<const glm::vec3> position, std::span<const glm::vec3> normal,
                              const InterpolationSettings& s, std::span<const std::uint8_t> usable,
-                             std::span<InterpolationResult> out) {
+                             std::span<InterpolationResult> out, const glm::vec3* viewer) {
   constexpr std::size_t kBatch = 16;
   std::array<ProbeGrid::Cage, kBatch> cages;
   std::array<Corners, kBatch> corner;
@@ -167,7 +179,7 @@ void interpolate_probes_many(const ProbeGrid& grid, const MapLayout& layout, con
       const glm::vec3& p = position[b + j];
       const glm::vec3& nrm = normal[b + j];
       cages[j] = grid.cage(p);
-      corner[j] = corners(cages[j], layout, p, nrm, p + nrm * (s.normal_bias * grid.min_spacing()), s.prune_occluded);
+      corner[j] = corners(cages[j], layout, p, nrm, visibility_test_point(grid, p, nrm, s, viewer), s.prune_occluded);
       for (std::size_t i = 0; i < 8; ++i)
         if (corner[j].texel[i] >= 0 && cages[j].weights[i] > 0 && !(s.prune_back_facing && corner[j].facing[i] < 0)) {
           // The filtered read takes this texel's row and the next.
@@ -183,9 +195,9 @@ void interpolate_probes_many(const ProbeGrid& grid, const MapLayout& layout, con
 InterpolationResult interpolate_probes_reference(const ProbeGrid& grid, const MapLayout& layout,
                                                  const std::vector<ProbeMapState>& states, const glm::vec3& p,
                                                  const glm::vec3& n, const InterpolationSettings& s,
-                                                 std::span<const std::uint8_t> usable) {
+                                                 std::span<const std::uint8_t> usable, const glm::vec3* viewer) {
   const ProbeGrid::Cage cage = grid.cage(p);
-  const glm::vec3 biased = p + n * (s.normal_bias * grid.min_spacing());
+  const glm::vec3 biased = visibility_test_point(grid, p, n, s, viewer);
   return weigh(cage, corners_reference(cage, layout, p, n, biased, s.prune_occluded), layout, states, s, usable);
 }
 

@@ -27,6 +27,13 @@ struct InterpolationSettings {
   // grid spacing's smallest axis), so a surface does not shadow itself.
   // Higher = fewer false occlusions, at the cost of more leaks at thin walls.
   float normal_bias = 0.1f;
+  // ... and this far towards the viewer, where the caller names one (the
+  // camera), as DDGI's view bias: a point on a cornice or a muntin, a few
+  // millimetres from a single-sheet wall, then lies clearly on the viewer's
+  // side of it for a probe beyond it, whatever its normal. Higher = fewer
+  // leaks through thin walls, at the cost of light judged a little off the
+  // surface.
+  float view_bias = 0.1f;
   // A probe whose Chebyshev visibility bound is below this is occluded.
   float visibility_threshold = 0.2f;
   // Above the threshold a probe's weight rises along a ramp, to full at
@@ -51,10 +58,12 @@ struct InterpolationResult {
 // usable[i] == 0 marks a probe that holds no light (buried in geometry or far
 // from every surface): it gets no weight, in the fallback neither. Empty =
 // every probe is usable. If no probe of the cage is usable, all weights are 0.
+// viewer: where the point is seen from (the camera), for the view bias;
+// null = none.
 InterpolationResult interpolate_probes(const ProbeGrid& grid, const MapLayout& layout,
                                        const std::vector<ProbeMapState>& states, const glm::vec3& position,
                                        const glm::vec3& normal, const InterpolationSettings& settings,
-                                       std::span<const std::uint8_t> usable = {});
+                                       std::span<const std::uint8_t> usable = {}, const glm::vec3* viewer = nullptr);
 
 // The same for many points: each batch of points' cages and corner geometry
 // first, their depth texels fetched together, then the weights, so the
@@ -63,14 +72,19 @@ InterpolationResult interpolate_probes(const ProbeGrid& grid, const MapLayout& l
 void interpolate_probes_many(const ProbeGrid& grid, const MapLayout& layout, const std::vector<ProbeMapState>& states,
                              std::span<const glm::vec3> position, std::span<const glm::vec3> normal,
                              const InterpolationSettings& settings, std::span<const std::uint8_t> usable,
-                             std::span<InterpolationResult> out);
+                             std::span<InterpolationResult> out, const glm::vec3* viewer = nullptr);
 
 // The same, one cage corner at a time: the plain statement that
 // interpolate_probes' vectorised corner geometry is tested against.
 InterpolationResult interpolate_probes_reference(const ProbeGrid& grid, const MapLayout& layout,
                                                  const std::vector<ProbeMapState>& states, const glm::vec3& position,
                                                  const glm::vec3& normal, const InterpolationSettings& settings,
-                                                 std::span<const std::uint8_t> usable = {});
+                                                 std::span<const std::uint8_t> usable = {}, const glm::vec3* viewer = nullptr);
+
+// Where the visibility test puts the point: moved along the normal and
+// towards the viewer (if any) by the settings' biases, in grid spacings.
+glm::vec3 visibility_test_point(const ProbeGrid& grid, const glm::vec3& position, const glm::vec3& normal,
+                                const InterpolationSettings& settings, const glm::vec3* viewer);
 
 // Chebyshev upper bound on the probability that the probe sees a point at
 // `distance`, from the mean and variance of its hit distance in that direction.

@@ -44,7 +44,7 @@ ProbeField::ProbeField(ProbeFieldSettings s)
 bool ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, float* out) const { return interpolate(p, n, probes_.sh.data(), out); }
 
 bool ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float* probe_sh, float* out) const {
-  const InterpolationResult r = interpolate_probes(grid_, settings_.map, probes_.maps, p, n, settings_.interpolation, probes_.usable);
+  const InterpolationResult r = interpolate_probes(grid_, settings_.map, probes_.maps, p, n, settings_.interpolation, probes_.usable, viewer());
   for (int k = 0; k < 75; ++k) out[k] = 0.0f;
   bool lit = false;
   for (std::size_t i = 0; i < 8; ++i) {
@@ -78,13 +78,13 @@ ENGINE_ISA_DISPATCH(void, blend_two, (const InterpolationResult& r, const float*
 
 bool ProbeField::interpolate(const glm::vec3& p, const glm::vec3& n, const float* sh_a, float* out_a, const float* sh_b,
                              float* out_b) const {
-  return blend(interpolate_probes(grid_, settings_.map, probes_.maps, p, n, settings_.interpolation, probes_.usable), sh_a, out_a,
+  return blend(interpolate_probes(grid_, settings_.map, probes_.maps, p, n, settings_.interpolation, probes_.usable, viewer()), sh_a, out_a,
                sh_b, out_b);
 }
 
 void ProbeField::interpolation_weights(std::span<const glm::vec3> position, std::span<const glm::vec3> normal,
                                        std::span<InterpolationResult> out) const {
-  interpolate_probes_many(grid_, settings_.map, probes_.maps, position, normal, settings_.interpolation, probes_.usable, out);
+  interpolate_probes_many(grid_, settings_.map, probes_.maps, position, normal, settings_.interpolation, probes_.usable, out, viewer());
 }
 
 bool ProbeField::blend(const InterpolationResult& r, const float* sh_a, float* out_a, const float* sh_b, float* out_b) {

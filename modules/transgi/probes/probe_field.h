@@ -267,6 +267,14 @@ class ProbeField {
   // With a budget, probes equally stale are refreshed nearest to `p` first
   // (the camera) instead of round-robin.
   void set_focus(const glm::vec3& p) { focus_ = p; has_focus_ = true; }
+  // Where the shaded points are seen from (the camera): interpolate() and
+  // interpolation_weights() move their visibility test towards it
+  // (InterpolationSettings::view_bias). Lookups at the hits of reflection
+  // and contact rays take it too, a bias of a tenth of a cell that there
+  // points the camera's way rather than the ray's. The probes' own bounce
+  // light (feedback_source) takes none.
+  void set_viewer(const glm::vec3& p) { viewer_ = p; has_viewer_ = true; }
+  [[nodiscard]] const glm::vec3* viewer() const { return has_viewer_ ? &viewer_ : nullptr; }
   // Trilinear light at a point with no surface (no pruning, buried and far
   // probes excluded): the indirect and the direct sky SH, 75 each.
   void light_at_point(const glm::vec3& p, float* out75, float* out_direct75) const;
@@ -397,6 +405,8 @@ class ProbeField {
   std::optional<std::uint64_t> light_changed_at_;
   glm::vec3 focus_{0.0f};
   bool has_focus_ = false;
+  glm::vec3 viewer_{0.0f};
+  bool has_viewer_ = false;
 };
 
 }  // namespace transgi::probes

@@ -35,8 +35,10 @@ void tell(probes::ProbeField& field, const SceneChanges& c) {
 
 }  // namespace
 
-void sync_probe_volumes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res<render::SceneLights> lights,
-                        Res<TransGISettings> settings, Local<SeenVersions> seen) {
+void sync_probe_volumes(View<Get<const scene::Camera, const transform::WorldTransform>> cameras, View<Get<ProbeVolume>> volumes,
+                        Res<rt::RtScene> rt, Res<render::SceneLights> lights, Res<TransGISettings> settings, Res<GiFrame> frame,
+                        Local<SeenVersions> seen) {
+  const glm::vec3 eye = probes::viewer_of(cameras, frame->camera, rt->bounds_min(), rt->bounds_max()).sanitised().eye;
   const SceneChanges changes = changes_since(*seen, *rt, *lights);
   volumes.each([&](ProbeVolume& v) {
     if (v.fits_scene()) {
@@ -49,9 +51,11 @@ void sync_probe_volumes(View<Get<ProbeVolume>> volumes, Res<rt::RtScene> rt, Res
     wanted.blend_cells = v.blend_cells;
     if (!v.field || !(v.field->settings() == wanted)) {
       v.field = std::make_shared<probes::ProbeField>(wanted);
+      v.field->set_viewer(eye);
       return;
     }
     tell(*v.field, changes);
+    v.field->set_viewer(eye);
   });
   seen->geometry = lights->geometry_version;
   seen->lights = lights->lighting_version;
@@ -91,6 +95,7 @@ void sync_probe_cascades(View<Get<const scene::Camera, const transform::WorldTra
         [&](const probes::ProbeGrid& grid, int k) {
           auto f = std::make_shared<probes::ProbeField>(wanted(grid, k));
           if (k >= 0) f->set_focus(viewer.sanitised().eye);
+          f->set_viewer(viewer.sanitised().eye);
           return f;
         },
         [&](const probes::ProbeField& f, const probes::ProbeGrid& grid, int k) { return f.settings() == wanted(grid, k); },
@@ -98,6 +103,7 @@ void sync_probe_cascades(View<Get<const scene::Camera, const transform::WorldTra
         [&](probes::ProbeField& f, bool on_viewer) {
           tell(f, changes);
           if (on_viewer) f.set_focus(viewer.sanitised().eye);
+          f.set_viewer(viewer.sanitised().eye);
         });
   });
   frame->cascade_probes_entered = entered;

@@ -22,16 +22,19 @@ struct SeenVersions {
 
 // After it: every ProbeVolume has a field for the current settings and
 // bounds (fitted to the scene once, if it has none); fields whose scene
-// changed were told, so settled probes wake and moved geometry is reclassified.
-void sync_probe_volumes(engine::schedule::View<engine::schedule::Get<ProbeVolume>> volumes,
-                        engine::schedule::Res<engine::rt::RtScene> rt,
-                        engine::schedule::Res<engine::render::SceneLights> lights,
-                        engine::schedule::Res<TransGISettings> settings, engine::schedule::Local<SeenVersions> seen);
+// changed were told, so settled probes wake and moved geometry is
+// reclassified; each field's viewer is the frame's camera.
+void sync_probe_volumes(
+    engine::schedule::View<engine::schedule::Get<const engine::scene::Camera, const engine::transform::WorldTransform>> cameras,
+    engine::schedule::View<engine::schedule::Get<ProbeVolume>> volumes, engine::schedule::Res<engine::rt::RtScene> rt,
+    engine::schedule::Res<engine::render::SceneLights> lights, engine::schedule::Res<TransGISettings> settings,
+    engine::schedule::Res<GiFrame> frame, engine::schedule::Local<SeenVersions> seen);
 
 // After it: every ProbeCascades has one field per cascade, centred on the
 // camera; a field whose cascade origin moved has scrolled by whole cells
 // (its entered slab seeded from the next coarser cascade, queued first) and
-// its budget goes nearest the camera first; changes were told as above.
+// its budget goes nearest the camera first; changes were told as above;
+// each field's viewer is the camera.
 void sync_probe_cascades(
     engine::schedule::View<engine::schedule::Get<const engine::scene::Camera, const engine::transform::WorldTransform>> cameras,
     engine::schedule::View<engine::schedule::Get<ProbeCascades>> sets, engine::schedule::Res<engine::rt::RtScene> rt,

@@ -9,7 +9,9 @@
 //  PrepareRender  transgi::sync_probe_volumes: every ProbeVolume has a probe
 //                 field for the current settings and bounds; fields whose
 //                 scene changed this frame (geometry or lights) were told,
-//                 so settled probes wake and moved geometry is reclassified.
+//                 so settled probes wake and moved geometry is reclassified;
+//                 each field's viewer (its visibility test's view bias) is
+//                 the camera.
 //  Render         transgi::update_probes: probes traced, shared, accumulated
 //                 and projected for this frame.
 //                 transgi::render_gi: if GiFrame has a size, its gi / direct
