@@ -585,17 +585,27 @@ TEST(Interpolation, BackFacingProbesArePruned) {
   }
 }
 
+namespace {
+// Probe 1 (at x = 1 in a row of two) records one own hit a texel, at the
+// distance `hit_at(direction)` gives (none where it gives 0).
+template <class HitAt>
+void record_probe1_hits(std::vector<ProbeMapState>& states, const MapLayout& m, HitAt hit_at) {
+  std::vector<ShadedPoint> hits;
+  for (int t = 0; t < m.texel_count(); ++t) {
+    const glm::vec3 d = m.direction_of(t);
+    const float along = hit_at(d);
+    if (along > 0) hits.push_back({glm::vec3(1, 0, 0) + d * along, glm::vec3(0), d, along});
+  }
+  update_own_depth(states[1], m, hits, {});
+}
+}  // namespace
+
 TEST(Interpolation, OccludedProbeIsPrunedByChebyshev) {
   const ProbeGrid g{{0, 0, 0}, {1, 0, 0}, {2, 1, 1}};
   const MapLayout m{32, 16};
   auto states = open_space_states(g, m);
   // Probe 1 at x = 1 has a wall at x = 0.8: its own rays towards -x hit it.
-  std::vector<ShadedPoint> wall_hits;
-  for (int t = 0; t < m.texel_count(); ++t) {
-    const glm::vec3 d = m.direction_of(t);
-    if (d.x < -0.1f) wall_hits.push_back({glm::vec3(1, 0, 0) + d * (0.2f / -d.x), glm::vec3(0), d, 0.2f / -d.x});
-  }
-  update_own_depth(states[1], m, wall_hits, {});
+  record_probe1_hits(states, m, [](const glm::vec3& d) { return d.x < -0.1f ? 0.2f / -d.x : 0.0f; });
   // A point at x = 0.4 facing +y (so neither probe is behind it): probe 1
   // must not see it through the wall, probe 0 takes all the weight.
   const auto r = interpolate_probes(g, m, states, {0.4f, 0, 0}, {0, 1, 0}, {});
@@ -647,14 +657,7 @@ TEST(Interpolation, AProbeBeyondAWallsEdgeFadesInInsteadOfFlipping) {
   auto states = open_space_states(g, m);
   // Probe 1 at x = 1: a wall at x = 0.8 below y = 0; above it, the room's
   // far wall at x = -1.
-  std::vector<ShadedPoint> wall_hits;
-  for (int t = 0; t < m.texel_count(); ++t) {
-    const glm::vec3 d = m.direction_of(t);
-    if (d.x > -0.1f) continue;
-    const float along = d.y < 0 ? 0.2f / -d.x : 2.0f / -d.x;
-    wall_hits.push_back({glm::vec3(1, 0, 0) + d * along, glm::vec3(0), d, along});
-  }
-  update_own_depth(states[1], m, wall_hits, {});
+  record_probe1_hits(states, m, [](const glm::vec3& d) { return d.x > -0.1f ? 0.0f : (d.y < 0 ? 0.2f : 2.0f) / -d.x; });
   const auto probe1_weight = [&](float y, const InterpolationSettings& s) {
     const InterpolationResult r = interpolate_probes(g, m, states, {0.4f, y, 0.0f}, {0, 0, 1}, s);
     float w = 0;
