@@ -22,9 +22,14 @@ float visibility_weight(float visibility, const InterpolationSettings& s) {
 
 namespace {
 // The four texels around `at` and their bilinear weights (filtered_visibility).
-struct Footprint {
-  std::array<int, 4> texel{};
-  std::array<float, 4> weight{};
+struct Footprint {  // left uninitialised where weigh() does not test a corner
+  std::array<int, 4> texel;
+  std::array<float, 4> weight;
+};
+// A depth texel's two binary16 moments (DepthMap::Texel without its NaN
+// initialiser: weigh() copies only the corners it tests).
+struct TexelBits {
+  std::uint16_t mean, variance;
 };
 
 Footprint footprint(const MapLayout& layout, glm::vec2 at) {
@@ -46,7 +51,7 @@ Footprint footprint(const MapLayout& layout, glm::vec2 at) {
 // v4, a library call in the scalar build; exact either way.
 ENGINE_INLINE_BODY float half_to_float(std::uint16_t h) { return static_cast<float>(std::bit_cast<_Float16>(h)); }
 
-ENGINE_INLINE_BODY float visibility_of(const std::array<DepthMap::Texel, 4>& texels, const Footprint& f, float unit,
+ENGINE_INLINE_BODY float visibility_of(const std::array<TexelBits, 4>& texels, const Footprint& f, float unit,
                                        float distance) {
   float m1 = 0, m2 = 0, sum = 0;
   for (std::size_t k = 0; k < 4; ++k) {
@@ -65,8 +70,11 @@ ENGINE_INLINE_BODY float visibility_of(const std::array<DepthMap::Texel, 4>& tex
 
 float filtered_visibility(const DepthMap& depth, const MapLayout& layout, glm::vec2 at, float distance) {
   const Footprint f = footprint(layout, at);
-  std::array<DepthMap::Texel, 4> texels;
-  for (std::size_t k = 0; k < 4; ++k) texels[k] = depth.texels[static_cast<std::size_t>(f.texel[k])];
+  std::array<TexelBits, 4> texels;
+  for (std::size_t k = 0; k < 4; ++k) {
+    const DepthMap::Texel& t = depth.texels[static_cast<std::size_t>(f.texel[k])];
+    texels[k] = {t.mean, t.variance};
+  }
   return visibility_of(texels, f, depth.unit, distance);
 }
 
@@ -221,14 +229,17 @@ ENGINE_INLINE_BODY InterpolationResult weigh_body(const ProbeGrid::Cage& cage, c
     keep[i] = cage.weights[i] > 0 && holds_light && !(s.prune_back_facing && facing[i] < 0);
   }
   // The depth reads (often cache misses) are issued together, so they overlap.
-  std::array<Footprint, 8> foot{};
-  std::array<std::array<DepthMap::Texel, 4>, 8> depth{};
+  std::array<Footprint, 8> foot;
+  std::array<std::array<TexelBits, 4>, 8> depth;
   const bool test_depth = s.prune_occluded;
   for (std::size_t i = 0; i < 8; ++i)
     if (keep[i] && test_depth && c.texel[i] >= 0) {
       foot[i] = footprint(layout, c.at[i]);
       const std::vector<DepthMap::Texel>& texels = states[static_cast<std::size_t>(cage.probes[i])].depth.texels;
-      for (std::size_t k = 0; k < 4; ++k) depth[i][k] = texels[static_cast<std::size_t>(foot[i].texel[k])];
+      for (std::size_t k = 0; k < 4; ++k) {
+        const DepthMap::Texel& t = texels[static_cast<std::size_t>(foot[i].texel[k])];
+        depth[i][k] = {t.mean, t.variance};
+      }
     }
   float sum = 0;
   for (std::size_t i = 0; i < 8; ++i) {
