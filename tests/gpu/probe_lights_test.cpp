@@ -29,7 +29,7 @@ struct Cascades {
 
 // Three 6^3 cascades (0.4, 0.8, 1.6 m cells) centred on a point of the
 // level, updated for 12 frames, the finer lit beyond their box by the
-// coarser, as the plugin runs them.
+// coarser, as the plugin runs them, seen from that point.
 Cascades level_cascades(const rt::RtScene& scene, const render::LightSet& lights, const glm::vec3& eye, int count = 3,
                         float finest_cell = 0.4f, bool far_field = false) {
   probes::CascadeSettings c;
@@ -54,6 +54,8 @@ Cascades level_cascades(const rt::RtScene& scene, const render::LightSet& lights
     s.blend_cells = probes::kFallbackBlendCells;
     out.owned.push_back(std::make_unique<probes::ProbeField>(s));
   }
+  // The camera at the eye, as the probe sync systems set it: both sides take the view bias.
+  for (const auto& f : out.owned) f->set_viewer(eye);
   const int fields = static_cast<int>(out.owned.size());
   for (int frame = 0; frame < 12; ++frame)
     for (int k = fields - 1; k >= 0; --k)
