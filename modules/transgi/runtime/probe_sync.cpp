@@ -49,12 +49,10 @@ void sync_probe_volumes(View<Get<const scene::Camera, const transform::WorldTran
     probes::ProbeFieldSettings wanted = settings->probes;
     wanted.grid = probes::ProbeGrid::centred_in(v.min, v.max, v.dims);
     wanted.blend_cells = v.blend_cells;
-    if (!v.field || !(v.field->settings() == wanted)) {
-      v.field = std::make_shared<probes::ProbeField>(wanted);
-      v.field->set_viewer(eye);
-      return;
-    }
-    tell(*v.field, changes);
+    if (!v.field || !(v.field->settings() == wanted))
+      v.field = std::make_shared<probes::ProbeField>(wanted);  // new: nothing to tell
+    else
+      tell(*v.field, changes);
     v.field->set_viewer(eye);
   });
   seen->geometry = lights->geometry_version;
