@@ -198,10 +198,14 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
   // Among the (up to four) previous cells around where the point was seen,
   // within `reach` in the object's frame, on the same object, normals alike:
   // the nearest fresh one (a value to reuse; only for reuse_colour) and the
-  // nearest of any (the track, the kept transfer). Where nothing moved, the
-  // same cell is as good as the nearest.
+  // nearest of any (the kept transfer). Where nothing moved, the same cell is
+  // as good as the nearest. The track: the nearest of any within
+  // `track_reach`, from the 4 x 4 cells around where none of the four is.
+  struct Picks {
+    std::int32_t fresh = kDecode, any = kDecode, track = kDecode;
+  };
   const auto previous_cells = [&](std::size_t c, const Motion& m, const glm::vec3& p_obj, const glm::vec3& n_obj, float reach,
-                                  bool reuse_colour) -> std::pair<std::int32_t, std::int32_t> {
+                                  float track_reach, bool reuse_colour) -> Picks {
     const auto matches = [&](const Key& k, float& d2) {
       if (k.object != m.prev_object) return false;
       const float cos_normal =
@@ -213,33 +217,46 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
       return true;
     };
     float d2 = 0;
-    if (!reuse_colour && matches(prev_.key[c], d2) && d2 <= reach * reach) return {kDecode, static_cast<std::int32_t>(c)};
+    if (!reuse_colour && matches(prev_.key[c], d2) && d2 <= reach * reach)
+      return {kDecode, static_cast<std::int32_t>(c), static_cast<std::int32_t>(c)};
     const glm::vec3 local = m.prev_m * p_obj + m.prev_t;
-    if (!(local.z < 0)) return {kDecode, kDecode};  // behind last frame's camera
+    if (!(local.z < 0)) return {};  // behind last frame's camera
     // The previous cells around where the point was seen (cell centres at integers).
     const float inv = -1.0f / local.z;
     const float u = prev_u0 + prev_kx * local.x * inv, v = prev_v0 - prev_ky * local.y * inv;
-    if (!(u > -1.0f && v > -1.0f && u < static_cast<float>(prev_.grid_w) && v < static_cast<float>(prev_.grid_h))) return {kDecode, kDecode};
+    if (!(u > -1.0f && v > -1.0f && u < static_cast<float>(prev_.grid_w) && v < static_cast<float>(prev_.grid_h))) return {};
     const int i0 = static_cast<int>(u + 1.0f) - 1, j0 = static_cast<int>(v + 1.0f) - 1;  // floor, as u, v > -1
-    float best = reach * reach, best_any = reach * reach;
-    std::int32_t pick = kDecode, pick_any = kDecode;
-    for (int dj = 0; dj < 2; ++dj)
-      for (int di = 0; di < 2; ++di) {
-        const int pi = i0 + di, pj = j0 + dj;
-        if (pi < 0 || pj < 0 || pi >= prev_.grid_w || pj >= prev_.grid_h) continue;
-        const std::size_t q = static_cast<std::size_t>(pj) * static_cast<std::size_t>(prev_.grid_w) + static_cast<std::size_t>(pi);
-        const Key& k = prev_.key[q];
-        if (!matches(k, d2)) continue;
-        if (reuse_colour && k.fresh && d2 <= best) {
-          best = d2;
-          pick = static_cast<std::int32_t>(q);
-        }
-        if (d2 <= best_any) {
-          best_any = d2;
-          pick_any = static_cast<std::int32_t>(q);
-        }
+    float best = reach * reach, best_any = reach * reach, best_track = track_reach * track_reach;
+    Picks picks;
+    const auto look = [&](int di, int dj, bool inner) {
+      const int pi = i0 + di, pj = j0 + dj;
+      if (pi < 0 || pj < 0 || pi >= prev_.grid_w || pj >= prev_.grid_h) return;
+      const std::size_t q = static_cast<std::size_t>(pj) * static_cast<std::size_t>(prev_.grid_w) + static_cast<std::size_t>(pi);
+      const Key& k = prev_.key[q];
+      if (!matches(k, d2)) return;
+      if (inner && reuse_colour && k.fresh && d2 <= best) {
+        best = d2;
+        picks.fresh = static_cast<std::int32_t>(q);
       }
-    return {pick, pick_any};
+      if (inner && d2 <= best_any) {
+        best_any = d2;
+        picks.any = static_cast<std::int32_t>(q);
+      }
+      if (d2 <= best_track) {
+        best_track = d2;
+        picks.track = static_cast<std::int32_t>(q);
+      }
+    };
+    for (int dj = 0; dj < 2; ++dj)
+      for (int di = 0; di < 2; ++di) look(di, dj, true);
+    // At an edge the jitter can put a cell's point on the far side of the
+    // 2 x 2 cells around it, on the surface the last frame's cells beyond
+    // them saw: the track looks one cell further.
+    if (picks.track == kDecode)
+      for (int dj = -1; dj < 3; ++dj)
+        for (int di = -1; di < 3; ++di)
+          if (dj < 0 || dj > 1 || di < 0 || di > 1) look(di, dj, false);
+    return picks;
   };
   // A kept transfer is taken while the point is within a footprint of where
   // it was decoded (it does not creep cell by cell), the view direction
@@ -290,11 +307,19 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
       if (m.prev_object == kNoObject || (!reuse_colour && !track && !keeps)) continue;
       // Within a cell's footprint at the point's depth, in object units.
       const float reach = depth * spread * cell_pixels * m.to_object_scale;
-      const auto [pick, pick_any] = previous_cells(c, m, p_obj, n_obj, reach, reuse_colour);
-      if (reuse_colour) source[c] = pick;
-      if (track) (*track)[c] = pick_any;
-      if (keeps && pick_any != kDecode) {
-        const auto q = static_cast<std::size_t>(pick_any);
+      // The track's reach is the cell's footprint on its surface, as a kept
+      // transfer's (transfer_still_holds): where the surface is seen at a
+      // grazing angle the jitter moves the point up to 1 / cos further along
+      // it. With the cell's own footprint and the 2 x 2 cells alone, a tenth
+      // to a fifth of the Living Room's cells lost their track every frame of
+      // a still view, their near field's mean restarting from one frame's noise.
+      const glm::vec3 wo_track = keeps ? wo_obj : -glm::normalize(m.a * dir);
+      const float track_reach = reach / std::max(std::abs(glm::dot(n_obj, wo_track)), 0.25f);
+      const Picks picks = previous_cells(c, m, p_obj, n_obj, reach, track_reach, reuse_colour);
+      if (reuse_colour) source[c] = picks.fresh;
+      if (track) (*track)[c] = picks.track;
+      if (keeps && picks.any != kDecode) {
+        const auto q = static_cast<std::size_t>(picks.any);
         const std::uint32_t slot = prev_.slot.empty() ? kNoSlot : prev_.slot[q];
         if (slot != kNoSlot && transfer_still_holds(prev_.anchor[q], p_obj, n_obj, wo_obj, reach)) {
           cur_.slot[c] = slot;
