@@ -387,7 +387,6 @@ TransGISettings realtime_preset() {
   s.realtime.transfer_max_age = 32;
   s.taa.enabled = true;
   s.direct_light = DirectLight::Deterministic;
-  s.mirror.light_samples = 4;  // the frame's budget; the quality preset's 16 only shows in mirrors
   s.probes.fixed_pattern = true;  // with the deterministic direct light: no seed anywhere in the image
   // One ray from about 4096 cells a frame, averaged over frames: gives a
   // daylit room the contact light the metre-spaced probes miss (the

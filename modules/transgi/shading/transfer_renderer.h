@@ -30,16 +30,19 @@ enum class TransferSource {
 // Near-mirrors (metallic, roughness at most `max_roughness`; negative = off)
 // get one reflection ray instead of SH transfer, which cannot hold a mirror
 // (the paper's limitation; engines trace reflections): the hit's radiance is
-// its diffuse albedo / pi times the probe irradiance there plus
-// `light_samples` next-event samples, weighted by the mirror's Fresnel. Used
-// by the quality and the real-time path alike. Higher max_roughness = more
+// its diffuse albedo / pi times the probe irradiance there plus its direct
+// light (the quality path: `light_samples` next-event samples; the real-time
+// path: the probes' direct SH and a shadow ray per punctual light), weighted
+// by the mirror's Fresnel. Used by both paths. Higher max_roughness = more
 // surfaces reflect sharply, at the cost of one ray per such pixel and the
 // glossy blur lost.
 struct MirrorRay {
   float max_roughness = 0.05f;
+  // The quality path only (the real-time path lights its reflections' hits
+  // with the probes' direct SH and one shadow ray per punctual light).
   // Higher = less grain in what a mirror shows (a light seen through a
   // window is found by few samples), at the cost of shadow rays per mirror
-  // pixel. The real-time preset takes 4.
+  // pixel.
   int light_samples = 16;
   // The real-time path only: metals rougher than max_roughness up to this
   // reflect by one GGX-sampled ray a pixel, a different one at each phase
