@@ -96,6 +96,27 @@ Diff diff_on(const Lit::Frame& f, ecs::Entity entity) {
   return d;
 }
 
+// GiHistory::plan on its own: the edge scene seen from one camera, each
+// frame traced (with the antialiasing's jitter where given) and planned.
+struct Planning {
+  EdgeScene s;
+  const rt::RtScene& rt = s.app.world().resource<rt::RtScene>();
+  const scene::SceneAssets& assets = s.app.world().resource<scene::SceneAssets>();
+  const render::CameraRays rays{scene::Camera{}, camera_at({0.3f, 1.2f, 3.5f}), kW, kH};
+  shading::GiHistory history;
+  shading::RealtimeGiSettings rs;
+  std::vector<std::int32_t> source;
+  shading::GBuffer g;
+  shading::UpsamplingPlan up;
+  void frame(glm::vec2 jitter = glm::vec2(0.0f), std::vector<std::int32_t>* track = nullptr) {
+    s.app.jobs().run([&] {
+      shading::trace_gbuffer(rt, assets, rays, kW, kH, g, nullptr, nullptr, jitter);
+      shading::plan_upsampling(g.guide, kW, kH, rs, up);
+      history.plan(up, g, rt, source, track);
+    });
+  }
+};
+
 }  // namespace
 
 // The real-time frame hands last frame's GI image back (RealtimeGiScratch::
@@ -175,21 +196,14 @@ TEST(GiHistory, AMovingObjectReusesThroughItsMotionAndWhatItUncoversIsDecoded) {
 // Each reused cell must name a previous cell on the same object, and most
 // of the box's cells of this frame's reuse colour must find one.
 TEST(GiHistory, CellsFindTheirPointsThroughTheObjectsMotion) {
-  EdgeScene s;
-  const auto& rt = s.app.world().resource<rt::RtScene>();
-  const auto& assets = s.app.world().resource<scene::SceneAssets>();
-  const render::CameraRays rays(scene::Camera{}, camera_at({0.3f, 1.2f, 3.5f}), kW, kH);
-  shading::GiHistory history;
-  shading::RealtimeGiSettings rs;
-  std::vector<std::int32_t> source;
-  shading::GBuffer g;
-  shading::UpsamplingPlan up;
+  Planning p;
+  EdgeScene& s = p.s;
+  const std::vector<std::int32_t>& source = p.source;
+  const shading::GBuffer& g = p.g;
+  const shading::UpsamplingPlan& up = p.up;
+  shading::GiHistory& history = p.history;
   std::vector<ecs::Entity> before;
-  s.app.jobs().run([&] {
-    g = shading::trace_gbuffer(rt, assets, rays, kW, kH);
-    shading::plan_upsampling(g.guide, kW, kH, rs, up);
-    history.plan(up, g, rt, source);
-  });
+  p.frame();
   for (const std::int32_t c : source) ASSERT_EQ(c, shading::GiHistory::kDecode) << "no history yet";
   // Values that name their cell, so a reuse shows where it came from.
   std::vector<glm::vec3> value(up.cell_pixel.size()), direct;
@@ -204,11 +218,7 @@ TEST(GiHistory, CellsFindTheirPointsThroughTheObjectsMotion) {
   t.translation.x += 0.3f;
   t.rotation = glm::angleAxis(0.9f, glm::vec3(0, 1, 0));
   s.app.update();
-  s.app.jobs().run([&] {
-    g = shading::trace_gbuffer(rt, assets, rays, kW, kH);
-    shading::plan_upsampling(g.guide, kW, kH, rs, up);
-    history.plan(up, g, rt, source);
-  });
+  p.frame();
   int box_tries = 0, box_reused = 0, reused = 0;
   for (std::size_t c = 0; c < source.size(); ++c) {
     if (!(up.cell_guide[c].w > 0)) continue;
@@ -270,25 +280,15 @@ TEST(GiHistory, AMovingCameraReusesThroughReprojectionAndACutOnlyWhatBothViewsSa
 // every frame of a still view, and here 3.6 % did; now at most 1 % may
 // (measured 0.03 %).
 TEST(GiHistory, AStillViewUnderJitterKeepsItsCellsTracks) {
-  EdgeScene s;
-  const auto& rt = s.app.world().resource<rt::RtScene>();
-  const auto& assets = s.app.world().resource<scene::SceneAssets>();
-  const render::CameraRays rays(scene::Camera{}, camera_at({0.3f, 1.2f, 3.5f}), kW, kH);
-  shading::GiHistory history;
-  shading::RealtimeGiSettings rs;
-  std::vector<std::int32_t> source, track;
-  shading::GBuffer g;
-  shading::UpsamplingPlan up;
+  Planning p;
+  std::vector<std::int32_t> track;
+  const shading::UpsamplingPlan& up = p.up;
   // The antialiasing's Halton (2, 3) offsets, centred on the pixel.
   const glm::vec2 jitter[] = {{0.0f, -0.1667f}, {-0.25f, 0.1667f}, {0.25f, -0.3889f}, {-0.375f, -0.0556f},
                               {0.125f, 0.2778f}, {-0.125f, -0.2778f}, {0.375f, 0.0556f}, {-0.4375f, 0.3889f}};
   std::size_t lit = 0, lost = 0;
   for (int f = 0; f < 8; ++f) {
-    s.app.jobs().run([&] {
-      shading::trace_gbuffer(rt, assets, rays, kW, kH, g, nullptr, nullptr, jitter[f]);
-      shading::plan_upsampling(g.guide, kW, kH, rs, up);
-      history.plan(up, g, rt, source, &track);
-    });
+    p.frame(jitter[f], &track);
     std::vector<glm::vec3> value(up.cell_pixel.size(), glm::vec3(0.0f)), direct;
     std::vector<std::uint8_t> fresh(up.cell_pixel.size());
     for (std::size_t c = 0; c < value.size(); ++c) fresh[c] = up.cell_guide[c].w > 0;
@@ -298,7 +298,7 @@ TEST(GiHistory, AStillViewUnderJitterKeepsItsCellsTracks) {
           ++lit;
           if (track[c] == shading::GiHistory::kDecode) ++lost;
         }
-    history.store(value, direct, fresh);
+    p.history.store(value, direct, fresh);
   }
   std::printf("still view, 7 jittered frames: %zu of %zu lit cells lost their track (%.1f %%)\n", lost, lit, 100.0 * lost / lit);
   ASSERT_GT(lit, 1000u);

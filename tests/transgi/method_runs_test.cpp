@@ -17,12 +17,20 @@ namespace {
 const std::string kScene = std::string(TRANSGI_CONTENT_DIR) + "/test_scenes/cornell_box/scene.gltf";
 constexpr int kW = 48, kH = 27, kWindow = 8, kFrames = 24;
 
+// What both methods' runs share: the frames, how many are timed, a 4^3
+// grid, no progress bar.
+template <class Options>
+Options run_options(int timing_frames) {
+  Options o;
+  o.frames = kFrames;
+  o.timing_frames = timing_frames;
+  o.placement.scene_dims = glm::ivec3(4);
+  o.progress = false;
+  return o;
+}
+
 eval::MethodRun transgi_run(int temporal_window, int timing_frames) {
-  eval::TransgiRunOptions t;
-  t.frames = kFrames;
-  t.timing_frames = timing_frames;
-  t.placement.scene_dims = glm::ivec3(4);
-  t.progress = false;
+  auto t = run_options<eval::TransgiRunOptions>(timing_frames);
   t.settings.direct_spp = 0;
   t.settings.temporal_window = temporal_window;
   eval::LoadedScene scene = eval::load_scene(kScene, "", 2);
@@ -31,11 +39,7 @@ eval::MethodRun transgi_run(int temporal_window, int timing_frames) {
 }
 
 eval::MethodRun ddgi_run(int temporal_window, int timing_frames) {
-  eval::DdgiRunOptions d;
-  d.frames = kFrames;
-  d.timing_frames = timing_frames;
-  d.placement.scene_dims = glm::ivec3(4);
-  d.progress = false;
+  auto d = run_options<eval::DdgiRunOptions>(timing_frames);
   d.render.direct_spp = 0;
   d.render.temporal_window = temporal_window;
   eval::LoadedScene scene = eval::load_scene(kScene, "", 2);
