@@ -881,7 +881,9 @@ TEST(GameSession, TheFirstFrameHasTheNearFieldsWholeLight) {
   // first frames after the probes' warm-up showed its sparse lattice as
   // blocks on shaded faces (the sofa's front), fading over a dozen frames.
   // The image warm-up traces every cell for 8 thrown-away frames: frame 0
-  // must be much nearer frame 30 than without it.
+  // must be much nearer frame 30 than without it. (Without it frame 0 is a
+  // cut, whose contact light fades in, NearFieldRays::cut_fade_frames: that
+  // alone took the difference from 0.029 to 0.019; the warm-up to 0.013.)
   const auto first_vs_later = [](int image_warmup) {
     game::GameOptions o = level_options(320, 180);
     o.view = "gi";
@@ -892,5 +894,5 @@ TEST(GameSession, TheFirstFrameHasTheNearFieldsWholeLight) {
   const double with_images = first_vs_later(8), probes_only = first_vs_later(0);
   std::printf("[ measured ] frame 0 against frame 30, mean |difference| / mean: %.4f with the image warm-up, %.4f probes only\n",
               with_images, probes_only);
-  EXPECT_LT(with_images, 0.65 * probes_only);
+  EXPECT_LT(with_images, 0.8 * probes_only);
 }

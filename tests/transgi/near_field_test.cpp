@@ -8,6 +8,7 @@
 // L0 by L:  dE = pi (1 - (h / R)^2) (L - L0).
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include <gtest/gtest.h>
 
@@ -274,46 +275,76 @@ TEST(NearField, TheSeparableFilterKeepsAConstantTakesOnlyValidPixelsAndNeverCros
 // 10 % (64 rays a sample on both; measured 4.5 % apart: the real-time grid
 // samples every second pixel and its filter reaches twice as far, on a light
 // that falls steeply with height), and the wall's top gets none.
-TEST(NearField, TheRealTimePathAgreesWithTheQualityPath) {
-  app::App app(app::AppOptions{.jobs = {.threads = 2}});
-  scene::SceneAssets a;
-  a.generation = scene::next_scene_generation();
-  a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({10, 10}, 0)),
-              std::make_shared<scene::MeshAsset>(scene::make_quad({2, 1}, 1))};
-  a.materials = {lambert(glm::vec3(0.5f)), lambert(glm::vec3(0.8f))};
-  app.world().insert_resource<scene::SceneAssets>(std::move(a));
-  app.add_plugin<rt::RtPlugin>();
-  ecs::World& w = app.world();
-  const ecs::Entity floor = w.spawn();
-  w.emplace<transform::Transform>(floor);
-  w.emplace<scene::MeshInstance>(floor, scene::MeshInstance{0});
-  const ecs::Entity wall = w.spawn();  // 4 x 2 m, standing on the floor at z = -1, facing +z
-  transform::Transform wt = transform::Transform::from_translation({0, 1, -1});
-  wt.rotation = glm::angleAxis(glm::half_pi<float>(), glm::vec3(1, 0, 0));
-  w.emplace<transform::Transform>(wall, wt);
-  w.emplace<scene::MeshInstance>(wall, scene::MeshInstance{1});
-  const ecs::Entity sun = w.spawn();
-  transform::Transform st;
-  st.rotation = glm::quatLookAt(glm::vec3(0, -1, 0), glm::vec3(0, 0, 1));  // straight down: the wall is edge-on
-  w.emplace<transform::Transform>(sun, st);
-  w.emplace<scene::PunctualLight>(sun, scene::PunctualLight{.type = scene::PunctualLight::Type::Directional, .intensity = 2.0f});
-  const ecs::Entity camera = w.spawn();
-  transform::Transform cam = transform::Transform::from_translation({0, 1, 2});
-  cam.rotation = glm::quatLookAt(glm::vec3(0, 0, -1), glm::vec3(0, 1, 0));
-  w.emplace<transform::Transform>(camera, cam);
-  w.emplace<scene::Camera>(camera, scene::Camera{.yfov_radians = 0.9f});
-  app.update();
+namespace {
+// A wall standing on a sunlit floor, probes holding no light: the wall's GI
+// is its contact light alone (the real-time near field's tests below).
+struct WallOnSunlitFloor {
+  app::App app{app::AppOptions{.jobs = {.threads = 2}}};
+  ecs::Entity wall{};
+  probes::ProbeFieldSettings ps;
+  std::unique_ptr<probes::ProbeField> field;
+  std::unique_ptr<render::LightSet> lights;
+  std::unique_ptr<render::CameraRays> rays;
+  ecs::Entity camera{};
+  static constexpr int kSize = 48;
 
-  const auto& rt = w.resource<rt::RtScene>();
-  const auto& assets = w.resource<scene::SceneAssets>();
-  const render::LightSet lights(rt, render::gather_punctual_lights(w), nullptr);
-  const int size = 48;
-  const render::CameraRays rays(w.get<scene::Camera>(camera), w.get<transform::WorldTransform>(camera), size, size);
-  probes::ProbeFieldSettings ps;  // never updated: it holds no light
-  ps.grid = probes::ProbeGrid{{-2, 0.1f, -0.9f}, {2, 2.1f, 1.1f}, {5, 3, 3}};
-  ps.map = probes::MapLayout{8, 4};
-  const probes::ProbeField field(ps);
-  const probes::ProbeField* fields[] = {&field};
+  WallOnSunlitFloor() {
+    scene::SceneAssets a;
+    a.generation = scene::next_scene_generation();
+    a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({10, 10}, 0)),
+                std::make_shared<scene::MeshAsset>(scene::make_quad({2, 1}, 1))};
+    a.materials = {lambert(glm::vec3(0.5f)), lambert(glm::vec3(0.8f))};
+    app.world().insert_resource<scene::SceneAssets>(std::move(a));
+    app.add_plugin<rt::RtPlugin>();
+    ecs::World& w = app.world();
+    const ecs::Entity floor = w.spawn();
+    w.emplace<transform::Transform>(floor);
+    w.emplace<scene::MeshInstance>(floor, scene::MeshInstance{0});
+    wall = w.spawn();  // 4 x 2 m, standing on the floor at z = -1, facing +z
+    transform::Transform wt = transform::Transform::from_translation({0, 1, -1});
+    wt.rotation = glm::angleAxis(glm::half_pi<float>(), glm::vec3(1, 0, 0));
+    w.emplace<transform::Transform>(wall, wt);
+    w.emplace<scene::MeshInstance>(wall, scene::MeshInstance{1});
+    const ecs::Entity sun = w.spawn();
+    transform::Transform st;
+    st.rotation = glm::quatLookAt(glm::vec3(0, -1, 0), glm::vec3(0, 0, 1));  // straight down: the wall is edge-on
+    w.emplace<transform::Transform>(sun, st);
+    w.emplace<scene::PunctualLight>(sun, scene::PunctualLight{.type = scene::PunctualLight::Type::Directional, .intensity = 2.0f});
+    camera = w.spawn();
+    transform::Transform cam = transform::Transform::from_translation({0, 1, 2});
+    cam.rotation = glm::quatLookAt(glm::vec3(0, 0, -1), glm::vec3(0, 1, 0));
+    w.emplace<transform::Transform>(camera, cam);
+    w.emplace<scene::Camera>(camera, scene::Camera{.yfov_radians = 0.9f});
+    app.update();
+    lights = std::make_unique<render::LightSet>(w.resource<rt::RtScene>(), render::gather_punctual_lights(w), nullptr);
+    look_from(cam);
+    ps.grid = probes::ProbeGrid{{-2, 0.1f, -0.9f}, {2, 2.1f, 1.1f}, {5, 3, 3}};  // never updated: it holds no light
+    ps.map = probes::MapLayout{8, 4};
+    field = std::make_unique<probes::ProbeField>(ps);
+  }
+  // The camera rays from `pose` (the camera entity's transform).
+  void look_from(const transform::Transform& pose) {
+    ecs::World& w = app.world();
+    w.get_mut<transform::Transform>(camera) = pose;
+    app.update();
+    rays = std::make_unique<render::CameraRays>(w.get<scene::Camera>(camera), w.get<transform::WorldTransform>(camera), kSize, kSize);
+  }
+  [[nodiscard]] const rt::RtScene& rt() { return app.world().resource<rt::RtScene>(); }
+  [[nodiscard]] const scene::SceneAssets& assets() { return app.world().resource<scene::SceneAssets>(); }
+};
+}  // namespace
+
+TEST(NearField, TheRealTimePathAgreesWithTheQualityPath) {
+  WallOnSunlitFloor scene;
+  const ecs::Entity wall = scene.wall;
+  const probes::ProbeFieldSettings& ps = scene.ps;
+  const auto& rt = scene.rt();
+  const auto& assets = scene.assets();
+  const render::LightSet& lights = *scene.lights;
+  const int size = WallOnSunlitFloor::kSize;
+  const render::CameraRays& rays = *scene.rays;
+  const probes::ProbeField* fields[] = {scene.field.get()};
+  app::App& app = scene.app;
   const shading::NearFieldRays near{.rays = 64, .reach_cells = 1.0f, .filter_radius = 2};
   const shading::LightAt no_light = [](const glm::vec3&, const glm::vec3&, float* out) { std::fill_n(out, 75, 0.0f); };
 
@@ -395,4 +426,66 @@ TEST(NearField, TheRealTimePathAgreesWithTheQualityPath) {
   EXPECT_LT(step_b / sum_b, 0.05);
   EXPECT_GT(low, 0.0);
   EXPECT_EQ(high, 0.0) << "above the reach (one 1 m cell) of the floor, nothing";
+}
+
+// After a cut (here the first frame: every cell's mean starts at once) the
+// contact light fades in over NearFieldRays::cut_fade_frames frames of its
+// mean: the first frame shows exactly an eighth of it, frame 8 all of it,
+// the same image as without the fade (the means themselves are not
+// faded). A step of the camera starts only some cells' means: nothing
+// fades, the image is the one without the fade.
+TEST(NearField, AfterACutTheContactLightFadesInAndAStepDoesNot) {
+  WallOnSunlitFloor scene;
+  const probes::ProbeField* fields[] = {scene.field.get()};
+  const int size = WallOnSunlitFloor::kSize;
+  struct Run {
+    shading::RealtimeGiScratch scratch;
+    std::vector<image::ImageRGB> frames;
+  };
+  const auto run = [&](int cut_fade, int frames, Run& r) {
+    shading::NearFieldRays near{.rays = 4, .reach_cells = 1.0f, .filter_radius = 2};
+    near.cut_fade_frames = cut_fade;
+    shading::RealtimeGiSettings reuse;
+    reuse.reuse_history = true;
+    shading::GBuffer g;
+    scene.app.jobs().run([&] {
+      for (int f = 0; f < frames; ++f) {
+        shading::trace_gbuffer(scene.rt(), scene.assets(), *scene.rays, size, size, g);
+        r.frames.push_back(shading::shade_gi_realtime({.gbuffer = g,
+                                                       .scene = scene.rt(),
+                                                       .assets = scene.assets(),
+                                                       .fields = fields,
+                                                       .settings = reuse,
+                                                       .mirror_lights = scene.lights.get(),
+                                                       .mirror = shading::MirrorRay{.max_roughness = -1},
+                                                       .near_field = near},
+                                                      {.scratch = &r.scratch}));
+      }
+    });
+  };
+  Run faded, plain;
+  run(8, 9, faded);
+  run(0, 9, plain);
+  double first_faded = 0, first_plain = 0, last_difference = 0;
+  for (std::size_t p = 0; p < plain.frames[0].pixels.size(); ++p) {
+    first_faded += faded.frames[0].pixels[p].g;
+    first_plain += plain.frames[0].pixels[p].g;
+    last_difference = std::max(last_difference, static_cast<double>(std::abs(faded.frames[8].pixels[p].g - plain.frames[8].pixels[p].g)));
+  }
+  std::printf("first frame's GI summed: %.5f faded, %.5f without; frame 8's largest difference %.3g\n", first_faded, first_plain,
+              last_difference);
+  ASSERT_GT(first_plain, 1.0) << "contact light from the sunlit floor";
+  EXPECT_NEAR(first_faded, first_plain / 8.0, 1e-4 * first_plain);
+  EXPECT_EQ(last_difference, 0.0) << "after 8 frames the fade is over";
+  // A 15 cm step: some cells see new points (the test fails if any new point
+  // counted as a cut), far fewer than a quarter of them.
+  transform::Transform step = transform::Transform::from_translation({0.15f, 1, 2});
+  step.rotation = glm::quatLookAt(glm::vec3(0, 0, -1), glm::vec3(0, 1, 0));
+  scene.look_from(step);
+  run(8, 1, faded);
+  run(0, 1, plain);
+  double step_difference = 0;
+  for (std::size_t p = 0; p < plain.frames.back().pixels.size(); ++p)
+    step_difference = std::max(step_difference, static_cast<double>(std::abs(faded.frames.back().pixels[p].g - plain.frames.back().pixels[p].g)));
+  EXPECT_EQ(step_difference, 0.0) << "a step of the camera is no cut";
 }

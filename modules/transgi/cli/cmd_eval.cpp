@@ -41,7 +41,7 @@ int run_eval(const std::vector<std::string>& argv) {
                   {"scene", "model", "out", "width", "height", "spp", "frames", "ddgi-frames", "ddgi-warmup", "probe-grid",
                    "gbuffer-spp", "camera", "threads", "cache", "seed", "reference-error", "temporal", "probe-volume", "cascades",
                    "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "cascade-map-width", "reflections", "near-field-rays", "near-field-reach",
-                   "near-field-filter", "near-field-budget", "near-field-history", "map-width"},
+                   "near-field-filter", "near-field-budget", "near-field-history", "near-field-cut-fade", "map-width"},
                   {"decompose", "allow-unbaked"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const std::filesystem::path out = args.str("out");

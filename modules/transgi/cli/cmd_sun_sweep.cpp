@@ -68,7 +68,7 @@ int run_sun_sweep(const std::vector<std::string>& argv) {
   const Args args("sun-sweep", argv,
                   {"scene", "model", "out", "width", "height", "positions", "frames", "warmup", "elevation-from",
                    "elevation-to", "azimuth-from", "azimuth-to", "reference-spp", "camera", "threads", "preset",
-                   "probe-budget", "probe-steady-budget", "probe-settle", "backend", "device", "device-inference", "device-lights", "reflections", "near-field-rays", "near-field-reach", "near-field-filter", "near-field-budget", "near-field-history", "gi-scale", "gi-reuse", "taa", "map-width", "direct", "probe-volume", "probe-grid", "cascades",
+                   "probe-budget", "probe-steady-budget", "probe-settle", "backend", "device", "device-inference", "device-lights", "reflections", "near-field-rays", "near-field-reach", "near-field-filter", "near-field-budget", "near-field-history", "near-field-cut-fade", "gi-scale", "gi-reuse", "taa", "map-width", "direct", "probe-volume", "probe-grid", "cascades",
                    "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "cascade-map-width", "settle-tolerance", "changed-first", "probe-skip"},
                   {"allow-unbaked"});
   const std::string scene_path = args.str("scene"), model_path = args.str("model");

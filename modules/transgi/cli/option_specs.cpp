@@ -104,6 +104,8 @@ std::vector<OptionSpec> runtime_option_specs(const std::string& default_preset) 
               "real-time path: GI cells that trace near-field rays a frame (0 = no limit): higher = less noise at high resolutions, at the cost of ray time"),
       integer("near-field-history", "F", 1, 255, by_preset(q.near_field.history_frames, r.near_field.history_frames),
               "real-time path: frames a cell's contact light is averaged over: higher = less noise, at the cost of lag after a change of light"),
+      integer("near-field-cut-fade", "F", 0, 255, by_preset(q.near_field.cut_fade_frames, r.near_field.cut_fade_frames),
+              "real-time path: frames the contact light fades in over after a cut or a sudden turn (0 = off): higher = calmer, at the cost of contact light missing meanwhile"),
   };
 }
 

@@ -43,6 +43,7 @@ void near_field_from(const Args& args, shading::NearFieldRays& n) {
   n.filter_radius = static_cast<int>(args.integer("near-field-filter", 0, 16, n.filter_radius));
   n.cell_budget = static_cast<int>(args.integer("near-field-budget", 0, 1 << 24, n.cell_budget));
   n.history_frames = static_cast<int>(args.integer("near-field-history", 1, 255, n.history_frames));
+  n.cut_fade_frames = static_cast<int>(args.integer("near-field-cut-fade", 0, 255, n.cut_fade_frames));
 }
 
 runtime::ProbePlacement probe_placement_from(const Args& args, runtime::ProbeVolumeMode default_mode) {

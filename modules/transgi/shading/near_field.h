@@ -50,6 +50,14 @@ struct NearFieldRays {
   // running mean, restarted near a moved object). Higher = less noise, at
   // the cost of contact light that lags a change of light as many frames.
   int history_frames = 32;
+  // Real-time path: after a cut, or a turn as sudden (a quarter of the view
+  // seen anew in one frame), each new surface's contact light fades in over
+  // this many frames of its mean instead of showing its first frames'
+  // estimates, which mottled the whole view with the filter's blotches.
+  // Higher = a calmer first moment after a cut, at the cost of contact light
+  // missing in proportion for that many frames. 0 = off (surfaces seen anew
+  // as the camera moves, a few percent a frame, never fade).
+  int cut_fade_frames = 8;
   bool operator==(const NearFieldRays&) const = default;
 };
 

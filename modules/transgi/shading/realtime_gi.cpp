@@ -42,6 +42,9 @@ struct ContactScratch {
   // light and how many frames it holds; this frame's, then swapped.
   std::vector<glm::vec3> mean, mean_next;
   std::vector<std::uint8_t> count, count_next;
+  // Per cell of the last frame: its mean started in a cut (NearFieldRays::
+  // cut_fade_frames) and still fades in; this frame's, then swapped.
+  std::vector<std::uint8_t> fading, fading_next;
   std::vector<std::int32_t> track;  // GiHistory::plan's
   std::vector<std::uint8_t> moved, near_moved, near_moved_row;  // GiHistory::plan's, and it dilated
   std::uint64_t frame = 0;
@@ -277,6 +280,12 @@ constexpr int kMovingContactFrames = 4;
 // light restarts: about twice the filter's reach.
 constexpr int kContactResetCells = 8;
 
+// The share of the lit cells whose means start in one frame above which the
+// frame is a cut (NearFieldRays::cut_fade_frames): the Living Room's
+// fly-through starts 1-5 % of them a frame while it moves (the tracks kept
+// under the jitter), 82 % where its path turns by 78 degrees.
+constexpr float kCutShare = 0.25f;
+
 // Adds the near field's contact light (near_field.h) to the cells decoded
 // this frame (`cells`: cells[k]'s value is value[k]), times each one's
 // contact gain. The rays leave a lattice of cells (NearFieldRays::
@@ -373,17 +382,42 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
     // object's own point keeps kMovingContactFrames).
     scratch.mean_next.resize(grid);
     scratch.count_next.assign(grid, 0);
+    scratch.fading_next.assign(grid, 0);
+    if (scratch.fading.size() != grid) scratch.fading.assign(grid, 0);
+    const auto knows = [&](std::size_t c) {
+      const std::int32_t q = track[c];
+      const bool on_moved = reset_near_moved && moved[c] == GiHistory::kMovedHere;
+      return q >= 0 && static_cast<std::size_t>(q) < scratch.count.size() && scratch.count[static_cast<std::size_t>(q)] > 0 &&
+             (on_moved || !(reset_near_moved && scratch.near_moved[c]));
+    };
+    // A cut (or a turn as sudden): most of the view starts its means at once.
+    const int fade_frames = std::clamp(near_field.cut_fade_frames, 0, history);
+    bool cut = false;
+    if (fade_frames > 1) {
+      std::atomic<std::size_t> lit{0}, starting{0};
+      engine::jobs::parallel_for<std::size_t>(0, grid, 4096, [&](std::size_t b, std::size_t e) {
+        std::size_t l = 0, n = 0;
+        for (std::size_t c = b; c < e; ++c)
+          if (up.cell_guide[c].w > 0) {
+            ++l;
+            if (scratch.estimated[c] && !knows(c)) ++n;
+          }
+        lit.fetch_add(l, std::memory_order_relaxed);
+        starting.fetch_add(n, std::memory_order_relaxed);
+      });
+      cut = static_cast<float>(starting.load()) > kCutShare * static_cast<float>(lit.load());
+    }
     // A cell that no estimate reached carries its point's mean unchanged.
     engine::jobs::parallel_for<std::size_t>(0, grid, 4096, [&](std::size_t b, std::size_t e) {
       for (std::size_t c = b; c < e; ++c) {
         const std::int32_t q = track[c];
         const bool on_moved = reset_near_moved && moved[c] == GiHistory::kMovedHere;
-        const bool known = q >= 0 && static_cast<std::size_t>(q) < scratch.count.size() && scratch.count[static_cast<std::size_t>(q)] > 0 &&
-                           (on_moved || !(reset_near_moved && scratch.near_moved[c]));
+        const bool known = knows(c);
         if (!scratch.estimated[c]) {
           if (known) {
             scratch.mean_next[c] = scratch.mean[static_cast<std::size_t>(q)];
             scratch.count_next[c] = scratch.count[static_cast<std::size_t>(q)];
+            scratch.fading_next[c] = scratch.fading[static_cast<std::size_t>(q)];
           }
           continue;
         }
@@ -392,15 +426,23 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
                                            static_cast<float>(n + 1)
                                      : scratch.filtered[c];
         scratch.count_next[c] = static_cast<std::uint8_t>(n + 1);
+        const bool fading = known ? scratch.fading[static_cast<std::size_t>(q)] != 0 : cut;
+        scratch.fading_next[c] = fading && n + 1 < fade_frames ? 1 : 0;
       }
     });
     std::swap(scratch.mean, scratch.mean_next);
     std::swap(scratch.count, scratch.count_next);
+    std::swap(scratch.fading, scratch.fading_next);
     ++scratch.frame;
   }
   // (A cell with no estimate yet, tracked or not, holds a zero mean or filtered value.)
+  // A mean that started in a cut counts in proportion to its frames until it
+  // holds cut_fade_frames.
+  const float fade_frames = static_cast<float>(std::max(1, near_field.cut_fade_frames));
   const auto contact = [&](std::size_t c) {
-    return tracked ? (scratch.count[c] > 0 ? scratch.mean[c] : glm::vec3(0.0f)) : scratch.filtered[c];
+    if (!tracked) return scratch.filtered[c];
+    if (scratch.count[c] == 0) return glm::vec3(0.0f);
+    return scratch.fading[c] ? scratch.mean[c] * (static_cast<float>(scratch.count[c]) / fade_frames) : scratch.mean[c];
   };
   engine::jobs::parallel_for<std::size_t>(0, cells.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k)
