@@ -252,7 +252,7 @@ void GiHistory::plan(const UpsamplingPlan& up, const GBuffer& g, const engine::r
     // At an edge the jitter can put a cell's point on the far side of the
     // 2 x 2 cells around it, on the surface the last frame's cells beyond
     // them saw: the track looks one cell further.
-    if (picks.track == kDecode)
+    if (track && picks.track == kDecode)
       for (int dj = -1; dj < 3; ++dj)
         for (int di = -1; di < 3; ++di)
           if (dj < 0 || dj > 1 || di < 0 || di > 1) look(di, dj, false);

@@ -374,8 +374,11 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
               scratch.near_moved[y * grid_w + i] = 1;
     });
   }
+  const int history = std::clamp(near_field.history_frames, 1, 255);  // counts are bytes
+  // A mean that started in a cut counts in proportion to its frames until it
+  // holds this many (no more than a mean holds).
+  const int fade_frames = std::clamp(near_field.cut_fade_frames, 0, history);
   if (tracked) {
-    const int history = std::clamp(near_field.history_frames, 1, 255);  // counts are bytes
     // The running mean over the last history_frames frames of each surface
     // point, followed through the GI history's track (a point seen anew, or
     // one near a moved object, starts from this frame's estimate; a moved
@@ -391,7 +394,6 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
              (on_moved || !(reset_near_moved && scratch.near_moved[c]));
     };
     // A cut (or a turn as sudden): most of the view starts its means at once.
-    const int fade_frames = std::clamp(near_field.cut_fade_frames, 0, history);
     bool cut = false;
     if (fade_frames > 1) {
       std::atomic<std::size_t> lit{0}, starting{0};
@@ -436,13 +438,10 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
     ++scratch.frame;
   }
   // (A cell with no estimate yet, tracked or not, holds a zero mean or filtered value.)
-  // A mean that started in a cut counts in proportion to its frames until it
-  // holds cut_fade_frames.
-  const float fade_frames = static_cast<float>(std::max(1, near_field.cut_fade_frames));
   const auto contact = [&](std::size_t c) {
     if (!tracked) return scratch.filtered[c];
     if (scratch.count[c] == 0) return glm::vec3(0.0f);
-    return scratch.fading[c] ? scratch.mean[c] * (static_cast<float>(scratch.count[c]) / fade_frames) : scratch.mean[c];
+    return scratch.fading[c] ? scratch.mean[c] * (static_cast<float>(scratch.count[c]) / static_cast<float>(fade_frames)) : scratch.mean[c];
   };
   engine::jobs::parallel_for<std::size_t>(0, cells.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k)
