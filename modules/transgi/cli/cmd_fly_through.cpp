@@ -15,6 +15,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "cli/args.h"
+#include "cli/option_specs.h"
 #include "cli/commands.h"
 #include "cli/reference_view.h"
 #include "cli/runtime_options.h"
@@ -75,11 +76,7 @@ std::pair<glm::vec3, glm::vec3> along(const std::vector<glm::vec3>& path, float 
 }  // namespace
 
 int run_fly_through(const std::vector<std::string>& argv) {
-  const Args args("fly-through", argv,
-                  {"scene", "model", "out", "width", "height", "frames", "path", "stops", "reference-spp", "threads", "preset",
-                   "probe-budget", "probe-steady-budget", "probe-settle", "backend", "device", "device-inference", "device-lights", "reflections", "near-field-rays", "near-field-reach", "near-field-filter", "near-field-budget", "near-field-history", "near-field-cut-fade", "gi-scale", "gi-reuse", "taa", "map-width", "direct", "probe-volume", "probe-grid", "cascades", "cascade-cell",
-                   "cascade-look-ahead", "cascade-fit-scene", "cascade-map-width", "pitch"},
-                  {"allow-unbaked"});
+  const Args args("fly-through", argv, fly_through_option_specs(), kFlyThroughSynopsis);
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const std::filesystem::path out = args.str("out");
   const int width = static_cast<int>(args.integer("width", 16, 8192, 320));

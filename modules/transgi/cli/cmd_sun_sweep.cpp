@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "cli/args.h"
+#include "cli/option_specs.h"
 #include "cli/commands.h"
 #include "cli/reference_view.h"
 #include "cli/runtime_options.h"
@@ -65,12 +66,7 @@ void write_text(const std::filesystem::path& path, const std::string& text) {
 }  // namespace
 
 int run_sun_sweep(const std::vector<std::string>& argv) {
-  const Args args("sun-sweep", argv,
-                  {"scene", "model", "out", "width", "height", "positions", "frames", "warmup", "elevation-from",
-                   "elevation-to", "azimuth-from", "azimuth-to", "reference-spp", "camera", "threads", "preset",
-                   "probe-budget", "probe-steady-budget", "probe-settle", "backend", "device", "device-inference", "device-lights", "reflections", "near-field-rays", "near-field-reach", "near-field-filter", "near-field-budget", "near-field-history", "near-field-cut-fade", "gi-scale", "gi-reuse", "taa", "map-width", "direct", "probe-volume", "probe-grid", "cascades",
-                   "cascade-cell", "cascade-look-ahead", "cascade-fit-scene", "cascade-map-width", "settle-tolerance", "changed-first", "probe-skip"},
-                  {"allow-unbaked"});
+  const Args args("sun-sweep", argv, sun_sweep_option_specs(), kSunSweepSynopsis);
   const std::string scene_path = args.str("scene"), model_path = args.str("model");
   const std::filesystem::path out = args.str("out");
   const int width = static_cast<int>(args.integer("width", 16, 8192, 320));

@@ -220,4 +220,60 @@ std::vector<OptionSpec> bench_frame_option_specs() {
   return o;
 }
 
+const char* const kFlyThroughSynopsis =
+    "usage: transgi fly-through --scene S.gltf --model M.tgm --out DIR --path X,Y,Z;X,Y,Z;... [options]\n"
+    "  The camera flies the path with the real-time frame running; every frame is checked, and the stops are\n"
+    "  compared with the path tracer.\n";
+
+std::vector<OptionSpec> fly_through_option_specs() {
+  std::vector<OptionSpec> o = {
+      text("scene", "PATH", "", "the glTF scene"),
+      text("model", "PATH", "", "the baked transfer model (.tgm)"),
+      flag("allow-unbaked", "shade meshes the model has no latents for diffusely instead of refusing"),
+      text("out", "DIR", "", "the folder the stops' GI images, the path tracer's and the per-frame CSV go to"),
+      text("path", "X,Y,Z;...", "", "the camera's polyline, two points or more, flown at an even speed"),
+      integer("width", "W", 16, 8192, "320", "frame width in pixels"),
+      integer("height", "H", 16, 8192, "180", "frame height in pixels"),
+      integer("frames", "N", 2, 100000, "300", "frames the flight takes"),
+      text("stops", "F,F,...", "a third, two thirds and the last frame", "frames compared with the path tracer"),
+      integer("reference-spp", "N", 0, 1 << 20, "256", "the path tracer's samples per pixel at the stops (0 = no comparison)"),
+      number("pitch", "DEG", -89.0, 89.0, "-10", "the camera's pitch while it flies"),
+      integer("threads", "T", 0, 1024, "0 (every core)", "worker threads"),
+  };
+  append(o, runtime_option_specs("realtime"));
+  append(o, placement_option_specs(runtime::ProbeVolumeMode::Cascades));
+  return o;
+}
+
+const char* const kSunSweepSynopsis =
+    "usage: transgi sun-sweep --scene S.gltf --model M.tgm --out DIR [options]\n"
+    "  The sun steps across the sky with the real-time frame running; after each step, the frames until the GI\n"
+    "  settles, and the settled image against the path tracer.\n";
+
+std::vector<OptionSpec> sun_sweep_option_specs() {
+  std::vector<OptionSpec> o = {
+      text("scene", "PATH", "", "the glTF scene (with a directional light)"),
+      text("model", "PATH", "", "the baked transfer model (.tgm)"),
+      flag("allow-unbaked", "shade meshes the model has no latents for diffusely instead of refusing"),
+      text("out", "DIR", "", "the folder the settled GI images, the path tracer's and the CSVs go to"),
+      integer("width", "W", 16, 8192, "320", "frame width in pixels"),
+      integer("height", "H", 16, 8192, "180", "frame height in pixels"),
+      text("camera", "NAME", "the scene's first", "the camera node to render from"),
+      integer("positions", "N", 1, 360, "8", "places the sun steps through"),
+      integer("frames", "N", 17, 100000, "96", "frames run at each place"),
+      integer("warmup", "N", 0, 100000, "96", "frames run before the first step"),
+      number("elevation-from", "DEG", -90, 90, "10", "the sun's first elevation"),
+      number("elevation-to", "DEG", -90, 90, "80", "the sun's last elevation"),
+      number("azimuth-from", "DEG", -360, 360, "the scene's sun", "the sun's first azimuth"),
+      number("azimuth-to", "DEG", -360, 360, "the scene's sun", "the sun's last azimuth"),
+      number("settle-tolerance", "F", 1e-4, 1.0, "0.05", "how near its settled value the GI's mean must stay to count as settled"),
+      integer("reference-spp", "N", 0, 1 << 20, "512", "the path tracer's samples per pixel (0 = no comparison)"),
+      choice("probe-skip", {"on", "off"}, "on", "skip probes in walls and probes whose light has converged"),
+      integer("threads", "T", 0, 1024, "0 (every core)", "worker threads"),
+  };
+  append(o, runtime_option_specs("realtime"));
+  append(o, placement_option_specs(runtime::ProbeVolumeMode::Cascades));
+  return o;
+}
+
 }  // namespace transgi::cli

@@ -27,5 +27,10 @@ extern const char* const kRenderSynopsis;
 // The same for `bench-frame`.
 std::vector<OptionSpec> bench_frame_option_specs();
 extern const char* const kBenchFrameSynopsis;
+// The same for `fly-through` and `sun-sweep`.
+std::vector<OptionSpec> fly_through_option_specs();
+extern const char* const kFlyThroughSynopsis;
+std::vector<OptionSpec> sun_sweep_option_specs();
+extern const char* const kSunSweepSynopsis;
 
 }  // namespace transgi::cli
