@@ -191,16 +191,32 @@ std::vector<OptionSpec> render_option_specs() {
   return o;
 }
 
+namespace {
+
+// The options of a command that runs the real-time frame on a scene: the
+// scene and model first, the command's own, then the runtime's and the probe
+// placement's.
+std::vector<OptionSpec> real_time_run_specs(std::vector<OptionSpec> own) {
+  std::vector<OptionSpec> o = {
+      text("scene", "PATH", "", "the glTF scene"),
+      text("model", "PATH", "", "the baked transfer model (.tgm)"),
+      flag("allow-unbaked", "shade meshes the model has no latents for diffusely instead of refusing"),
+  };
+  append(o, std::move(own));
+  append(o, runtime_option_specs("realtime"));
+  append(o, placement_option_specs(runtime::ProbeVolumeMode::Cascades));
+  return o;
+}
+
+}  // namespace
+
 const char* const kBenchFrameSynopsis =
     "usage: transgi bench-frame --scene S.gltf --model M.tgm [options]\n"
     "  The real-time frame's time, stage by stage, with an object moving.\n";
 
 std::vector<OptionSpec> bench_frame_option_specs() {
   const runtime::TransGISettings r = runtime::realtime_preset();
-  std::vector<OptionSpec> o = {
-      text("scene", "PATH", "", "the glTF scene"),
-      text("model", "PATH", "", "the baked transfer model (.tgm)"),
-      flag("allow-unbaked", "shade meshes the model has no latents for diffusely instead of refusing"),
+  return real_time_run_specs({
       integer("width", "W", 16, 8192, "640", "frame width in pixels"),
       integer("height", "H", 16, 8192, "360", "frame height in pixels"),
       integer("frames", "N", 1, 100000, "100", "frames timed"),
@@ -214,10 +230,7 @@ std::vector<OptionSpec> bench_frame_option_specs() {
       text("gi-out", "PATH", "none", "the last frame's GI pass as EXR"),
       text("reference-out", "PATH", "none", "the path tracer's GI pass of the moved scene as EXR"),
       integer("reference-spp", "N", 1, 1 << 20, "1024", "samples per pixel of --reference-out"),
-  };
-  append(o, runtime_option_specs("realtime"));
-  append(o, placement_option_specs(runtime::ProbeVolumeMode::Cascades));
-  return o;
+  });
 }
 
 const char* const kFlyThroughSynopsis =
@@ -226,10 +239,7 @@ const char* const kFlyThroughSynopsis =
     "  compared with the path tracer.\n";
 
 std::vector<OptionSpec> fly_through_option_specs() {
-  std::vector<OptionSpec> o = {
-      text("scene", "PATH", "", "the glTF scene"),
-      text("model", "PATH", "", "the baked transfer model (.tgm)"),
-      flag("allow-unbaked", "shade meshes the model has no latents for diffusely instead of refusing"),
+  return real_time_run_specs({
       text("out", "DIR", "", "the folder the stops' GI images, the path tracer's and the per-frame CSV go to"),
       text("path", "X,Y,Z;...", "", "the camera's polyline, two points or more, flown at an even speed"),
       integer("width", "W", 16, 8192, "320", "frame width in pixels"),
@@ -239,10 +249,7 @@ std::vector<OptionSpec> fly_through_option_specs() {
       integer("reference-spp", "N", 0, 1 << 20, "256", "the path tracer's samples per pixel at the stops (0 = no comparison)"),
       number("pitch", "DEG", -89.0, 89.0, "-10", "the camera's pitch while it flies"),
       integer("threads", "T", 0, 1024, "0 (every core)", "worker threads"),
-  };
-  append(o, runtime_option_specs("realtime"));
-  append(o, placement_option_specs(runtime::ProbeVolumeMode::Cascades));
-  return o;
+  });
 }
 
 const char* const kSunSweepSynopsis =
@@ -251,10 +258,7 @@ const char* const kSunSweepSynopsis =
     "  settles, and the settled image against the path tracer.\n";
 
 std::vector<OptionSpec> sun_sweep_option_specs() {
-  std::vector<OptionSpec> o = {
-      text("scene", "PATH", "", "the glTF scene (with a directional light)"),
-      text("model", "PATH", "", "the baked transfer model (.tgm)"),
-      flag("allow-unbaked", "shade meshes the model has no latents for diffusely instead of refusing"),
+  return real_time_run_specs({
       text("out", "DIR", "", "the folder the settled GI images, the path tracer's and the CSVs go to"),
       integer("width", "W", 16, 8192, "320", "frame width in pixels"),
       integer("height", "H", 16, 8192, "180", "frame height in pixels"),
@@ -270,10 +274,7 @@ std::vector<OptionSpec> sun_sweep_option_specs() {
       integer("reference-spp", "N", 0, 1 << 20, "512", "the path tracer's samples per pixel (0 = no comparison)"),
       choice("probe-skip", {"on", "off"}, "on", "skip probes in walls and probes whose light has converged"),
       integer("threads", "T", 0, 1024, "0 (every core)", "worker threads"),
-  };
-  append(o, runtime_option_specs("realtime"));
-  append(o, placement_option_specs(runtime::ProbeVolumeMode::Cascades));
-  return o;
+  });
 }
 
 }  // namespace transgi::cli
