@@ -15,6 +15,7 @@
 
 #include "engine/app/app.h"
 #include "engine/render/light_set.h"
+#include "engine/render/surface.h"
 #include "engine/rt/rt_plugin.h"
 #include "engine/scene/components.h"
 #include "engine/scene/procedural.h"
@@ -22,6 +23,7 @@
 #include "probes/probe_field.h"
 #include "shading/realtime_gi.h"
 #include "shading/transfer_renderer.h"
+#include "engine/material/brdf.h"
 #include "engine/material/specular_albedo.h"
 #include "engine/math/rng.h"
 
@@ -239,6 +241,55 @@ TEST(ReflectedLight, SplitsWhatTheRayMeetsIntoDirectAndGi) {
   const shading::ReflectedLight below = shading::reflected_light(rt, from({-5, 0, 0}), -up, &sky, irradiance);
   EXPECT_EQ(below.direct, glm::vec3(0.0f));
   EXPECT_EQ(below.gi, glm::vec3(0.0f));
+}
+
+// A reflection ray that meets a varnished surface (a diffuse base under a
+// specular layer) takes back its whole directional albedo towards the ray's
+// origin / pi x the irradiance it is given (reflected_gi), not its diffuse
+// albedo alone: the specular layer reflects the room's light too. Known
+// answer: engine::material::directional_albedo of the surface's parameters,
+// at normal incidence and at 60 degrees, within float rounding; and more
+// than the diffuse albedo's share, by the layer's albedo less what it takes
+// from the base.
+TEST(ReflectedLight, AVarnishedSurfaceReflectsItsWholeDirectionalAlbedo) {
+  app::App app(app::AppOptions{.jobs = {.threads = 1}});
+  scene::SceneAssets a;
+  a.generation = scene::next_scene_generation();
+  a.meshes = {std::make_shared<scene::MeshAsset>(scene::make_quad({4, 4}, 0))};
+  material::Material varnish = lambert(glm::vec3(0.25f, 0.5f, 0.75f));
+  varnish.specular_factor = 1.0f;
+  varnish.roughness_factor = 0.3f;
+  a.materials = {varnish};
+  app.world().insert_resource<scene::SceneAssets>(std::move(a));
+  app.add_plugin<rt::RtPlugin>();
+  ecs::World& w = app.world();
+  // The varnished quad 1 m above the origin, facing down.
+  const ecs::Entity e = w.spawn();
+  transform::Transform t = transform::Transform::from_translation({0, 1, 0});
+  t.rotation = glm::angleAxis(glm::pi<float>(), glm::vec3(1, 0, 0));
+  w.emplace<transform::Transform>(e, t);
+  w.emplace<scene::MeshInstance>(e, scene::MeshInstance{0});
+  app.update();
+  const auto& rt = w.resource<rt::RtScene>();
+  const shading::HitIrradiance irradiance = [](const render::Surface&) { return glm::vec3(2.0f); };
+  shading::GSample from;
+  from.hit = true;
+  from.normal_world = from.geometric_normal = glm::vec3(0, 1, 0);
+  for (const float degrees : {0.0f, 60.0f}) {
+    const float a_rad = glm::radians(degrees);
+    const glm::vec3 wi(std::sin(a_rad), std::cos(a_rad), 0.0f);
+    const shading::ReflectedLight r = shading::reflected_light(rt, from, wi, nullptr, irradiance);
+    rt::Hit hit;
+    ASSERT_TRUE(rt.intersect(rt::Ray{from.position, wi}, hit));
+    const render::Surface surface = render::make_surface(rt, hit, wi);
+    const glm::vec3 albedo = material::directional_albedo(surface.brdf, std::cos(a_rad));
+    const glm::vec3 diffuse = material::diffuse_albedo(surface.brdf);
+    EXPECT_EQ(r.direct, glm::vec3(0.0f));
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(r.gi[c], albedo[c] * 2.0f / glm::pi<float>(), 1e-6f) << degrees << " degrees, channel " << c;
+      EXPECT_GT(r.gi[c], diffuse[c] * 2.0f / glm::pi<float>() + 0.005f) << degrees << " degrees, channel " << c;
+    }
+  }
 }
 
 // A dielectric's reflection rays weigh, on average, its specular layer's

@@ -212,7 +212,7 @@ struct ReflectionPacket {
       const render::Surface& hit = surface_[j];
       const glm::vec3 irradiance = sh_irradiance(sh_ + j * 75, hit.shading_normal) + sh_irradiance(sh_direct_ + j * 75, hit.shading_normal) +
                                    punctual_irradiance(scene, lights, hit);
-      light[static_cast<std::size_t>(lit_[j])].gi = reflected_gi(hit, irradiance);
+      light[static_cast<std::size_t>(lit_[j])].gi = reflected_gi(hit, direction[lit_[j]], irradiance);
     }
   }
 

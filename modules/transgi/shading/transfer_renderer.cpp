@@ -1,5 +1,6 @@
 #include "shading/transfer_renderer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -84,8 +85,9 @@ std::optional<ReflectedLight> reflected_without_irradiance(const engine::render:
   return std::nullopt;
 }
 
-glm::vec3 reflected_gi(const engine::render::Surface& hit, const glm::vec3& irradiance) {
-  return engine::material::diffuse_albedo(hit.brdf) * engine::math::kInvPi * glm::max(irradiance, glm::vec3(0.0f));
+glm::vec3 reflected_gi(const engine::render::Surface& hit, const glm::vec3& wi, const glm::vec3& irradiance) {
+  const float cos_o = std::clamp(-glm::dot(hit.shading_normal, wi), 0.0f, 1.0f);
+  return engine::material::directional_albedo(hit.brdf, cos_o) * engine::math::kInvPi * glm::max(irradiance, glm::vec3(0.0f));
 }
 
 ReflectedLight reflected_light(const engine::rt::RtScene& scene, const GSample& smp, const glm::vec3& wi,
@@ -97,7 +99,7 @@ ReflectedLight reflected_light(const engine::rt::RtScene& scene, const GSample& 
   if (!scene.intersect(ray, hit)) return *reflected_without_irradiance(nullptr, wi, sky);
   const render::Surface s = render::make_surface(scene, hit, wi);
   if (const std::optional<ReflectedLight> r = reflected_without_irradiance(&s, wi, sky)) return *r;
-  return {glm::vec3(0.0f), reflected_gi(s, irradiance(s))};
+  return {glm::vec3(0.0f), reflected_gi(s, wi, irradiance(s))};
 }
 
 bool sample_reflection(const GSample& smp, bool mirror, glm::vec2 u, glm::vec3& wi_world, glm::vec3& weight) {

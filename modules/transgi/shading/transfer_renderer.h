@@ -118,8 +118,9 @@ struct ReflectedLight {
 // The irradiance at a reflection ray's hit.
 using HitIrradiance = std::function<glm::vec3(const engine::render::Surface& hit)>;
 // Traces from the sample along wi: a miss sees `sky` (the lighting
-// environment; null = black), an emitter its emission, a diffuse hit
-// reflects its diffuse albedo / pi x irradiance(hit). Not weighted.
+// environment; null = black), an emitter its emission, a hit with a diffuse
+// lobe reflects its directional albedo towards the sample / pi x
+// irradiance(hit) (reflected_gi). Not weighted.
 ReflectedLight reflected_light(const engine::rt::RtScene& scene, const GSample& sample, const glm::vec3& wi,
                                const engine::scene::Environment* sky, const HitIrradiance& irradiance);
 // reflected_light in parts, for callers that trace many rays at once and
@@ -131,7 +132,13 @@ bool reflection_ray(const engine::rt::RtScene& scene, const GSample& sample, con
 // std::nullopt, and reflected_gi(hit, irradiance at it) is its light.
 std::optional<ReflectedLight> reflected_without_irradiance(const engine::render::Surface* hit, const glm::vec3& wi,
                                                            const engine::scene::Environment* sky);
-glm::vec3 reflected_gi(const engine::render::Surface& hit, const glm::vec3& irradiance);
+// The light a reflection ray's hit sends back along the ray (wi: the ray's
+// direction) from its irradiance taken as arriving evenly: its whole
+// directional albedo towards the ray's origin (diffuse and specular lobes,
+// engine::material::directional_albedo) / pi. A varnished wall or table
+// seen in a floor reflects the room with its specular layer too; the
+// diffuse albedo alone left that light out.
+glm::vec3 reflected_gi(const engine::render::Surface& hit, const glm::vec3& wi, const glm::vec3& irradiance);
 // The quality path's mirror: the light leaving a point of a near-mirror
 // towards the viewer, its Fresnel times what the reflection ray finds
 // (reflected_light above, no sky), its hit lit by the probes (light_at) and
