@@ -286,6 +286,14 @@ constexpr int kContactResetCells = 8;
 // under the jitter), 82 % where its path turns by 78 degrees.
 constexpr float kCutShare = 0.25f;
 
+// A pixel decoded on its own takes the contact light of the cells within
+// this many cells of it whose guide is like its own: depth within this
+// fraction, normals weighed by their cosine to this power (looser than the
+// upsampling's 5 %, which such a pixel failed).
+constexpr int kEdgeContactCells = 2;
+constexpr float kEdgeContactDepthTolerance = 0.2f;
+constexpr int kEdgeContactNormalPower = 8;
+
 // Adds the near field's contact light (near_field.h) to the cells decoded
 // this frame (`cells`: cells[k]'s value is value[k]), times each one's
 // contact gain. The rays leave a lattice of cells (NearFieldRays::
@@ -300,7 +308,7 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
                        const engine::render::LightSet* lights, const NearFieldRays& near_field, const UpsamplingPlan& up,
                        std::span<const std::size_t> cells, const std::function<float(std::size_t)>& own_masked_within, std::span<const glm::vec3> contact_gain,
                        std::span<const std::int32_t> track, std::span<const std::uint8_t> moved, ContactScratch& scratch,
-                       std::vector<glm::vec3>& value) {
+                       std::span<const std::size_t> edge_pixels, std::vector<glm::vec3>& value) {
   const NearLightAt light_at = [&](const glm::vec3& p, const glm::vec3& n, float* out) { probes::interpolate_fields(fields, p, n, out); };
   const std::size_t grid = up.cell_pixel.size(), grid_w = static_cast<std::size_t>(up.grid_w);
   const std::size_t grid_h = static_cast<std::size_t>(up.grid_h);
@@ -446,6 +454,32 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
   engine::jobs::parallel_for<std::size_t>(0, cells.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k)
       value[k] = glm::max(value[k] + contact_gain[k] * contact(cells[k]), kContactFloor * value[k]);
+  });
+  // The pixels decoded on their own (value slots cells.size() on) lie where
+  // no cell of the grid is on their surface within the upsampling's
+  // tolerance: silhouettes, a window's muntins, a chair's rails. Contact
+  // light varies slowly along a surface, so each takes the mean of the cells
+  // around it on a surface like its own within a looser tolerance; without
+  // it they lacked the near field's share and read darker than the surfaces
+  // beside them (docs/image-quality.md, 2026-11-28).
+  const auto has_contact = [&](std::size_t c) { return tracked ? scratch.count[c] > 0 : scratch.estimated[c] != 0; };
+  const std::size_t width = static_cast<std::size_t>(up.width);
+  engine::jobs::parallel_for<std::size_t>(0, edge_pixels.size(), 256, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const std::size_t p = edge_pixels[i], k = cells.size() + i;
+      const int cx = up.col0[p % width], cy = up.row0[p / width];
+      glm::vec3 sum(0.0f);
+      float weight = 0;
+      for (int y = std::max(0, cy - kEdgeContactCells); y <= std::min(up.grid_h - 1, cy + kEdgeContactCells); ++y)
+        for (int x = std::max(0, cx - kEdgeContactCells); x <= std::min(up.grid_w - 1, cx + kEdgeContactCells); ++x) {
+          const std::size_t c = static_cast<std::size_t>(y) * grid_w + static_cast<std::size_t>(x);
+          if (!has_contact(c)) continue;
+          const float w = guide_similarity(g.guide[p], up.cell_guide[c], kEdgeContactDepthTolerance, kEdgeContactNormalPower);
+          sum += w * contact(c);
+          weight += w;
+        }
+      if (weight > 0) value[k] = glm::max(value[k] + contact_gain[k] * (sum / weight), kContactFloor * value[k]);
+    }
   });
 }
 
@@ -950,7 +984,7 @@ engine::image::ImageRGB shade_gi_realtime(const RealtimeGiRequest& request, cons
     add_contact_light(g, in.scene, fields, request.mirror_lights, in.near_field, sc.up, sc.decoded_cells, own_masked_within, sc.contact_gain,
                       in.reuse ? std::span<const std::int32_t>(sc.contact.track) : std::span<const std::int32_t>(),
                       in.reuse ? std::span<const std::uint8_t>(sc.contact.moved) : std::span<const std::uint8_t>(), sc.contact,
-                      sc.value);
+                      std::span<const std::size_t>(sc.decode).subspan(sc.decoded_cells.size()), sc.value);
     stats.near_ms = ms_since(t0);
   }
   if (in.reuse) stats.reused_cells = merge_reused_cells(in, sc);
