@@ -352,6 +352,27 @@ struct WallOnSunlitFloor {
   }
   [[nodiscard]] const rt::RtScene& rt() { return app.world().resource<rt::RtScene>(); }
   [[nodiscard]] const scene::SceneAssets& assets() { return app.world().resource<scene::SceneAssets>(); }
+  // One real-time GI frame the game's way (the GI reuse on), its G-buffer
+  // traced into g, its histories in scratch.
+  image::ImageRGB realtime_frame(const shading::NearFieldRays& near, shading::RealtimeGiScratch& scratch, shading::GBuffer& g) {
+    shading::RealtimeGiSettings reuse;
+    reuse.reuse_history = true;
+    const probes::ProbeField* fields[] = {field.get()};
+    image::ImageRGB gi;
+    app.jobs().run([&] {
+      shading::trace_gbuffer(rt(), assets(), *rays, kSize, kSize, g);
+      gi = shading::shade_gi_realtime({.gbuffer = g,
+                                       .scene = rt(),
+                                       .assets = assets(),
+                                       .fields = fields,
+                                       .settings = reuse,
+                                       .mirror_lights = lights.get(),
+                                       .mirror = shading::MirrorRay{.max_roughness = -1},
+                                       .near_field = near},
+                                      {.scratch = &scratch});
+    });
+    return gi;
+  }
 };
 }  // namespace
 
@@ -509,31 +530,15 @@ TEST(NearField, APixelDecodedOnItsOwnTakesTheContactLightOfItsSurface) {
 // and a 48 x 48 view); bound 35 %.
 TEST(NearField, AroundAMovedObjectTheRestartedContactLightIsNotBlotchy) {
   WallOnSunlitFloor scene(false, true);
-  const probes::ProbeField* fields[] = {scene.field.get()};
   const int size = WallOnSunlitFloor::kSize;
   shading::NearFieldRays near{.rays = 1, .reach_cells = 1.0f, .filter_radius = 2};
   near.cell_budget = 60;
   near.cut_fade_frames = 0;  // the cube's surroundings are most of this small view: no cut's fade
-  shading::RealtimeGiSettings reuse;
-  reuse.reuse_history = true;
   shading::RealtimeGiScratch scratch;
   shading::GBuffer g;
   image::ImageRGB gi;
   const auto frames = [&](int n) {
-    scene.app.jobs().run([&] {
-      for (int f = 0; f < n; ++f) {
-        shading::trace_gbuffer(scene.rt(), scene.assets(), *scene.rays, size, size, g);
-        gi = shading::shade_gi_realtime({.gbuffer = g,
-                                         .scene = scene.rt(),
-                                         .assets = scene.assets(),
-                                         .fields = fields,
-                                         .settings = reuse,
-                                         .mirror_lights = scene.lights.get(),
-                                         .mirror = shading::MirrorRay{.max_roughness = -1},
-                                         .near_field = near},
-                                        {.scratch = &scratch});
-      }
-    });
+    for (int f = 0; f < n; ++f) gi = scene.realtime_frame(near, scratch, g);
   };
   frames(24);
   scene.app.world().get_mut<transform::Transform>(scene.block).translation.x += 0.3f;
@@ -566,8 +571,6 @@ TEST(NearField, AroundAMovedObjectTheRestartedContactLightIsNotBlotchy) {
 // fades, the image is the one without the fade.
 TEST(NearField, AfterACutTheContactLightFadesInAndAStepDoesNot) {
   WallOnSunlitFloor scene;
-  const probes::ProbeField* fields[] = {scene.field.get()};
-  const int size = WallOnSunlitFloor::kSize;
   struct Run {
     shading::RealtimeGiScratch scratch;
     std::vector<image::ImageRGB> frames;
@@ -575,23 +578,8 @@ TEST(NearField, AfterACutTheContactLightFadesInAndAStepDoesNot) {
   const auto run = [&](int cut_fade, int frames, Run& r) {
     shading::NearFieldRays near{.rays = 4, .reach_cells = 1.0f, .filter_radius = 2};
     near.cut_fade_frames = cut_fade;
-    shading::RealtimeGiSettings reuse;
-    reuse.reuse_history = true;
     shading::GBuffer g;
-    scene.app.jobs().run([&] {
-      for (int f = 0; f < frames; ++f) {
-        shading::trace_gbuffer(scene.rt(), scene.assets(), *scene.rays, size, size, g);
-        r.frames.push_back(shading::shade_gi_realtime({.gbuffer = g,
-                                                       .scene = scene.rt(),
-                                                       .assets = scene.assets(),
-                                                       .fields = fields,
-                                                       .settings = reuse,
-                                                       .mirror_lights = scene.lights.get(),
-                                                       .mirror = shading::MirrorRay{.max_roughness = -1},
-                                                       .near_field = near},
-                                                      {.scratch = &r.scratch}));
-      }
-    });
+    for (int f = 0; f < frames; ++f) r.frames.push_back(scene.realtime_frame(near, r.scratch, g));
   };
   Run faded, plain;
   run(8, 9, faded);

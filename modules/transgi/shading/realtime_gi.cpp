@@ -363,6 +363,15 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
               scratch.near_moved[y * grid_w + i] = 1;
     });
   }
+  // Cell c's contact estimate from its own rays (a cell that hits).
+  const auto trace_cell = [&](std::size_t c) {
+    const std::size_t p = up.cell_pixel[c];
+    const GSample& s = g.samples[p];
+    engine::math::Pcg32 rng = engine::math::make_rng(0x4EA2F1ull, p, stream);  // no seed: by frame, not by run
+    const float reach = near_field.reach_cells * probes::fields_at(fields, s.position).field[0]->placement().min_spacing();
+    scratch.contact[c] = near_field_irradiance(scene, lights, s, nullptr, reach, own_masked_within(p), near_field.rays, light_at, rng);
+    scratch.valid[c] = 1;
+  };
   const std::size_t lattice_rows = (grid_h + rows_k - 1) / rows_k, lattice_cols = (grid_w + cols_k - 1) / cols_k + 1;
   engine::jobs::parallel_for<std::size_t>(0, lattice_rows * lattice_cols, 64, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
@@ -370,14 +379,7 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
       const std::size_t i = (k % lattice_cols) * cols_k + (r % 2) * (cols_k / 2) + shift_i;
       if (j >= grid_h || i >= grid_w) continue;
       const std::size_t c = j * grid_w + i;
-      if (!(up.cell_guide[c].w > 0)) continue;
-      const std::size_t p = up.cell_pixel[c];
-      const GSample& s = g.samples[p];
-      engine::math::Pcg32 rng = engine::math::make_rng(0x4EA2F1ull, p, stream);  // no seed: by frame, not by run
-      const float reach = near_field.reach_cells * probes::fields_at(fields, s.position).field[0]->placement().min_spacing();
-      scratch.contact[c] =
-          near_field_irradiance(scene, lights, s, nullptr, reach, own_masked_within(p), near_field.rays, light_at, rng);
-      scratch.valid[c] = 1;
+      if (up.cell_guide[c].w > 0) trace_cell(c);
     }
   });
   // Where the means restart (near a moved object, below), every other cell
@@ -389,14 +391,7 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
     engine::jobs::parallel_for<std::size_t>(0, grid, 256, [&](std::size_t b, std::size_t e) {
       for (std::size_t c = b; c < e; ++c) {
         if ((c / grid_w + c % grid_w + stream) % 2 != 0) continue;
-        if (!scratch.near_moved[c] || scratch.valid[c] || !(up.cell_guide[c].w > 0)) continue;
-        const std::size_t p = up.cell_pixel[c];
-        const GSample& s = g.samples[p];
-        engine::math::Pcg32 rng = engine::math::make_rng(0x4EA2F1ull, p, stream);
-        const float reach = near_field.reach_cells * probes::fields_at(fields, s.position).field[0]->placement().min_spacing();
-        scratch.contact[c] =
-            near_field_irradiance(scene, lights, s, nullptr, reach, own_masked_within(p), near_field.rays, light_at, rng);
-        scratch.valid[c] = 1;
+        if (scratch.near_moved[c] && !scratch.valid[c] && up.cell_guide[c].w > 0) trace_cell(c);
       }
     });
   filter_near_field_separable(up.cell_guide, up.grid_w, up.grid_h, scratch.contact, scratch.valid, scratch.wanted,
