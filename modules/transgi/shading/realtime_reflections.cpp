@@ -261,9 +261,10 @@ void trace_dielectric_rays(const GBuffer& g, const engine::rt::RtScene& scene, s
 // Per ray: the light of the rays within kReach blocks on its plane, the sum
 // of their weighted light over the sum of their weights, each Gaussian in
 // their pixels' distance; a sharper lobe gathers from nearer rays (its
-// reflection changes faster across the surface).
+// reflection changes faster across the surface). At kSigma a ray 3 blocks
+// away weighs exp(-2.88), about 6 %, of the ray's own: 2 blocks reach far enough.
 void gather_rays(const GBuffer& g, DielectricRays& rays) {
-  constexpr int kReach = 3;
+  constexpr int kReach = 2;
   constexpr float kSigma = 2.5f;  // pixels, at roughness 0.4 and above
   const std::size_t width = static_cast<std::size_t>(g.width);
   rays.mean_direct.resize(rays.traced.size());
