@@ -48,6 +48,18 @@ struct ContactScratch {
   std::vector<std::int32_t> track;  // GiHistory::plan's
   std::vector<std::uint8_t> moved, near_moved, near_moved_row;  // GiHistory::plan's, and it dilated
   std::uint64_t frame = 0;
+
+  // Whether cell c has contact light this frame: a mean (tracked) or a
+  // filtered estimate that reached it.
+  [[nodiscard]] bool has_contact(std::size_t c, bool tracked) const { return tracked ? count[c] > 0 : estimated[c] != 0; }
+  // Cell c's contact light this frame: its mean (tracked; in proportion to
+  // its frames while it fades in after a cut) or its filtered estimate; zero
+  // where none has reached it yet.
+  [[nodiscard]] glm::vec3 contact_of(std::size_t c, bool tracked, int fade_frames) const {
+    if (!tracked) return filtered[c];
+    if (count[c] == 0) return glm::vec3(0.0f);
+    return fading[c] ? mean[c] * (static_cast<float>(count[c]) / static_cast<float>(fade_frames)) : mean[c];
+  }
 };
 
 struct RealtimeGiScratch::Impl {
@@ -294,6 +306,128 @@ constexpr int kEdgeContactCells = 2;
 constexpr float kEdgeContactDepthTolerance = 0.2f;
 constexpr int kEdgeContactNormalPower = 8;
 
+// Marks scratch.near_moved: the cells within kContactResetCells of where a
+// moved object is or was (`moved`, GiHistory::plan's). The contact light
+// there changed with the move, so their means restart (else the floor beside
+// a moved object keeps its old light for frames: a ghost). False, with
+// nothing marked, where nothing moved.
+bool mark_near_moved(const UpsamplingPlan& up, std::span<const std::uint8_t> moved, ContactScratch& scratch) {
+  const std::size_t grid = up.cell_pixel.size(), grid_w = static_cast<std::size_t>(up.grid_w);
+  const std::size_t grid_h = static_cast<std::size_t>(up.grid_h);
+  if (moved.size() != grid || std::none_of(moved.begin(), moved.end(), [](std::uint8_t m) { return m != 0; })) return false;
+  const int radius = kContactResetCells;
+  scratch.near_moved_row.assign(grid, 0);
+  scratch.near_moved.assign(grid, 0);
+  engine::jobs::parallel_for<std::size_t>(0, grid_h, 8, [&](std::size_t b, std::size_t e) {
+    for (std::size_t j = b; j < e; ++j)
+      for (std::size_t i = 0; i < grid_w; ++i)
+        if (moved[j * grid_w + i])
+          for (std::size_t x = i > static_cast<std::size_t>(radius) ? i - radius : 0; x <= std::min(grid_w - 1, i + radius); ++x)
+            scratch.near_moved_row[j * grid_w + x] = 1;
+  });
+  engine::jobs::parallel_for<std::size_t>(0, grid_w, 64, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i)
+      for (std::size_t j = 0; j < grid_h; ++j)
+        if (scratch.near_moved_row[j * grid_w + i])
+          for (std::size_t y = j > static_cast<std::size_t>(radius) ? j - radius : 0; y <= std::min(grid_h - 1, j + radius); ++y)
+            scratch.near_moved[y * grid_w + i] = 1;
+  });
+  return true;
+}
+
+// The running mean over the last `history` frames of each cell's surface
+// point, followed through the GI history's track (a point seen anew, or one
+// near a moved object, starts from this frame's estimate; a moved object's
+// own point keeps kMovingContactFrames); after a cut, the means that start
+// fade in over fade_frames (NearFieldRays::cut_fade_frames).
+void update_contact_means(const UpsamplingPlan& up, std::span<const std::int32_t> track, std::span<const std::uint8_t> moved,
+                          bool reset_near_moved, int history, int fade_frames, ContactScratch& scratch) {
+  const std::size_t grid = up.cell_pixel.size();
+  scratch.mean_next.resize(grid);
+  scratch.count_next.assign(grid, 0);
+  scratch.fading_next.assign(grid, 0);
+  if (scratch.fading.size() != grid) scratch.fading.assign(grid, 0);
+  const auto knows = [&](std::size_t c) {
+    const std::int32_t q = track[c];
+    const bool on_moved = reset_near_moved && moved[c] == GiHistory::kMovedHere;
+    return q >= 0 && static_cast<std::size_t>(q) < scratch.count.size() && scratch.count[static_cast<std::size_t>(q)] > 0 &&
+           (on_moved || !(reset_near_moved && scratch.near_moved[c]));
+  };
+  // A cut (or a turn as sudden): most of the view starts its means at once.
+  bool cut = false;
+  if (fade_frames > 1) {
+    std::atomic<std::size_t> lit{0}, starting{0};
+    engine::jobs::parallel_for<std::size_t>(0, grid, 4096, [&](std::size_t b, std::size_t e) {
+      std::size_t l = 0, n = 0;
+      for (std::size_t c = b; c < e; ++c)
+        if (up.cell_guide[c].w > 0) {
+          ++l;
+          if (scratch.estimated[c] && !knows(c)) ++n;
+        }
+      lit.fetch_add(l, std::memory_order_relaxed);
+      starting.fetch_add(n, std::memory_order_relaxed);
+    });
+    cut = static_cast<float>(starting.load()) > kCutShare * static_cast<float>(lit.load());
+  }
+  // A cell that no estimate reached carries its point's mean unchanged.
+  engine::jobs::parallel_for<std::size_t>(0, grid, 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t c = b; c < e; ++c) {
+      const std::int32_t q = track[c];
+      const bool on_moved = reset_near_moved && moved[c] == GiHistory::kMovedHere;
+      const bool known = knows(c);
+      if (!scratch.estimated[c]) {
+        if (known) {
+          scratch.mean_next[c] = scratch.mean[static_cast<std::size_t>(q)];
+          scratch.count_next[c] = scratch.count[static_cast<std::size_t>(q)];
+          scratch.fading_next[c] = scratch.fading[static_cast<std::size_t>(q)];
+        }
+        continue;
+      }
+      const int n = known ? std::min<int>(scratch.count[static_cast<std::size_t>(q)], (on_moved ? std::min(history, kMovingContactFrames) : history) - 1) : 0;
+      scratch.mean_next[c] = n > 0 ? (scratch.mean[static_cast<std::size_t>(q)] * static_cast<float>(n) + scratch.filtered[c]) /
+                                         static_cast<float>(n + 1)
+                                   : scratch.filtered[c];
+      scratch.count_next[c] = static_cast<std::uint8_t>(n + 1);
+      const bool fading = known ? scratch.fading[static_cast<std::size_t>(q)] != 0 : cut;
+      scratch.fading_next[c] = fading && n + 1 < fade_frames ? 1 : 0;
+    }
+  });
+  std::swap(scratch.mean, scratch.mean_next);
+  std::swap(scratch.count, scratch.count_next);
+  std::swap(scratch.fading, scratch.fading_next);
+  ++scratch.frame;
+}
+
+// The pixels decoded on their own (value slots first_slot on) lie where
+// no cell of the grid is on their surface within the upsampling's
+// tolerance: silhouettes, a window's muntins, a chair's rails. Contact
+// light varies slowly along a surface, so each takes the mean of the cells
+// around it on a surface like its own within a looser tolerance; without
+// it they lacked the near field's share and read darker than the surfaces
+// beside them (docs/image-quality.md, 2026-11-28).
+void add_edge_contact(const GBuffer& g, const UpsamplingPlan& up, const ContactScratch& scratch, bool tracked, int fade_frames,
+                      std::span<const std::size_t> edge_pixels, std::size_t first_slot, std::span<const glm::vec3> contact_gain,
+                      std::vector<glm::vec3>& value) {
+  const std::size_t width = static_cast<std::size_t>(up.width), grid_w = static_cast<std::size_t>(up.grid_w);
+  engine::jobs::parallel_for<std::size_t>(0, edge_pixels.size(), 256, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const std::size_t p = edge_pixels[i], k = first_slot + i;
+      const int cx = up.col0[p % width], cy = up.row0[p / width];
+      glm::vec3 sum(0.0f);
+      float weight = 0;
+      for (int y = std::max(0, cy - kEdgeContactCells); y <= std::min(up.grid_h - 1, cy + kEdgeContactCells); ++y)
+        for (int x = std::max(0, cx - kEdgeContactCells); x <= std::min(up.grid_w - 1, cx + kEdgeContactCells); ++x) {
+          const std::size_t c = static_cast<std::size_t>(y) * grid_w + static_cast<std::size_t>(x);
+          if (!scratch.has_contact(c, tracked)) continue;
+          const float w = guide_similarity(g.guide[p], up.cell_guide[c], kEdgeContactDepthTolerance, kEdgeContactNormalPower);
+          sum += w * scratch.contact_of(c, tracked, fade_frames);
+          weight += w;
+        }
+      if (weight > 0) value[k] = glm::max(value[k] + contact_gain[k] * (sum / weight), kContactFloor * value[k]);
+    }
+  });
+}
+
 // Adds the near field's contact light (near_field.h) to the cells decoded
 // this frame (`cells`: cells[k]'s value is value[k]), times each one's
 // contact gain. The rays leave a lattice of cells (NearFieldRays::
@@ -339,30 +473,8 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
     });
   else
     for (const std::size_t c : cells) scratch.wanted[c] = 1;
-  // Cells within kContactResetCells of where a moved object is or was: the
-  // contact light there changed with the move, so their means restart (else
-  // the floor beside a moved object keeps its old light for frames: a ghost).
-  const bool reset_near_moved =
-      tracked && moved.size() == grid && std::any_of(moved.begin(), moved.end(), [](std::uint8_t m) { return m != 0; });
-  if (reset_near_moved) {
-    const int radius = kContactResetCells;
-    scratch.near_moved_row.assign(grid, 0);
-    scratch.near_moved.assign(grid, 0);
-    engine::jobs::parallel_for<std::size_t>(0, grid_h, 8, [&](std::size_t b, std::size_t e) {
-      for (std::size_t j = b; j < e; ++j)
-        for (std::size_t i = 0; i < grid_w; ++i)
-          if (moved[j * grid_w + i])
-            for (std::size_t x = i > static_cast<std::size_t>(radius) ? i - radius : 0; x <= std::min(grid_w - 1, i + radius); ++x)
-              scratch.near_moved_row[j * grid_w + x] = 1;
-    });
-    engine::jobs::parallel_for<std::size_t>(0, grid_w, 64, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i)
-        for (std::size_t j = 0; j < grid_h; ++j)
-          if (scratch.near_moved_row[j * grid_w + i])
-            for (std::size_t y = j > static_cast<std::size_t>(radius) ? j - radius : 0; y <= std::min(grid_h - 1, j + radius); ++y)
-              scratch.near_moved[y * grid_w + i] = 1;
-    });
-  }
+  // Near a moved object the means restart (mark_near_moved).
+  const bool reset_near_moved = tracked && mark_near_moved(up, moved, scratch);
   // Cell c's contact estimate from its own rays (a cell that hits).
   const auto trace_cell = [&](std::size_t c) {
     const std::size_t p = up.cell_pixel[c];
@@ -382,7 +494,7 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
       if (up.cell_guide[c].w > 0) trace_cell(c);
     }
   });
-  // Where the means restart (near a moved object, below), every other cell
+  // Where the means restart (near a moved object: near_moved), every other cell
   // traces (a checkerboard that alternates by frame), not only the
   // lattice's: a restarted mean is this frame's filtered estimate alone, and
   // from the lattice's few rays it mottled the wall behind a rolling ball
@@ -400,101 +512,12 @@ void add_contact_light(const GBuffer& g, const engine::rt::RtScene& scene, std::
   // A mean that started in a cut counts in proportion to its frames until it
   // holds this many (no more than a mean holds).
   const int fade_frames = std::clamp(near_field.cut_fade_frames, 0, history);
-  if (tracked) {
-    // The running mean over the last history_frames frames of each surface
-    // point, followed through the GI history's track (a point seen anew, or
-    // one near a moved object, starts from this frame's estimate; a moved
-    // object's own point keeps kMovingContactFrames).
-    scratch.mean_next.resize(grid);
-    scratch.count_next.assign(grid, 0);
-    scratch.fading_next.assign(grid, 0);
-    if (scratch.fading.size() != grid) scratch.fading.assign(grid, 0);
-    const auto knows = [&](std::size_t c) {
-      const std::int32_t q = track[c];
-      const bool on_moved = reset_near_moved && moved[c] == GiHistory::kMovedHere;
-      return q >= 0 && static_cast<std::size_t>(q) < scratch.count.size() && scratch.count[static_cast<std::size_t>(q)] > 0 &&
-             (on_moved || !(reset_near_moved && scratch.near_moved[c]));
-    };
-    // A cut (or a turn as sudden): most of the view starts its means at once.
-    bool cut = false;
-    if (fade_frames > 1) {
-      std::atomic<std::size_t> lit{0}, starting{0};
-      engine::jobs::parallel_for<std::size_t>(0, grid, 4096, [&](std::size_t b, std::size_t e) {
-        std::size_t l = 0, n = 0;
-        for (std::size_t c = b; c < e; ++c)
-          if (up.cell_guide[c].w > 0) {
-            ++l;
-            if (scratch.estimated[c] && !knows(c)) ++n;
-          }
-        lit.fetch_add(l, std::memory_order_relaxed);
-        starting.fetch_add(n, std::memory_order_relaxed);
-      });
-      cut = static_cast<float>(starting.load()) > kCutShare * static_cast<float>(lit.load());
-    }
-    // A cell that no estimate reached carries its point's mean unchanged.
-    engine::jobs::parallel_for<std::size_t>(0, grid, 4096, [&](std::size_t b, std::size_t e) {
-      for (std::size_t c = b; c < e; ++c) {
-        const std::int32_t q = track[c];
-        const bool on_moved = reset_near_moved && moved[c] == GiHistory::kMovedHere;
-        const bool known = knows(c);
-        if (!scratch.estimated[c]) {
-          if (known) {
-            scratch.mean_next[c] = scratch.mean[static_cast<std::size_t>(q)];
-            scratch.count_next[c] = scratch.count[static_cast<std::size_t>(q)];
-            scratch.fading_next[c] = scratch.fading[static_cast<std::size_t>(q)];
-          }
-          continue;
-        }
-        const int n = known ? std::min<int>(scratch.count[static_cast<std::size_t>(q)], (on_moved ? std::min(history, kMovingContactFrames) : history) - 1) : 0;
-        scratch.mean_next[c] = n > 0 ? (scratch.mean[static_cast<std::size_t>(q)] * static_cast<float>(n) + scratch.filtered[c]) /
-                                           static_cast<float>(n + 1)
-                                     : scratch.filtered[c];
-        scratch.count_next[c] = static_cast<std::uint8_t>(n + 1);
-        const bool fading = known ? scratch.fading[static_cast<std::size_t>(q)] != 0 : cut;
-        scratch.fading_next[c] = fading && n + 1 < fade_frames ? 1 : 0;
-      }
-    });
-    std::swap(scratch.mean, scratch.mean_next);
-    std::swap(scratch.count, scratch.count_next);
-    std::swap(scratch.fading, scratch.fading_next);
-    ++scratch.frame;
-  }
-  // (A cell with no estimate yet, tracked or not, holds a zero mean or filtered value.)
-  const auto contact = [&](std::size_t c) {
-    if (!tracked) return scratch.filtered[c];
-    if (scratch.count[c] == 0) return glm::vec3(0.0f);
-    return scratch.fading[c] ? scratch.mean[c] * (static_cast<float>(scratch.count[c]) / static_cast<float>(fade_frames)) : scratch.mean[c];
-  };
+  if (tracked) update_contact_means(up, track, moved, reset_near_moved, history, fade_frames, scratch);
   engine::jobs::parallel_for<std::size_t>(0, cells.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k)
-      value[k] = glm::max(value[k] + contact_gain[k] * contact(cells[k]), kContactFloor * value[k]);
+      value[k] = glm::max(value[k] + contact_gain[k] * scratch.contact_of(cells[k], tracked, fade_frames), kContactFloor * value[k]);
   });
-  // The pixels decoded on their own (value slots cells.size() on) lie where
-  // no cell of the grid is on their surface within the upsampling's
-  // tolerance: silhouettes, a window's muntins, a chair's rails. Contact
-  // light varies slowly along a surface, so each takes the mean of the cells
-  // around it on a surface like its own within a looser tolerance; without
-  // it they lacked the near field's share and read darker than the surfaces
-  // beside them (docs/image-quality.md, 2026-11-28).
-  const auto has_contact = [&](std::size_t c) { return tracked ? scratch.count[c] > 0 : scratch.estimated[c] != 0; };
-  const std::size_t width = static_cast<std::size_t>(up.width);
-  engine::jobs::parallel_for<std::size_t>(0, edge_pixels.size(), 256, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) {
-      const std::size_t p = edge_pixels[i], k = cells.size() + i;
-      const int cx = up.col0[p % width], cy = up.row0[p / width];
-      glm::vec3 sum(0.0f);
-      float weight = 0;
-      for (int y = std::max(0, cy - kEdgeContactCells); y <= std::min(up.grid_h - 1, cy + kEdgeContactCells); ++y)
-        for (int x = std::max(0, cx - kEdgeContactCells); x <= std::min(up.grid_w - 1, cx + kEdgeContactCells); ++x) {
-          const std::size_t c = static_cast<std::size_t>(y) * grid_w + static_cast<std::size_t>(x);
-          if (!has_contact(c)) continue;
-          const float w = guide_similarity(g.guide[p], up.cell_guide[c], kEdgeContactDepthTolerance, kEdgeContactNormalPower);
-          sum += w * contact(c);
-          weight += w;
-        }
-      if (weight > 0) value[k] = glm::max(value[k] + contact_gain[k] * (sum / weight), kContactFloor * value[k]);
-    }
-  });
+  add_edge_contact(g, up, scratch, tracked, fade_frames, edge_pixels, cells.size(), contact_gain, value);
 }
 
 }  // namespace

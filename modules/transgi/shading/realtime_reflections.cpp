@@ -222,9 +222,10 @@ struct ReflectionPacket {
 
  private:
   // A metal met by a reflection ray reflects what its own reflection ray
-  // finds, one bounce further: the sky or an emitter as they are, a surface
-  // by its albedo / pi times the probes' irradiance there. All of it is GI
-  // at the pixel (it reached the pixel's surface after the metal's bounce).
+  // finds, one bounce further (reflected_light: the sky or an emitter as
+  // they are, a surface lit as the packet's hits are), times the metal's
+  // weight. All of it is GI at the pixel: it reached the pixel's surface
+  // after the metal's bounce.
   static glm::vec3 metal_bounce(const GBuffer& g, const engine::rt::RtScene& scene, std::span<const probes::ProbeField* const> fields,
                                 const engine::render::LightSet* lights, const engine::render::Surface& metal, const glm::vec3& wi,
                                 std::size_t pixel) {
@@ -239,20 +240,15 @@ struct ReflectionPacket {
     math::Pcg32 rng = math::make_rng(0x3E7A1ull, pixel, jitter_phase(g));
     glm::vec3 wi2, weight;
     if (!sample_reflection(at, false, {rng.next_float(), rng.next_float()}, wi2, weight)) return glm::vec3(0.0f);
-    const scene::Environment* sky = lights ? lights->environment() : nullptr;
-    rt::Ray ray;
-    if (!reflection_ray(scene, at, wi2, ray)) return glm::vec3(0.0f);
-    rt::Hit hit;
-    if (!scene.intersect(ray, hit)) return weight * (sky ? sky->radiance(wi2) : glm::vec3(0.0f));
-    const render::Surface s = render::make_surface(scene, hit, wi2);
-    if (const std::optional<ReflectedLight> r = reflected_without_irradiance(&s, wi2, sky)) return weight * (r->direct + r->gi);
-    float sh[75], sh_direct[75];
-    probes::interpolate_fields_many(
-        fields, &s.position, &s.shading_normal, 1, [](std::size_t, const probes::ProbeField* f) { return f->light_sh_all().data(); },
-        [](std::size_t, const probes::ProbeField* f) { return f->direct_sh_all().data(); }, sh, sh_direct);
-    const glm::vec3 irradiance = sh_irradiance(sh, s.shading_normal) + sh_irradiance(sh_direct, s.shading_normal) +
-                                 punctual_irradiance(scene, lights, s);
-    return weight * reflected_gi(s, wi2, irradiance);
+    const HitIrradiance irradiance = [&](const render::Surface& s) {
+      float sh[75], sh_direct[75];
+      probes::interpolate_fields_many(
+          fields, &s.position, &s.shading_normal, 1, [](std::size_t, const probes::ProbeField* f) { return f->light_sh_all().data(); },
+          [](std::size_t, const probes::ProbeField* f) { return f->direct_sh_all().data(); }, sh, sh_direct);
+      return sh_irradiance(sh, s.shading_normal) + sh_irradiance(sh_direct, s.shading_normal) + punctual_irradiance(scene, lights, s);
+    };
+    const ReflectedLight r = reflected_light(scene, at, wi2, lights ? lights->environment() : nullptr, irradiance);
+    return weight * (r.direct + r.gi);
   }
 
   std::array<engine::rt::Ray, kPacket> rays_;
