@@ -22,6 +22,9 @@ layout(std430, set = 0, binding = 6) buffer KnownPass { uint known_pass[]; };  /
 // Per probe of the batch: which map of Frame holds its samples (the raster
 // writes one map per probe of the grid, the batch is the updated ones).
 layout(std430, set = 0, binding = 7) readonly buffer FrameProbe { uint frame_probe[]; };
+// Per probe of the batch: which map of History and Sampled is its own (its
+// slot in a field's resident maps, or its place in the batch).
+layout(std430, set = 0, binding = 8) readonly buffer MapSlot { uint map_slot[]; };
 layout(push_constant) uniform PushBlock { AccumulatePush p; };
 
 #include "half_bits.glsl"
@@ -119,7 +122,8 @@ uint stored_bits(float target, float before, uint was, bool same_scale) {
 void main() {
   const uint q = gl_WorkGroupID.x, lane = gl_LocalInvocationID.x;
   if (q >= p.probes) return;
-  const uint base = q * p.texels, frame_base = frame_probe[q] * p.texels;
+  // base: this batch's scratch (Filled, KnownPass); map_base: the maps.
+  const uint base = q * p.texels, map_base = map_slot[q] * p.texels, frame_base = frame_probe[q] * p.texels;
 
   // 1. The peak and the change groups over this frame's sampled texels.
   {
@@ -128,13 +132,13 @@ void main() {
     float og[kAccumulateChangeGroups], ng[kAccumulateChangeGroups];
     for (uint g = 0u; g < kAccumulateChangeGroups; ++g) og[g] = ng[g] = 0.0;
     for (uint t = lane; t < p.texels; t += kAccumulateGroupSize) {
-      const vec3 old = history_at(base + t, scale);
+      const vec3 old = history_at(map_base + t, scale);
       peak = max(peak, max3(old));
       const vec4 f = frame[frame_base + t];
       if (f.w > 0.0) {
         const vec3 mean = f.rgb / f.w;
         peak = max(peak, max3(mean));
-        if (sampled[base + t] > 0u) {
+        if (sampled[map_base + t] > 0u) {
           og[t % kAccumulateChangeGroups] += luminance(old);
           ng[t % kAccumulateChangeGroups] += luminance(mean);
         }
@@ -154,7 +158,7 @@ void main() {
   const float h = s_h, old_scale = s_old_scale, new_scale = s_new_scale, inv = 1.0 / new_scale;
   const bool changed = s_changed != 0u, same_scale = new_scale == old_scale;
   for (uint t = lane; t < p.texels; t += kAccumulateGroupSize) {
-    const uint at = base + t;
+    const uint at = map_base + t, out_at = base + t;
     const uint rg = history[2u * at], b = history[2u * at + 1u];
     const vec3 old = vec3(from_half_bits(rg), from_half_bits(rg >> 16), from_half_bits(b)) * old_scale;
     vec3 next = old;
@@ -180,10 +184,10 @@ void main() {
     history[2u * at + 1u] = b_bits;
     sampled[at] = was_sampled;
     const vec3 stored = vec3(from_half_bits(r_bits), from_half_bits(g_bits), from_half_bits(b_bits)) * new_scale;
-    filled[3u * at] = stored.r;
-    filled[3u * at + 1u] = stored.g;
-    filled[3u * at + 2u] = stored.b;
-    known_pass[at] = was_sampled > 0u ? 0u : kUnknown;
+    filled[3u * out_at] = stored.r;
+    filled[3u * out_at + 1u] = stored.g;
+    filled[3u * out_at + 2u] = stored.b;
+    known_pass[out_at] = was_sampled > 0u ? 0u : kUnknown;
   }
   memoryBarrierBuffer();
   barrier();

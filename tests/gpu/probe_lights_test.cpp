@@ -7,12 +7,15 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "engine/math/rng.h"
 #include "engine/render/light_set.h"
 #include "engine/rt/rt_scene.h"
 #include "eval/method_runs.h"
+#include "gpu/vulkan_probe_kernels.h"
 #include "gpu/vulkan_probe_lights.h"
 #include "gpu_fixture.h"
 #include "probes/cascades.h"
@@ -208,4 +211,65 @@ TEST(VulkanProbeLights, PointsWithNoLitProbeTakeTheCoarsestCascadesMeanLight) {
   const Compared got = compare_lights(*ctx, c, eye, 2000, 9);
   EXPECT_GT(got.mean_light, got.points / 50) << "some points should find no lit probe and take the mean light";
   EXPECT_LE(got.differ, got.points / 200) << "expected at most 0.5 % of points to differ, got " << got.differ;
+}
+
+// A field on the Vulkan backend keeps its radiance maps on the device
+// between updates (VulkanMapStore): its host copies stay as reset left
+// them, and read_back_maps() brings the device's. A field switched to the
+// CPU backend takes them along: its maps equal those of the same run read
+// back, not the blank ones, and its next update continues from them.
+TEST(VulkanMapStore, AFieldSwitchedToTheCpuTakesItsMapsFromTheDevice) {
+  GPU_TEST_CONTEXT_OR_SKIP(unused);
+  std::string why;
+  std::shared_ptr<engine::gpu::VulkanContext> ctx(engine::gpu::VulkanContext::create({}, &why));
+  ASSERT_TRUE(ctx) << why;
+  std::shared_ptr<transgi::gpu::VulkanProbeKernels> kernels = transgi::gpu::make_probe_kernels(ctx, nullptr, &why);
+  if (!kernels) GTEST_SKIP() << why;
+  eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
+  const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
+  const render::LightSet lights(scene, render::gather_punctual_lights(loaded.app->world()), nullptr);
+  probes::ProbeFieldSettings s;
+  s.grid = probes::ProbeGrid::centred_in(scene.bounds_min(), scene.bounds_max(), glm::ivec3(4));
+  s.map = probes::MapLayout{16, 8};
+  s.rays_per_probe = 32;
+  probes::ProbeField switched(s), stayed(s);
+  loaded.app->jobs().run([&] {
+    for (probes::ProbeField* f : {&switched, &stayed}) {
+      f->set_kernels(kernels);
+      for (int frame = 0; frame < 6; ++frame) f->update(scene, lights);
+    }
+  });
+  std::size_t held = 0, blank = 0;
+  for (const probes::ProbeMapState& m : stayed.states()) {
+    if (m.device_stamp == 0) continue;
+    ++held;
+    bool any = false;
+    for (const std::uint8_t v : m.sampled) any = any || v != 0;
+    blank += any ? 0 : 1;
+  }
+  EXPECT_GT(held, stayed.states().size() / 2) << "most probes' maps should be held on the device";
+  EXPECT_EQ(blank, held) << "the host's copies of maps the device holds are as reset left them";
+  switched.set_kernels(nullptr);
+  stayed.read_back_maps();
+  std::size_t compared = 0, sampled = 0;
+  for (std::size_t q = 0; q < stayed.states().size(); ++q) {
+    const probes::ProbeMapState& a = switched.states()[q];
+    const probes::ProbeMapState& b = stayed.states()[q];
+    ASSERT_EQ(a.device_stamp, 0u);
+    ASSERT_EQ(b.device_stamp, 0u);
+    if (!b.held()) continue;
+    ++compared;
+    float largest = 0.0f, worst = 0.0f;
+    for (std::size_t t = 0; t < b.sampled.size(); ++t) {
+      sampled += b.sampled[t];
+      largest = std::max(largest, b.radiance_at(t).g);
+      worst = std::max(worst, std::abs(a.radiance_at(t).g - b.radiance_at(t).g));
+    }
+    EXPECT_LE(worst, 1e-2f * largest + 1e-6f) << "probe " << q;
+  }
+  EXPECT_GT(compared, 0u);
+  EXPECT_GT(sampled, compared * 16 * 8 / 2) << "the maps read back should be mostly sampled";
+  // The switched field's next update runs on the CPU from the maps it took.
+  loaded.app->jobs().run([&] { switched.update(scene, lights); });
+  EXPECT_EQ(ctx->validation_errors(), 0);
 }

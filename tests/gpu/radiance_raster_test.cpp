@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "engine/math/rng.h"
@@ -174,10 +176,10 @@ TEST(VulkanProbeKernels, ShareAccumulateProjectIsOneSubmissionAndEqualsTheCpuBac
     std::vector<std::uint8_t> cpu_changed(batch.size()), gpu_changed(batch.size());
     std::vector<float> cpu_sh(batch.size() * 75), gpu_sh(batch.size() * 75);
     probes::ShareAccumulateTimes times;
-    const auto cpu_stats = cpu_kernels.share_accumulate_project(f.grid, projector, f.points, f.depth_ptrs, sharing, batch, cpu_ptrs,
+    const auto cpu_stats = cpu_kernels.share_accumulate_project(f.grid, projector, f.points, f.depth_ptrs, sharing, batch, cpu_ptrs, nullptr,
                                                                 accumulation, cpu_changed, cpu_sh, times);
     const engine::gpu::GpuTraffic before = ctx->traffic();
-    const auto gpu_stats = gpu_kernels->share_accumulate_project(f.grid, projector, f.points, f.depth_ptrs, sharing, batch, gpu_ptrs,
+    const auto gpu_stats = gpu_kernels->share_accumulate_project(f.grid, projector, f.points, f.depth_ptrs, sharing, batch, gpu_ptrs, nullptr,
                                                                  accumulation, gpu_changed, gpu_sh, times);
     const engine::gpu::GpuTraffic t = ctx->traffic() - before;
     const std::size_t texels = static_cast<std::size_t>(f.layout.texel_count());
@@ -201,4 +203,123 @@ TEST(VulkanProbeKernels, ShareAccumulateProjectIsOneSubmissionAndEqualsTheCpuBac
     std::printf("frame %d: largest SH coefficient %.4g, largest difference %.3g\n", frame, largest, worst);
     EXPECT_LE(worst, 1e-3f * largest) << "frame " << frame;
   }
+}
+
+// The maps kept on the device between updates (VulkanMapStore): over five
+// updates, one probe reset on the host between the second and third, and
+// the maps read back before the fifth (so that they go up again, through
+// the staging copy), every update's SH and change flags equal the CPU
+// backend's as above; no map comes back unless read back, and none goes up
+// once the device holds it; the maps read back equal the CPU's to binary16
+// rounding.
+namespace {
+// With stage_device_only, the store's buffers are written and read through
+// staging copies, as on a discrete GPU.
+void maps_stay_on_the_device(bool stage_device_only) {
+  std::string why;
+  engine::gpu::GpuOptions options;
+  options.stage_device_only = stage_device_only;
+  std::shared_ptr<engine::gpu::VulkanContext> ctx(engine::gpu::VulkanContext::create(options, &why));
+  ASSERT_TRUE(ctx) << why;
+  std::shared_ptr<gpu::VulkanProbeKernels> gpu_kernels = gpu::make_probe_kernels(ctx, nullptr, &why);
+  if (!gpu_kernels) GTEST_SKIP() << why;
+  probes::CpuProbeKernels cpu_kernels;
+  const Frame f = random_frame(31);
+  const probes::MapProjector projector(f.layout);
+  const probes::SharingSettings sharing;
+  const probes::AccumulationSettings accumulation;
+  std::vector<int> batch;
+  for (int q = 0; q < f.grid.count(); ++q)
+    if (f.targets[static_cast<std::size_t>(q)]) batch.push_back(q);
+  const std::size_t texels = static_cast<std::size_t>(f.layout.texel_count());
+  // One state a probe of the grid, as a field keeps them; the batch points into them.
+  const auto fresh_states = [&] {
+    std::vector<probes::ProbeMapState> s(static_cast<std::size_t>(f.grid.count()));
+    for (auto& m : s) m.reset(f.layout.texel_count(), f.grid.min_spacing());
+    return s;
+  };
+  std::vector<probes::ProbeMapState> cpu_states = fresh_states(), gpu_states = fresh_states(), plain_states = fresh_states();
+  const auto pointers = [&](std::vector<probes::ProbeMapState>& s) {
+    std::vector<probes::ProbeMapState*> p;
+    for (const int q : batch) p.push_back(&s[static_cast<std::size_t>(q)]);
+    return p;
+  };
+  const std::vector<probes::ProbeMapState*> cpu_ptrs = pointers(cpu_states), gpu_ptrs = pointers(gpu_states),
+                                            plain_ptrs = pointers(plain_states);
+  std::unique_ptr<probes::ProbeMapStore> store = gpu_kernels->make_map_store(f.layout, f.grid.count());
+  ASSERT_TRUE(store);
+  const std::uint64_t maps_bytes = batch.size() * texels * (8 + 4);
+  for (int frame = 0; frame < 5; ++frame) {
+    if (frame == 2) {  // a probe restarted on the host: its fresh (blank) maps replace the device's
+      cpu_states[static_cast<std::size_t>(batch[0])].reset(f.layout.texel_count(), f.grid.min_spacing());
+      gpu_states[static_cast<std::size_t>(batch[0])].reset(f.layout.texel_count(), f.grid.min_spacing());
+      plain_states[static_cast<std::size_t>(batch[0])].reset(f.layout.texel_count(), f.grid.min_spacing());
+    }
+    if (frame == 4) {
+      store->read_back(gpu_states);
+      for (const int q : batch) {
+        const probes::ProbeMapState& g = gpu_states[static_cast<std::size_t>(q)];
+        const probes::ProbeMapState& c = cpu_states[static_cast<std::size_t>(q)];
+        ASSERT_EQ(g.device_stamp, 0u) << "probe " << q;
+        float largest = 0.0f, worst = 0.0f;
+        for (std::size_t t = 0; t < texels; ++t) {
+          largest = std::max(largest, c.radiance_at(t).r);
+          worst = std::max(worst, std::abs(g.radiance_at(t).r - c.radiance_at(t).r));
+          ASSERT_EQ(g.sampled[t], c.sampled[t]) << "probe " << q << " texel " << t;
+        }
+        EXPECT_LE(worst, 2e-3f * largest) << "probe " << q;
+      }
+    }
+    std::vector<std::uint8_t> cpu_changed(batch.size()), gpu_changed(batch.size()), plain_changed(batch.size());
+    std::vector<float> cpu_sh(batch.size() * 75), gpu_sh(batch.size() * 75), plain_sh(batch.size() * 75);
+    probes::ShareAccumulateTimes times;
+    cpu_kernels.share_accumulate_project(f.grid, projector, f.points, f.depth_ptrs, sharing, batch, cpu_ptrs, nullptr, accumulation,
+                                         cpu_changed, cpu_sh, times);
+    engine::gpu::GpuTraffic before = ctx->traffic();
+    gpu_kernels->share_accumulate_project(f.grid, projector, f.points, f.depth_ptrs, sharing, batch, plain_ptrs, nullptr,
+                                          accumulation, plain_changed, plain_sh, times);
+    const engine::gpu::GpuTraffic plain = ctx->traffic() - before;
+    before = ctx->traffic();
+    gpu_kernels->share_accumulate_project(f.grid, projector, f.points, f.depth_ptrs, sharing, batch, gpu_ptrs, store.get(),
+                                          accumulation, gpu_changed, gpu_sh, times);
+    const engine::gpu::GpuTraffic t = ctx->traffic() - before;
+    std::printf("frame %d: maps on the device: %llu bytes up, %llu back; sent each update: %llu up, %llu back\n", frame,
+                static_cast<unsigned long long>(t.host_to_device_bytes), static_cast<unsigned long long>(t.device_to_host_bytes),
+                static_cast<unsigned long long>(plain.host_to_device_bytes), static_cast<unsigned long long>(plain.device_to_host_bytes));
+    EXPECT_EQ(t.submissions, 1u) << "frame " << frame;
+    // Back: the states' 32-byte scalars, the SH and the guard's two counts.
+    EXPECT_LE(t.device_to_host_bytes, batch.size() * (32 + 75 * 4) + 8) << "frame " << frame;
+    EXPECT_GE(plain.device_to_host_bytes, t.device_to_host_bytes + maps_bytes) << "frame " << frame;
+    // Up: the maps only where the device does not hold them (after the read-back), and a blank map never.
+    if (frame == 4)
+      EXPECT_GE(t.host_to_device_bytes + 64, plain.host_to_device_bytes) << "frame " << frame;
+    else
+      EXPECT_LE(t.host_to_device_bytes + maps_bytes, plain.host_to_device_bytes) << "frame " << frame;
+    EXPECT_EQ(gpu_changed, cpu_changed) << "frame " << frame;
+    float largest = 0.0f, worst = 0.0f;
+    for (const float v : cpu_sh) largest = std::max(largest, std::abs(v));
+    ASSERT_GT(largest, 0.0f);
+    for (std::size_t k = 0; k < cpu_sh.size(); ++k) worst = std::max(worst, std::abs(gpu_sh[k] - cpu_sh[k]));
+    std::printf("frame %d: largest SH coefficient %.4g, largest difference %.3g\n", frame, largest, worst);
+    EXPECT_LE(worst, 1e-3f * largest) << "frame " << frame;
+  }
+  // A state the device holds is refused by the CPU backend until read back.
+  std::vector<std::uint8_t> changed(batch.size());
+  std::vector<float> sh(batch.size() * 75);
+  probes::ShareAccumulateTimes times;
+  EXPECT_THROW(cpu_kernels.share_accumulate_project(f.grid, projector, f.points, f.depth_ptrs, sharing, batch, gpu_ptrs, nullptr,
+                                                    accumulation, changed, sh, times),
+               std::logic_error);
+  EXPECT_EQ(ctx->validation_errors(), 0);
+}
+}  // namespace
+
+TEST(VulkanMapStore, TheMapsStayOnTheDeviceAndEqualTheCpuBackend) {
+  GPU_TEST_CONTEXT_OR_SKIP(unused);
+  maps_stay_on_the_device(false);
+}
+
+TEST(VulkanMapStore, TheSameThroughStagingCopiesAsOnADiscreteGpu) {
+  GPU_TEST_CONTEXT_OR_SKIP(unused);
+  maps_stay_on_the_device(true);
 }

@@ -13,6 +13,7 @@
 #include "engine/gpu/compute_pipeline.h"
 #include "engine/gpu/gpu_buffer.h"
 #include "engine/gpu/vulkan_context.h"
+#include "gpu/vulkan_map_store.h"
 #include "probes/probe_map.h"
 
 namespace transgi::gpu {
@@ -33,13 +34,17 @@ class VulkanProbeAccumulator {
   // prepare: the states' maps written for the kernel; this frame's samples
   // read from `device_frames` (a device buffer of vec4 (sum, count) per
   // texel, one map per probe of a grid: probe i's is map frame_maps[i]),
-  // not uploaded.
+  // not uploaded. With a `store`, the maps are its slots frame_maps[i]
+  // (VulkanMapStore::stage sends up only what it does not hold); without,
+  // they are written here from the states and read back by finish.
   void prepare(std::span<probes::ProbeMapState* const> states, const engine::gpu::GpuBuffer& device_frames,
-               std::span<const std::uint32_t> frame_maps, const probes::AccumulationSettings& settings);
-  // record: the dispatch, into a command buffer being recorded.
+               std::span<const std::uint32_t> frame_maps, const probes::AccumulationSettings& settings,
+               VulkanMapStore* store = nullptr);
+  // record: the store's uploads and the dispatch, into a command buffer being recorded.
   void record(VkCommandBuffer cmd) const;
-  // finish, after the submission completed: the states' maps and flags read
-  // back (changed[i]), and the filled maps where `filled` is not empty.
+  // finish, after the submission completed: the states' scalars and flags
+  // read back (changed[i]), their maps too where prepare had no store, and
+  // the filled maps where `filled` is not empty.
   void finish(std::span<probes::ProbeMapState* const> states, std::span<std::uint8_t> changed,
               std::span<glm::vec3> filled) const;
   // The filled maps on the device (states.size() x texel_count() x 3
@@ -47,14 +52,17 @@ class VulkanProbeAccumulator {
   [[nodiscard]] const engine::gpu::GpuBuffer& filled_on_device() const { return filled_; }
 
  private:
-  // The states' maps into the kernel's buffers, the push constants set.
+  // The states' scalars (and, without a store, their maps) into the
+  // kernel's buffers, the push constants set.
   void write_states(std::span<probes::ProbeMapState* const> states, const probes::AccumulationSettings& settings);
+  void write_maps(std::span<probes::ProbeMapState* const> states);
 
   engine::gpu::VulkanContext& ctx_;
   probes::MapLayout layout_;
   std::unique_ptr<engine::gpu::ComputePipeline> pipeline_;
-  engine::gpu::GpuBuffer states_, history_, sampled_, frame_, filled_, solid_angle_, known_, frame_maps_;
+  engine::gpu::GpuBuffer states_, history_, sampled_, frame_, filled_, solid_angle_, known_, frame_maps_, map_slots_;
   std::size_t probes_ = 0;
+  const VulkanMapStore* store_ = nullptr;  // this update's, from prepare
   std::vector<std::uint8_t> push_;
 };
 

@@ -17,7 +17,7 @@ probes::SharingStats VulkanProbeKernels::share_accumulate_project(
     const probes::ProbeGrid& grid, const probes::MapProjector& projector,
     const std::vector<std::vector<probes::ShadedPoint>>& points, const std::vector<const probes::DepthMap*>& own_depth,
     const probes::SharingSettings& sharing, std::span<const int> batch, std::span<probes::ProbeMapState* const> states,
-    const probes::AccumulationSettings& accumulation, std::span<std::uint8_t> changed, std::span<float> sh,
+    probes::ProbeMapStore* store, const probes::AccumulationSettings& accumulation, std::span<std::uint8_t> changed, std::span<float> sh,
     probes::ShareAccumulateTimes& times) {
   using Clock = std::chrono::steady_clock;
   const auto ms_since = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
@@ -37,7 +37,9 @@ probes::SharingStats VulkanProbeKernels::share_accumulate_project(
     frame_maps[i] = static_cast<std::uint32_t>(batch[i]);
   }
   r->prepare(grid, points, own_depth, sharing, targets);
-  a->prepare(states, r->samples_on_device(), frame_maps, accumulation);
+  auto* maps = dynamic_cast<VulkanMapStore*>(store);
+  if (store && !maps) throw std::invalid_argument("VulkanProbeKernels: a map store from another backend");
+  a->prepare(states, r->samples_on_device(), frame_maps, accumulation, maps);
   times.share_ms = ms_since(t0);
   const auto t1 = Clock::now();
   // One submission, a timestamp after each stage: the samples and the
@@ -62,6 +64,10 @@ probes::SharingStats VulkanProbeKernels::share_accumulate_project(
   p->read(sh);
   times.accumulate_ms = ms_since(t1);
   return stats;
+}
+
+std::unique_ptr<probes::ProbeMapStore> VulkanProbeKernels::make_map_store(const probes::MapLayout& layout, int probes) {
+  return std::make_unique<VulkanMapStore>(ctx_, layout, probes);
 }
 
 void VulkanProbeKernels::shade_probe_rays(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,

@@ -41,10 +41,12 @@ class VulkanProbeKernels : public probes::ProbeKernels {
                                                 const std::vector<std::vector<probes::ShadedPoint>>& points,
                                                 const std::vector<const probes::DepthMap*>& own_depth,
                                                 const probes::SharingSettings& sharing, std::span<const int> batch,
-                                                std::span<probes::ProbeMapState* const> states,
+                                                std::span<probes::ProbeMapState* const> states, probes::ProbeMapStore* store,
                                                 const probes::AccumulationSettings& accumulation,
                                                 std::span<std::uint8_t> changed, std::span<float> sh,
                                                 probes::ShareAccumulateTimes& times) override;
+  // The maps on this device between updates (VulkanMapStore).
+  [[nodiscard]] std::unique_ptr<probes::ProbeMapStore> make_map_store(const probes::MapLayout& layout, int probes) override;
   engine::rt::RayBatchTracer* tracer() override { return &tracer_; }
   // The real-time frame's transfer decoder on this device, made for
   // `model`'s network when first asked (and again for another model); null

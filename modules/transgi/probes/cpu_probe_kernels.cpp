@@ -1,6 +1,8 @@
 #include "probes/cpu_probe_kernels.h"
 
 #include <chrono>
+#include <stdexcept>
+#include <string>
 
 #include "engine/jobs/parallel_for.h"
 #include "engine/math/rng.h"
@@ -52,12 +54,17 @@ SharingStats CpuProbeKernels::share_accumulate_project(const ProbeGrid& grid, co
                                                        const std::vector<std::vector<ShadedPoint>>& points,
                                                        const std::vector<const DepthMap*>& own_depth,
                                                        const SharingSettings& sharing, std::span<const int> batch,
-                                                       std::span<ProbeMapState* const> states,
+                                                       std::span<ProbeMapState* const> states, ProbeMapStore* store,
                                                        const AccumulationSettings& accumulation,
                                                        std::span<std::uint8_t> changed, std::span<float> sh,
                                                        ShareAccumulateTimes& times) {
   using Clock = std::chrono::steady_clock;
   const auto ms_since = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
+  if (store) throw std::invalid_argument("CpuProbeKernels: a map store from another backend");
+  for (std::size_t i = 0; i < states.size(); ++i)
+    if (states[i]->device_stamp != 0)
+      throw std::logic_error("CpuProbeKernels: probe " + std::to_string(batch[i]) +
+                             "'s maps are held on a device; read them back first (ProbeMapStore::read_back)");
   auto t0 = Clock::now();
   std::vector<std::uint8_t> targets(static_cast<std::size_t>(grid.count()), 0);
   for (const int q : batch) targets[static_cast<std::size_t>(q)] = 1;

@@ -19,8 +19,10 @@ class CpuProbeKernels final : public ProbeKernels {
                                         const std::vector<std::vector<ShadedPoint>>& points,
                                         const std::vector<const DepthMap*>& own_depth, const SharingSettings& sharing,
                                         std::span<const int> batch, std::span<ProbeMapState* const> states,
-                                        const AccumulationSettings& accumulation, std::span<std::uint8_t> changed,
+                                        ProbeMapStore* store, const AccumulationSettings& accumulation, std::span<std::uint8_t> changed,
                                         std::span<float> sh, ShareAccumulateTimes& times) override;
+  // The maps live in the ProbeMapStates: no store.
+  [[nodiscard]] std::unique_ptr<ProbeMapStore> make_map_store(const MapLayout&, int) override { return nullptr; }
   engine::rt::RayBatchTracer* tracer() override { return nullptr; }
   [[nodiscard]] const char* name() const override { return "cpu"; }
 };

@@ -4,6 +4,7 @@
 #include <tuple>
 #include <atomic>
 #include <chrono>
+#include <exception>
 #include <limits>
 #include <cmath>
 
@@ -102,7 +103,22 @@ glm::vec3 ProbeField::irradiance(const glm::vec3& p, const glm::vec3& n) const {
 }
 
 void ProbeField::set_kernels(std::shared_ptr<ProbeKernels> kernels) {
-  kernels_ = kernels ? std::move(kernels) : cpu_probe_kernels();
+  if (!kernels) kernels = cpu_probe_kernels();
+  if (kernels == kernels_) return;  // set every frame by the plugin: the store stays
+  try {
+    read_back_maps();  // what the old backend's device holds, before its store goes
+  } catch (const std::exception&) {
+    // The device failed with the maps on it: those probes start afresh.
+    for (std::size_t q = 0; q < probes_.maps.size(); ++q)
+      if (probes_.maps[q].device_stamp != 0) forget_light(static_cast<int>(q));
+  }
+  map_store_.reset();
+  kernels_ = std::move(kernels);
+  map_store_ = kernels_->make_map_store(settings_.map, grid_.count());
+}
+
+void ProbeField::read_back_maps() {
+  if (map_store_) map_store_->read_back(probes_.maps);
 }
 
 std::size_t ProbeField::memory_bytes() const {
@@ -480,7 +496,7 @@ ProbeField::LightIntoProbes ProbeField::share_accumulate_project(UpdateWork& w) 
   std::vector<float> projected(batch.size() * 75);
   LightIntoProbes result;
   result.sharing = kernels_->share_accumulate_project(grid_, projector_, w.points, depth, settings_.sharing, batch, batch_states,
-                                                      settings_.accumulation, batch_changed, projected, result.times);
+                                                      map_store_.get(), settings_.accumulation, batch_changed, projected, result.times);
 
   std::atomic<int> bad_probes{0};
   // After probe q's map took its frame (changed: it detected a change of

@@ -327,6 +327,10 @@ class ProbeField {
   // backend, or the CPU's: the default, and what null selects). Shared: one
   // backend serves every field of a scene.
   void set_kernels(std::shared_ptr<ProbeKernels> kernels);
+  // A device backend keeps the probes' radiance maps on its device between
+  // updates (ProbeMapStore): this copies them into states() for readers on
+  // the host. The CPU backend's maps are always there.
+  void read_back_maps();
   // This field as its own and finer cascades' probe rays read its light.
   [[nodiscard]] ProbeFeedbackSource feedback_source() const;
 
@@ -336,6 +340,9 @@ class ProbeField {
   // settings().grid with each probe where relocation moved it.
   [[nodiscard]] const ProbeGrid& grid() const { return grid_; }
   [[nodiscard]] std::uint64_t frame() const { return frame_; }
+  // Each probe's maps: the radiance and sampled maps only as of the last
+  // read_back_maps() where a device backend holds them (the depth maps and
+  // the scalars are always current).
   [[nodiscard]] const std::vector<ProbeMapState>& states() const { return probes_.maps; }
   [[nodiscard]] ProbeState state(int probe) const { return probes_.state[static_cast<std::size_t>(probe)]; }
   // Per probe, 1 unless buried or far: what interpolation weighs.
@@ -390,6 +397,9 @@ class ProbeField {
 
   ProbeFieldSettings settings_;
   std::shared_ptr<ProbeKernels> kernels_;
+  // kernels_'s store of the radiance maps (null for the CPU's); declared
+  // after kernels_, so destroyed before the backend it belongs to.
+  std::unique_ptr<ProbeMapStore> map_store_;
   ProbeGrid grid_;  // settings_.grid, relocated
   MapProjector projector_;
   // The length probe depths are stored in units of (ProbeMapState::reset).

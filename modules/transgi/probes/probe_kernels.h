@@ -10,6 +10,7 @@
 // backend for the CPU's.
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -71,6 +72,20 @@ struct ShareAccumulateTimes {
   double share_ms = 0.0, accumulate_ms = 0.0;
 };
 
+// Where a device backend keeps a field's radiance maps between frames, so
+// that they do not cross the bus every update (issue 36): slot q holds probe
+// q's radiance and sampled maps once an update has sent them up, and the
+// device's accumulation updates them in place. Made by the backend
+// (ProbeKernels::make_map_store), owned by the field.
+class ProbeMapStore {
+ public:
+  virtual ~ProbeMapStore() = default;
+  // The maps this store holds, copied into states[q] for every probe q
+  // whose device_stamp it gave (their stamps zeroed: the host's maps are
+  // current again). For the host's readers: a backend switch, tools, tests.
+  virtual void read_back(std::span<ProbeMapState> states) = 0;
+};
+
 // Takes ray i of the j-th listed probe. A probe's rays come in order, on one
 // thread, so it may write that probe's data without locks.
 using ProbeRayConsumer = std::function<void(int j, int i, const ProbeRayHit& hit)>;
@@ -95,14 +110,22 @@ class ProbeKernels {
   // targets), accumulated into *states[i] (accumulate; its result in
   // changed[i]), filled (filled_radiance with accumulation.fill_passes) and
   // projected as projector.project into sh[i * 75, i * 75 + 75). `times`
-  // gets the host time of the sharing and of the rest.
+  // gets the host time of the sharing and of the rest. `store`: this
+  // backend's store of the field's maps (make_map_store), whose slot
+  // batch[i] holds states[i]'s; null: the states' maps are read and written
+  // on the host (a device sends them up and back). Throws std::logic_error
+  // for a state whose maps another store holds (read them back first).
   virtual SharingStats share_accumulate_project(const ProbeGrid& grid, const MapProjector& projector,
                                                 const std::vector<std::vector<ShadedPoint>>& points,
                                                 const std::vector<const DepthMap*>& own_depth,
                                                 const SharingSettings& sharing, std::span<const int> batch,
-                                                std::span<ProbeMapState* const> states,
+                                                std::span<ProbeMapState* const> states, ProbeMapStore* store,
                                                 const AccumulationSettings& accumulation, std::span<std::uint8_t> changed,
                                                 std::span<float> sh, ShareAccumulateTimes& times) = 0;
+  // A store for the maps of a field of `probes` probes laid out as
+  // `layout`, kept on this backend's device; null where the maps live in
+  // the ProbeMapStates themselves (the CPU).
+  [[nodiscard]] virtual std::unique_ptr<ProbeMapStore> make_map_store(const MapLayout& layout, int probes) = 0;
   // The backend's ray tracer for the probes' relocation rays (and the
   // G-buffer's camera rays); null = the RtScene's own (Embree) queries.
   virtual engine::rt::RayBatchTracer* tracer() = 0;

@@ -19,6 +19,7 @@ void ProbeMapState::reset(int texels, float depth_unit) {
   stable_frames = 0;
   depth_frames = 0;
   drift = 0.0f;
+  device_stamp = 0;
 }
 
 void ProbeMapState::release() {

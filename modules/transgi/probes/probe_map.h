@@ -58,6 +58,13 @@ struct ProbeMapState {
   float drift = 0.0f;     // exponential mean of the signed relative frame change
   int stable_frames = 0;  // (neither changed nor drifting)
   int depth_frames = 0;   // frames of own depth since reset or since the geometry last moved  // consecutive frames after the warm-up without a detected change
+  // Non-zero while a device's map store (ProbeMapStore, probe_kernels.h)
+  // holds this probe's radiance and sampled maps: after the device's
+  // accumulation they are newer than `radiance` and `sampled` here, which
+  // are stale until the store reads them back (and zeroes this). reset()
+  // and release() zero it too: the host's fresh maps are then the truth,
+  // sent up before the next update.
+  std::uint64_t device_stamp = 0;
 
   // depth_unit: the length the depth is stored in units of (the grid's
   // smallest spacing).
