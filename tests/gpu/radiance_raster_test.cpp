@@ -67,6 +67,24 @@ Frame random_frame(std::uint64_t seed) {
   return f;
 }
 
+// The probes a frame updates (its targets), in order.
+std::vector<int> updated_probes(const Frame& f) {
+  std::vector<int> batch;
+  for (int q = 0; q < f.grid.count(); ++q)
+    if (f.targets[static_cast<std::size_t>(q)]) batch.push_back(q);
+  return batch;
+}
+
+// The device's SH against the CPU's: each coefficient within 1e-3 of the largest.
+void expect_sh_near(const std::vector<float>& cpu_sh, const std::vector<float>& gpu_sh, int frame) {
+  float largest = 0.0f, worst = 0.0f;
+  for (const float v : cpu_sh) largest = std::max(largest, std::abs(v));
+  ASSERT_GT(largest, 0.0f);
+  for (std::size_t k = 0; k < cpu_sh.size(); ++k) worst = std::max(worst, std::abs(gpu_sh[k] - cpu_sh[k]));
+  std::printf("frame %d: largest SH coefficient %.4g, largest difference %.3g\n", frame, largest, worst);
+  EXPECT_LE(worst, 1e-3f * largest) << "frame " << frame;
+}
+
 }  // namespace
 
 // Rounding may put a point the other side of a texel border or of the
@@ -157,9 +175,7 @@ TEST(VulkanProbeKernels, ShareAccumulateProjectIsOneSubmissionAndEqualsTheCpuBac
   const probes::MapProjector projector(f.layout);
   const probes::SharingSettings sharing;
   const probes::AccumulationSettings accumulation;
-  std::vector<int> batch;
-  for (int q = 0; q < f.grid.count(); ++q)
-    if (f.targets[static_cast<std::size_t>(q)]) batch.push_back(q);
+  const std::vector<int> batch = updated_probes(f);
   const auto fresh_states = [&] {
     std::vector<probes::ProbeMapState> s(batch.size());
     for (auto& m : s) m.reset(f.layout.texel_count(), f.grid.min_spacing());
@@ -196,12 +212,7 @@ TEST(VulkanProbeKernels, ShareAccumulateProjectIsOneSubmissionAndEqualsTheCpuBac
     EXPECT_NEAR(static_cast<double>(gpu_stats.rejected_by_guard), static_cast<double>(cpu_stats.rejected_by_guard),
                 1e-3 * cpu_stats.rejected_by_guard + 1);
     EXPECT_EQ(gpu_changed, cpu_changed) << "frame " << frame;
-    float largest = 0.0f, worst = 0.0f;
-    for (const float v : cpu_sh) largest = std::max(largest, std::abs(v));
-    ASSERT_GT(largest, 0.0f);
-    for (std::size_t k = 0; k < cpu_sh.size(); ++k) worst = std::max(worst, std::abs(gpu_sh[k] - cpu_sh[k]));
-    std::printf("frame %d: largest SH coefficient %.4g, largest difference %.3g\n", frame, largest, worst);
-    EXPECT_LE(worst, 1e-3f * largest) << "frame " << frame;
+    expect_sh_near(cpu_sh, gpu_sh, frame);
   }
 }
 
@@ -228,9 +239,7 @@ void maps_stay_on_the_device(bool stage_device_only) {
   const probes::MapProjector projector(f.layout);
   const probes::SharingSettings sharing;
   const probes::AccumulationSettings accumulation;
-  std::vector<int> batch;
-  for (int q = 0; q < f.grid.count(); ++q)
-    if (f.targets[static_cast<std::size_t>(q)]) batch.push_back(q);
+  const std::vector<int> batch = updated_probes(f);
   const std::size_t texels = static_cast<std::size_t>(f.layout.texel_count());
   // One state a probe of the grid, as a field keeps them; the batch points into them.
   const auto fresh_states = [&] {
@@ -296,12 +305,7 @@ void maps_stay_on_the_device(bool stage_device_only) {
     else
       EXPECT_LE(t.host_to_device_bytes + maps_bytes, plain.host_to_device_bytes) << "frame " << frame;
     EXPECT_EQ(gpu_changed, cpu_changed) << "frame " << frame;
-    float largest = 0.0f, worst = 0.0f;
-    for (const float v : cpu_sh) largest = std::max(largest, std::abs(v));
-    ASSERT_GT(largest, 0.0f);
-    for (std::size_t k = 0; k < cpu_sh.size(); ++k) worst = std::max(worst, std::abs(gpu_sh[k] - cpu_sh[k]));
-    std::printf("frame %d: largest SH coefficient %.4g, largest difference %.3g\n", frame, largest, worst);
-    EXPECT_LE(worst, 1e-3f * largest) << "frame " << frame;
+    expect_sh_near(cpu_sh, gpu_sh, frame);
   }
   // A state the device holds is refused by the CPU backend until read back.
   std::vector<std::uint8_t> changed(batch.size());
