@@ -235,7 +235,8 @@ void maps_stay_on_the_device(bool stage_device_only) {
   std::shared_ptr<gpu::VulkanProbeKernels> gpu_kernels = gpu::make_probe_kernels(ctx, nullptr, &why);
   if (!gpu_kernels) GTEST_SKIP() << why;
   probes::CpuProbeKernels cpu_kernels;
-  const Frame f = random_frame(31);
+  Frame f = random_frame(31);
+  for (probes::DepthMap& d : f.depth) d.stamp_version();  // as update_own_depth leaves them
   const probes::MapProjector projector(f.layout);
   const probes::SharingSettings sharing;
   const probes::AccumulationSettings accumulation;
@@ -257,8 +258,13 @@ void maps_stay_on_the_device(bool stage_device_only) {
                                             plain_ptrs = pointers(plain_states);
   std::unique_ptr<probes::ProbeMapStore> store = gpu_kernels->make_map_store(f.layout, f.grid.count());
   ASSERT_TRUE(store);
-  const std::uint64_t maps_bytes = batch.size() * texels * (8 + 4);
+  const std::uint64_t maps_bytes = batch.size() * texels * (8 + 4), depth_bytes = f.depth.size() * texels * 4;
   for (int frame = 0; frame < 5; ++frame) {
+    if (frame == 3) {  // a probe's own depth moved in: its neighbours' guard rejects what lies past it
+      probes::DepthMap& d = f.depth[static_cast<std::size_t>(batch[1])];
+      for (std::size_t t = 0; t < texels; ++t) d.set(t, 0.2f * f.grid.min_spacing(), 0.0f);
+      d.stamp_version();
+    }
     if (frame == 2) {  // a probe restarted on the host: its fresh (blank) maps replace the device's
       cpu_states[static_cast<std::size_t>(batch[0])].reset(f.layout.texel_count(), f.grid.min_spacing());
       gpu_states[static_cast<std::size_t>(batch[0])].reset(f.layout.texel_count(), f.grid.min_spacing());
@@ -282,15 +288,15 @@ void maps_stay_on_the_device(bool stage_device_only) {
     std::vector<std::uint8_t> cpu_changed(batch.size()), gpu_changed(batch.size()), plain_changed(batch.size());
     std::vector<float> cpu_sh(batch.size() * 75), gpu_sh(batch.size() * 75), plain_sh(batch.size() * 75);
     probes::ShareAccumulateTimes times;
-    cpu_kernels.share_accumulate_project(f.grid, projector, f.points, f.depth_ptrs, sharing, batch, cpu_ptrs, nullptr, accumulation,
-                                         cpu_changed, cpu_sh, times);
+    const probes::SharingStats cpu_stats = cpu_kernels.share_accumulate_project(
+        f.grid, projector, f.points, f.depth_ptrs, sharing, batch, cpu_ptrs, nullptr, accumulation, cpu_changed, cpu_sh, times);
     engine::gpu::GpuTraffic before = ctx->traffic();
     gpu_kernels->share_accumulate_project(f.grid, projector, f.points, f.depth_ptrs, sharing, batch, plain_ptrs, nullptr,
                                           accumulation, plain_changed, plain_sh, times);
     const engine::gpu::GpuTraffic plain = ctx->traffic() - before;
     before = ctx->traffic();
-    gpu_kernels->share_accumulate_project(f.grid, projector, f.points, f.depth_ptrs, sharing, batch, gpu_ptrs, store.get(),
-                                          accumulation, gpu_changed, gpu_sh, times);
+    const probes::SharingStats gpu_stats = gpu_kernels->share_accumulate_project(
+        f.grid, projector, f.points, f.depth_ptrs, sharing, batch, gpu_ptrs, store.get(), accumulation, gpu_changed, gpu_sh, times);
     const engine::gpu::GpuTraffic t = ctx->traffic() - before;
     std::printf("frame %d: maps on the device: %llu bytes up, %llu back; sent each update: %llu up, %llu back\n", frame,
                 static_cast<unsigned long long>(t.host_to_device_bytes), static_cast<unsigned long long>(t.device_to_host_bytes),
@@ -299,11 +305,20 @@ void maps_stay_on_the_device(bool stage_device_only) {
     // Back: the states' 32-byte scalars, the SH and the guard's two counts.
     EXPECT_LE(t.device_to_host_bytes, batch.size() * (32 + 75 * 4) + 8) << "frame " << frame;
     EXPECT_GE(plain.device_to_host_bytes, t.device_to_host_bytes + maps_bytes) << "frame " << frame;
-    // Up: the maps only where the device does not hold them (after the read-back), and a blank map never.
-    if (frame == 4)
-      EXPECT_GE(t.host_to_device_bytes + 64, plain.host_to_device_bytes) << "frame " << frame;
+    // Up: the maps only where the device does not hold them (after the
+    // read-back), a blank map never; the depth maps on the first update,
+    // then only the one whose version changed.
+    const std::uint64_t maps_up = frame == 4 ? maps_bytes : 0,
+                        depth_up = frame == 0 ? depth_bytes : frame == 3 ? texels * 4 : 0;
+    // (The first plain update also sent the kernels' constant tables, made for it.)
+    if (frame == 0)
+      EXPECT_LE(t.host_to_device_bytes + maps_bytes + depth_bytes, plain.host_to_device_bytes + maps_up + depth_up);
     else
-      EXPECT_LE(t.host_to_device_bytes + maps_bytes, plain.host_to_device_bytes) << "frame " << frame;
+      EXPECT_EQ(t.host_to_device_bytes + maps_bytes + depth_bytes, plain.host_to_device_bytes + maps_up + depth_up) << "frame " << frame;
+    std::printf("frame %d: %zu samples accepted, %zu rejected by the depth guard (the CPU: %zu, %zu)\n", frame, gpu_stats.accepted,
+                gpu_stats.rejected_by_guard, cpu_stats.accepted, cpu_stats.rejected_by_guard);
+    EXPECT_NEAR(static_cast<double>(gpu_stats.rejected_by_guard), static_cast<double>(cpu_stats.rejected_by_guard),
+                1e-3 * cpu_stats.rejected_by_guard + 1) << "frame " << frame;
     EXPECT_EQ(gpu_changed, cpu_changed) << "frame " << frame;
     expect_sh_near(cpu_sh, gpu_sh, frame);
   }

@@ -15,9 +15,11 @@ void write_probe_field(const probes::ProbeGrid& grid, const std::vector<probes::
     for (std::size_t q = b; q < e; ++q) {
       const probes::DepthMap& d = states[q].depth;
       const bool holds = usable.empty() || usable[q] != 0;
-      std::uint32_t* dst = depth.data() + depth_base + q * texels;
-      if (holds && d.texels.size() == texels) std::memcpy(dst, d.texels.data(), texels * 4);
-      else std::memset(dst, 0, texels * 4);
+      if (!depth.empty()) {
+        std::uint32_t* dst = depth.data() + depth_base + q * texels;
+        if (holds && d.texels.size() == texels) std::memcpy(dst, d.texels.data(), texels * 4);
+        else std::memset(dst, 0, texels * 4);
+      }
       const glm::vec3 off = grid.offsets.empty() ? glm::vec3(0.0f) : grid.offsets[q];
       probes[probe_base + q] = {off.x, off.y, off.z, d.unit, holds ? 1u : 0u, 0, 0, 0};
     }

@@ -66,7 +66,8 @@ inline ProbeFieldGpu probe_field_gpu(const probes::ProbeGrid& grid, const probes
 // A field's probes (relocation offset, depth unit, whether it holds light)
 // into probes[probe_base ..] and their depth moments, `texels` a probe, into
 // depth[depth_base ..] (zeros for a probe that holds none), as the
-// interpolation kernels read them. usable empty: every probe.
+// interpolation kernels read them. usable empty: every probe. depth empty:
+// the probes only (the depth goes up another way, a VulkanMapStore's copy).
 void write_probe_field(const probes::ProbeGrid& grid, const std::vector<probes::ProbeMapState>& states,
                        std::span<const std::uint8_t> usable, std::size_t texels, std::size_t probe_base,
                        std::size_t depth_base, std::span<std::uint32_t> depth, std::span<ProbeGpu> probes);

@@ -1,6 +1,7 @@
 #include "gpu/vulkan_map_store.h"
 
 #include <atomic>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -11,6 +12,14 @@ namespace transgi::gpu {
 
 namespace {
 constexpr std::size_t kHistoryBytes = 2 * sizeof(std::uint32_t), kSampledBytes = sizeof(std::uint32_t);
+constexpr std::size_t kDepthBytes = sizeof(probes::DepthMap::Texel);
+static_assert(kDepthBytes == 4, "a depth texel is two binary16, one 32-bit word on the device");
+// A texel never hit (DepthMap::Texel's initialiser: mean NaN, variance 0),
+// as the 32-bit word vkCmdFillBuffer repeats (mean in the low half).
+constexpr probes::DepthMap::Texel kNeverHit{};
+constexpr std::uint32_t kNeverHitBits = std::uint32_t{kNeverHit.mean} | std::uint32_t{kNeverHit.variance} << 16;
+// The version a slot holds when its map is blank (no stamp is ever this).
+constexpr std::uint64_t kBlankDepth = ~std::uint64_t{0};
 
 // Stamps are unique across every store of the process, so a state one
 // store holds is never taken for one another store holds.
@@ -35,7 +44,55 @@ VulkanMapStore::VulkanMapStore(std::shared_ptr<engine::gpu::VulkanContext> ctx, 
                engine::gpu::GpuBuffer::Placement::DeviceOnly),
       sampled_(*ctx_, std::max<std::size_t>(1, static_cast<std::size_t>(probes_) * texels_) * kSampledBytes,
                engine::gpu::GpuBuffer::Placement::DeviceOnly),
-      stamp_(static_cast<std::size_t>(probes_), 0) {}
+      stamp_(static_cast<std::size_t>(probes_), 0),
+      depth_(*ctx_, std::max<std::size_t>(1, static_cast<std::size_t>(probes_) * texels_) * kDepthBytes,
+             engine::gpu::GpuBuffer::Placement::DeviceOnly),
+      depth_version_(static_cast<std::size_t>(probes_), 0) {}
+
+void VulkanMapStore::stage_depth(std::span<const probes::DepthMap* const> depth) {
+  if (depth.size() != static_cast<std::size_t>(probes_))
+    throw std::invalid_argument("VulkanMapStore::stage_depth: " + std::to_string(depth.size()) + " depth maps for a field of " +
+                                std::to_string(probes_) + " probes");
+  depth_copies_.clear();
+  blank_depth_slots_.clear();
+  std::vector<std::size_t> send;
+  for (std::size_t q = 0; q < depth.size(); ++q) {
+    const probes::DepthMap* d = depth[q];
+    const bool held = d && d->texels.size() == texels_;
+    if (held && d->version != 0 && d->version == depth_version_[q]) continue;
+    bool blank = true;
+    for (std::size_t t = 0; held && t < texels_ && blank; ++t)
+      blank = d->texels[t].mean == kNeverHit.mean && d->texels[t].variance == kNeverHit.variance;
+    if (blank) {
+      // Never hit, as DepthMap::reset leaves it; "blank" is a version of its own.
+      if (depth_version_[q] != kBlankDepth) blank_depth_slots_.push_back(static_cast<int>(q));
+      depth_version_[q] = kBlankDepth;
+      continue;
+    }
+    send.push_back(q);
+    depth_version_[q] = d->version;  // 0 (not stamped) goes up every time
+  }
+  if (send.empty()) return;
+  const std::size_t per = texels_ * kDepthBytes;
+  if (depth_staging_.size() < send.size() * per) depth_staging_ = engine::gpu::GpuBuffer(*ctx_, send.size() * per);
+  const auto bytes = depth_staging_.mapped_as<std::uint8_t>(send.size() * per);
+  engine::jobs::parallel_for<std::size_t>(0, send.size(), 8, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) std::memcpy(bytes.data() + k * per, depth[send[k]]->texels.data(), per);
+  });
+  for (std::size_t k = 0; k < send.size(); ++k)
+    depth_copies_.push_back({k * per, static_cast<VkDeviceSize>(send[k]) * per, per});
+}
+
+void VulkanMapStore::record_depth_uploads(VkCommandBuffer cmd) const {
+  if (depth_copies_.empty() && blank_depth_slots_.empty()) return;
+  const std::size_t per = texels_ * kDepthBytes;
+  for (const int q : blank_depth_slots_) vkCmdFillBuffer(cmd, depth_.handle(), static_cast<VkDeviceSize>(q) * per, per, kNeverHitBits);
+  if (!depth_copies_.empty())
+    vkCmdCopyBuffer(cmd, depth_staging_.handle(), depth_.handle(), static_cast<std::uint32_t>(depth_copies_.size()), depth_copies_.data());
+  engine::gpu::record_memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                                     VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                     VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT);
+}
 
 void VulkanMapStore::stage(std::span<probes::ProbeMapState* const> states, std::span<const int> slots) {
   if (states.size() != slots.size())

@@ -4,7 +4,10 @@
 // binary16 history (r | g << 16, then b: 8 bytes a texel) and sampled flags
 // (4 bytes a texel), as shaders/probe_accumulation.comp reads and writes
 // them in place. Only maps the host changed (a reset, a first update) go
-// up, in the update's own submission; nothing comes back unless asked.
+// up, in the update's own submission; nothing comes back unless asked. It
+// also keeps a copy of each probe's depth map (4 bytes a texel, the host's
+// DepthMap::Texel), sent up when its version changed, for the kernels that
+// read the depth (the raster's guard, the probe rays' bounce light).
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -35,6 +38,16 @@ class VulkanMapStore final : public probes::ProbeMapStore {
   // nothing sent), then a barrier before the kernels that read them.
   void record_uploads(VkCommandBuffer cmd) const;
 
+  // Before a submission that reads depth[q] (one map a probe of the field,
+  // null or of another size where the probe holds none): the maps whose
+  // version this store does not hold are staged (a blank or missing one as
+  // never hit, with nothing sent), for record_depth_uploads.
+  void stage_depth(std::span<const probes::DepthMap* const> depth);
+  void record_depth_uploads(VkCommandBuffer cmd) const;
+  // The depth copies, probe q's at q * texels, current once the uploads
+  // recorded before have run.
+  [[nodiscard]] const engine::gpu::GpuBuffer& depth() const { return depth_; }
+
   [[nodiscard]] const engine::gpu::GpuBuffer& history() const { return history_; }
   [[nodiscard]] const engine::gpu::GpuBuffer& sampled() const { return sampled_; }
   [[nodiscard]] const probes::MapLayout& layout() const { return layout_; }
@@ -52,6 +65,12 @@ class VulkanMapStore final : public probes::ProbeMapStore {
   engine::gpu::GpuBuffer staging_;
   std::vector<VkBufferCopy> history_copies_, sampled_copies_;
   std::vector<int> blank_slots_;
+  // The depth copies: the version each slot holds (0: none known), and
+  // this submission's uploads.
+  engine::gpu::GpuBuffer depth_, depth_staging_;
+  std::vector<std::uint64_t> depth_version_;
+  std::vector<VkBufferCopy> depth_copies_;
+  std::vector<int> blank_depth_slots_;
 };
 
 }  // namespace transgi::gpu

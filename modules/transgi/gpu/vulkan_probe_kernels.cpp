@@ -36,9 +36,9 @@ probes::SharingStats VulkanProbeKernels::share_accumulate_project(
     targets[static_cast<std::size_t>(batch[i])] = 1;
     frame_maps[i] = static_cast<std::uint32_t>(batch[i]);
   }
-  r->prepare(grid, points, own_depth, sharing, targets);
   auto* maps = dynamic_cast<VulkanMapStore*>(store);
   if (store && !maps) throw std::invalid_argument("VulkanProbeKernels: a map store from another backend");
+  r->prepare(grid, points, own_depth, sharing, targets, maps);
   a->prepare(states, r->samples_on_device(), frame_maps, accumulation, maps);
   times.share_ms = ms_since(t0);
   const auto t1 = Clock::now();

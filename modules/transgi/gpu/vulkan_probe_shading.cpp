@@ -10,6 +10,7 @@
 #include "engine/jobs/parallel_for.h"
 #include "gpu/probe_grid_gpu.h"
 #include "gpu/shader_path.h"
+#include "gpu/vulkan_map_store.h"
 #include "probe_shading_shared.h"
 #include "rt_shared.h"
 
@@ -108,7 +109,22 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
   // At least one element each: a binding needs a buffer even without fields.
   texel_count = std::max<std::size_t>(1, texel_count);
   const std::size_t probe_slots = std::max<std::size_t>(1, probe_count);
-  const auto depth = at_least(ctx_, depth_, texel_count * 4).mapped_as<std::uint32_t>(texel_count);
+  if (depth_.handle() == VK_NULL_HANDLE || depth_.size() < texel_count * 4)
+    depth_ = GpuBuffer(ctx_, texel_count * 4, GpuBuffer::Placement::DeviceOnly);
+  // Fields without a store send their depth up through staging; those with
+  // one have it staged into their store (only the changed maps).
+  std::vector<VkBufferCopy> host_depth, store_depth[2];
+  VulkanMapStore* stores[2] = {nullptr, nullptr};
+  std::size_t host_texels = 0;
+  for (int which = 0; which < 2; ++which) {
+    const probes::ProbeFeedbackSource* f = fields[which];
+    if (!f) continue;
+    stores[which] = dynamic_cast<VulkanMapStore*>(f->maps);
+    if (!stores[which]) host_texels += static_cast<std::size_t>(f->grid->count()) * static_cast<std::size_t>(f->layout.texel_count());
+  }
+  const auto staged = host_texels ? at_least(ctx_, depth_staging_, host_texels * 4).mapped_as<std::uint32_t>(host_texels)
+                                  : std::span<std::uint32_t>();
+  std::size_t staged_at = 0;
   const auto probe_info = at_least(ctx_, probes_, probe_slots * sizeof(ProbeGpu)).mapped_as<ProbeGpu>(probe_slots);
   const auto probe_sh = at_least(ctx_, probe_sh_, probe_slots * kTransferOutputs * sizeof(float))
                             .mapped_as<float>(probe_slots * kTransferOutputs);
@@ -126,7 +142,18 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
     const glm::vec3 held_min = f->held_min(), held_max = f->held_max();
     record.box_min_x = held_min.x, record.box_min_y = held_min.y, record.box_min_z = held_min.z;
     record.box_max_x = held_max.x, record.box_max_y = held_max.y, record.box_max_z = held_max.z;
-    write_probe_field(*f->grid, *f->states, f->usable, texels, probe_base, depth_base, depth, probe_info);
+    const std::size_t field_bytes = count * texels * 4;
+    if (VulkanMapStore* store = stores[which]) {
+      std::vector<const probes::DepthMap*> maps(count);
+      for (std::size_t q = 0; q < count; ++q) maps[q] = &(*f->states)[q].depth;
+      store->stage_depth(maps);
+      store_depth[which].push_back({0, depth_base * 4, field_bytes});
+      write_probe_field(*f->grid, *f->states, f->usable, texels, probe_base, 0, {}, probe_info);
+    } else {
+      write_probe_field(*f->grid, *f->states, f->usable, texels, probe_base, 0, staged.subspan(staged_at, count * texels), probe_info);
+      host_depth.push_back({staged_at * 4, depth_base * 4, field_bytes});
+      staged_at += count * texels;
+    }
     std::memcpy(probe_sh.data() + probe_base * kTransferOutputs, f->sh.data(), f->sh.size() * sizeof(float));
     probe_base += count;
     depth_base += count * texels;
@@ -171,6 +198,17 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
   const auto groups = static_cast<std::uint32_t>((n + kProbeShadingGroupSize - 1) / kProbeShadingGroupSize);
   const auto rt_groups = static_cast<std::uint32_t>((n + engine::gpu::kRtGroupSize - 1) / engine::gpu::kRtGroupSize);
   gpu_ms_ += std::max(0.0, ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
+    // The depth maps first: the stores' changed ones up, then both fields' into depth_.
+    for (int which = 0; which < 2; ++which)
+      if (stores[which]) stores[which]->record_depth_uploads(cmd);
+    for (int which = 0; which < 2; ++which)
+      if (stores[which])
+        vkCmdCopyBuffer(cmd, stores[which]->depth().handle(), depth_.handle(), static_cast<std::uint32_t>(store_depth[which].size()),
+                        store_depth[which].data());
+    if (!host_depth.empty())
+      vkCmdCopyBuffer(cmd, depth_staging_.handle(), depth_.handle(), static_cast<std::uint32_t>(host_depth.size()), host_depth.data());
+    engine::gpu::record_memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
     generate_->record_dispatch(cmd, groups, 1, 1, generate_push);
     engine::gpu::record_compute_barrier(cmd);
     trace_->record_dispatch(cmd, rt_groups, 1, 1, closest);

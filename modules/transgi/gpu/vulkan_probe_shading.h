@@ -84,7 +84,11 @@ class VulkanProbeShading {
   engine::gpu::GpuShadingScene scene_;
   std::unique_ptr<engine::gpu::ComputePipeline> generate_, trace_, begin_, shadow_trace_, finish_;
   engine::gpu::GpuBuffer origins_, directions_, rays_, hits_, items_, pending_, shadows_, shadow_hits_;
-  engine::gpu::GpuBuffer out_, feedback_, depth_, probes_, probe_sh_;
+  engine::gpu::GpuBuffer out_, feedback_, probes_, probe_sh_;
+  // Both fields' depth maps on the device, filled in the submission: from
+  // a field's VulkanMapStore (a copy on the device) or from the host
+  // through depth_staging_.
+  engine::gpu::GpuBuffer depth_, depth_staging_;
   double gpu_ms_ = 0;
 };
 

@@ -20,7 +20,7 @@ VulkanRadianceRaster::VulkanRadianceRaster(engine::gpu::VulkanContext& ctx, prob
 
 void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vector<std::vector<probes::ShadedPoint>>& points,
                                    const std::vector<const probes::DepthMap*>& own_depth, const probes::SharingSettings& s,
-                                   std::span<const std::uint8_t> targets) {
+                                   std::span<const std::uint8_t> targets, VulkanMapStore* store) {
   const auto count = static_cast<std::size_t>(grid.count());
   const auto texels = static_cast<std::size_t>(layout_.texel_count());
   if (points.size() != count || (!own_depth.empty() && own_depth.size() != count) ||
@@ -29,6 +29,10 @@ void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vec
                                 std::to_string(points.size()) + ", depth for " + std::to_string(own_depth.size()) +
                                 ", " + std::to_string(targets.size()) + " target flags");
   count_ = count;
+  if (store && (static_cast<std::size_t>(store->probes()) != count || store->layout().texel_count() != layout_.texel_count()))
+    throw std::invalid_argument("VulkanRadianceRaster: a map store of " + std::to_string(store->probes()) + " probes for a grid of " +
+                                std::to_string(count));
+  store_ = store && !own_depth.empty() ? store : nullptr;  // no depth maps given: none to read
 
   // Inputs go straight into the mapped buffers and results come straight out,
   // in parallel over probes: tens of MB of depth maps and samples a frame,
@@ -38,7 +42,9 @@ void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vec
   // A depth guard needs every probe's map; a probe without one (null) reads
   // as "never hit" (NaN), which the guard lets through, as the CPU does.
   const bool has_depth = !own_depth.empty();
-  const std::size_t depth_texels = has_depth ? count * texels : 1;
+  // Without a store every map is written here; with one, only the changed go up.
+  const bool write_depth = has_depth && !store_;
+  const std::size_t depth_texels = write_depth ? count * texels : 1;
   std::vector<ProbeGpu> info(count);
   std::vector<std::uint32_t>& target_flags = target_flags_;
   target_flags.assign(count, 1);
@@ -51,8 +57,14 @@ void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vec
   using DepthTexel = probes::DepthMap::Texel;
   const auto flat = engine::gpu::bind_at_least(ctx_, *pipeline_, 0, points_, std::max<std::size_t>(1, begin[count]) * sizeof(ShadedPointGpu))
                         .mapped_as<ShadedPointGpu>(begin[count]);
-  const auto depth = engine::gpu::bind_at_least(ctx_, *pipeline_, 2, depth_, depth_texels * sizeof(DepthTexel))
-                         .mapped_as<DepthTexel>(depth_texels);
+  if (store_) {
+    store_->stage_depth(own_depth);
+    pipeline_->bind(2, store_->depth());
+  } else {
+    engine::gpu::bind_at_least(ctx_, *pipeline_, 2, depth_, depth_texels * sizeof(DepthTexel));
+    pipeline_->bind(2, depth_);  // a store's may have been bound since
+  }
+  const auto depth = write_depth ? depth_.mapped_as<DepthTexel>(depth_texels) : std::span<DepthTexel>();
   engine::jobs::parallel_for<std::size_t>(0, count, 8, [&](std::size_t q0, std::size_t q1) {
     for (std::size_t q = q0; q < q1; ++q) {
       std::size_t i = begin[q];
@@ -60,7 +72,7 @@ void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vec
         flat[i++] = {pt.position.x, pt.position.y, pt.position.z, pt.distance, pt.radiance.x, pt.radiance.y,
                      pt.radiance.z, 0, pt.direction.x, pt.direction.y, pt.direction.z, 0, pt.normal.x, pt.normal.y,
                      pt.normal.z, 0};
-      if (!has_depth) continue;
+      if (!write_depth) continue;
       const probes::DepthMap* d = own_depth[q];
       if (d && d->texels.size() == texels) std::memcpy(&depth[q * texels], d->texels.data(), texels * sizeof(DepthTexel));
       else std::fill_n(&depth[q * texels], texels, DepthTexel{});
@@ -88,6 +100,7 @@ void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vec
 }
 
 void VulkanRadianceRaster::record(VkCommandBuffer cmd) const {
+  if (store_) store_->record_depth_uploads(cmd);
   if (count_ > 0) pipeline_->record_dispatch(cmd, static_cast<std::uint32_t>(count_), 1, 1, push_.data());
 }
 

@@ -9,6 +9,7 @@
 #include "engine/gpu/compute_pipeline.h"
 #include "engine/gpu/gpu_buffer.h"
 #include "engine/gpu/vulkan_context.h"
+#include "gpu/vulkan_map_store.h"
 #include "probes/radiance_sharing.h"
 
 namespace transgi::gpu {
@@ -25,10 +26,12 @@ class VulkanRadianceRaster {
 
   // The same in three steps, for a submission that holds other stages too.
   // prepare: the points, depth maps and targets written for the kernel.
+  // With the field's `store`, the depth maps are its copies (only the
+  // changed ones staged, sent by record).
   void prepare(const probes::ProbeGrid& grid, const std::vector<std::vector<probes::ShadedPoint>>& points,
                const std::vector<const probes::DepthMap*>& own_depth, const probes::SharingSettings& settings,
-               std::span<const std::uint8_t> targets = {});
-  // record: the dispatch, into a command buffer being recorded.
+               std::span<const std::uint8_t> targets = {}, VulkanMapStore* store = nullptr);
+  // record: the store's depth uploads and the dispatch, into a command buffer being recorded.
   void record(VkCommandBuffer cmd) const;
   // The samples on the device after the submission: vec4 (sum, count) per
   // texel, one map per probe of the grid (the targets' written).
@@ -43,6 +46,7 @@ class VulkanRadianceRaster {
   engine::gpu::GpuBuffer points_, ranges_, depth_, probes_, targets_, samples_, stats_;
   std::unique_ptr<engine::gpu::ComputePipeline> pipeline_;
   std::size_t count_ = 0;                 // the prepared grid's probes
+  VulkanMapStore* store_ = nullptr;  // the prepared update's, if any
   std::vector<std::uint32_t> target_flags_;
   std::vector<std::uint8_t> push_;
 };

@@ -320,7 +320,8 @@ ProbeFeedbackSource ProbeField::feedback_source() const {
                              probes_.usable,
                              settings_.interpolation,
                              frame_ > 0,
-                             settings_.hold_cells};
+                             settings_.hold_cells,
+                             map_store_.get()};
 }
 
 void ProbeField::trace_and_shade(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,

@@ -27,6 +27,8 @@ namespace transgi::probes {
 
 // A probe field as the bounce light of probe rays reads it
 // (ProbeField::irradiance): its relocated grid, maps, SH and usable flags.
+class ProbeMapStore;
+
 struct ProbeFeedbackSource {
   const ProbeGrid* grid = nullptr;
   MapLayout layout;
@@ -40,6 +42,9 @@ struct ProbeFeedbackSource {
   // (ProbeFieldSettings::hold_cells); past them a probe ray's hit takes the
   // outer field's light.
   float hold_cells = 0.0f;
+  // The field's store on the backend's device (ProbeField's), which keeps
+  // a copy of its depth maps too; null: the maps are sent from `states`.
+  ProbeMapStore* maps = nullptr;
   [[nodiscard]] glm::vec3 held_min() const { return grid->held_min(hold_cells); }
   [[nodiscard]] glm::vec3 held_max() const { return grid->held_max(hold_cells); }
 };
@@ -72,11 +77,13 @@ struct ShareAccumulateTimes {
   double share_ms = 0.0, accumulate_ms = 0.0;
 };
 
-// Where a device backend keeps a field's radiance maps between frames, so
-// that they do not cross the bus every update (issue 36): slot q holds probe
-// q's radiance and sampled maps once an update has sent them up, and the
-// device's accumulation updates them in place. Made by the backend
-// (ProbeKernels::make_map_store), owned by the field.
+// Where a device backend keeps a field's maps between frames, so that they
+// do not cross the bus every update (issue 36): slot q holds probe q's
+// radiance and sampled maps once an update has sent them up, and the
+// device's accumulation updates them in place; and a copy of its depth map
+// (updated on the host), sent again only when its DepthMap::version
+// changed. Made by the backend (ProbeKernels::make_map_store), owned by the
+// field.
 class ProbeMapStore {
  public:
   virtual ~ProbeMapStore() = default;

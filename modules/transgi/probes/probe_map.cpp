@@ -209,6 +209,7 @@ void update_own_depth(ProbeMapState& st, const MapLayout& layout, const std::vec
       st.depth.set(t, mean + (1 - h) * d, h * st.depth.variance(t) + h * (1 - h) * d * d);
     }
   }
+  st.depth.stamp_version();
 }
 
 std::vector<glm::vec3> filled_radiance(const ProbeMapState& st, const MapLayout& layout, int passes) {

@@ -12,10 +12,17 @@ namespace transgi::probes {
 void DepthMap::reset(int count, float unit_length) {
   texels.assign(static_cast<std::size_t>(count), Texel{});
   unit = unit_length > 0 && std::isfinite(unit_length) ? unit_length : 1.0f;
+  version = 0;
+}
+
+void DepthMap::stamp_version() {
+  static std::atomic<std::uint64_t> last{0};
+  version = last.fetch_add(1, std::memory_order_relaxed) + 1;
 }
 
 void DepthMap::set(std::size_t texel, float m, float v) {
   using engine::math::kHalfMax;
+  version = 0;
   const float mu = m / unit, var = v / (unit * unit);
   texels[texel].mean = engine::math::to_half(std::isnan(mu) ? mu : std::min(mu, kHalfMax));
   texels[texel].variance = engine::math::to_half(std::clamp(std::isfinite(var) ? var : kHalfMax, 0.0f, kHalfMax));

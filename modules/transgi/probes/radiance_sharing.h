@@ -89,6 +89,11 @@ struct DepthMap {
   };
   std::vector<Texel> texels;
   float unit = 1.0f;
+  // Names these texels for a device that keeps a copy (gpu::VulkanMapStore
+  // sends a map up only when its version is not the one it holds): unique
+  // in the process once stamped, 0 after reset() and set(), which a copy
+  // never takes for its own.
+  std::uint64_t version = 0;
 
   void reset(int count, float unit_length);
   [[nodiscard]] float mean(std::size_t texel) const { return engine::math::from_half(texels[texel].mean) * unit; }
@@ -97,6 +102,8 @@ struct DepthMap {
   }
   // Clamped into the half range (a hit 65,504 grid spacings away reads as that far).
   void set(std::size_t texel, float mean, float variance);
+  // A new version for the texels as they are now (after a batch of set()).
+  void stamp_version();
 };
 
 struct SharingStats {
