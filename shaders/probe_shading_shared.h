@@ -12,6 +12,8 @@ namespace transgi::gpu {
 #endif
 
 TRANSGI_CONST uint kProbeShadingGroupSize = 64u;
+// probe_points.comp: a tracing probe whose points the host dropped.
+TRANSGI_CONST uint kProbePointsSkip = 0xffffffffu;
 
 // ProbeRayHit's flags and PendingProbeRay's.
 TRANSGI_CONST uint kProbeRayHit = 1u;

@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "engine/gpu/gpu_error.h"
@@ -24,6 +26,9 @@
 #include "gpu/vulkan_probe_kernels.h"
 #include "gpu/vulkan_probe_shading.h"
 #include "gpu_fixture.h"
+#include "probes/cpu_probe_kernels.h"
+#include "probes/probe_map.h"
+#include "probes/probe_rays.h"
 #include "probes/interpolation.h"
 #include "shading/sh_light.h"
 
@@ -288,4 +293,122 @@ TEST(VulkanProbeShading, ASceneTooBigForTheDeviceRunsTheWholeFrameOnTheCpuBacken
   };
   const eval::MethodRun capped = run(runtime::Backend::Vulkan, ctx), cpu = run(runtime::Backend::Cpu, nullptr);
   gpu_test::expect_cpu_fallback_frame(capped.backend, capped.gi, cpu.backend, cpu.gi);
+}
+
+// The raster's points made on the device from the probe rays' hits
+// (probe_points.comp) instead of sent from the host: a grid of probes in the
+// sample level shades its rays on the device, the host builds each probe's
+// points from the hits as ProbeField does (and drops one probe's, as it does
+// for a probe that moved); the Vulkan backend's raster, accumulation and
+// projection then equal the CPU backend's on those points (SH within 1e-3 of
+// the largest, the depth guard's counts within 0.1 %), and the points do not
+// go up. With one point missing the points no longer match the rays: they go
+// up from the host (at least 64 bytes each), with the same result.
+TEST(VulkanProbeKernels, ThePointsAreMadeOnTheDeviceFromTheShadedRays) {
+  GPU_TEST_CONTEXT_OR_SKIP(unused);
+  std::string why;
+  std::shared_ptr<engine::gpu::VulkanContext> ctx(engine::gpu::VulkanContext::create({}, &why));
+  ASSERT_TRUE(ctx) << why;
+  std::shared_ptr<transgi::gpu::VulkanProbeKernels> kernels = transgi::gpu::make_probe_kernels(ctx, nullptr, &why);
+  if (!kernels) GTEST_SKIP() << why;
+  eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
+  const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
+  const render::LightSet lights(scene, test_punctual(), nullptr);
+  const probes::ProbeGrid grid = probes::ProbeGrid::centred_in(scene.bounds_min(), scene.bounds_max(), glm::ivec3(4, 3, 4));
+  const probes::MapLayout layout{16, 8};
+  const int count = grid.count(), m = 32;
+  std::vector<glm::vec3> origins, directions = probes::spherical_fibonacci(m);
+  std::vector<int> tracing;
+  for (int q = 0; q < count; ++q)
+    if (q % 5 != 3) {  // a few probes not traced this frame
+      tracing.push_back(q);
+      origins.push_back(grid.position(q));
+    }
+  probes::ProbeFeedbackSource self;
+  self.grid = &grid;
+  self.layout = layout;
+  self.lit = false;
+  std::vector<std::vector<probes::ShadedPoint>> points(static_cast<std::size_t>(count));
+  std::vector<std::vector<probes::ProbeRayHit>> hits(tracing.size());
+  kernels->shade_probe_rays(scene, lights, origins, tracing, directions, 7, 1, self, nullptr,
+                            [&](int j, int, const probes::ProbeRayHit& h) { hits[static_cast<std::size_t>(j)].push_back(h); });
+  for (std::size_t j = 0; j < tracing.size(); ++j)
+    for (std::size_t i = 0; i < hits[j].size(); ++i) {
+      const probes::ProbeRayHit& h = hits[j][i];
+      probes::ShadedPoint sp;
+      sp.direction = directions[i];
+      sp.distance = h.distance;
+      sp.position = h.position;
+      sp.radiance = h.radiance;
+      sp.normal = h.normal;
+      points[static_cast<std::size_t>(tracing[j])].push_back(sp);
+    }
+  points[static_cast<std::size_t>(tracing[2])].clear();  // a probe that moved: its points dropped
+  // Each probe's own depth from its points, as the field makes it.
+  std::vector<probes::ProbeMapState> depth_of(static_cast<std::size_t>(count));
+  std::vector<const probes::DepthMap*> own_depth;
+  for (int q = 0; q < count; ++q) {
+    probes::ProbeMapState& st = depth_of[static_cast<std::size_t>(q)];
+    st.reset(layout.texel_count(), grid.min_spacing());
+    probes::update_own_depth(st, layout, points[static_cast<std::size_t>(q)], probes::AccumulationSettings{});
+    own_depth.push_back(&st.depth);
+  }
+  std::vector<int> batch;
+  for (int q = 0; q < count; ++q)
+    if (q % 2 == 0) batch.push_back(q);
+  const probes::MapProjector projector(layout);
+  const probes::SharingSettings sharing;
+  const probes::AccumulationSettings accumulation;
+  const auto update = [&](probes::ProbeKernels& k, const std::vector<std::vector<probes::ShadedPoint>>& pts,
+                          std::vector<float>& sh, probes::SharingStats& stats) {
+    std::vector<probes::ProbeMapState> states(batch.size());
+    std::vector<probes::ProbeMapState*> ptrs;
+    for (auto& s : states) {
+      s.reset(layout.texel_count(), grid.min_spacing());
+      ptrs.push_back(&s);
+    }
+    std::vector<std::uint8_t> changed(batch.size());
+    sh.assign(batch.size() * 75, 0.0f);
+    probes::ShareAccumulateTimes times;
+    const engine::gpu::GpuTraffic before = ctx->traffic();
+    stats = k.share_accumulate_project(grid, projector, pts, own_depth, sharing, batch, ptrs, nullptr, accumulation, changed, sh, times);
+    return ctx->traffic() - before;
+  };
+  probes::CpuProbeKernels cpu;
+  std::vector<float> cpu_sh, device_sh, host_sh;
+  probes::SharingStats cpu_stats, device_stats, host_stats;
+  update(cpu, points, cpu_sh, cpu_stats);
+  update(*kernels, points, device_sh, device_stats);  // the first also sends the kernels' constant tables
+  const engine::gpu::GpuTraffic made = update(*kernels, points, device_sh, device_stats);
+  // One point fewer: the host's points are not the rays' any more.
+  std::vector<std::vector<probes::ShadedPoint>> fewer = points;
+  fewer[static_cast<std::size_t>(tracing[0])].pop_back();
+  std::vector<float> cpu_fewer_sh;
+  probes::SharingStats cpu_fewer_stats;
+  update(cpu, fewer, cpu_fewer_sh, cpu_fewer_stats);
+  const engine::gpu::GpuTraffic sent = update(*kernels, fewer, host_sh, host_stats);
+  std::size_t point_count = 0;
+  for (const auto& p : fewer) point_count += p.size();
+  std::printf("%zu points: %llu bytes up when made on the device, %llu when sent\n", point_count,
+              static_cast<unsigned long long>(made.host_to_device_bytes), static_cast<unsigned long long>(sent.host_to_device_bytes));
+  // (Made on the device, each traced probe's first point's index goes up instead: 4 bytes.)
+  EXPECT_GE(sent.host_to_device_bytes + tracing.size() * 4, made.host_to_device_bytes + point_count * 64);
+  const auto expect_near = [](const std::vector<float>& want, const std::vector<float>& got, const probes::SharingStats& ws,
+                              const probes::SharingStats& gs, const char* what) {
+    float largest = 0.0f, worst = 0.0f;
+    for (std::size_t k = 0; k < want.size(); ++k) {
+      largest = std::max(largest, std::abs(want[k]));
+      worst = std::max(worst, std::abs(got[k] - want[k]));
+    }
+    std::printf("%s: largest SH coefficient %.4g, largest difference %.3g; accepted %zu (CPU %zu), rejected %zu (CPU %zu)\n", what,
+                largest, worst, gs.accepted, ws.accepted, gs.rejected_by_guard, ws.rejected_by_guard);
+    EXPECT_GT(largest, 0.0f) << what;
+    EXPECT_LE(worst, 1e-3f * largest) << what;
+    EXPECT_NEAR(static_cast<double>(gs.accepted), static_cast<double>(ws.accepted), 1e-3 * ws.accepted + 1) << what;
+    EXPECT_NEAR(static_cast<double>(gs.rejected_by_guard), static_cast<double>(ws.rejected_by_guard), 1e-3 * ws.rejected_by_guard + 1)
+        << what;
+  };
+  expect_near(cpu_sh, device_sh, cpu_stats, device_stats, "points made on the device");
+  expect_near(cpu_fewer_sh, host_sh, cpu_fewer_stats, host_stats, "points sent from the host");
+  EXPECT_EQ(ctx->validation_errors(), 0);
 }

@@ -74,6 +74,10 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   }
 
  private:
+  // The last shade_probe_rays batch, whose hits stay on the device for the
+  // raster (VulkanRadianceRaster::DevicePoints): its probes and rays each.
+  std::vector<int> shaded_probes_;
+  std::uint32_t shaded_rays_per_probe_ = 0;
   std::shared_ptr<engine::gpu::VulkanContext> ctx_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanRadianceRaster>> rasters_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanShProjector>> projectors_;

@@ -73,6 +73,11 @@ class VulkanProbeShading {
              const probes::ProbeFeedbackSource* outer, std::vector<probes::ProbeRayHit>& out,
              std::vector<BounceInput>* bounce_inputs = nullptr);
 
+  // The last shade()'s results on the device (ProbeRayHitGpu per ray, in
+  // `out`'s order) and its directions (vec4 each), until the next shade().
+  [[nodiscard]] const engine::gpu::GpuBuffer& hits_on_device() const { return out_; }
+  [[nodiscard]] const engine::gpu::GpuBuffer& directions_on_device() const { return directions_; }
+
   [[nodiscard]] double take_gpu_ms() {
     const double ms = gpu_ms_;
     gpu_ms_ = 0;

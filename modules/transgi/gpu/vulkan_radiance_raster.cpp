@@ -8,6 +8,7 @@
 #include "engine/jobs/parallel_for.h"
 #include "gpu/probe_grid_gpu.h"
 #include "gpu/shader_path.h"
+#include "probe_shading_shared.h"
 #include "transgi_shared.h"
 
 namespace transgi::gpu {
@@ -18,9 +19,36 @@ VulkanRadianceRaster::VulkanRadianceRaster(engine::gpu::VulkanContext& ctx, prob
                                                               static_cast<std::uint32_t>(sizeof(RasterPush)));
 }
 
+namespace {
+// Whether every probe's points are its rays' in `rays` (all of them, or none
+// where the host dropped them) and no other probe has any; if so, where each
+// tracing probe's points begin in the raster's list (kProbePointsSkip: none).
+bool points_from_rays(const std::vector<std::vector<probes::ShadedPoint>>& points,
+                      const VulkanRadianceRaster::DevicePoints& rays, const std::vector<std::uint32_t>& begin,
+                      std::vector<std::uint32_t>& first) {
+  if (!rays.hits || !rays.directions || rays.rays_per_probe == 0) return false;
+  const std::size_t m = rays.rays_per_probe;
+  if (rays.hits->size() < rays.tracing.size() * m * sizeof(ProbeRayHitGpu) || rays.directions->size() < m * sizeof(glm::vec4))
+    return false;
+  first.assign(rays.tracing.size(), kProbePointsSkip);
+  std::size_t taken = 0;
+  for (std::size_t j = 0; j < rays.tracing.size(); ++j) {
+    const int q = rays.tracing[j];
+    if (q < 0 || static_cast<std::size_t>(q) >= points.size()) return false;
+    const std::size_t n = points[static_cast<std::size_t>(q)].size();
+    if (n == 0) continue;
+    if (n != m) return false;
+    first[j] = begin[static_cast<std::size_t>(q)];
+    taken += m;
+  }
+  return taken == begin.back();  // no probe has other points (nor one traced twice)
+}
+}  // namespace
+
 void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vector<std::vector<probes::ShadedPoint>>& points,
                                    const std::vector<const probes::DepthMap*>& own_depth, const probes::SharingSettings& s,
-                                   std::span<const std::uint8_t> targets, VulkanMapStore* store) {
+                                   std::span<const std::uint8_t> targets, VulkanMapStore* store,
+                                   const DevicePoints* device_points) {
   const auto count = static_cast<std::size_t>(grid.count());
   const auto texels = static_cast<std::size_t>(layout_.texel_count());
   if (points.size() != count || (!own_depth.empty() && own_depth.size() != count) ||
@@ -55,8 +83,31 @@ void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vec
     if (!targets.empty()) target_flags[q] = targets[q] ? 1u : 0u;
   }
   using DepthTexel = probes::DepthMap::Texel;
-  const auto flat = engine::gpu::bind_at_least(ctx_, *pipeline_, 0, points_, std::max<std::size_t>(1, begin[count]) * sizeof(ShadedPointGpu))
-                        .mapped_as<ShadedPointGpu>(begin[count]);
+  std::vector<std::uint32_t> first;
+  const bool on_device = device_points && points_from_rays(points, *device_points, begin, first);
+  point_groups_ = 0;
+  if (on_device) {
+    if (!points_pipeline_)
+      points_pipeline_ = std::make_unique<engine::gpu::ComputePipeline>(ctx_, compile_module_shader("probe_points.comp"), 4,
+                                                                        static_cast<std::uint32_t>(sizeof(point_push_)));
+    const std::size_t bytes = std::max<std::size_t>(1, begin[count]) * sizeof(ShadedPointGpu);
+    if (device_points_.handle() == VK_NULL_HANDLE || device_points_.size() < bytes)
+      device_points_ = engine::gpu::GpuBuffer(ctx_, bytes, engine::gpu::GpuBuffer::Placement::DeviceOnly);
+    engine::gpu::bind_at_least(ctx_, *points_pipeline_, 2, first_point_, first.size() * sizeof(std::uint32_t))
+        .upload(std::span<const std::uint32_t>(first));
+    points_pipeline_->bind(0, *device_points->hits);
+    points_pipeline_->bind(1, *device_points->directions);
+    points_pipeline_->bind(2, first_point_);
+    points_pipeline_->bind(3, device_points_);
+    pipeline_->bind(0, device_points_);
+    point_push_[0] = static_cast<std::uint32_t>(first.size()) * device_points->rays_per_probe;
+    point_push_[1] = device_points->rays_per_probe;
+    point_groups_ = (point_push_[0] + kProbeShadingGroupSize - 1) / kProbeShadingGroupSize;
+  } else {
+    engine::gpu::bind_at_least(ctx_, *pipeline_, 0, points_, std::max<std::size_t>(1, begin[count]) * sizeof(ShadedPointGpu));
+    pipeline_->bind(0, points_);  // device_points_ may have been bound since
+  }
+  const auto flat = on_device ? std::span<ShadedPointGpu>() : points_.mapped_as<ShadedPointGpu>(begin[count]);
   if (store_) {
     store_->stage_depth(own_depth);
     pipeline_->bind(2, store_->depth());
@@ -68,7 +119,7 @@ void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vec
   engine::jobs::parallel_for<std::size_t>(0, count, 8, [&](std::size_t q0, std::size_t q1) {
     for (std::size_t q = q0; q < q1; ++q) {
       std::size_t i = begin[q];
-      for (const auto& pt : points[q])
+      for (const auto& pt : on_device ? std::span<const probes::ShadedPoint>() : std::span<const probes::ShadedPoint>(points[q]))
         flat[i++] = {pt.position.x, pt.position.y, pt.position.z, pt.distance, pt.radiance.x, pt.radiance.y,
                      pt.radiance.z, 0, pt.direction.x, pt.direction.y, pt.direction.z, 0, pt.normal.x, pt.normal.y,
                      pt.normal.z, 0};
@@ -101,6 +152,10 @@ void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vec
 
 void VulkanRadianceRaster::record(VkCommandBuffer cmd) const {
   if (store_) store_->record_depth_uploads(cmd);
+  if (point_groups_ > 0) {
+    points_pipeline_->record_dispatch(cmd, point_groups_, 1, 1, point_push_);
+    engine::gpu::record_compute_barrier(cmd);
+  }
   if (count_ > 0) pipeline_->record_dispatch(cmd, static_cast<std::uint32_t>(count_), 1, 1, push_.data());
 }
 

@@ -25,12 +25,28 @@ class VulkanRadianceRaster {
                                  std::span<const std::uint8_t> targets = {}, double* gpu_ms = nullptr);
 
   // The same in three steps, for a submission that holds other stages too.
+  // The probe rays' hits on the device, as VulkanProbeShading left them:
+  // the rays of tracing probe j (rays_per_probe each, in the order of the
+  // directions) are probe tracing[j]'s points.
+  struct DevicePoints {
+    const engine::gpu::GpuBuffer* hits = nullptr;        // ProbeRayHitGpu per ray
+    const engine::gpu::GpuBuffer* directions = nullptr;  // vec4 per direction
+    std::span<const int> tracing;
+    std::uint32_t rays_per_probe = 0;
+  };
+
   // prepare: the points, depth maps and targets written for the kernel.
   // With the field's `store`, the depth maps are its copies (only the
-  // changed ones staged, sent by record).
+  // changed ones staged, sent by record). With `device_points` whose rays
+  // are `points` (every probe's points are its rays' or none), the points
+  // are made from them on the device (probe_points.comp) and not sent;
+  // otherwise they go up from `points`.
   void prepare(const probes::ProbeGrid& grid, const std::vector<std::vector<probes::ShadedPoint>>& points,
                const std::vector<const probes::DepthMap*>& own_depth, const probes::SharingSettings& settings,
-               std::span<const std::uint8_t> targets = {}, VulkanMapStore* store = nullptr);
+               std::span<const std::uint8_t> targets = {}, VulkanMapStore* store = nullptr,
+               const DevicePoints* device_points = nullptr);
+  // Whether the last prepare made the points on the device.
+  [[nodiscard]] bool points_made_on_device() const { return point_groups_ > 0; }
   // record: the store's depth uploads and the dispatch, into a command buffer being recorded.
   void record(VkCommandBuffer cmd) const;
   // The samples on the device after the submission: vec4 (sum, count) per
@@ -47,6 +63,11 @@ class VulkanRadianceRaster {
   std::unique_ptr<engine::gpu::ComputePipeline> pipeline_;
   std::size_t count_ = 0;                 // the prepared grid's probes
   VulkanMapStore* store_ = nullptr;  // the prepared update's, if any
+  // The points made on the device: probe_points.comp, its output, and the
+  // prepared dispatch (0 groups: the points went up from the host).
+  std::unique_ptr<engine::gpu::ComputePipeline> points_pipeline_;
+  engine::gpu::GpuBuffer device_points_, first_point_;
+  std::uint32_t point_groups_ = 0, point_push_[2] = {0, 0};
   std::vector<std::uint32_t> target_flags_;
   std::vector<std::uint8_t> push_;
 };
