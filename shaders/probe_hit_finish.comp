@@ -16,6 +16,7 @@ layout(std430, set = 0, binding = 3) readonly buffer Feedback { ProbeFeedbackGpu
 layout(std430, set = 0, binding = 4) readonly buffer Depth { uint depth[]; };      // both fields' depth texels
 layout(std430, set = 0, binding = 5) readonly buffer Probes { ProbeGpu probes[]; };  // both fields' probes
 layout(std430, set = 0, binding = 6) readonly buffer ProbeSh { float probe_sh[]; };  // both fields' probes x 75
+layout(std430, set = 0, binding = 7) writeonly buffer Briefs { ProbeRayBriefGpu briefs[]; };  // Out's fields the host needs
 layout(push_constant) uniform PushBlock { ProbeFinishPush p; };
 
 #include "probe_interpolation.glsl"
@@ -82,4 +83,5 @@ void main() {
   o.rg = radiance.g;
   o.rb = radiance.b;
   out_hits[i] = o;
+  briefs[i] = ProbeRayBriefGpu(o.distance, o.flags, o.er, o.eg, o.eb);
 }

@@ -42,6 +42,15 @@ struct PendingProbeRayGpu {
   float sx, sy, sz, pad3;         // shading normal
 };
 
+// What the host reads of a probe ray when the raster's points are made on
+// the device (probe_points.comp): enough to classify the probe, update its
+// depth and sky cells and project its emitters, 20 bytes instead of 64.
+struct ProbeRayBriefGpu {
+  float distance;
+  uint flags;
+  float er, eg, eb;  // emitted
+};
+
 // probes::ProbeRayHit.
 struct ProbeRayHitGpu {
   float px, py, pz, distance;
@@ -69,6 +78,7 @@ static_assert(sizeof(PendingProbeRayGpu) == 96 && offsetof(PendingProbeRayGpu, f
 static_assert(sizeof(ProbeRayHitGpu) == 64 && offsetof(ProbeRayHitGpu, flags) == 28 && offsetof(ProbeRayHitGpu, er) == 48,
               "ProbeRayHitGpu layout");
 static_assert(sizeof(ProbeFeedbackGpu) == 320, "ProbeFeedbackGpu layout");
+static_assert(sizeof(ProbeRayBriefGpu) == 20 && offsetof(ProbeRayBriefGpu, er) == 8, "ProbeRayBriefGpu layout");
 }  // namespace transgi::gpu
 #endif
 

@@ -9,9 +9,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -303,7 +305,10 @@ TEST(VulkanProbeShading, ASceneTooBigForTheDeviceRunsTheWholeFrameOnTheCpuBacken
 // projection then equal the CPU backend's on those points (SH within 1e-3 of
 // the largest, the depth guard's counts within 0.1 %), and the points do not
 // go up. With one point missing the points no longer match the rays: they go
-// up from the host (at least 64 bytes each), with the same result.
+// up from the host (at least 64 bytes each), with the same result. Then the
+// hits come back brief (set_brief_hits, the default): 44 bytes a ray fewer,
+// the same SH from the device's points, and host points that are not the
+// rays refused.
 TEST(VulkanProbeKernels, ThePointsAreMadeOnTheDeviceFromTheShadedRays) {
   GPU_TEST_CONTEXT_OR_SKIP(unused);
   std::string why;
@@ -330,8 +335,11 @@ TEST(VulkanProbeKernels, ThePointsAreMadeOnTheDeviceFromTheShadedRays) {
   self.lit = false;
   std::vector<std::vector<probes::ShadedPoint>> points(static_cast<std::size_t>(count));
   std::vector<std::vector<probes::ProbeRayHit>> hits(tracing.size());
+  kernels->set_brief_hits(false);  // whole hits: the CPU's points below are built from them
+  engine::gpu::GpuTraffic before_shading = ctx->traffic();
   kernels->shade_probe_rays(scene, lights, origins, tracing, directions, 7, 1, self, nullptr,
                             [&](int j, int, const probes::ProbeRayHit& h) { hits[static_cast<std::size_t>(j)].push_back(h); });
+  const engine::gpu::GpuTraffic whole = ctx->traffic() - before_shading;
   for (std::size_t j = 0; j < tracing.size(); ++j)
     for (std::size_t i = 0; i < hits[j].size(); ++i) {
       const probes::ProbeRayHit& h = hits[j][i];
@@ -410,5 +418,28 @@ TEST(VulkanProbeKernels, ThePointsAreMadeOnTheDeviceFromTheShadedRays) {
   };
   expect_near(cpu_sh, device_sh, cpu_stats, device_stats, "points made on the device");
   expect_near(cpu_fewer_sh, host_sh, cpu_fewer_stats, host_stats, "points sent from the host");
+
+  // The same rays again, their hits brief.
+  kernels->set_brief_hits(true);
+  std::atomic<std::size_t> brief_rays{0};  // the probes' rays are handed over from several threads
+  before_shading = ctx->traffic();
+  kernels->shade_probe_rays(scene, lights, origins, tracing, directions, 7, 1, self, nullptr,
+                            [&](int j, int i, const probes::ProbeRayHit& h) {
+                              const probes::ProbeRayHit& w = hits[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)];
+                              EXPECT_EQ(h.hit, w.hit);
+                              EXPECT_EQ(h.distance, w.distance);
+                              EXPECT_EQ(h.emitted, w.emitted);
+                              ++brief_rays;
+                            });
+  const engine::gpu::GpuTraffic brief = ctx->traffic() - before_shading;
+  std::printf("%zu rays: %llu bytes back with whole hits, %llu brief\n", brief_rays.load(),
+              static_cast<unsigned long long>(whole.device_to_host_bytes), static_cast<unsigned long long>(brief.device_to_host_bytes));
+  EXPECT_EQ(brief_rays.load(), tracing.size() * static_cast<std::size_t>(m));
+  EXPECT_GE(whole.device_to_host_bytes, brief.device_to_host_bytes + brief_rays.load() * 44);
+  std::vector<float> brief_sh;
+  probes::SharingStats brief_stats;
+  update(*kernels, points, brief_sh, brief_stats);
+  expect_near(cpu_sh, brief_sh, cpu_stats, brief_stats, "points made on the device, hits brief");
+  EXPECT_THROW(update(*kernels, fewer, brief_sh, brief_stats), std::logic_error);
   EXPECT_EQ(ctx->validation_errors(), 0);
 }

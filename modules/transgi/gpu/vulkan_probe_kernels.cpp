@@ -43,6 +43,9 @@ probes::SharingStats VulkanProbeKernels::share_accumulate_project(
   const VulkanRadianceRaster::DevicePoints rays{&shading_->hits_on_device(), &shading_->directions_on_device(), shaded_probes_,
                                                 shaded_rays_per_probe_};
   r->prepare(grid, points, own_depth, sharing, targets, maps, shaded_rays_per_probe_ > 0 ? &rays : nullptr);
+  if (shaded_brief_ && !r->points_made_on_device())
+    throw std::logic_error("VulkanProbeKernels: the points are not the last shading's rays, whose hits came back brief "
+                           "(set_brief_hits(false) for points of the caller's own)");
   a->prepare(states, r->samples_on_device(), frame_maps, accumulation, maps);
   times.share_ms = ms_since(t0);
   const auto t1 = Clock::now();
@@ -81,13 +84,15 @@ void VulkanProbeKernels::shade_probe_rays(const engine::rt::RtScene& scene, cons
                                           const probes::ProbeRayConsumer& consume) {
   std::vector<probes::ProbeRayHit> out;
   shaded_rays_per_probe_ = 0;  // the device's hits are this batch's only once it is shaded
+  shaded_brief_ = false;
   // The kernel reads no field it is not given: a field with no light yet is left out.
   if (!shading_->shade(scene, lights, tracer_, origins, probe_ids, directions, seed, sample, self.lit ? &self : nullptr,
-                       outer, out))
+                       outer, out, nullptr, brief_hits_))
     throw engine::gpu::GpuError("the Vulkan backend traces only scenes built with their assets (RtScene::assets())");
   const std::size_t m = directions.size();
   shaded_probes_.assign(probe_ids.begin(), probe_ids.end());
   shaded_rays_per_probe_ = static_cast<std::uint32_t>(m);
+  shaded_brief_ = brief_hits_;
   engine::jobs::parallel_for(0, static_cast<int>(origins.size()), 1, [&](int b, int e) {
     for (int j = b; j < e; ++j)
       for (std::size_t i = 0; i < m; ++i) consume(j, static_cast<int>(i), out[static_cast<std::size_t>(j) * m + i]);

@@ -48,6 +48,13 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   // The maps on this device between updates (VulkanMapStore).
   [[nodiscard]] std::unique_ptr<probes::ProbeMapStore> make_map_store(const probes::MapLayout& layout, int probes) override;
   engine::rt::RayBatchTracer* tracer() override { return &tracer_; }
+  // Whether shade_probe_rays hands over brief hits (the default): each
+  // ray's flags, distance and emission, not its position, normal and
+  // radiance, which stay on the device for the raster's points. The host's
+  // points are then only their counts, and share_accumulate_project throws
+  // std::logic_error for points that are not the last shading's rays. Off:
+  // whole hits, for a caller that builds its own points.
+  void set_brief_hits(bool brief) { brief_hits_ = brief; }
   // The real-time frame's transfer decoder on this device, made for
   // `model`'s network when first asked (and again for another model); null
   // where the kernel cannot hold that network, so the CPU decodes.
@@ -78,6 +85,8 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   // raster (VulkanRadianceRaster::DevicePoints): its probes and rays each.
   std::vector<int> shaded_probes_;
   std::uint32_t shaded_rays_per_probe_ = 0;
+  bool brief_hits_ = true;     // shade_probe_rays reads back ProbeRayBriefGpu, not the whole hits
+  bool shaded_brief_ = false;  // the last batch's hits came back brief
   std::shared_ptr<engine::gpu::VulkanContext> ctx_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanRadianceRaster>> rasters_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanShProjector>> projectors_;

@@ -51,7 +51,7 @@ VulkanProbeShading::VulkanProbeShading(engine::gpu::VulkanContext& ctx) : ctx_(c
   begin_ = std::make_unique<ComputePipeline>(ctx, compile_module_shader("probe_hit_begin.comp"),
                                              5 + engine::gpu::GpuShadingScene::kBindings, static_cast<std::uint32_t>(sizeof(ProbeHitPush)));
   shadow_trace_ = std::make_unique<ComputePipeline>(ctx, query, query_bindings, 2 * sizeof(std::uint32_t));
-  finish_ = std::make_unique<ComputePipeline>(ctx, compile_module_shader("probe_hit_finish.comp"), 7,
+  finish_ = std::make_unique<ComputePipeline>(ctx, compile_module_shader("probe_hit_finish.comp"), 8,
                                               static_cast<std::uint32_t>(sizeof(ProbeFinishPush)));
 }
 
@@ -68,7 +68,7 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
                                std::span<const int> probe_ids, std::span<const glm::vec3> directions, std::uint64_t seed,
                                std::uint64_t sample, const probes::ProbeFeedbackSource* self,
                                const probes::ProbeFeedbackSource* outer, std::vector<probes::ProbeRayHit>& out,
-                               std::vector<BounceInput>* bounce_inputs) {
+                               std::vector<BounceInput>* bounce_inputs, bool brief) {
   using engine::gpu::HitGpu;
   using engine::gpu::RayGpu;
   if (probe_ids.size() != origins.size())
@@ -76,6 +76,7 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
                                 std::to_string(probe_ids.size()) + " probe indices");
   if (self) check_source(*self);
   if (outer) check_source(*outer);
+  if (brief && bounce_inputs) throw std::invalid_argument("VulkanProbeShading: brief hits carry no bounce inputs");
   if (!scene.assets()) return false;
   scene_.sync(scene, lights);  // first: a scene the device cannot hold throws before out changes
   engine::gpu::GpuRtScene* rt = tracer.device_scene(scene);
@@ -97,6 +98,7 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
   at_least(ctx_, shadows_, n * sizeof(RayGpu));
   at_least(ctx_, shadow_hits_, n * sizeof(HitGpu));
   at_least(ctx_, out_, n * sizeof(ProbeRayHitGpu));
+  at_least(ctx_, briefs_, n * sizeof(ProbeRayBriefGpu));
 
   // The bounce light from the fields' probes, both fields in one set of buffers.
   const probes::ProbeFeedbackSource* fields[2] = {self, outer};
@@ -180,6 +182,7 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
   finish_->bind(0, pending_);
   finish_->bind(1, shadow_hits_);
   finish_->bind(2, out_);
+  finish_->bind(7, briefs_);
   finish_->bind(3, feedback_);
   finish_->bind(4, depth_);
   finish_->bind(5, probes_);
@@ -220,6 +223,23 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
     finish_->record_dispatch(cmd, groups, 1, 1, &finish_push);
   }));
 
+  if (brief) {
+    const auto briefs = briefs_.mapped_as<const ProbeRayBriefGpu>(n);
+    engine::jobs::parallel_for<std::size_t>(0, n, kRaysPerTask, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        const ProbeRayBriefGpu& g = briefs[i];
+        probes::ProbeRayHit& r = out[i];
+        r = probes::ProbeRayHit{};
+        r.hit = (g.flags & kProbeRayHit) != 0;
+        r.back_face = (g.flags & kProbeRayBackFace) != 0;
+        r.saw_light = (g.flags & kProbeRaySawLight) != 0;
+        r.replaced_non_finite = (g.flags & kProbeRayReplacedNonFinite) != 0;
+        r.distance = r.hit ? g.distance : std::numeric_limits<float>::infinity();
+        r.emitted = vec_of(g.er, g.eg, g.eb);
+      }
+    });
+    return true;
+  }
   const auto hits_out = out_.mapped_as<const ProbeRayHitGpu>(n);
   engine::jobs::parallel_for<std::size_t>(0, n, kRaysPerTask, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {

@@ -66,12 +66,16 @@ class VulkanProbeShading {
   // probe-major. Returns false, out untouched, where the tracer declines the
   // scene.
   // With `bounce_inputs` (and no fields), the bounce light is the caller's:
-  // each ray gets what it needs to add it (finish_bounce_light).
+  // each ray gets what it needs to add it (finish_bounce_light). With
+  // `brief`, only what the host needs where the hits stay on the device for
+  // the raster (probe_points.comp) comes back: each ray's hit, back-face,
+  // saw-light and non-finite flags, distance and emission (20 bytes, not
+  // 64); its position, normal and radiance are left zero.
   bool shade(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, engine::gpu::GpuRayTracer& tracer,
              std::span<const glm::vec3> origins, std::span<const int> probe_ids, std::span<const glm::vec3> directions,
              std::uint64_t seed, std::uint64_t sample, const probes::ProbeFeedbackSource* self,
              const probes::ProbeFeedbackSource* outer, std::vector<probes::ProbeRayHit>& out,
-             std::vector<BounceInput>* bounce_inputs = nullptr);
+             std::vector<BounceInput>* bounce_inputs = nullptr, bool brief = false);
 
   // The last shade()'s results on the device (ProbeRayHitGpu per ray, in
   // `out`'s order) and its directions (vec4 each), until the next shade().
@@ -89,7 +93,7 @@ class VulkanProbeShading {
   engine::gpu::GpuShadingScene scene_;
   std::unique_ptr<engine::gpu::ComputePipeline> generate_, trace_, begin_, shadow_trace_, finish_;
   engine::gpu::GpuBuffer origins_, directions_, rays_, hits_, items_, pending_, shadows_, shadow_hits_;
-  engine::gpu::GpuBuffer out_, feedback_, probes_, probe_sh_;
+  engine::gpu::GpuBuffer out_, briefs_, feedback_, probes_, probe_sh_;
   // Both fields' depth maps on the device, filled in the submission: from
   // a field's VulkanMapStore (a copy on the device) or from the host
   // through depth_staging_.

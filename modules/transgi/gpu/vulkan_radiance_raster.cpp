@@ -86,6 +86,7 @@ void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vec
   std::vector<std::uint32_t> first;
   const bool on_device = device_points && points_from_rays(points, *device_points, begin, first);
   point_groups_ = 0;
+  points_on_device_ = on_device;
   if (on_device) {
     if (!points_pipeline_)
       points_pipeline_ = std::make_unique<engine::gpu::ComputePipeline>(ctx_, compile_module_shader("probe_points.comp"), 4,

@@ -46,7 +46,7 @@ class VulkanRadianceRaster {
                std::span<const std::uint8_t> targets = {}, VulkanMapStore* store = nullptr,
                const DevicePoints* device_points = nullptr);
   // Whether the last prepare made the points on the device.
-  [[nodiscard]] bool points_made_on_device() const { return point_groups_ > 0; }
+  [[nodiscard]] bool points_made_on_device() const { return points_on_device_; }
   // record: the store's depth uploads and the dispatch, into a command buffer being recorded.
   void record(VkCommandBuffer cmd) const;
   // The samples on the device after the submission: vec4 (sum, count) per
@@ -68,6 +68,7 @@ class VulkanRadianceRaster {
   std::unique_ptr<engine::gpu::ComputePipeline> points_pipeline_;
   engine::gpu::GpuBuffer device_points_, first_point_;
   std::uint32_t point_groups_ = 0, point_push_[2] = {0, 0};
+  bool points_on_device_ = false;
   std::vector<std::uint32_t> target_flags_;
   std::vector<std::uint8_t> push_;
 };
