@@ -104,16 +104,36 @@ bool sample_light(vec3 p, float u_select, vec2 u, out LightSample ls) {
   int group = min(L.groups - 1, int(u_select * float(L.groups)));
   const float pg = 1.0 / float(L.groups);
   if (L.has_environment != 0 && group-- == 0) {
-    float pdf_v, pdf_u;
-    uint row, ignored;
-    const uint w = uint(L.env_width), h = uint(L.env_height);
-    const float v = distribution_sample(false, L.env_marginal_cdf, L.env_marginal_pdf, h, u.y, pdf_v, row);
-    const float x = distribution_sample(false, L.env_row_cdf + row * (w + 1u), L.env_row_pdf + row * w, w, u.x, pdf_u, ignored);
-    const float map_pdf = pdf_u * pdf_v;
+    // math::AliasDistribution2D::sample.
+    const float below_one = 1.0 - 1.0 / 16777216.0;
+    const uint w = uint(L.env_width), h = uint(L.env_height), n = w * h;
+    const float scaled = u.x * float(n);
+    const uint i = min(uint(max(scaled, 0.0)), n - 1u);
+    const float leftover = scaled - float(i);
+    const uint at = L.env_alias + 4u * i;
+    const float threshold = sh_light_tables[at];
+    float down = u.y, map_pdf = sh_light_tables[at + 2u];
+    uint bin = i;
+    if (down < threshold) {
+      down = down / threshold;
+    } else {
+      bin = floatBitsToUint(sh_light_tables[at + 1u]);
+      map_pdf = sh_light_tables[at + 3u];
+      down = (down - threshold) / (1.0 - threshold);
+    }
+    down = clamp(down, 0.0, below_one);
+    const float spacing = min(1.0, float(n) / 16777216.0);
+    const float across = clamp(leftover + spacing * fract(down * 1024.0), 0.0, below_one);
+    float x = min((float(bin % w) + across) / float(w), below_one);
+    float v = min((float(bin / w) + down) / float(h), below_one);
+    if (uint(x * float(w)) > bin % w) x = uintBitsToFloat(floatBitsToUint(x) - 1u);  // rounded onto the next bin's edge
+    if (uint(v * float(h)) > bin / w) v = uintBitsToFloat(floatBitsToUint(v) - 1u);
     const float sin_theta = sin(kShadingPi * v);
     ls.direction = normalize(env_to_world(env_uv_to_direction(vec2(x, v))));
     const float pdf = sin_theta > 0.0 ? map_pdf / (2.0 * kShadingPi * kShadingPi * sin_theta) : 0.0;
-    ls.radiance = environment_radiance(ls.direction);
+    // The sampled texel's radiance (Environment::sample): the direction may lie on its edge.
+    const uint texel = L.env_texels + 3u * bin;
+    ls.radiance = L.env_strength * vec3(sh_light_tables[texel], sh_light_tables[texel + 1u], sh_light_tables[texel + 2u]);
     ls.distance = shading_infinity();
     ls.pdf = pdf * pg;
     return pdf > 0.0;

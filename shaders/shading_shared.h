@@ -93,17 +93,18 @@ struct PunctualLightGpu {
 };
 
 // The light set's counts and the environment's frame; the environment's
-// texels and 2D distribution sit in one float buffer at these offsets (the
-// emissive triangles' CDF, triangles + 1 floats, in a buffer of its own).
+// texels and its alias table (math::AliasDistribution2D: per texel its
+// threshold, alias (as float bits), pdf and the alias's pdf) sit in one
+// float buffer at these offsets (the emissive triangles' CDF, triangles + 1
+// floats, in a buffer of its own).
 struct LightSetGpu {
   int groups, has_environment, triangles, punctual;
   int env_width, env_height;
   float env_strength;
   uint pad9;
   uint env_texels;    // width x height x RGB
-  uint env_marginal_cdf, env_marginal_pdf;  // height + 1, height
-  uint env_row_cdf;   // height x (width + 1)
-  uint env_row_pdf;   // height x width
+  uint env_alias;     // width x height x 4
+  uint pad10, pad11, pad12;
   uint pad0, pad1, pad2;
   float to_world_r0_x, to_world_r0_y, to_world_r0_z, pad3;  // rows of the map's local-to-world rotation
   float to_world_r1_x, to_world_r1_y, to_world_r1_z, pad4;

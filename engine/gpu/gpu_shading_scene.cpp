@@ -189,28 +189,20 @@ void GpuShadingScene::sync_lights(const render::LightSet& lights) {
     put_rows(h, offsetof(LightSetGpu, to_local_r0_x), env->to_local_matrix());
     const std::size_t texels = static_cast<std::size_t>(w) * static_cast<std::size_t>(ht);
     h.env_texels = 0;
-    h.env_marginal_cdf = static_cast<std::uint32_t>(3 * texels);
-    h.env_marginal_pdf = h.env_marginal_cdf + static_cast<std::uint32_t>(ht + 1);
-    h.env_row_cdf = h.env_marginal_pdf + static_cast<std::uint32_t>(ht);
-    h.env_row_pdf = h.env_row_cdf + static_cast<std::uint32_t>(ht) * static_cast<std::uint32_t>(w + 1);
+    h.env_alias = static_cast<std::uint32_t>(3 * texels);
     // The texels and distribution are what an environment is loaded with;
     // turning or dimming the sky changes only the header.
     if (img.pixels.data() != env_pixels_ || w != env_width_ || ht != env_height_) {
       std::vector<float> t;
-      t.reserve(h.env_row_pdf + texels);
+      t.reserve(h.env_alias + 4 * texels);
       for (int y = 0; y < ht; ++y)
         for (int x = 0; x < w; ++x) {
           const glm::vec3 c = img.at(x, y);
           t.insert(t.end(), {c.r, c.g, c.b});
         }
-      const math::Distribution2D& dist = env->distribution();
-      for (double c : dist.marginal().cdf()) t.push_back(static_cast<float>(c));
-      for (std::size_t y = 0; y < static_cast<std::size_t>(ht); ++y) t.push_back(bin_pdf(dist.marginal(), y));
-      for (const auto& row : dist.rows())
-        for (double c : row.cdf()) t.push_back(static_cast<float>(c));
-      for (const auto& row : dist.rows())
-        for (std::size_t x = 0; x < static_cast<std::size_t>(w); ++x) t.push_back(bin_pdf(row, x));
-      if (t.size() != h.env_row_pdf + texels) throw GpuError("GpuShadingScene: environment tables of unexpected size");
+      for (const math::AliasDistribution2D::Entry& e : env->distribution().entries())
+        t.insert(t.end(), {e.threshold, std::bit_cast<float>(e.alias), e.pdf, e.alias_pdf});
+      if (t.size() != h.env_alias + 4 * texels) throw GpuError("GpuShadingScene: environment tables of unexpected size");
       upload_to(ctx_, light_tables_, std::move(t), kStatic, "environment map's tables");
       env_pixels_ = img.pixels.data();
       env_width_ = w;

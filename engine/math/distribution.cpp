@@ -88,4 +88,98 @@ float Distribution2D::pdf(glm::vec2 uv) const {
   return marginal_.pdf(uv.y) * rows_[row].pdf(uv.x);
 }
 
+AliasDistribution2D::AliasDistribution2D(std::span<const float> f, int width, int height)
+    : width_(std::max(0, width)), height_(std::max(0, height)) {
+  const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
+  if (n == 0 || f.size() < n) {
+    width_ = height_ = 0;
+    return;
+  }
+  std::vector<double> value(n);
+  double sum = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float v = f[i];
+    value[i] = v >= 0.0f && std::isfinite(v) ? static_cast<double>(v) : 0.0;
+    sum += value[i];
+  }
+  entries_.assign(n, Entry{});
+  if (!(sum > 0)) {  // uniform: every bin keeps itself
+    for (std::size_t i = 0; i < n; ++i) entries_[i].alias = static_cast<std::uint32_t>(i);
+    return;
+  }
+  const double mean = sum / static_cast<double>(n);
+  std::vector<double> scaled(n);  // n x the bin's probability: 1 is a full bin
+  std::vector<std::uint32_t> small, large;
+  for (std::size_t i = 0; i < n; ++i) {
+    scaled[i] = value[i] / mean;
+    entries_[i].pdf = static_cast<float>(scaled[i]);
+    entries_[i].alias = static_cast<std::uint32_t>(i);
+    (scaled[i] < 1.0 ? small : large).push_back(static_cast<std::uint32_t>(i));
+  }
+  // Vose: each under-full bin is topped up from an over-full one, which
+  // becomes its alias; what is left of that one goes back on a list.
+  while (!small.empty() && !large.empty()) {
+    const std::uint32_t s = small.back(), l = large.back();
+    small.pop_back();
+    large.pop_back();
+    entries_[s].threshold = static_cast<float>(scaled[s]);
+    entries_[s].alias = l;
+    scaled[l] = (scaled[l] + scaled[s]) - 1.0;
+    (scaled[l] < 1.0 ? small : large).push_back(l);
+  }
+  // The rest are full up to rounding: they keep themselves.
+  for (const std::uint32_t i : small) entries_[i].threshold = 1.0f, entries_[i].alias = i;
+  for (const std::uint32_t i : large) entries_[i].threshold = 1.0f, entries_[i].alias = i;
+  for (Entry& e : entries_) e.alias_pdf = entries_[e.alias].pdf;
+}
+
+glm::vec2 AliasDistribution2D::sample(glm::vec2 u, float* pdf, std::uint32_t* bin_out) const {
+  if (entries_.empty()) {
+    if (pdf) *pdf = 0.0f;
+    if (bin_out) *bin_out = 0;
+    return {0.0f, 0.0f};
+  }
+  static constexpr float kBelowOne = 1.0f - 0x1p-24f;
+  const auto n = static_cast<std::uint32_t>(entries_.size());
+  const float scaled = u.x * static_cast<float>(n);
+  const std::uint32_t i = std::min(static_cast<std::uint32_t>(std::max(scaled, 0.0f)), n - 1);
+  const float leftover = scaled - static_cast<float>(i);
+  const Entry& e = entries_[i];
+  float down = u.y;
+  std::uint32_t bin = i;
+  float p = e.pdf;
+  if (down < e.threshold) {
+    down = down / e.threshold;
+  } else {
+    bin = e.alias;
+    p = e.alias_pdf;
+    down = (down - e.threshold) / (1.0f - e.threshold);
+  }
+  down = std::clamp(down, 0.0f, kBelowOne);
+  // Across the bin: what u.x leaves after the bin, only a few bits for a
+  // large table (u.x's spacing times n, for u.x in [1/2, 1)), filled in
+  // with bits of `down`, so that samples do not sit on the bin's edge,
+  // which a direction's round trip (Environment::pdf) can put in the next bin.
+  const float spacing = std::min(1.0f, static_cast<float>(n) * 0x1p-24f);
+  const float across = std::clamp(leftover + spacing * (down * 1024.0f - std::floor(down * 1024.0f)), 0.0f, kBelowOne);
+  const auto w = static_cast<std::uint32_t>(width_);
+  if (pdf) *pdf = p;
+  if (bin_out) *bin_out = bin;
+  // In the bin itself: a leftover just under 1 can round up onto the next
+  // bin's edge, which then steps back one ulp.
+  const auto in_bin = [](float at, std::uint32_t b, int size) {
+    float t = std::min((static_cast<float>(b) + at) / static_cast<float>(size), kBelowOne);
+    if (static_cast<std::uint32_t>(t * static_cast<float>(size)) > b) t = std::nextafter(t, 0.0f);
+    return t;
+  };
+  return {in_bin(across, bin % w, width_), in_bin(down, bin / w, height_)};
+}
+
+float AliasDistribution2D::pdf(glm::vec2 uv) const {
+  if (entries_.empty()) return 0.0f;
+  const auto x = std::min(width_ - 1, static_cast<int>(std::max(0.0f, uv.x) * static_cast<float>(width_)));
+  const auto y = std::min(height_ - 1, static_cast<int>(std::max(0.0f, uv.y) * static_cast<float>(height_)));
+  return entries_[static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x)].pdf;
+}
+
 }  // namespace engine::math

@@ -58,4 +58,43 @@ class Distribution2D {
   Distribution1D marginal_;
 };
 
+// The same piecewise-constant density as Distribution2D over a width x
+// height table, sampled with Walker's alias method (Vose's construction):
+// a sample reads one entry instead of searching a marginal and a row (an
+// environment map's tables are tens of MB, and each search a few cache
+// misses). u.x picks the bin (its leftover places the sample across the
+// bin), u.y decides between the bin and its alias (its rescaled leftover
+// places the sample down the bin). The GPU's light sampling
+// (shaders/light_sampling.glsl) reads the same entries the same way.
+class AliasDistribution2D {
+ public:
+  // threshold: u.y below it keeps the bin, else its alias; pdf: the bin's
+  // density w.r.t. the unit square, alias_pdf: the alias bin's.
+  struct Entry {
+    float threshold = 1.0f;
+    std::uint32_t alias = 0;
+    float pdf = 1.0f, alias_pdf = 1.0f;
+  };
+
+  AliasDistribution2D() = default;
+  // f is row-major, width x height, rows are v; non-finite and negative
+  // values count as 0, an all-zero f is uniform.
+  AliasDistribution2D(std::span<const float> f, int width, int height);
+
+  // Returns (u, v) in [0,1)^2 and its density w.r.t. the unit square; bin:
+  // the bin it lies in (y * width + x), which a caller reads its value from
+  // rather than find it again from (u, v): a sample can lie on the bin's
+  // edge, which a round trip through a direction can put in the next bin.
+  [[nodiscard]] glm::vec2 sample(glm::vec2 u, float* pdf, std::uint32_t* bin = nullptr) const;
+  [[nodiscard]] float pdf(glm::vec2 uv) const;
+  [[nodiscard]] bool empty() const { return entries_.empty(); }
+  [[nodiscard]] int width() const { return width_; }
+  [[nodiscard]] int height() const { return height_; }
+  [[nodiscard]] const std::vector<Entry>& entries() const { return entries_; }
+
+ private:
+  std::vector<Entry> entries_;
+  int width_ = 0, height_ = 0;
+};
+
 }  // namespace engine::math

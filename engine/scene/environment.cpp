@@ -25,7 +25,7 @@ Environment::Environment(image::ImageRGB image, float strength, const glm::mat4&
     for (int x = 0; x < w; ++x)
       weights[static_cast<std::size_t>(y) * w + x] = math::luminance(image_.at(x, y)) * sin_theta;
   }
-  distribution_ = math::Distribution2D(weights, w, h);
+  distribution_ = math::AliasDistribution2D(weights, w, h);
 }
 
 void Environment::set_yaw(float radians) {
@@ -58,14 +58,23 @@ glm::vec3 Environment::radiance(const glm::vec3& world_dir) const {
 }
 
 glm::vec3 Environment::sample(glm::vec2 u, glm::vec3* world_dir, float* pdf) const {
+  if (!valid()) {
+    *world_dir = glm::vec3(0.0f, 1.0f, 0.0f);
+    *pdf = 0.0f;
+    return glm::vec3(0.0f);
+  }
   float map_pdf = 0;
-  const glm::vec2 uv = distribution_.sample(u, &map_pdf);
+  std::uint32_t texel = 0;
+  const glm::vec2 uv = distribution_.sample(u, &map_pdf, &texel);
   const float sin_theta = std::sin(kPi * uv.y);
   const glm::vec3 local = uv_to_direction(uv);
   *world_dir = glm::normalize(to_world_ * local);
   // dA(uv) = 2 pi^2 sin(theta) d(omega)^-1
   *pdf = sin_theta > 0 ? map_pdf / (2.0f * kPi * kPi * sin_theta) : 0.0f;
-  return radiance(*world_dir);
+  // The sampled texel's radiance, which the pdf is of (the direction may lie
+  // on its edge, which radiance(direction) could place in the next texel).
+  const auto w = static_cast<std::uint32_t>(image_.width);
+  return strength_ * image_.at(static_cast<int>(texel % w), static_cast<int>(texel / w));
 }
 
 float Environment::pdf(const glm::vec3& world_dir) const {

@@ -43,7 +43,7 @@ class Environment {
   // The map's frame and importance distribution, for kernels that sample it.
   [[nodiscard]] const glm::mat3& to_world_matrix() const { return to_world_; }
   [[nodiscard]] const glm::mat3& to_local_matrix() const { return to_local_; }
-  [[nodiscard]] const math::Distribution2D& distribution() const { return distribution_; }
+  [[nodiscard]] const math::AliasDistribution2D& distribution() const { return distribution_; }
 
   // Map-local direction <-> (u, v).
   static glm::vec2 direction_to_uv(const glm::vec3& local);
@@ -56,7 +56,7 @@ class Environment {
   glm::mat3 to_local_{1.0f};
   glm::mat3 loaded_to_world_{1.0f};
   float yaw_ = 0.0f;
-  math::Distribution2D distribution_;
+  math::AliasDistribution2D distribution_;
 };
 
 // A constant-radiance environment (for furnace tests) is just a 1x1 map.
