@@ -18,6 +18,7 @@
 #include "gpu/vulkan_probe_kernels.h"
 #include "gpu/vulkan_probe_lights.h"
 #include "gpu_fixture.h"
+#include "probe_kernels_fixture.h"
 #include "probes/cascades.h"
 
 using namespace transgi;
@@ -220,11 +221,9 @@ TEST(VulkanProbeLights, PointsWithNoLitProbeTakeTheCoarsestCascadesMeanLight) {
 // back, not the blank ones, and its next update continues from them.
 TEST(VulkanMapStore, AFieldSwitchedToTheCpuTakesItsMapsFromTheDevice) {
   GPU_TEST_CONTEXT_OR_SKIP(unused);
-  std::string why;
-  std::shared_ptr<engine::gpu::VulkanContext> ctx(engine::gpu::VulkanContext::create({}, &why));
-  ASSERT_TRUE(ctx) << why;
-  std::shared_ptr<transgi::gpu::VulkanProbeKernels> kernels = transgi::gpu::make_probe_kernels(ctx, nullptr, &why);
-  if (!kernels) GTEST_SKIP() << why;
+  OWN_PROBE_KERNELS_OR_SKIP(own);
+  const std::shared_ptr<engine::gpu::VulkanContext>& ctx = own.ctx;
+  const std::shared_ptr<transgi::gpu::VulkanProbeKernels>& kernels = own.kernels;
   eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
   const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
   const render::LightSet lights(scene, render::gather_punctual_lights(loaded.app->world()), nullptr);

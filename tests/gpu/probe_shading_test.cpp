@@ -28,6 +28,7 @@
 #include "gpu/vulkan_probe_kernels.h"
 #include "gpu/vulkan_probe_shading.h"
 #include "gpu_fixture.h"
+#include "probe_kernels_fixture.h"
 #include "probes/cpu_probe_kernels.h"
 #include "probes/probe_map.h"
 #include "probes/probe_rays.h"
@@ -311,11 +312,9 @@ TEST(VulkanProbeShading, ASceneTooBigForTheDeviceRunsTheWholeFrameOnTheCpuBacken
 // rays refused.
 TEST(VulkanProbeKernels, ThePointsAreMadeOnTheDeviceFromTheShadedRays) {
   GPU_TEST_CONTEXT_OR_SKIP(unused);
-  std::string why;
-  std::shared_ptr<engine::gpu::VulkanContext> ctx(engine::gpu::VulkanContext::create({}, &why));
-  ASSERT_TRUE(ctx) << why;
-  std::shared_ptr<transgi::gpu::VulkanProbeKernels> kernels = transgi::gpu::make_probe_kernels(ctx, nullptr, &why);
-  if (!kernels) GTEST_SKIP() << why;
+  OWN_PROBE_KERNELS_OR_SKIP(own);
+  const std::shared_ptr<engine::gpu::VulkanContext>& ctx = own.ctx;
+  const std::shared_ptr<transgi::gpu::VulkanProbeKernels>& kernels = own.kernels;
   eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
   const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
   const render::LightSet lights(scene, test_punctual(), nullptr);

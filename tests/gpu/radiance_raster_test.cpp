@@ -16,6 +16,7 @@
 #include "gpu/vulkan_radiance_raster.h"
 #include "probes/cpu_probe_kernels.h"
 #include "gpu_fixture.h"
+#include "probe_kernels_fixture.h"
 
 using namespace transgi;
 
@@ -165,11 +166,9 @@ TEST(VulkanRadianceRaster, WithoutGuardsEveryPointIsCountedOncePerNeighbour) {
 // 1e-3 of the largest, every change flag equal.
 TEST(VulkanProbeKernels, ShareAccumulateProjectIsOneSubmissionAndEqualsTheCpuBackend) {
   GPU_TEST_CONTEXT_OR_SKIP(unused);
-  std::string why;
-  std::shared_ptr<engine::gpu::VulkanContext> ctx(engine::gpu::VulkanContext::create({}, &why));
-  ASSERT_TRUE(ctx) << why;
-  std::shared_ptr<gpu::VulkanProbeKernels> gpu_kernels = gpu::make_probe_kernels(ctx, nullptr, &why);
-  if (!gpu_kernels) GTEST_SKIP() << why;
+  OWN_PROBE_KERNELS_OR_SKIP(own);
+  const std::shared_ptr<engine::gpu::VulkanContext>& ctx = own.ctx;
+  const std::shared_ptr<gpu::VulkanProbeKernels>& gpu_kernels = own.kernels;
   probes::CpuProbeKernels cpu_kernels;
   const Frame f = random_frame(29);
   const probes::MapProjector projector(f.layout);
@@ -227,13 +226,11 @@ namespace {
 // With stage_device_only, the store's buffers are written and read through
 // staging copies, as on a discrete GPU.
 void maps_stay_on_the_device(bool stage_device_only) {
-  std::string why;
   engine::gpu::GpuOptions options;
   options.stage_device_only = stage_device_only;
-  std::shared_ptr<engine::gpu::VulkanContext> ctx(engine::gpu::VulkanContext::create(options, &why));
-  ASSERT_TRUE(ctx) << why;
-  std::shared_ptr<gpu::VulkanProbeKernels> gpu_kernels = gpu::make_probe_kernels(ctx, nullptr, &why);
-  if (!gpu_kernels) GTEST_SKIP() << why;
+  OWN_PROBE_KERNELS_OR_SKIP(own, options);
+  const std::shared_ptr<engine::gpu::VulkanContext>& ctx = own.ctx;
+  const std::shared_ptr<gpu::VulkanProbeKernels>& gpu_kernels = own.kernels;
   probes::CpuProbeKernels cpu_kernels;
   Frame f = random_frame(31);
   for (probes::DepthMap& d : f.depth) d.stamp_version();  // as update_own_depth leaves them

@@ -23,6 +23,17 @@ constexpr std::size_t kRaysPerTask = 4096;
 
 glm::vec3 vec_of(float x, float y, float z) { return {x, y, z}; }
 
+// What a brief and a whole hit share: the flags, the distance (infinite
+// where the ray escaped) and the emission.
+void take_brief(std::uint32_t flags, float distance, const glm::vec3& emitted, probes::ProbeRayHit& r) {
+  r.hit = (flags & kProbeRayHit) != 0;
+  r.back_face = (flags & kProbeRayBackFace) != 0;
+  r.saw_light = (flags & kProbeRaySawLight) != 0;
+  r.replaced_non_finite = (flags & kProbeRayReplacedNonFinite) != 0;
+  r.distance = r.hit ? distance : std::numeric_limits<float>::infinity();
+  r.emitted = emitted;
+}
+
 void check_source(const probes::ProbeFeedbackSource& f) {
   const auto count = static_cast<std::size_t>(f.grid->count());
   if (f.states->size() != count || f.sh.size() != count * kTransferOutputs || (!f.usable.empty() && f.usable.size() != count))
@@ -228,14 +239,8 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
     engine::jobs::parallel_for<std::size_t>(0, n, kRaysPerTask, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         const ProbeRayBriefGpu& g = briefs[i];
-        probes::ProbeRayHit& r = out[i];
-        r = probes::ProbeRayHit{};
-        r.hit = (g.flags & kProbeRayHit) != 0;
-        r.back_face = (g.flags & kProbeRayBackFace) != 0;
-        r.saw_light = (g.flags & kProbeRaySawLight) != 0;
-        r.replaced_non_finite = (g.flags & kProbeRayReplacedNonFinite) != 0;
-        r.distance = r.hit ? g.distance : std::numeric_limits<float>::infinity();
-        r.emitted = vec_of(g.er, g.eg, g.eb);
+        out[i] = probes::ProbeRayHit{};
+        take_brief(g.flags, g.distance, vec_of(g.er, g.eg, g.eb), out[i]);
       }
     });
     return true;
@@ -245,15 +250,10 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
     for (std::size_t i = b; i < e; ++i) {
       const ProbeRayHitGpu& g = hits_out[i];
       probes::ProbeRayHit& r = out[i];
-      r.hit = (g.flags & kProbeRayHit) != 0;
-      r.back_face = (g.flags & kProbeRayBackFace) != 0;
-      r.saw_light = (g.flags & kProbeRaySawLight) != 0;
-      r.replaced_non_finite = (g.flags & kProbeRayReplacedNonFinite) != 0;
-      r.distance = r.hit ? g.distance : std::numeric_limits<float>::infinity();
+      take_brief(g.flags, g.distance, vec_of(g.er, g.eg, g.eb), r);
       r.position = vec_of(g.px, g.py, g.pz);
       r.normal = vec_of(g.nx, g.ny, g.nz);
       r.radiance = vec_of(g.rr, g.rg, g.rb);
-      r.emitted = vec_of(g.er, g.eg, g.eb);
     }
   });
   if (bounce_inputs) {
