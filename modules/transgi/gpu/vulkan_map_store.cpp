@@ -94,7 +94,7 @@ void VulkanMapStore::record_depth_uploads(VkCommandBuffer cmd) const {
                                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT);
 }
 
-void VulkanMapStore::stage(std::span<probes::ProbeMapState* const> states, std::span<const int> slots) {
+void VulkanMapStore::stage(std::span<probes::ProbeMapState* const> states, std::span<const std::uint32_t> slots) {
   if (states.size() != slots.size())
     throw std::invalid_argument("VulkanMapStore::stage: " + std::to_string(states.size()) + " states for " +
                                 std::to_string(slots.size()) + " slots");
@@ -103,8 +103,8 @@ void VulkanMapStore::stage(std::span<probes::ProbeMapState* const> states, std::
   blank_slots_.clear();
   std::vector<std::size_t> send;  // indices into states
   for (std::size_t i = 0; i < states.size(); ++i) {
-    const int q = slots[i];
-    if (q < 0 || q >= probes_)
+    const std::uint32_t q = slots[i];
+    if (q >= static_cast<std::uint32_t>(probes_))
       throw std::out_of_range("VulkanMapStore: slot " + std::to_string(q) + " of a field of " + std::to_string(probes_) + " probes");
     probes::ProbeMapState& m = *states[i];
     const std::uint64_t held = stamp_[static_cast<std::size_t>(q)];
@@ -115,7 +115,7 @@ void VulkanMapStore::stage(std::span<probes::ProbeMapState* const> states, std::
       throw std::invalid_argument("VulkanMapStore: probe " + std::to_string(q) + "'s maps are not of " + std::to_string(texels_) +
                                   " texels");
     if (blank(m))
-      blank_slots_.push_back(q);
+      blank_slots_.push_back(static_cast<int>(q));
     else
       send.push_back(i);
     m.device_stamp = stamp_[static_cast<std::size_t>(q)] = next_stamp();

@@ -33,7 +33,7 @@ class VulkanMapStore final : public probes::ProbeMapStore {
   // submission (record_uploads), and is stamped as held. Throws
   // std::logic_error for a state another store holds, std::out_of_range for
   // a slot past the field.
-  void stage(std::span<probes::ProbeMapState* const> states, std::span<const int> slots);
+  void stage(std::span<probes::ProbeMapState* const> states, std::span<const std::uint32_t> slots);
   // The staged maps copied into their slots (blank maps zero-filled, with
   // nothing sent), then a barrier before the kernels that read them.
   void record_uploads(VkCommandBuffer cmd) const;

@@ -84,8 +84,7 @@ void VulkanProbeAccumulator::prepare(std::span<probes::ProbeMapState* const> sta
   // Where each state's maps are: its slot of the store, or its place in this batch.
   std::vector<std::uint32_t> slots(states.size());
   if (store) {
-    std::vector<int> probe_slots(frame_maps.begin(), frame_maps.end());
-    store->stage(states, probe_slots);
+    store->stage(states, frame_maps);
     pipeline_->bind(1, store->history());
     pipeline_->bind(2, store->sampled());
     slots.assign(frame_maps.begin(), frame_maps.end());

@@ -45,6 +45,40 @@ bool points_from_rays(const std::vector<std::vector<probes::ShadedPoint>>& point
 }
 }  // namespace
 
+bool VulkanRadianceRaster::bind_device_points(const std::vector<std::vector<probes::ShadedPoint>>& points,
+                                              const DevicePoints& rays, const std::vector<std::uint32_t>& begin) {
+  std::vector<std::uint32_t> first;
+  points_on_device_ = points_from_rays(points, rays, begin, first);
+  if (!points_on_device_) return false;
+  if (!points_pipeline_)
+    points_pipeline_ = std::make_unique<engine::gpu::ComputePipeline>(ctx_, compile_module_shader("probe_points.comp"), 4,
+                                                                      static_cast<std::uint32_t>(sizeof(point_push_)));
+  const std::size_t bytes = std::max<std::size_t>(1, begin.back()) * sizeof(ShadedPointGpu);
+  if (device_points_.handle() == VK_NULL_HANDLE || device_points_.size() < bytes)
+    device_points_ = engine::gpu::GpuBuffer(ctx_, bytes, engine::gpu::GpuBuffer::Placement::DeviceOnly);
+  engine::gpu::bind_at_least(ctx_, *points_pipeline_, 2, first_point_, first.size() * sizeof(std::uint32_t))
+      .upload(std::span<const std::uint32_t>(first));
+  points_pipeline_->bind(0, *rays.hits);
+  points_pipeline_->bind(1, *rays.directions);
+  points_pipeline_->bind(2, first_point_);
+  points_pipeline_->bind(3, device_points_);
+  pipeline_->bind(0, device_points_);
+  point_push_[0] = static_cast<std::uint32_t>(first.size()) * rays.rays_per_probe;
+  point_push_[1] = rays.rays_per_probe;
+  point_groups_ = (point_push_[0] + kProbeShadingGroupSize - 1) / kProbeShadingGroupSize;
+  return true;
+}
+
+void VulkanRadianceRaster::bind_depth(const std::vector<const probes::DepthMap*>& own_depth, std::size_t host_texels) {
+  if (store_) {
+    store_->stage_depth(own_depth);
+    pipeline_->bind(2, store_->depth());
+    return;
+  }
+  engine::gpu::bind_at_least(ctx_, *pipeline_, 2, depth_, host_texels * sizeof(probes::DepthMap::Texel));
+  pipeline_->bind(2, depth_);  // a store's may have been bound since
+}
+
 void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vector<std::vector<probes::ShadedPoint>>& points,
                                    const std::vector<const probes::DepthMap*>& own_depth, const probes::SharingSettings& s,
                                    std::span<const std::uint8_t> targets, VulkanMapStore* store,
@@ -83,39 +117,15 @@ void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vec
     if (!targets.empty()) target_flags[q] = targets[q] ? 1u : 0u;
   }
   using DepthTexel = probes::DepthMap::Texel;
-  std::vector<std::uint32_t> first;
-  const bool on_device = device_points && points_from_rays(points, *device_points, begin, first);
   point_groups_ = 0;
-  points_on_device_ = on_device;
-  if (on_device) {
-    if (!points_pipeline_)
-      points_pipeline_ = std::make_unique<engine::gpu::ComputePipeline>(ctx_, compile_module_shader("probe_points.comp"), 4,
-                                                                        static_cast<std::uint32_t>(sizeof(point_push_)));
-    const std::size_t bytes = std::max<std::size_t>(1, begin[count]) * sizeof(ShadedPointGpu);
-    if (device_points_.handle() == VK_NULL_HANDLE || device_points_.size() < bytes)
-      device_points_ = engine::gpu::GpuBuffer(ctx_, bytes, engine::gpu::GpuBuffer::Placement::DeviceOnly);
-    engine::gpu::bind_at_least(ctx_, *points_pipeline_, 2, first_point_, first.size() * sizeof(std::uint32_t))
-        .upload(std::span<const std::uint32_t>(first));
-    points_pipeline_->bind(0, *device_points->hits);
-    points_pipeline_->bind(1, *device_points->directions);
-    points_pipeline_->bind(2, first_point_);
-    points_pipeline_->bind(3, device_points_);
-    pipeline_->bind(0, device_points_);
-    point_push_[0] = static_cast<std::uint32_t>(first.size()) * device_points->rays_per_probe;
-    point_push_[1] = device_points->rays_per_probe;
-    point_groups_ = (point_push_[0] + kProbeShadingGroupSize - 1) / kProbeShadingGroupSize;
-  } else {
+  points_on_device_ = false;
+  const bool on_device = device_points && bind_device_points(points, *device_points, begin);
+  if (!on_device) {
     engine::gpu::bind_at_least(ctx_, *pipeline_, 0, points_, std::max<std::size_t>(1, begin[count]) * sizeof(ShadedPointGpu));
     pipeline_->bind(0, points_);  // device_points_ may have been bound since
   }
   const auto flat = on_device ? std::span<ShadedPointGpu>() : points_.mapped_as<ShadedPointGpu>(begin[count]);
-  if (store_) {
-    store_->stage_depth(own_depth);
-    pipeline_->bind(2, store_->depth());
-  } else {
-    engine::gpu::bind_at_least(ctx_, *pipeline_, 2, depth_, depth_texels * sizeof(DepthTexel));
-    pipeline_->bind(2, depth_);  // a store's may have been bound since
-  }
+  bind_depth(own_depth, depth_texels);
   const auto depth = write_depth ? depth_.mapped_as<DepthTexel>(depth_texels) : std::span<DepthTexel>();
   engine::jobs::parallel_for<std::size_t>(0, count, 8, [&](std::size_t q0, std::size_t q1) {
     for (std::size_t q = q0; q < q1; ++q) {

@@ -57,6 +57,15 @@ class VulkanRadianceRaster {
   probes::SharingStats finish(std::vector<probes::FrameSamples>* out) const;
 
  private:
+  // prepare's steps. The points made on the device from `rays` where they
+  // are `points` (probe_points.comp bound, the raster reading its output);
+  // false: not, nothing bound.
+  bool bind_device_points(const std::vector<std::vector<probes::ShadedPoint>>& points, const DevicePoints& rays,
+                          const std::vector<std::uint32_t>& begin);
+  // The depth maps the raster reads: the store's copies (the changed ones
+  // staged), or host_texels texels written here.
+  void bind_depth(const std::vector<const probes::DepthMap*>& own_depth, std::size_t host_texels);
+
   engine::gpu::VulkanContext& ctx_;
   probes::MapLayout layout_;
   engine::gpu::GpuBuffer points_, ranges_, depth_, probes_, targets_, samples_, stats_;
