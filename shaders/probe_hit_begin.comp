@@ -52,7 +52,8 @@ void main() {
     shadows[i] = shadow;
     return;
   }
-  const Surface s = make_surface(hit.instance, hit.mesh, hit.primitive, hit.u, hit.v, dir);
+  Surface s = make_surface(hit.instance, hit.mesh, hit.primitive, hit.u, hit.v, dir);
+  s.brdf.roughness = max(s.brdf.roughness, kProbeHitMinRoughness);
   vec3 e = s.emission;
   if (!finite3(e)) {
     e = vec3(0.0);

@@ -1,9 +1,11 @@
 #include "probes/probe_rays.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "engine/math/sampling.h"
+#include "probe_shading_shared.h"
 
 namespace transgi::probes {
 
@@ -62,7 +64,8 @@ PendingProbeRay begin_probe_ray(const engine::rt::RtScene& scene, const engine::
     return p;
   }
   const rt::Hit& hit = *traced;
-  const render::Surface s = render::make_surface(scene, hit, dir);
+  render::Surface s = render::make_surface(scene, hit, dir);
+  s.brdf.roughness = std::max(s.brdf.roughness, gpu::kProbeHitMinRoughness);
   r.emitted = s.emission;
   if (!std::isfinite(r.emitted.r + r.emitted.g + r.emitted.b)) {
     r.emitted = glm::vec3(0.0f);
