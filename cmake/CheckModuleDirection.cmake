@@ -8,7 +8,7 @@ set(violations "")
 function(check_layer dir pattern)
   file(GLOB_RECURSE files LIST_DIRECTORIES false
        ${ROOT}/${dir}/*.h ${ROOT}/${dir}/*.hpp ${ROOT}/${dir}/*.cpp ${ROOT}/${dir}/*.cc
-       ${ROOT}/${dir}/*.glsl ${ROOT}/${dir}/*.comp ${ROOT}/${dir}/*.inl)
+       ${ROOT}/${dir}/*.glsl ${ROOT}/${dir}/*.comp ${ROOT}/${dir}/*.vert ${ROOT}/${dir}/*.frag ${ROOT}/${dir}/*.inl)
   foreach(f IN LISTS files)
     file(STRINGS ${f} lines REGEX "^[ \t]*#[ \t]*include")
     foreach(line IN LISTS lines)

@@ -36,7 +36,7 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/shaders/ DESTINATION ${ENGINE_INSTALLED_
 # Both folders are named once, in CMakeLists.txt (ENGINE_INSTALLED_SHADER_*),
 # which the programs are compiled with.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/shaders/ DESTINATION ${ENGINE_INSTALLED_SHADER_DIR} COMPONENT runtime
-  FILES_MATCHING PATTERN "*.comp" PATTERN "*.glsl")
+  FILES_MATCHING PATTERN "*.comp" PATTERN "*.vert" PATTERN "*.frag" PATTERN "*.glsl")
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/content/levels/living_room DESTINATION ${TRANSGI_INSTALL_DATADIR}/levels
   COMPONENT runtime)
 

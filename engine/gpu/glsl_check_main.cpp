@@ -1,4 +1,4 @@
-// glsl_check FILE... [-I DIR]... [-D NAME=VALUE]...: compiles each compute shader the way the
+// glsl_check FILE... [-I DIR]... [-D NAME=VALUE]...: compiles each shader (its stage by its extension) the way the
 // engine does at run time and prints "file:line: error: ..." for each
 // problem. The build runs it over shaders/, so a GLSL error fails the build.
 #include <cstdio>
@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
   int failed = 0;
   for (const char* f : files) {
     try {
-      const auto spirv = engine::gpu::compile_compute_shader(f, options);
+      const auto spirv = engine::gpu::compile_shader(f, options);
       std::printf("glsl_check: %s: %zu SPIR-V words\n", f, spirv.size());
     } catch (const engine::gpu::GpuError& e) {
       std::fprintf(stderr, "%s\n", e.what());

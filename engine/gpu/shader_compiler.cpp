@@ -68,19 +68,29 @@ class Includer : public glslang::TShader::Includer {
   std::vector<fs::path> dirs_;
 };
 
+EShLanguage glslang_stage(ShaderStage stage) {
+  switch (stage) {
+    case ShaderStage::Vertex: return EShLangVertex;
+    case ShaderStage::Fragment: return EShLangFragment;
+    case ShaderStage::Compute: break;
+  }
+  return EShLangCompute;
+}
+
 std::vector<std::uint32_t> compile(std::string_view source, const std::string& name, const fs::path& main_dir,
-                                   const ShaderCompileOptions& options) {
+                                   const ShaderCompileOptions& options, ShaderStage stage = ShaderStage::Compute) {
+  const EShLanguage language = glslang_stage(stage);
   std::lock_guard lock(glslang_mutex());
   std::string preamble;
   for (const auto& d : options.defines) preamble += "#define " + d.name + " " + d.value + "\n";
 
-  glslang::TShader shader(EShLangCompute);
+  glslang::TShader shader(language);
   const char* text = source.data();
   const int length = static_cast<int>(source.size());
   const char* names = name.c_str();
   shader.setStringsWithLengthsAndNames(&text, &length, &names, 1);
   shader.setPreamble(preamble.c_str());
-  shader.setEnvInput(glslang::EShSourceGlsl, EShLangCompute, glslang::EShClientVulkan, 100);
+  shader.setEnvInput(glslang::EShSourceGlsl, language, glslang::EShClientVulkan, 100);
   shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_2);
   shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_5);
   Includer includer(main_dir, options.include_dirs);
@@ -96,7 +106,7 @@ std::vector<std::uint32_t> compile(std::string_view source, const std::string& n
   spv::SpvBuildLogger logger;
   glslang::SpvOptions spv_options;
   spv_options.validate = true;
-  glslang::GlslangToSpv(*program.getIntermediate(EShLangCompute), spirv, &logger, &spv_options);
+  glslang::GlslangToSpv(*program.getIntermediate(language), spirv, &logger, &spv_options);
   const std::string extra = logger.getAllMessages();
   if (spirv.empty()) throw GpuError(name + ": SPIR-V generation failed: " + extra);
   return spirv;
@@ -141,6 +151,21 @@ std::vector<std::uint32_t> compile_compute_shader(const fs::path& file, const Sh
   std::string source;
   if (!read_text(file, source)) throw GpuError(file.string() + ": cannot read the shader");
   return compile(source, file.string(), file.parent_path(), options);
+}
+
+ShaderStage shader_stage_of(const fs::path& file) {
+  const std::string ext = file.extension().string();
+  if (ext == ".comp") return ShaderStage::Compute;
+  if (ext == ".vert") return ShaderStage::Vertex;
+  if (ext == ".frag") return ShaderStage::Fragment;
+  throw GpuError(file.string() + ": not a shader stage glslang names (.comp, .vert, .frag)");
+}
+
+std::vector<std::uint32_t> compile_shader(const fs::path& file, const ShaderCompileOptions& options) {
+  const ShaderStage stage = shader_stage_of(file);
+  std::string source;
+  if (!read_text(file, source)) throw GpuError(file.string() + ": cannot read the shader");
+  return compile(source, file.string(), file.parent_path(), options, stage);
 }
 
 std::vector<std::uint32_t> compile_compute_source(std::string_view source, const std::string& name,

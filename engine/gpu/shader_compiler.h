@@ -1,5 +1,6 @@
 #pragma once
-// GLSL 4.60 compute shaders to SPIR-V with glslang's C++ API, at run time.
+// GLSL 4.60 shaders (compute, and the vertex and fragment stages of a raster
+// pass) to SPIR-V with glslang's C++ API, at run time.
 // Run time rather than only at build time so that a shader can be edited and
 // reloaded while the engine runs (shaders/README.md); the build also compiles
 // every shader once with the same code (the glsl_check tool), so a GLSL error
@@ -28,10 +29,18 @@ struct ShaderCompileOptions {
   std::vector<ShaderDefine> defines;
 };
 
+enum class ShaderStage { Compute, Vertex, Fragment };
+
+// The stage a file holds, by its extension as glslang's tools name them:
+// .comp, .vert, .frag. Throws GpuError for any other.
+ShaderStage shader_stage_of(const std::filesystem::path& file);
+
 // Compiles one compute shader file. Throws GpuError (unreadable file,
 // compile or link errors, each as "file:line: message").
 std::vector<std::uint32_t> compile_compute_shader(const std::filesystem::path& file,
                                                   const ShaderCompileOptions& options = {});
+// Any stage, by the file's extension (shader_stage_of).
+std::vector<std::uint32_t> compile_shader(const std::filesystem::path& file, const ShaderCompileOptions& options = {});
 
 // The same for source text; `name` stands for the file in messages, and
 // includes are looked up in options.include_dirs only.

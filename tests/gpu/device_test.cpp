@@ -114,6 +114,26 @@ TEST(ShaderCompiler, AnErrorInAnIncludedHeaderNamesTheHeaderAndItsLine) {
   EXPECT_THROW(compile_compute_shader(dir / "missing.comp"), GpuError);
 }
 
+// The stage comes from the extension, as glslang's tools read it: a vertex
+// shader's gl_Position is no compute shader's, and an unknown extension is
+// refused with the file's name.
+TEST(ShaderCompiler, TheStageIsTheFilesExtension) {
+  const auto dir = std::filesystem::temp_directory_path() / "engine_gpu_stage_test";
+  std::filesystem::create_directories(dir);
+  const char* vertex = "#version 460\nvoid main() { gl_Position = vec4(float(gl_VertexIndex), 0.0, 0.0, 1.0); }\n";
+  for (const char* name : {"v.vert", "v.comp", "v.glsl"}) std::ofstream(dir / name) << vertex;
+  const auto spirv = compile_shader(dir / "v.vert");
+  ASSERT_GT(spirv.size(), 5u);
+  EXPECT_EQ(spirv[0], 0x07230203u);
+  EXPECT_THROW(compile_shader(dir / "v.comp"), GpuError) << "gl_Position is not a compute shader's";
+  try {
+    compile_shader(dir / "v.glsl");
+    FAIL() << "expected an unknown stage";
+  } catch (const GpuError& e) {
+    EXPECT_NE(std::string(e.what()).find("v.glsl"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ShaderCompiler, AValidShaderBecomesSpirvWithItsMagicNumber) {
   const auto spirv = compile_compute_source("#version 460\nlayout(local_size_x = 1) in;\nvoid main() {}\n", "ok.comp");
   ASSERT_GT(spirv.size(), 5u);
