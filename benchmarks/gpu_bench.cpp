@@ -15,7 +15,9 @@
 
 #include "engine/app/app.h"
 #include "engine/gpu/gpu_rt_scene.h"
+#include "engine/gpu/visibility_pass.h"
 #include "engine/gpu/vulkan_context.h"
+#include "engine/render/camera_rays.h"
 #include "engine/rt/rt_scene.h"
 #include "engine/jobs/job_system.h"
 #include "engine/jobs/parallel_for.h"
@@ -41,6 +43,11 @@ class Holder {
   Holder() : scene_(transgi::eval::load_scene(level_path(), "", 2)) {}
   engine::app::App& app() { return *scene_.app; }
   const engine::rt::RtScene& rt() { return scene_.app->world().resource<engine::rt::RtScene>(); }
+  engine::render::CameraRays camera(int width, int height) {
+    auto& w = scene_.app->world();
+    return {w.get<engine::scene::Camera>(scene_.camera), w.get<engine::transform::WorldTransform>(scene_.camera), width, height};
+  }
+  float near_plane() { return scene_.app->world().get<engine::scene::Camera>(scene_.camera).znear; }
 
  private:
   transgi::eval::LoadedScene scene_;
@@ -188,8 +195,66 @@ void BM_RayTraversal(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(rays.size()));
 }
 
+// Primary visibility of the sample level's camera at range(1) x 9/16 of it.
+// Arg 0: the camera rays made on the host and traced by the GPU
+// (GpuRtScene::intersect with ray queries, as the Vulkan G-buffer traces
+// them today); 1: the raster visibility pass and its resolve
+// (VisibilityPass), which sends no rays. Counter gpu_ms: the device's time;
+// hits must agree.
+void BM_PrimaryVisibility(benchmark::State& state) {
+  static eval_scene::Holder level;
+  const int width = static_cast<int>(state.range(1)), height = width * 9 / 16;
+  const engine::render::CameraRays camera = level.camera(width, height);
+  std::string why;
+  auto* ctx = context<true>(&why);
+  if (!ctx) return state.SkipWithError(("no Vulkan device: " + why).c_str());
+  const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  std::vector<engine::rt::Hit> hits(n);
+  std::vector<std::uint8_t> found(n);
+  engine::gpu::GpuRtScene gpu(*ctx);
+  gpu.sync(level.rt());
+  double gpu_ms = 0;
+  if (state.range(0) == 0) {
+    state.SetLabel(ctx->info().ray_query ? "camera rays, ray query" : "camera rays, compute BVH");
+    std::vector<engine::rt::Ray> rays(n);
+    for (auto _ : state) {
+      double ms = 0;
+      level.app().jobs().run([&] {
+        engine::jobs::parallel_for<std::size_t>(0, n, 4096, [&](std::size_t b, std::size_t e) {
+          for (std::size_t i = b; i < e; ++i)
+            rays[i] = camera.generate(glm::vec2(static_cast<float>(i % static_cast<std::size_t>(width)) + 0.5f,
+                                                static_cast<float>(i / static_cast<std::size_t>(width)) + 0.5f));
+        });
+        gpu.intersect(rays, hits, found, &ms);
+      });
+      gpu_ms += ms;
+    }
+  } else {
+    if (!engine::gpu::VisibilityPass::supported(*ctx, &why)) return state.SkipWithError(why.c_str());
+    state.SetLabel("raster visibility pass");
+    engine::gpu::VisibilityPass pass(*ctx);
+    for (auto _ : state) {
+      double ms = 0;
+      pass.render(gpu, camera, {0.5f, 0.5f}, level.near_plane(), hits, found, &ms);
+      gpu_ms += ms;
+    }
+  }
+  state.counters["gpu_ms"] = gpu_ms / static_cast<double>(state.iterations());
+  std::size_t n_hits = 0;
+  for (const std::uint8_t f : found) n_hits += f;
+  state.counters["hits"] = static_cast<double>(n_hits);
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n));
+}
+
 }  // namespace
 
+BENCHMARK(BM_PrimaryVisibility)
+    ->Args({0, 640})
+    ->Args({1, 640})
+    ->Args({0, 1920})
+    ->Args({1, 1920})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RayTraversal)->Arg(0)->Arg(1)->Arg(2)->Arg(0)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FusedInference)
     ->Args({0, kPoints})

@@ -13,19 +13,28 @@
 #include "rt_shared.h"
 
 namespace engine::gpu {
-namespace {
 
-BvhNodeGpu to_gpu(const rt::BvhNode& n) {
-  return {n.bounds.min.x, n.bounds.min.y, n.bounds.min.z, n.first, n.bounds.max.x, n.bounds.max.y, n.bounds.max.z, n.count};
-}
-
-// ENGINE_SHADER_DIR, else the installed folder beside the program (bin/ ->
-// ../ENGINE_INSTALLED_SHADER_DIR), else the source tree's.
 std::filesystem::path engine_shader_dir() {
   if (const char* env = std::getenv("ENGINE_SHADER_DIR"); env && *env) return env;
   if (const std::string_view installed = ENGINE_INSTALLED_SHADER_DIR; !installed.empty())
     if (auto dir = core::beside_executable(std::filesystem::path("..") / installed)) return *dir;
   return ENGINE_SOURCE_SHADER_DIR;
+}
+
+ShaderCompileOptions engine_shader_options() {
+  const auto dir = engine_shader_dir();
+  ShaderCompileOptions options;
+  options.include_dirs.push_back(dir);
+  // Installed, the headers the kernels share with C++ are with the C++ headers.
+  if (auto shared = core::installed_twin(dir, ENGINE_INSTALLED_SHADER_DIR, ENGINE_INSTALLED_SHADER_INCLUDE_DIR))
+    options.include_dirs.push_back(*shared);
+  return options;
+}
+
+namespace {
+
+BvhNodeGpu to_gpu(const rt::BvhNode& n) {
+  return {n.bounds.min.x, n.bounds.min.y, n.bounds.min.z, n.first, n.bounds.max.x, n.bounds.max.y, n.bounds.max.z, n.count};
 }
 
 // `what` names the data in the error where it is larger than a kernel can bind.
@@ -87,11 +96,7 @@ std::vector<VkDescriptorType> GpuRtScene::binding_types(const VulkanContext& ctx
 
 GpuRtScene::GpuRtScene(VulkanContext& ctx) : ctx_(ctx) {
   const auto dir = engine_shader_dir();
-  ShaderCompileOptions options;
-  options.include_dirs.push_back(dir);
-  // Installed, the headers the kernels share with C++ are with the C++ headers.
-  if (auto shared = core::installed_twin(dir, ENGINE_INSTALLED_SHADER_DIR, ENGINE_INSTALLED_SHADER_INCLUDE_DIR))
-    options.include_dirs.push_back(*shared);
+  ShaderCompileOptions options = engine_shader_options();
   options.defines = shader_defines(ctx);
   query_ = std::make_unique<ComputePipeline>(ctx, compile_compute_shader(dir / "rt_query.comp", options),
                                              binding_types(ctx, 2, 2 + kBindings),
@@ -140,6 +145,7 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
     }
     blas_root_.assign(assets->meshes.size(), 0);
     triangle_offset_.assign(assets->meshes.size(), 0);
+    finite_triangles_.assign(assets->meshes.size(), 0);
     mesh_box_.assign(assets->meshes.size(), rt::BvhBox{});
     std::vector<BlasInput> blas_inputs(assets->meshes.size());
     for (std::size_t m = 0; m < assets->meshes.size(); ++m) {
@@ -173,6 +179,8 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
       blas_root_[m] = static_cast<std::uint32_t>(nodes.size());
       triangle_offset_[m] = static_cast<std::uint32_t>(tris.size());
       blas_inputs[m].triangles = static_cast<std::uint32_t>(finite_triangles.size());
+      // Both orders list the finite triangles first.
+      finite_triangles_[m] = static_cast<std::uint32_t>(finite_triangles.size());
       for (const auto& n : bvh.nodes) nodes.push_back(to_gpu(n));
       for (std::uint32_t item : bvh.order) {
         const glm::uvec3 tri = mesh.triangles[item];
@@ -234,8 +242,11 @@ void GpuRtScene::sync(const rt::RtScene& rt) {
   }
   std::vector<InstanceGpu> instances;
   std::vector<TlasInstance> tlas_instances;
+  draws_.clear();
   for (std::uint32_t item : tlas.order) {
     const rt::InstanceRecord& r = *live[item];
+    if (finite_triangles_[r.mesh] > 0)
+      draws_.push_back({triangle_offset_[r.mesh], finite_triangles_[r.mesh], static_cast<std::uint32_t>(instances.size())});
     // World to object: x_o = R^T (x_w - T) / s, as rows of a 3 x 4 matrix.
     const glm::mat3 rt_ = glm::transpose(glm::mat3_cast(r.to_world.rotation)) / r.to_world.scale;
     const glm::vec3 off = -(rt_ * r.to_world.translation);
@@ -275,6 +286,20 @@ void GpuRtScene::bind(ComputePipeline& pipeline, std::uint32_t first) const {
   pipeline.bind(first + 7, alpha_textures_);
 }
 
+ecs::Entity GpuRtScene::entity_of(std::uint32_t id) const {
+  const rt::InstanceRecord* record = synced_ ? synced_->instance(id) : nullptr;
+  return record ? record->entity : ecs::Entity{};
+}
+
+GpuRtRasterView GpuRtScene::raster_view() const {
+  if (instances_.handle() == VK_NULL_HANDLE) throw GpuError("GpuRtScene::raster_view before sync");
+  GpuRtRasterView v;
+  v.buffers = {structures_ ? &instances_ : &tlas_, &instances_, &blas_, &triangles_, &triangle_uvs_, &alpha_materials_,
+               &alpha_bytes_, &alpha_textures_};
+  v.draws = draws_;
+  return v;
+}
+
 std::span<const HitGpu> GpuRtScene::run_query(std::span<const rt::Ray> rays, bool any_hit, double* gpu_ms) {
   const std::size_t n = rays.size();
   if (rays_.handle() == VK_NULL_HANDLE || rays_.size() < n * sizeof(RayGpu)) rays_ = GpuBuffer(ctx_, n * sizeof(RayGpu));
@@ -309,8 +334,7 @@ void GpuRtScene::intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hit
       const HitGpu h = out[i];
       found[i] = h.instance != kRtNoHit ? 1 : 0;
       if (!found[i]) continue;
-      const rt::InstanceRecord* record = synced_ ? synced_->instance(h.instance) : nullptr;
-      hits[i].entity = record ? record->entity : ecs::Entity{};
+      hits[i].entity = entity_of(h.instance);
       hits[i].instance = h.instance;
       hits[i].mesh = h.mesh;
       hits[i].primitive = h.primitive;

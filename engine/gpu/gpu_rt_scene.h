@@ -14,7 +14,9 @@
 // Kernels include shaders/rt_traversal.glsl, compiled with shader_defines(),
 // make their pipelines with binding_types(), and bind() kBindings
 // consecutive slots; both traversals give the same hits.
+#include <array>
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <span>
 #include <vector>
@@ -29,6 +31,28 @@
 #include "rt_shared.h"
 
 namespace engine::gpu {
+
+// Where the engine's kernels are read at run time: $ENGINE_SHADER_DIR, else
+// the installed folder beside the program (bin/ ->
+// ../ENGINE_INSTALLED_SHADER_DIR), else the source tree's.
+std::filesystem::path engine_shader_dir();
+// What the engine's kernels are compiled with: the folders their includes
+// are found in (the shader folder, and installed, the headers' folder).
+ShaderCompileOptions engine_shader_options();
+
+// What a raster pass over the scene reads (VisibilityPass): the buffers
+// rt_traversal.glsl's BVH variant binds, in its order (where the driver
+// holds the TLAS, the instances' buffer stands in for the TLAS nodes, which
+// no raster stage reads), and one draw per live instance: `triangles` of
+// the triangle buffer from `first_triangle` (its mesh's finite ones), under
+// InstanceGpu `instance`.
+struct GpuRtRasterView {
+  struct Draw {
+    std::uint32_t first_triangle = 0, triangles = 0, instance = 0;
+  };
+  std::array<const GpuBuffer*, 8> buffers{};
+  std::span<const Draw> draws;
+};
 
 struct GpuRtStats {
   bool ray_query = false;  // traced with VK_KHR_ray_query (the node counts are then 0)
@@ -66,6 +90,13 @@ class GpuRtScene {
   // (tmin, tmax]; traversal stops at the first hit.
   void occluded(std::span<const rt::Ray> rays, std::span<std::uint8_t> blocked, double* gpu_ms = nullptr);
 
+  // The entity of RtScene instance `id` as of the last sync (a hit's
+  // Hit::entity), or none.
+  [[nodiscard]] ecs::Entity entity_of(std::uint32_t id) const;
+
+  // For a raster pass; throws GpuError before the first sync.
+  [[nodiscard]] GpuRtRasterView raster_view() const;
+
   // Bindings bind() fills.
   static constexpr std::uint32_t kBindings = 8;
 
@@ -81,7 +112,8 @@ class GpuRtScene {
   VulkanContext& ctx_;
   const rt::RtScene* synced_ = nullptr;
   std::uint64_t generation_ = 0;
-  std::vector<std::uint32_t> blas_root_, triangle_offset_;  // per mesh
+  std::vector<std::uint32_t> blas_root_, triangle_offset_, finite_triangles_;  // per mesh
+  std::vector<GpuRtRasterView::Draw> draws_;
   // Per mesh, the object-space box of its finite triangles: a mesh with a
   // stray non-finite vertex has a non-finite MeshAsset box, which would drop
   // every instance of it from the TLAS, while Embree skips only the

@@ -18,53 +18,14 @@
 #include "engine/rt/bvh_builder.h"
 #include "engine/scene/procedural.h"
 #include "gpu_fixture.h"
+#include "rt_world.h"
 
 using namespace engine;
+using gpu_test::build_world;
+using gpu_test::RtWorld;
 
 namespace {
 
-struct RtWorld {
-  scene::SceneAssets assets;
-  rt::RtScene rt;
-  std::vector<transform::Similarity> xf;
-  std::vector<std::uint32_t> mesh_of;
-};
-
-// A closed room (inward box) with rotated, scaled and overlapping spheres,
-// tori, boxes and tubes in it: concave, convex and thin geometry.
-void build_world(RtWorld& w) {
-  w.assets.generation = scene::next_scene_generation();
-  auto add = [&](scene::MeshAsset m) {
-    m.compute_bounds();
-    w.assets.meshes.push_back(std::make_shared<scene::MeshAsset>(std::move(m)));
-  };
-  add(scene::make_box(glm::vec3(5.0f, 3.0f, 4.0f), true));
-  add(scene::make_uv_sphere(0.7f, 48, 24));
-  add(scene::make_torus(0.8f, 0.25f, 40, 16));
-  add(scene::make_box(glm::vec3(0.4f, 0.9f, 0.3f)));
-  add(scene::make_tube(0.3f, 1.5f, 24, 0.6f));
-  w.assets.materials.resize(1);
-  w.rt.set_assets(&w.assets);
-  math::Pcg32 rng(77, 1);
-  for (std::uint32_t i = 0; i < 13; ++i) {
-    transform::Similarity s;
-    const std::uint32_t mesh = i == 0 ? 0 : 1 + (i % 4);
-    if (i > 0) {
-      s.translation = glm::vec3(8.0f * rng.next_float() - 4.0f, 5.0f * rng.next_float() - 2.5f, 6.0f * rng.next_float() - 3.0f);
-      s.rotation = glm::normalize(glm::quat(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f));
-      s.scale = 0.5f + 1.5f * rng.next_float();
-    }
-    w.rt.upsert_instance(ecs::Entity{i, 0}, mesh, s);
-    w.xf.push_back(s);
-    w.mesh_of.push_back(mesh);
-  }
-  // One removed instance leaves a hole in the ids, as a despawn would.
-  w.rt.upsert_instance(ecs::Entity{99, 0}, 1, transform::Similarity{});
-  w.rt.remove_instance(ecs::Entity{99, 0});
-  w.rt.commit();
-}
-
-// A point inside build_world's room (its walls at +-5, +-3, +-4).
 glm::vec3 point_in_room(math::Pcg32& rng) {
   return glm::vec3(9.6f * rng.next_float() - 4.8f, 5.6f * rng.next_float() - 2.8f, 7.6f * rng.next_float() - 3.8f);
 }

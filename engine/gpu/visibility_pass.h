@@ -1,0 +1,87 @@
+#pragma once
+// Primary visibility the way engines rasterise it: a visibility buffer
+// (Burns and Hunt, "The Visibility Buffer", JCGT 2013). A raster pipeline
+// draws every live instance of the GpuRtScene (its triangles pulled from the
+// scene's triangle buffer by vertex index, no vertex buffers) with a depth
+// test and writes, per pixel, which instance and triangle cover it; a
+// compute pass then meets each pixel's camera ray with that triangle and
+// writes the hit records rt_query.comp writes (HitGpu), so the stages after
+// the G-buffer read the raster's hits and the ray tracer's alike.
+//
+// Every pixel is sampled at the same film offset (a rasteriser samples one
+// point per pixel; a jitter per frame moves them all), where the CPU's
+// G-buffer may jitter each pixel on its own. Cut-outs (glTF MASK) are
+// tested at the fragment as RtScene tests a ray's hit. Draws every triangle
+// two-sided, as the ray tracer sees them. The queue must support graphics
+// (supported()).
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan_core.h>
+
+#include "engine/gpu/compute_pipeline.h"
+#include "engine/gpu/gpu_buffer.h"
+#include "engine/render/camera_rays.h"
+#include "engine/rt/ray.h"
+
+namespace engine::gpu {
+
+class GpuRtScene;
+class VulkanContext;
+
+class VisibilityPass {
+ public:
+  // False, with *why, where the context's queue cannot rasterise.
+  static bool supported(const VulkanContext& ctx, std::string* why = nullptr);
+
+  explicit VisibilityPass(VulkanContext& ctx);
+  ~VisibilityPass();
+  VisibilityPass(const VisibilityPass&) = delete;
+  VisibilityPass& operator=(const VisibilityPass&) = delete;
+
+  // Sizes the targets for `camera` and binds `scene` as of its last sync;
+  // call before record() whenever either changed. `sample`: the film offset
+  // inside each pixel, in [0, 1)^2 ((0.5, 0.5) is the centre). `near_plane`:
+  // nothing closer to the camera is drawn (scene::Camera::znear).
+  void prepare(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane);
+  // Records the draw, the visibility buffer's copy and the resolve into
+  // `cmd`: after it, hits_on_device() holds width x height HitGpu, row by
+  // row from the top-left.
+  void record(VkCommandBuffer cmd) const;
+  [[nodiscard]] const GpuBuffer& hits_on_device() const { return hits_; }
+
+  // prepare, record in a submission of its own, and the hits read back as
+  // GpuRtScene::intersect gives them (found[i]: pixel i saw a surface);
+  // *gpu_ms: the submission's device time.
+  void render(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane,
+              std::span<rt::Hit> hits, std::span<std::uint8_t> found, double* gpu_ms = nullptr);
+
+ private:
+  void make_targets(std::uint32_t width, std::uint32_t height);
+  void destroy_targets();
+
+  VulkanContext& ctx_;
+  const GpuRtScene* scene_ = nullptr;
+  std::uint32_t width_ = 0, height_ = 0;
+  std::vector<std::uint8_t> push_;  // VisibilityPushGpu
+  // The raster pipeline: its set binds rt_traversal.glsl's eight buffers.
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkRenderPass render_pass_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;
+  VkShaderModule vertex_ = VK_NULL_HANDLE, fragment_ = VK_NULL_HANDLE;
+  // The targets: instance + 1 and triangle per pixel, and reversed depth.
+  VkImage visibility_image_ = VK_NULL_HANDLE, depth_image_ = VK_NULL_HANDLE;
+  VkDeviceMemory visibility_memory_ = VK_NULL_HANDLE, depth_memory_ = VK_NULL_HANDLE;
+  VkImageView visibility_view_ = VK_NULL_HANDLE, depth_view_ = VK_NULL_HANDLE;
+  VkFramebuffer framebuffer_ = VK_NULL_HANDLE;
+  GpuBuffer visibility_, hits_;
+  std::unique_ptr<ComputePipeline> resolve_;
+};
+
+}  // namespace engine::gpu

@@ -1,0 +1,242 @@
+// The raster visibility pass (engine/gpu/visibility_pass) against the GPU
+// ray tracer (GpuRtScene::intersect, itself tested against Embree) on the
+// same camera rays: every pixel must see the same instance and triangle at
+// the same distance and barycentrics. A rasteriser and a ray test decide a
+// pixel that falls on an edge between triangles by different rules (the
+// top-left rule against a watertight intersection in floating point), so a
+// few pixels on shared edges may go to the other triangle (at most 0.5 %
+// of the pixels, and those only where the two hits lie at the same
+// distance), and a ray grazing a silhouette may round the other way than
+// the raster's sample (at most 0.1 %, and only where a neighbouring pixel
+// of the raster's sees what the ray saw). Every test runs with the BVH traversal and with ray queries,
+// whose scenes bind the raster's buffers differently.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "engine/gpu/gpu_rt_scene.h"
+#include "engine/gpu/visibility_pass.h"
+#include "engine/render/camera_rays.h"
+#include "engine/scene/procedural.h"
+#include "gpu_fixture.h"
+#include "rt_world.h"
+
+using namespace engine;
+
+namespace {
+
+enum class Traversal { ComputeBvh, RayQuery };
+
+class VisibilityPassTest : public testing::TestWithParam<Traversal> {};
+
+std::string traversal_name(const testing::TestParamInfo<Traversal>& info) {
+  return info.param == Traversal::RayQuery ? "RayQuery" : "ComputeBvh";
+}
+
+struct Agreement {
+  std::size_t pixels = 0, hits = 0, edge_ties = 0, silhouettes = 0, differ = 0, bad_depth = 0, bad_barycentrics = 0;
+};
+
+constexpr std::uint32_t kNothing = 0xffffffffu;
+
+// Whether a 4-neighbour of pixel i in the raster's image sees `instance`
+// (kNothing: the sky): pixel i then lies on that surface's silhouette,
+// where a ray grazing an edge and a rasteriser's sample may round apart.
+bool beside(const std::vector<rt::Hit>& hits, const std::vector<std::uint8_t>& found, std::size_t i, std::uint32_t instance,
+            int width) {
+  const int x = static_cast<int>(i) % width, y = static_cast<int>(i) / width;
+  const int height = static_cast<int>(hits.size()) / width;
+  for (const glm::ivec2 d : {glm::ivec2(1, 0), glm::ivec2(-1, 0), glm::ivec2(0, 1), glm::ivec2(0, -1)}) {
+    const int nx = x + d.x, ny = y + d.y;
+    if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
+    const auto j = static_cast<std::size_t>(ny * width + nx);
+    if ((found[j] ? hits[j].instance : kNothing) == instance) return true;
+  }
+  return false;
+}
+
+// The raster's hits against the tracer's for the camera rays through film
+// (x, y) + sample; prints the counts under `what`.
+Agreement compare(const char* what, gpu::VisibilityPass& pass, gpu::GpuRtScene& gpu_rt, const render::CameraRays& camera,
+                  glm::vec2 sample, float near_plane) {
+  const int w = camera.width(), h = camera.height();
+  const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  std::vector<rt::Ray> rays(n);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) rays[static_cast<std::size_t>(y * w + x)] = camera.generate(glm::vec2(x, y) + sample);
+  std::vector<rt::Hit> want(n), got(n);
+  std::vector<std::uint8_t> want_found(n), got_found(n);
+  gpu_rt.intersect(rays, want, want_found);
+  pass.render(gpu_rt, camera, sample, near_plane, got, got_found);
+  Agreement a;
+  a.pixels = n;
+  for (std::size_t i = 0; i < n; ++i) {
+    a.hits += want_found[i];
+    const rt::Hit &p = want[i], &q = got[i];
+    if (want_found[i] != got_found[i] || (want_found[i] && (p.instance != q.instance || p.primitive != q.primitive))) {
+      if (want_found[i] && got_found[i] && std::abs(p.t - q.t) <= 1e-3f * p.t) ++a.edge_ties;
+      else if (beside(got, got_found, i, want_found[i] ? p.instance : kNothing, w)) ++a.silhouettes;
+      else ++a.differ;
+      continue;
+    }
+    if (!want_found[i]) continue;
+    if (!(std::abs(p.t - q.t) <= 1e-4f * p.t)) ++a.bad_depth;
+    if (glm::length(p.barycentric - q.barycentric) > 1e-3f) ++a.bad_barycentrics;
+    EXPECT_EQ(q.entity, p.entity) << "pixel " << i;
+    EXPECT_EQ(q.mesh, p.mesh) << "pixel " << i;
+  }
+  std::printf("visibility (%s): %zu pixels, %zu hits, %zu ties on shared edges, %zu on silhouettes, %zu differ, %zu "
+              "depths and %zu barycentrics off\n", what, a.pixels, a.hits, a.edge_ties, a.silhouettes, a.differ, a.bad_depth,
+              a.bad_barycentrics);
+  return a;
+}
+
+void expect_agreement(const Agreement& a) {
+  EXPECT_EQ(a.differ, 0u) << "a pixel away from any edge saw another surface";
+  EXPECT_LE(a.edge_ties, a.pixels / 200);
+  EXPECT_LE(a.silhouettes, a.pixels / 1000);
+  EXPECT_EQ(a.bad_depth, 0u);
+  EXPECT_EQ(a.bad_barycentrics, 0u);
+  EXPECT_GT(a.hits, a.pixels / 2);
+}
+
+gpu::VulkanContext* context_for(Traversal t, std::string* why) {
+  gpu::VulkanContext* ctx = gpu_test::context_with(false, t == Traversal::RayQuery, why);
+  if (!ctx) {
+    *why = "no Vulkan device: " + *why;
+    return nullptr;
+  }
+  if (t == Traversal::RayQuery && !ctx->info().ray_query) {
+    *why = ctx->info().name + " has no VK_KHR_ray_query";
+    return nullptr;
+  }
+  if (!gpu::VisibilityPass::supported(*ctx, why)) return nullptr;
+  return ctx;
+}
+
+}  // namespace
+
+#define VISIBILITY_CONTEXT_OR_SKIP(name)                                 \
+  std::string visibility_why_;                                           \
+  gpu::VulkanContext* name = context_for(GetParam(), &visibility_why_); \
+  if (!name) GTEST_SKIP() << visibility_why_
+
+// A closed room of rotated, scaled, overlapping meshes, seen from inside at
+// two sub-pixel offsets, then after one instance moved and the scene synced.
+TEST_P(VisibilityPassTest, SeesWhatTheCameraRaysHitInARoomOfObjects) {
+  VISIBILITY_CONTEXT_OR_SKIP(ctx);
+  gpu_test::RtWorld world;
+  gpu_test::build_world(world);
+  gpu::GpuRtScene gpu_rt(*ctx);
+  gpu_rt.sync(world.rt);
+  scene::Camera lens;
+  lens.yfov_radians = 1.1f;
+  transform::Similarity at;
+  at.translation = glm::vec3(-3.5f, 1.0f, 3.0f);
+  at.rotation = glm::angleAxis(-0.7f, glm::vec3(0, 1, 0)) * glm::angleAxis(-0.2f, glm::vec3(1, 0, 0));
+  const render::CameraRays camera(lens, at, 160, 90);
+  gpu::VisibilityPass pass(*ctx);
+  expect_agreement(compare("room, pixel centres", pass, gpu_rt, camera, {0.5f, 0.5f}, 0.01f));
+  expect_agreement(compare("room, offset (0.2, 0.7)", pass, gpu_rt, camera, {0.2f, 0.7f}, 0.01f));
+  // The nearest sphere or torus moved in front of the camera.
+  transform::Similarity moved = world.xf[1];
+  moved.translation = at.translation + at.rotation * glm::vec3(0.3f, 0.0f, -2.0f);
+  world.rt.upsert_instance(ecs::Entity{1, 0}, world.mesh_of[1], moved);
+  world.rt.commit();
+  gpu_rt.sync(world.rt);
+  const Agreement after = compare("room, an instance moved", pass, gpu_rt, camera, {0.5f, 0.5f}, 0.01f);
+  expect_agreement(after);
+  EXPECT_EQ(ctx->validation_errors(), 0);
+}
+
+// Cut-out screens (glTF MASK, checkered alpha textures) in front of a
+// wall: a fragment the ray would pass through is discarded. Pixels whose
+// hit lies at a texel's edge may round to either texel, as between the two
+// tracers (rt_traversal_test.cpp).
+TEST_P(VisibilityPassTest, CutOutsPassWhereTheRaysPass) {
+  VISIBILITY_CONTEXT_OR_SKIP(ctx);
+  scene::SceneAssets assets;
+  assets.generation = scene::next_scene_generation();
+  scene::MeshAsset wall = scene::make_quad({4.0f, 4.0f}, 0);
+  wall.compute_bounds();
+  scene::MeshAsset screen = scene::make_quad({2.0f, 2.0f}, 1);
+  for (auto& uv : screen.uvs) uv *= 3.0f;
+  screen.compute_bounds();
+  assets.meshes = {std::make_shared<scene::MeshAsset>(wall), std::make_shared<scene::MeshAsset>(screen)};
+  assets.materials.resize(2);
+  assets.materials[1].alpha_mode = material::AlphaMode::Mask;
+  assets.materials[1].alpha_cutoff = 0.5f;
+  assets.materials[1].base_color_texture = 0;
+  scene::Texture t;
+  t.width = t.height = 8;
+  t.rgba.assign(8 * 8 * 4, 255);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) t.rgba[static_cast<std::size_t>(y * 8 + x) * 4 + 3] = (x + y) % 2 ? 0 : 255;
+  assets.textures.push_back(t);
+  rt::RtScene rt;
+  rt.set_assets(&assets);
+  const glm::quat upright = glm::angleAxis(1.5707963f, glm::vec3(1.0f, 0.0f, 0.0f));
+  transform::Similarity at_wall, at_screen;
+  at_wall.translation = glm::vec3(0.0f, 0.0f, -2.0f);
+  at_wall.rotation = upright;
+  at_screen.rotation = glm::angleAxis(0.3f, glm::vec3(0.0f, 1.0f, 0.0f)) * upright;
+  rt.upsert_instance(ecs::Entity{0, 0}, 0, at_wall);
+  rt.upsert_instance(ecs::Entity{1, 0}, 1, at_screen);
+  rt.commit();
+  gpu::GpuRtScene gpu_rt(*ctx);
+  gpu_rt.sync(rt);
+  scene::Camera lens;
+  lens.yfov_radians = 0.9f;
+  transform::Similarity eye;
+  eye.translation = glm::vec3(0.0f, 0.0f, 3.0f);
+  const render::CameraRays camera(lens, eye, 128, 96);
+  gpu::VisibilityPass pass(*ctx);
+  const Agreement a = compare("cut-outs", pass, gpu_rt, camera, {0.5f, 0.5f}, 0.01f);
+  // A texel-edge disagreement is a screen hit against a wall hit beside
+  // a pixel of either: it counts as a silhouette.
+  EXPECT_EQ(a.differ, 0u);
+  EXPECT_LE(a.silhouettes, a.pixels / 500);
+  EXPECT_LE(a.edge_ties, a.pixels / 200);
+  EXPECT_EQ(a.bad_depth, 0u);
+  EXPECT_GT(a.hits, a.pixels / 2);
+  EXPECT_EQ(ctx->validation_errors(), 0);
+}
+
+// Nothing nearer the camera than the near plane is drawn (the ray tracer
+// has no near plane): with the camera half a unit from the wall and the
+// near plane beyond it, every pixel sees nothing.
+TEST_P(VisibilityPassTest, NothingNearerThanTheNearPlaneIsDrawn) {
+  VISIBILITY_CONTEXT_OR_SKIP(ctx);
+  scene::SceneAssets assets;
+  assets.generation = scene::next_scene_generation();
+  scene::MeshAsset wall = scene::make_quad({4.0f, 4.0f}, 0);
+  wall.compute_bounds();
+  assets.meshes = {std::make_shared<scene::MeshAsset>(wall)};
+  assets.materials.resize(1);
+  rt::RtScene rt;
+  rt.set_assets(&assets);
+  transform::Similarity at_wall;
+  at_wall.rotation = glm::angleAxis(1.5707963f, glm::vec3(1.0f, 0.0f, 0.0f));
+  rt.upsert_instance(ecs::Entity{0, 0}, 0, at_wall);
+  rt.commit();
+  gpu::GpuRtScene gpu_rt(*ctx);
+  gpu_rt.sync(rt);
+  transform::Similarity eye;
+  eye.translation = glm::vec3(0.0f, 0.0f, 0.5f);
+  const render::CameraRays camera(scene::Camera{}, eye, 32, 32);
+  gpu::VisibilityPass pass(*ctx);
+  std::vector<rt::Hit> hits(32 * 32);
+  std::vector<std::uint8_t> found(32 * 32);
+  pass.render(gpu_rt, camera, {0.5f, 0.5f}, 0.4f, hits, found);
+  EXPECT_EQ(std::count(found.begin(), found.end(), 1), 32 * 32) << "the wall is beyond a near plane at 0.4";
+  pass.render(gpu_rt, camera, {0.5f, 0.5f}, 0.6f, hits, found);
+  EXPECT_EQ(std::count(found.begin(), found.end(), 1), 0) << "the wall is nearer than a near plane at 0.6";
+}
+
+INSTANTIATE_TEST_SUITE_P(Traversals, VisibilityPassTest, testing::Values(Traversal::ComputeBvh, Traversal::RayQuery),
+                         traversal_name);
