@@ -1,9 +1,14 @@
 #include "engine/gpu/gpu_ray_tracer.h"
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 namespace engine::gpu {
+
+GpuRayTracer::GpuRayTracer(VulkanContext& ctx) : ctx_(ctx), raster_(ctx.info().raster_visibility) {}
+
+GpuRayTracer::~GpuRayTracer() = default;
 
 bool GpuRayTracer::follow(const rt::RtScene& scene) {
   if (!scene.assets()) return false;
@@ -33,6 +38,24 @@ bool GpuRayTracer::occluded(const rt::RtScene& scene, std::span<const rt::Ray> r
   gpu_ms_ += std::max(0.0, ms);
   return true;
 }
+
+bool GpuRayTracer::camera_hits(const rt::RtScene& scene, const render::CameraRays& camera, glm::vec2 film_offset,
+                               std::span<rt::Hit> hits, std::span<std::uint8_t> found) {
+  if (!raster_ || !follow(scene)) return false;
+  if (!visibility_) visibility_ = std::make_unique<VisibilityPass>(ctx_);
+  // A camera ray starts at the eye (tmin 0); the raster needs a near plane:
+  // a millionth of the scene's size, where a reversed float depth keeps
+  // its precision all the same.
+  const glm::vec3 extent = scene.bounds_max() - scene.bounds_min();
+  const float size = std::max({extent.x, extent.y, extent.z});
+  const float near_plane = std::isfinite(size) && size > 0 ? 1e-6f * size : 1e-6f;
+  double ms = 0;
+  visibility_->render(*rt_, camera, film_offset, near_plane, hits, found, &ms);
+  gpu_ms_ += std::max(0.0, ms);
+  return true;
+}
+
+void GpuRayTracer::set_raster_visibility(bool enabled) { raster_ = enabled && VisibilityPass::supported(ctx_); }
 
 double GpuRayTracer::take_device_ms() { return std::exchange(gpu_ms_, 0.0); }
 

@@ -2,18 +2,22 @@
 // rt::RayBatchTracer on a Vulkan device: a GpuRtScene that follows the
 // RtScene (synced whenever its top level was committed again) and traces
 // each batch in one dispatch, alpha-masked materials cut out as Embree's
-// filter does. Declines only a scene without assets.
+// filter does; and a camera's hits from a raster visibility pass where the
+// device's queue can rasterise. Declines only a scene without assets.
 #include <memory>
 #include <vector>
 
 #include "engine/gpu/gpu_rt_scene.h"
+#include "engine/gpu/visibility_pass.h"
+#include "engine/render/camera_hit_tracer.h"
 #include "engine/rt/ray_batch_tracer.h"
 
 namespace engine::gpu {
 
-class GpuRayTracer : public rt::RayBatchTracer {
+class GpuRayTracer : public rt::RayBatchTracer, public render::CameraHitTracer {
  public:
-  explicit GpuRayTracer(VulkanContext& ctx) : ctx_(ctx) {}
+  explicit GpuRayTracer(VulkanContext& ctx);
+  ~GpuRayTracer() override;
 
   bool intersect(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<rt::Hit> hits,
                  std::span<std::uint8_t> found) override;
@@ -21,6 +25,16 @@ class GpuRayTracer : public rt::RayBatchTracer {
   bool occluded(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<std::uint8_t> blocked) override;
   // GPU milliseconds of the traces since the last call (timestamps).
   double take_device_ms() override;
+  // The raster visibility pass (VisibilityPass) where the device's options
+  // ask for it (DeviceInfo::raster_visibility) or set_raster_visibility
+  // did; else null, and the camera's rays are traced.
+  render::CameraHitTracer* camera_hit_tracer() override { return raster_ ? this : nullptr; }
+  bool camera_hits(const rt::RtScene& scene, const render::CameraRays& camera, glm::vec2 film_offset, std::span<rt::Hit> hits,
+                   std::span<std::uint8_t> found) override;
+  // Whether the G-buffer takes its hits from the raster pass, where the
+  // queue can rasterise, whatever the device's options say: a test or a
+  // benchmark compares the two.
+  void set_raster_visibility(bool enabled);
   // The device's copy of `scene`, synced, for kernels that trace in their
   // own submissions (GpuRtScene::bind); null where it declines the scene.
   GpuRtScene* device_scene(const rt::RtScene& scene) { return follow(scene) ? rt_.get() : nullptr; }
@@ -28,6 +42,8 @@ class GpuRayTracer : public rt::RayBatchTracer {
  private:
   VulkanContext& ctx_;
   std::unique_ptr<GpuRtScene> rt_;
+  std::unique_ptr<VisibilityPass> visibility_;  // made on the first camera_hits
+  bool raster_ = false;
   const rt::RtScene* synced_ = nullptr;
   std::size_t commits_ = 0;
   bool follow(const rt::RtScene& scene);  // syncs when needed; false: declines the scene

@@ -106,6 +106,17 @@ std::string VulkanContext::describe_device(const GpuOptions& options, const Devi
     else if (std::strcmp(env, "on") != 0) return std::string("ENGINE_GPU_RAY_QUERY=") + env + ": expected on or off";
   }
   info_.ray_query = want_ray_query && ray_query_enabled;
+  bool want_raster = options.raster_visibility;
+  if (const char* env = std::getenv("ENGINE_GPU_RASTER_VISIBILITY")) {
+    if (std::strcmp(env, "off") == 0) want_raster = false;
+    else if (std::strcmp(env, "on") == 0) want_raster = true;
+    else return std::string("ENGINE_GPU_RASTER_VISIBILITY=") + env + ": expected on or off";
+  }
+  std::uint32_t families = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, nullptr);
+  std::vector<VkQueueFamilyProperties> family(families);
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, family.data());
+  info_.raster_visibility = want_raster && queue_family_ < families && (family[queue_family_].queueFlags & VK_QUEUE_GRAPHICS_BIT);
   info_.scratch_alignment = features.scratch_alignment;
   info_.name = props.deviceName;
   info_.kind = kind_of(props.deviceType);
@@ -360,7 +371,8 @@ std::string describe(const DeviceInfo& info) {
   if (info.mappable_device_local_bytes > 0)
     std::snprintf(bar, sizeof bar, "%.1f GiB", static_cast<double>(info.mappable_device_local_bytes) / (1u << 30));
   return "vulkan (" + info.name + "; " + info.driver + "; mapped buffers: " + buffers + "; mappable device-local heap: " +
-         bar + "; rays: " + (info.ray_query ? "VK_KHR_ray_query" : "compute BVH traversal") + ")";
+         bar + "; rays: " + (info.ray_query ? "VK_KHR_ray_query" : "compute BVH traversal") +
+         "; camera: " + (info.raster_visibility ? "raster visibility pass" : "rays") + ")";
 }
 
 std::vector<std::uint32_t> rank_buffer_memory_types(const VkPhysicalDeviceMemoryProperties& mem, std::uint32_t type_bits,

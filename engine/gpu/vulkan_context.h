@@ -57,6 +57,13 @@ struct GpuOptions {
   // it; false: the compute-shader BVH traversal everywhere.
   // ENGINE_GPU_RAY_QUERY=off turns it off for A/B runs (on: as asked here).
   bool ray_query = true;
+  // The camera's hits from a raster visibility pass (VisibilityPass) where
+  // the queue can rasterise, instead of the camera rays traced. Off by
+  // default: a rasteriser's top-left rule and a ray's edge test decide a
+  // sample that falls exactly on an edge apart, so the frame is not the CPU
+  // backend's to the bound the backend tests hold it to (docs/gpu.md).
+  // ENGINE_GPU_RASTER_VISIBILITY=on|off sets it for A/B runs.
+  bool raster_visibility = false;
   // For a window that presents on the kernels' device: instance extensions
   // to enable (GLFW's surface extensions), device extensions to enable
   // (VK_KHR_swapchain), and a test the queue family must pass besides
@@ -94,6 +101,9 @@ struct DeviceInfo {
   // acceleration structures and buffer device addresses) and
   // GpuOptions::ray_query asked for it.
   bool ray_query = false;
+  // The camera's hits come from the raster visibility pass: asked for
+  // (GpuOptions::raster_visibility) and the queue can rasterise.
+  bool raster_visibility = false;
   std::uint32_t scratch_alignment = 0;  // minAccelerationStructureScratchOffsetAlignment
 };
 

@@ -8,6 +8,10 @@
 
 #include "engine/rt/rt_scene.h"
 
+namespace engine::render {
+class CameraHitTracer;
+}
+
 namespace engine::rt {
 
 class RayBatchTracer {
@@ -25,6 +29,9 @@ class RayBatchTracer {
   // Device milliseconds the traces took since the last call (0 where the
   // backend cannot time them), so each stage that traces can take its own.
   virtual double take_device_ms() { return 0.0; }
+  // The same backend's way to see a camera's pixels without tracing their
+  // rays (a raster pass), or null where it has none.
+  virtual render::CameraHitTracer* camera_hit_tracer() { return nullptr; }
 };
 
 }  // namespace engine::rt

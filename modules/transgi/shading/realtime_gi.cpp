@@ -13,6 +13,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "engine/jobs/parallel_for.h"
+#include "engine/render/camera_hit_tracer.h"
 #include "engine/math/sampling.h"
 #include "shading/gi_history.h"
 #include "shading/realtime_direct.h"
@@ -191,7 +192,15 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
   std::vector<std::uint8_t>& batch_found = g.batch.found;
   std::vector<std::size_t>& tile_first = g.batch.tile_first;
   tile_first.clear();
-  if (tracer) {
+  // A backend that rasterises the camera's view gives every pixel's hit in
+  // image order; else it traces the camera rays.
+  bool by_pixel = false;
+  if (engine::render::CameraHitTracer* raster = tracer ? tracer->camera_hit_tracer() : nullptr) {
+    batch_hits.resize(g.samples.size());
+    batch_found.resize(g.samples.size());
+    by_pixel = raster->camera_hits(scene, camera, glm::vec2(0.5f) + jitter, batch_hits, batch_found);
+  }
+  if (tracer && !by_pixel) {
     // Where each tile's rays start, then the rays in parallel (serially,
     // 1080p's 2 M rays cost more than the GPU's traversal of them).
     tile_first.resize(static_cast<std::size_t>(tiles_x) * tiles_y);
@@ -242,7 +251,12 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
         for (std::size_t b = 0; b < sizeof(GSample); b += 64) __builtin_prefetch(first_byte + b, 1, 3);
         __builtin_prefetch(reinterpret_cast<const char*>(&g.samples[pixel[i]] + 1) - 1, 1, 3);
       }
-      if (tile_first.empty()) {
+      if (by_pixel) {
+        for (int i = 0; i < n; ++i) {
+          found[i] = batch_found[pixel[i]] != 0;
+          hits[i] = batch_hits[pixel[i]];
+        }
+      } else if (tile_first.empty()) {
         scene.intersect16_coherent(rays, n, hits, found);
       } else {
         const std::size_t first = tile_first[static_cast<std::size_t>(t)];

@@ -1,0 +1,27 @@
+#pragma once
+// A backend that finds what a pinhole camera sees at every pixel somewhere
+// other than Embree: a GPU's raster visibility pass (engine/gpu/
+// visibility_pass). The G-buffer asks its ray tracer for one
+// (rt::RayBatchTracer::camera_hit_tracer) and, where there is one, takes the
+// camera's hits from it instead of tracing the camera rays.
+#include <cstdint>
+#include <span>
+
+#include "engine/render/camera_rays.h"
+#include "engine/rt/rt_scene.h"
+
+namespace engine::render {
+
+class CameraHitTracer {
+ public:
+  virtual ~CameraHitTracer() = default;
+  // The hits of camera.generate((x, y) + film_offset) for every pixel,
+  // row by row from the top-left, as RtScene::intersect gives them (a
+  // rasteriser and a ray may round a pixel on an edge apart); found[i]:
+  // pixel i saw a surface. Returns false, touching nothing, where this
+  // backend cannot see the scene exactly.
+  virtual bool camera_hits(const rt::RtScene& scene, const CameraRays& camera, glm::vec2 film_offset, std::span<rt::Hit> hits,
+                           std::span<std::uint8_t> found) = 0;
+};
+
+}  // namespace engine::render
