@@ -52,8 +52,7 @@ void main() {
     shadows[i] = shadow;
     return;
   }
-  Surface s = make_surface(hit.instance, hit.mesh, hit.primitive, hit.u, hit.v, dir);
-  s.brdf.roughness = max(s.brdf.roughness, kProbeHitMinRoughness);
+  const Surface s = make_surface(hit.instance, hit.mesh, hit.primitive, hit.u, hit.v, dir);
   vec3 e = s.emission;
   if (!finite3(e)) {
     e = vec3(0.0);
@@ -77,7 +76,16 @@ void main() {
   if (!emitter && wo.z > 0.0) {
     o.flags |= kProbeRayTakesFeedback;
     // probe_rays.cpp's begin_probe_ray: the feedback is reflected by every lobe.
-    const vec3 albedo = directional_albedo(s.brdf, wo.z) * kShadingInvPi;
+    const vec3 own = directional_albedo(s.brdf, wo.z);
+    const vec3 albedo = own * kShadingInvPi;
+    // begin_probe_ray's blurred lobe, scaled to the surface's own albedo.
+    Brdf blurred = s.brdf;
+    vec3 energy = vec3(1.0);
+    if (blurred.roughness < kProbeHitMinRoughness) {
+      blurred.roughness = kProbeHitMinRoughness;
+      const vec3 rough = directional_albedo(blurred, wo.z);
+      for (int k = 0; k < 3; ++k) energy[k] = rough[k] > 0.0 ? own[k] / rough[k] : 0.0;
+    }
     o.ar = albedo.r;
     o.ag = albedo.g;
     o.ab = albedo.b;
@@ -91,7 +99,7 @@ void main() {
     LightSample ls;
     if (sample_light(s.position, u_sel, vec2(ux, uy), ls) && dot(ls.direction, s.geometric_normal) > 0.0) {
       const vec3 wi = to_local(s.frame, ls.direction);
-      const vec3 f = wi.z > 0.0 ? brdf_eval(s.brdf, wo, wi) : vec3(0.0);
+      const vec3 f = wi.z > 0.0 ? brdf_eval(blurred, wo, wi) * energy : vec3(0.0);
       if (f != vec3(0.0)) {
         const vec3 origin = offset_ray_origin(s.position, s.geometric_normal, p.offset_scale);
         const float tmax = isinf(ls.distance) ? shading_infinity() : ls.distance * (1.0 - 1e-4);

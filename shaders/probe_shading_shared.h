@@ -15,12 +15,13 @@ TRANSGI_CONST uint kProbeShadingGroupSize = 64u;
 // probe_points.comp: a tracing probe whose points the host dropped.
 TRANSGI_CONST uint kProbePointsSkip = 0xffffffffu;
 // The least roughness a probe ray's hit reflects its light sample with (what
-// Cycles calls Filter Glossy). A mirror-like lobe meeting the light sample's
+// Cycles calls Filter Glossy), its energy kept at the surface's own
+// directional albedo. A mirror-like lobe meeting the light sample's
 // direction by chance turns one ray into a spike thousands of times the
 // probe's mean, which its map then holds for dozens of frames as a glow; a
 // probe's low-order SH cannot hold a sharp reflection anyway. Higher = fewer
 // and weaker spikes, at the cost of blurrier glints in the probes' light.
-TRANSGI_CONST float kProbeHitMinRoughness = 0.3f;
+TRANSGI_CONST float kProbeHitMinRoughness = 0.5f;
 
 // ProbeRayHit's flags and PendingProbeRay's.
 TRANSGI_CONST uint kProbeRayHit = 1u;

@@ -64,8 +64,7 @@ PendingProbeRay begin_probe_ray(const engine::rt::RtScene& scene, const engine::
     return p;
   }
   const rt::Hit& hit = *traced;
-  render::Surface s = render::make_surface(scene, hit, dir);
-  s.brdf.roughness = std::max(s.brdf.roughness, gpu::kProbeHitMinRoughness);
+  const render::Surface s = render::make_surface(scene, hit, dir);
   r.emitted = s.emission;
   if (!std::isfinite(r.emitted.r + r.emitted.g + r.emitted.b)) {
     r.emitted = glm::vec3(0.0f);
@@ -87,6 +86,16 @@ PendingProbeRay begin_probe_ray(const engine::rt::RtScene& scene, const engine::
                           math::kInvPi;
   p.shading_normal = s.shading_normal;
   p.to_probe = -dir;
+  // The light sample is reflected by a lobe at least kProbeHitMinRoughness
+  // rough, scaled to the surface's own directional albedo: the blur keeps
+  // the energy (a rougher GGX lobe alone reflects less: single scattering).
+  material::BrdfParams blurred = s.brdf;
+  glm::vec3 energy(1.0f);
+  if (lobes == HitLobes::All && blurred.roughness < gpu::kProbeHitMinRoughness) {
+    blurred.roughness = gpu::kProbeHitMinRoughness;
+    const glm::vec3 own = material::directional_albedo(s.brdf, wo.z), rough = material::directional_albedo(blurred, wo.z);
+    for (int k = 0; k < 3; ++k) energy[k] = rough[k] > 0 ? own[k] / rough[k] : 0.0f;
+  }
   render::LightSample ls;
   const float u_sel = rng.next_float();
   const glm::vec2 u{rng.next_float(), rng.next_float()};
@@ -94,7 +103,7 @@ PendingProbeRay begin_probe_ray(const engine::rt::RtScene& scene, const engine::
     const glm::vec3 wi = s.frame.to_local(ls.direction);
     const glm::vec3 f = !(wi.z > 0)                ? glm::vec3(0.0f)
                         : lobes == HitLobes::Diffuse ? material::brdf_eval_diffuse(s.brdf, wo, wi)
-                                                     : material::brdf_eval(s.brdf, wo, wi);
+                                                     : material::brdf_eval(blurred, wo, wi) * energy;
     if (f != glm::vec3(0.0f)) {
       const glm::vec3 o = rt::offset_ray_origin(s.position, s.geometric_normal, scene.offset_scale());
       const float tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);

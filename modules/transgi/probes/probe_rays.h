@@ -69,8 +69,9 @@ enum class HitLobes { All, Diffuse };
 
 // Everything up to the shadow ray: the surface, its emission, and one
 // next-event-estimation sample (MIS-free: delta and area lights alike are
-// sampled, never hit), reflected as if the surface were at least
-// gpu::kProbeHitMinRoughness rough (probe_shading_shared.h says why).
+// sampled, never hit), reflected by all lobes as if the surface were at
+// least gpu::kProbeHitMinRoughness rough, with its own directional albedo
+// (probe_shading_shared.h says why).
 // `traced` null: the ray escaped.
 PendingProbeRay begin_probe_ray(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
                                 const glm::vec3& dir, const engine::rt::Hit* traced, engine::math::Pcg32& rng,
