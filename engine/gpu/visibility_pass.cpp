@@ -135,36 +135,6 @@ VkPipeline make_raster_pipeline(VkDevice device, VkPipelineLayout layout, VkRend
   return pipeline;
 }
 
-// A 2D target of `format` in device memory, with its view.
-void make_image(VulkanContext& ctx, std::uint32_t width, std::uint32_t height, VkFormat format, VkImageUsageFlags usage,
-                VkImageAspectFlags aspect, VkImage& image, VkDeviceMemory& memory, VkImageView& view) {
-  const VkDevice d = ctx.device();
-  VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-  ici.imageType = VK_IMAGE_TYPE_2D;
-  ici.format = format;
-  ici.extent = {width, height, 1};
-  ici.mipLevels = 1;
-  ici.arrayLayers = 1;
-  ici.samples = VK_SAMPLE_COUNT_1_BIT;
-  ici.tiling = VK_IMAGE_TILING_OPTIMAL;
-  ici.usage = usage;
-  ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-  ENGINE_VK_CHECK(vkCreateImage(d, &ici, nullptr, &image));
-  VkMemoryRequirements req;
-  vkGetImageMemoryRequirements(d, image, &req);
-  VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-  mai.allocationSize = req.size;
-  mai.memoryTypeIndex = ctx.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  ENGINE_VK_CHECK(vkAllocateMemory(d, &mai, nullptr, &memory));
-  ENGINE_VK_CHECK(vkBindImageMemory(d, image, memory, 0));
-  VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
-  vci.image = image;
-  vci.viewType = VK_IMAGE_VIEW_TYPE_2D;
-  vci.format = format;
-  vci.subresourceRange = {aspect, 0, 1, 0, 1};
-  ENGINE_VK_CHECK(vkCreateImageView(d, &vci, nullptr, &view));
-}
-
 }  // namespace
 
 bool VisibilityPass::supported(const VulkanContext& ctx, std::string* why) {
@@ -230,28 +200,19 @@ VisibilityPass::~VisibilityPass() {
 }
 
 void VisibilityPass::destroy_targets() {
-  const VkDevice d = ctx_.device();
-  if (framebuffer_) vkDestroyFramebuffer(d, framebuffer_, nullptr);
-  for (VkImageView v : {visibility_view_, depth_view_})
-    if (v) vkDestroyImageView(d, v, nullptr);
-  for (VkImage i : {visibility_image_, depth_image_})
-    if (i) vkDestroyImage(d, i, nullptr);
-  for (VkDeviceMemory m : {visibility_memory_, depth_memory_})
-    if (m) vkFreeMemory(d, m, nullptr);
+  if (framebuffer_) vkDestroyFramebuffer(ctx_.device(), framebuffer_, nullptr);
   framebuffer_ = VK_NULL_HANDLE;
-  visibility_view_ = depth_view_ = VK_NULL_HANDLE;
-  visibility_image_ = depth_image_ = VK_NULL_HANDLE;
-  visibility_memory_ = depth_memory_ = VK_NULL_HANDLE;
+  visibility_image_ = DeviceImage();
+  depth_image_ = DeviceImage();
   width_ = height_ = 0;
 }
 
 void VisibilityPass::make_targets(std::uint32_t width, std::uint32_t height) {
   destroy_targets();
-  make_image(ctx_, width, height, kVisibilityFormat, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-             VK_IMAGE_ASPECT_COLOR_BIT, visibility_image_, visibility_memory_, visibility_view_);
-  make_image(ctx_, width, height, kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT,
-             depth_image_, depth_memory_, depth_view_);
-  const std::array<VkImageView, 2> views{visibility_view_, depth_view_};
+  visibility_image_ = DeviceImage(ctx_, width, height, kVisibilityFormat,
+                                  VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, VK_IMAGE_ASPECT_COLOR_BIT);
+  depth_image_ = DeviceImage(ctx_, width, height, kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT);
+  const std::array<VkImageView, 2> views{visibility_image_.view(), depth_image_.view()};
   VkFramebufferCreateInfo fci{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
   fci.renderPass = render_pass_;
   fci.attachmentCount = static_cast<std::uint32_t>(views.size());
@@ -325,7 +286,7 @@ void VisibilityPass::record(VkCommandBuffer cmd) const {
   VkBufferImageCopy copy{};
   copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
   copy.imageExtent = {width_, height_, 1};
-  vkCmdCopyImageToBuffer(cmd, visibility_image_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, visibility_.handle(), 1, &copy);
+  vkCmdCopyImageToBuffer(cmd, visibility_image_.image(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, visibility_.handle(), 1, &copy);
   record_memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                         VK_ACCESS_SHADER_READ_BIT);
   const std::uint32_t pixels = width_ * height_;

@@ -23,6 +23,7 @@
 #include <vulkan/vulkan_core.h>
 
 #include "engine/gpu/compute_pipeline.h"
+#include "engine/gpu/device_image.h"
 #include "engine/gpu/gpu_buffer.h"
 #include "engine/render/camera_rays.h"
 #include "engine/rt/ray.h"
@@ -76,9 +77,7 @@ class VisibilityPass {
   VkDescriptorSet set_ = VK_NULL_HANDLE;
   VkShaderModule vertex_ = VK_NULL_HANDLE, fragment_ = VK_NULL_HANDLE;
   // The targets: instance + 1 and triangle per pixel, and reversed depth.
-  VkImage visibility_image_ = VK_NULL_HANDLE, depth_image_ = VK_NULL_HANDLE;
-  VkDeviceMemory visibility_memory_ = VK_NULL_HANDLE, depth_memory_ = VK_NULL_HANDLE;
-  VkImageView visibility_view_ = VK_NULL_HANDLE, depth_view_ = VK_NULL_HANDLE;
+  DeviceImage visibility_image_, depth_image_;
   VkFramebuffer framebuffer_ = VK_NULL_HANDLE;
   GpuBuffer visibility_, hits_;
   std::unique_ptr<ComputePipeline> resolve_;

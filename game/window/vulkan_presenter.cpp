@@ -18,6 +18,7 @@
 #include <backends/imgui_impl_vulkan.h>
 
 #include "engine/gpu/compute_pipeline.h"
+#include "engine/gpu/device_image.h"
 #include "engine/gpu/gpu_buffer.h"
 #include "engine/gpu/gpu_error.h"
 #include "engine/image/png.h"
@@ -352,38 +353,15 @@ class VulkanPresenter final : public Presenter {
 
   // The image the game frame is copied into, then blitted from.
   void make_game_image(int width, int height) {
-    const VkDevice d = ctx_->device();
     vkQueueWaitIdle(ctx_->queue());
     destroy_game_image();
-    VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-    ici.imageType = VK_IMAGE_TYPE_2D;
-    ici.format = VK_FORMAT_R8G8B8A8_UNORM;
-    ici.extent = {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height), 1};
-    ici.mipLevels = 1;
-    ici.arrayLayers = 1;
-    ici.samples = VK_SAMPLE_COUNT_1_BIT;
-    ici.tiling = VK_IMAGE_TILING_OPTIMAL;
-    ici.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-    ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    ENGINE_VK_CHECK(vkCreateImage(d, &ici, nullptr, &game_image_));
-    VkMemoryRequirements req;
-    vkGetImageMemoryRequirements(d, game_image_, &req);
-    VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    mai.allocationSize = req.size;
-    mai.memoryTypeIndex = ctx_->memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    ENGINE_VK_CHECK(vkAllocateMemory(d, &mai, nullptr, &game_memory_));
-    ENGINE_VK_CHECK(vkBindImageMemory(d, game_image_, game_memory_, 0));
+    game_image_ = engine::gpu::DeviceImage(*ctx_, static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height),
+                                           VK_FORMAT_R8G8B8A8_UNORM, VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
     image_width_ = width;
     image_height_ = height;
   }
 
-  void destroy_game_image() {
-    const VkDevice d = ctx_->device();
-    if (game_image_) vkDestroyImage(d, game_image_, nullptr);
-    if (game_memory_) vkFreeMemory(d, game_memory_, nullptr);
-    game_image_ = VK_NULL_HANDLE;
-    game_memory_ = VK_NULL_HANDLE;
-  }
+  void destroy_game_image() { game_image_ = engine::gpu::DeviceImage(); }
 
   // The window cleared, the game image scaled into the view's rectangle
   // (window coordinates to framebuffer pixels), ready for the UI pass.
@@ -393,14 +371,14 @@ class VulkanPresenter final : public Presenter {
     const VkClearColorValue clear{{0.08f, 0.08f, 0.09f, 1.0f}};
     const VkImageSubresourceRange all{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
     vkCmdClearColorImage(cmd_, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &clear, 1, &all);
-    if (game_image_ && game_width_ == image_width_ && game_height_ == image_height_) {
-      transition(cmd_, game_image_, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
+    if (game_image_.image() && game_width_ == image_width_ && game_height_ == image_height_) {
+      transition(cmd_, game_image_.image(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
                  VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
       VkBufferImageCopy copy{};
       copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
       copy.imageExtent = {static_cast<std::uint32_t>(image_width_), static_cast<std::uint32_t>(image_height_), 1};
-      vkCmdCopyBufferToImage(cmd_, staging_.handle(), game_image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
-      transition(cmd_, game_image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+      vkCmdCopyBufferToImage(cmd_, staging_.handle(), game_image_.image(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
+      transition(cmd_, game_image_.image(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                  VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                  VK_PIPELINE_STAGE_TRANSFER_BIT);
       int ww = 0, wh = 0;
@@ -415,7 +393,7 @@ class VulkanPresenter final : public Presenter {
       blit.dstOffsets[0] = {px(view.min.x * sx, fw), px(view.min.y * sy, fh), 0};
       blit.dstOffsets[1] = {px(view.max.x * sx, fw), px(view.max.y * sy, fh), 1};
       if (blit.dstOffsets[1].x > blit.dstOffsets[0].x && blit.dstOffsets[1].y > blit.dstOffsets[0].y)
-        vkCmdBlitImage(cmd_, game_image_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+        vkCmdBlitImage(cmd_, game_image_.image(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
                        &blit, VK_FILTER_LINEAR);
     }
     transition(cmd_, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
@@ -513,8 +491,7 @@ class VulkanPresenter final : public Presenter {
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
   VkSemaphore acquired_ = VK_NULL_HANDLE, rendered_ = VK_NULL_HANDLE;
-  VkImage game_image_ = VK_NULL_HANDLE;
-  VkDeviceMemory game_memory_ = VK_NULL_HANDLE;
+  engine::gpu::DeviceImage game_image_;
   int image_width_ = 0, image_height_ = 0;  // game_image_'s size
   int game_width_ = 0, game_height_ = 0;    // this frame's image's size
   engine::gpu::GpuBuffer staging_, read_back_;

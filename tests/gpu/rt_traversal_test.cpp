@@ -267,11 +267,7 @@ TEST_P(GpuRtTraversal, AlphaMaskedTrianglesAreCutOutAsEmbreesFilterDoes) {
   TRAVERSAL_CONTEXT_OR_SKIP(ctx, false);
   scene::SceneAssets assets;
   assets.generation = scene::next_scene_generation();
-  scene::MeshAsset wall = scene::make_quad({4.0f, 4.0f}, 0);
-  wall.compute_bounds();
-  scene::MeshAsset screen = scene::make_quad({2.0f, 2.0f}, 1);
-  for (auto& uv : screen.uvs) uv *= 3.0f;
-  screen.compute_bounds();
+  const scene::MeshAsset wall = gpu_test::wall_quad(), screen = gpu_test::screen_quad(1);
   scene::MeshAsset mirrored = screen;
   for (auto& m : mirrored.triangle_material) m = 2;
   assets.meshes = {std::make_shared<scene::MeshAsset>(wall), std::make_shared<scene::MeshAsset>(screen),

@@ -54,4 +54,20 @@ inline void build_world(RtWorld& w) {
 }
 
 // A point inside build_world's room (its walls at +-5, +-3, +-4).
+// The cut-out tests' pieces (make_quad lies in the XZ plane): a 4 x 4 wall
+// of material 0, and a 2 x 2 screen of `material` whose UVs run to 3, so
+// that its texture repeats.
+inline engine::scene::MeshAsset wall_quad() {
+  engine::scene::MeshAsset wall = engine::scene::make_quad({4.0f, 4.0f}, 0);
+  wall.compute_bounds();
+  return wall;
+}
+
+inline engine::scene::MeshAsset screen_quad(std::uint32_t material) {
+  engine::scene::MeshAsset screen = engine::scene::make_quad({2.0f, 2.0f}, material);
+  for (auto& uv : screen.uvs) uv *= 3.0f;
+  screen.compute_bounds();
+  return screen;
+}
+
 }  // namespace gpu_test

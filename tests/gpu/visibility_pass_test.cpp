@@ -162,11 +162,7 @@ TEST_P(VisibilityPassTest, CutOutsPassWhereTheRaysPass) {
   VISIBILITY_CONTEXT_OR_SKIP(ctx);
   scene::SceneAssets assets;
   assets.generation = scene::next_scene_generation();
-  scene::MeshAsset wall = scene::make_quad({4.0f, 4.0f}, 0);
-  wall.compute_bounds();
-  scene::MeshAsset screen = scene::make_quad({2.0f, 2.0f}, 1);
-  for (auto& uv : screen.uvs) uv *= 3.0f;
-  screen.compute_bounds();
+  const scene::MeshAsset wall = gpu_test::wall_quad(), screen = gpu_test::screen_quad(1);
   assets.meshes = {std::make_shared<scene::MeshAsset>(wall), std::make_shared<scene::MeshAsset>(screen)};
   assets.materials.resize(2);
   assets.materials[1].alpha_mode = material::AlphaMode::Mask;
@@ -214,9 +210,7 @@ TEST_P(VisibilityPassTest, NothingNearerThanTheNearPlaneIsDrawn) {
   VISIBILITY_CONTEXT_OR_SKIP(ctx);
   scene::SceneAssets assets;
   assets.generation = scene::next_scene_generation();
-  scene::MeshAsset wall = scene::make_quad({4.0f, 4.0f}, 0);
-  wall.compute_bounds();
-  assets.meshes = {std::make_shared<scene::MeshAsset>(wall)};
+  assets.meshes = {std::make_shared<scene::MeshAsset>(gpu_test::wall_quad())};
   assets.materials.resize(1);
   rt::RtScene rt;
   rt.set_assets(&assets);
