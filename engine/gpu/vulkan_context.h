@@ -58,12 +58,13 @@ struct GpuOptions {
   // ENGINE_GPU_RAY_QUERY=off turns it off for A/B runs (on: as asked here).
   bool ray_query = true;
   // The camera's hits from a raster visibility pass (VisibilityPass) where
-  // the queue can rasterise, instead of the camera rays traced. Off by
-  // default: a rasteriser's top-left rule and a ray's edge test decide a
-  // sample that falls exactly on an edge apart, so the frame is not the CPU
-  // backend's to the bound the backend tests hold it to (docs/gpu.md).
+  // the queue can rasterise, instead of the camera rays traced: no camera
+  // rays cross the bus and the GPU's rasteriser finds them. A sample that
+  // falls exactly on an edge may go to the other surface than a ray's edge
+  // test gives it (the top-left rule), so the frame equals the CPU
+  // backend's except at such pixels (docs/gpu.md).
   // ENGINE_GPU_RASTER_VISIBILITY=on|off sets it for A/B runs.
-  bool raster_visibility = false;
+  bool raster_visibility = true;
   // For a window that presents on the kernels' device: instance extensions
   // to enable (GLFW's surface extensions), device extensions to enable
   // (VK_KHR_swapchain), and a test the queue family must pass besides

@@ -34,8 +34,7 @@ TEST(GpuGBuffer, EqualsEmbreesPacketsOnTheCornellBox) {
   const int width = 96, height = 64;
   const render::CameraRays rays(w.get<scene::Camera>(s.camera), w.get<transform::WorldTransform>(s.camera), width, height);
   // The camera's hits from the raster visibility pass where the device
-  // rasterises (lavapipe does; GpuOptions::raster_visibility is off by
-  // default), then from the camera rays traced.
+  // rasterises (lavapipe does), then from the camera rays traced.
   for (const bool raster : {true, false}) {
     shading::GBuffer want, got;
     gpu::GpuRayTracer tracer(*ctx);
