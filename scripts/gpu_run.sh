@@ -2,7 +2,8 @@
 # The device check, in one call of the `device` tool (docs/gpu.md):
 # `scripts/gpu_pack.sh` here, then `bash scripts/gpu_run.sh` there with
 # carry [".gl", ".devpack"]. The GPU tests on the real GPU, then 1080p frames of the level
-# and Bitterli's Living Room, the Vulkan and CPU backends alternating; every
+# and Bitterli's Living Room, the Vulkan and CPU backends alternating (and the
+# level with the camera's rays traced instead of rasterised); every
 # output in $OUT/results.tgz (the tool brings back at most 8 files). The
 # tests' content paths are compiled in as /work/main/...: a link makes them resolve.
 set -u
@@ -26,6 +27,9 @@ run level_vk $L --backend vulkan
 run level_cpu $L --backend cpu
 run level_vk_di $L --backend vulkan --device-inference on
 run level_vk2 $L --backend vulkan
+ENGINE_GPU_RASTER_VISIBILITY=off run level_vk_camera_rays $L --backend vulkan
+echo "== gpu_bench: primary visibility, rasterised against traced"
+timeout 90 /tmp/pk/gpu_bench --benchmark_filter=PrimaryVisibility > $R/gpu_bench_visibility.txt 2>&1; tail -6 $R/gpu_bench_visibility.txt
 run bitterli_vk $B --backend vulkan
 run bitterli_cpu $B --backend cpu
 ddgi() { name=$1; shift; echo "== $name: $*"; t0=$(date +%s); timeout 90 $T render "$@" --method ddgi --width 1920 --height 1080 --frames 24 --out $R/$name.exr > $R/$name.txt 2>&1; echo "rc $? in $(( $(date +%s) - t0 )) s"; grep -iE "stage|ms" $R/$name.txt | tail -8; rm -f $R/$name.exr; }
