@@ -1,7 +1,8 @@
 #version 460
 // The visibility buffer turned into the hits rt_query.comp gives for the
-// same camera rays (t, barycentrics, instance id, primitive, mesh): each
-// pixel's ray meets the triangle the raster found there.
+// same camera rays (t, barycentrics, instance id, primitive), as
+// VisibilityHitGpu: each pixel's ray meets the triangle the raster found
+// there.
 #extension GL_GOOGLE_include_directive : require
 #define RT_SET 0
 #define RT_BINDING 2
@@ -10,7 +11,7 @@
 
 layout(local_size_x = kVisibilityGroupSize) in;
 layout(std430, set = 0, binding = 0) readonly buffer Visibility { uvec2 visibility[]; };
-layout(std430, set = 0, binding = 1) writeonly buffer Hits { HitGpu hits[]; };
+layout(std430, set = 0, binding = 1) writeonly buffer Hits { VisibilityHitGpu hits[]; };
 layout(push_constant) uniform PushBlock { VisibilityPushGpu p; };
 #include "visibility.glsl"
 
@@ -19,7 +20,7 @@ void main() {
   if (i >= p.width * p.height) return;
   const uvec2 v = visibility[i];
   if (v.x == 0u) {
-    hits[i] = rt_no_hit(uintBitsToFloat(0x7f800000u));  // +inf, as a missed camera ray has
+    hits[i] = VisibilityHitGpu(uintBitsToFloat(0x7f800000u), 0.0, 0.0, kRtNoHit, 0u);  // t = +inf, as a missed ray's
     return;
   }
   const InstanceGpu I = rt_instances[v.x - 1u];
@@ -27,14 +28,5 @@ void main() {
   vec3 o, d;
   visibility_to_object(I, vec3(p.origin_x, p.origin_y, p.origin_z), visibility_ray_direction(visibility_film(uvec2(i % p.width, i / p.width))), o, d);
   const vec3 b = visibility_barycentrics(t, o, d);
-  HitGpu h;
-  h.t = b.z;
-  h.u = b.x;
-  h.v = b.y;
-  h.instance = I.id;
-  h.primitive = t.primitive;
-  h.mesh = I.mesh;
-  h.pad0 = 0u;
-  h.pad1 = 0u;
-  hits[i] = h;
+  hits[i] = VisibilityHitGpu(b.z, b.x, b.y, I.id, t.primitive);
 }

@@ -25,7 +25,18 @@ struct VisibilityPushGpu {
   uint width, height;
 };
 
+// A pixel's hit as the resolve writes it: rt_query.comp's HitGpu without
+// the mesh (the instance's record names it) and the padding, 20 bytes
+// instead of 32, since every pixel's comes back to the host.
+// instance == kRtNoHit: the pixel saw nothing.
+struct VisibilityHitGpu {
+  float t, u, v;
+  uint instance;   // RtScene instance id
+  uint primitive;  // the triangle's index in its mesh
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(VisibilityHitGpu) == 20 && offsetof(VisibilityHitGpu, instance) == 12, "VisibilityHitGpu layout");
 static_assert(sizeof(VisibilityPushGpu) == 80 && offsetof(VisibilityPushGpu, c0_x) == 16 &&
               offsetof(VisibilityPushGpu, sample_x) == 64, "VisibilityPushGpu layout");
 }  // namespace engine::gpu

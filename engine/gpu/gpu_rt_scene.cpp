@@ -287,9 +287,11 @@ void GpuRtScene::bind(ComputePipeline& pipeline, std::uint32_t first) const {
 }
 
 ecs::Entity GpuRtScene::entity_of(std::uint32_t id) const {
-  const rt::InstanceRecord* record = synced_ ? synced_->instance(id) : nullptr;
+  const rt::InstanceRecord* record = instance_record(id);
   return record ? record->entity : ecs::Entity{};
 }
+
+const rt::InstanceRecord* GpuRtScene::instance_record(std::uint32_t id) const { return synced_ ? synced_->instance(id) : nullptr; }
 
 GpuRtRasterView GpuRtScene::raster_view() const {
   if (instances_.handle() == VK_NULL_HANDLE) throw GpuError("GpuRtScene::raster_view before sync");

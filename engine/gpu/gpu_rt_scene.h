@@ -93,6 +93,8 @@ class GpuRtScene {
   // The entity of RtScene instance `id` as of the last sync (a hit's
   // Hit::entity), or none.
   [[nodiscard]] ecs::Entity entity_of(std::uint32_t id) const;
+  // Its whole record (entity, mesh, transform), or null.
+  [[nodiscard]] const rt::InstanceRecord* instance_record(std::uint32_t id) const;
 
   // For a raster pass; throws GpuError before the first sync.
   [[nodiscard]] GpuRtRasterView raster_view() const;

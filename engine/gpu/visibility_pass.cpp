@@ -223,7 +223,7 @@ void VisibilityPass::make_targets(std::uint32_t width, std::uint32_t height) {
   ENGINE_VK_CHECK(vkCreateFramebuffer(ctx_.device(), &fci, nullptr, &framebuffer_));
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
   visibility_ = GpuBuffer(ctx_, pixels * 2 * sizeof(std::uint32_t), GpuBuffer::Placement::DeviceOnly);
-  hits_ = GpuBuffer(ctx_, pixels * sizeof(HitGpu));
+  hits_ = GpuBuffer(ctx_, pixels * sizeof(VisibilityHitGpu));
   resolve_->bind(0, visibility_);
   resolve_->bind(1, hits_);
   width_ = width;
@@ -302,14 +302,15 @@ void VisibilityPass::render(const GpuRtScene& scene, const render::CameraRays& c
   prepare(scene, camera, sample, near_plane);
   const double ms = ctx_.submit_and_wait([&](VkCommandBuffer cmd) { record(cmd); });
   if (gpu_ms) *gpu_ms = ms;
-  const std::span<const HitGpu> out = hits_.mapped_as<const HitGpu>(pixels);
+  const std::span<const VisibilityHitGpu> out = hits_.mapped_as<const VisibilityHitGpu>(pixels);
   for (std::size_t i = 0; i < pixels; ++i) {
-    const HitGpu& h = out[i];
+    const VisibilityHitGpu& h = out[i];
     found[i] = h.instance != kRtNoHit ? 1 : 0;
     if (!found[i]) continue;
-    hits[i].entity = scene.entity_of(h.instance);
+    const rt::InstanceRecord* record = scene.instance_record(h.instance);
+    hits[i].entity = record ? record->entity : ecs::Entity{};
     hits[i].instance = h.instance;
-    hits[i].mesh = h.mesh;
+    hits[i].mesh = record ? record->mesh : 0;
     hits[i].primitive = h.primitive;
     hits[i].barycentric = {h.u, h.v};
     hits[i].t = h.t;

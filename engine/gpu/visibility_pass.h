@@ -5,8 +5,9 @@
 // scene's triangle buffer by vertex index, no vertex buffers) with a depth
 // test and writes, per pixel, which instance and triangle cover it; a
 // compute pass then meets each pixel's camera ray with that triangle and
-// writes the hit records rt_query.comp writes (HitGpu), so the stages after
-// the G-buffer read the raster's hits and the ray tracer's alike.
+// writes its hit (VisibilityHitGpu: rt_query.comp's HitGpu less the mesh,
+// which the instance names, and the padding), so the stages after the
+// G-buffer read the raster's hits and the ray tracer's alike.
 //
 // Every pixel is sampled at the same film offset (a rasteriser samples one
 // point per pixel; a jitter per frame moves them all), where the CPU's
@@ -49,7 +50,7 @@ class VisibilityPass {
   // nothing closer to the camera is drawn (scene::Camera::znear).
   void prepare(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane);
   // Records the draw, the visibility buffer's copy and the resolve into
-  // `cmd`: after it, hits_on_device() holds width x height HitGpu, row by
+  // `cmd`: after it, hits_on_device() holds width x height VisibilityHitGpu, row by
   // row from the top-left.
   void record(VkCommandBuffer cmd) const;
   [[nodiscard]] const GpuBuffer& hits_on_device() const { return hits_; }
