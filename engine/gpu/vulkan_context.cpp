@@ -116,7 +116,8 @@ std::string VulkanContext::describe_device(const GpuOptions& options, const Devi
   vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, nullptr);
   std::vector<VkQueueFamilyProperties> family(families);
   vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, family.data());
-  info_.raster_visibility = want_raster && queue_family_ < families && (family[queue_family_].queueFlags & VK_QUEUE_GRAPHICS_BIT);
+  info_.graphics_queue = queue_family_ < families && (family[queue_family_].queueFlags & VK_QUEUE_GRAPHICS_BIT);
+  info_.raster_visibility = want_raster && info_.graphics_queue;
   info_.scratch_alignment = features.scratch_alignment;
   info_.name = props.deviceName;
   info_.kind = kind_of(props.deviceType);

@@ -102,8 +102,10 @@ struct DeviceInfo {
   // acceleration structures and buffer device addresses) and
   // GpuOptions::ray_query asked for it.
   bool ray_query = false;
+  // The queue the context submits to supports graphics (a raster pass).
+  bool graphics_queue = false;
   // The camera's hits come from the raster visibility pass: asked for
-  // (GpuOptions::raster_visibility) and the queue can rasterise.
+  // (GpuOptions::raster_visibility) and graphics_queue.
   bool raster_visibility = false;
   std::uint32_t scratch_alignment = 0;  // minAccelerationStructureScratchOffsetAlignment
 };

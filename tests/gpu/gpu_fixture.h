@@ -45,6 +45,29 @@ inline engine::gpu::VulkanContext* context(std::string* why) { return context_wi
 // copies (GpuOptions::stage_device_only), as on a discrete GPU.
 inline engine::gpu::VulkanContext* staging_context(std::string* why) { return context_with(true, true, why); }
 
+// The two ways the device traces (and binds its scene for a raster pass),
+// for tests that run once each way.
+enum class Traversal { ComputeBvh, RayQuery };
+
+inline std::string traversal_name(const testing::TestParamInfo<Traversal>& info) {
+  return info.param == Traversal::RayQuery ? "RayQuery" : "ComputeBvh";
+}
+
+// The context that traces the parameter's way, or null with the reason.
+inline engine::gpu::VulkanContext* traversal_context(Traversal t, bool staging, std::string* why) {
+  engine::gpu::VulkanContext* ctx = context_with(staging, t == Traversal::RayQuery, why);
+  if (!ctx) {
+    *why = "no Vulkan device: " + *why;
+    return nullptr;
+  }
+  if (t == Traversal::RayQuery && !ctx->info().ray_query) {
+    *why = ctx->info().name + " (" + ctx->info().driver +
+           ") has no VK_KHR_ray_query; Mesa 25's lavapipe (bookworm-backports, scripts/setup-deps.sh) has it";
+    return nullptr;
+  }
+  return ctx;
+}
+
 }  // namespace gpu_test
 
 namespace gpu_test {

@@ -23,6 +23,9 @@
 using namespace engine;
 using gpu_test::build_world;
 using gpu_test::RtWorld;
+using gpu_test::Traversal;
+using gpu_test::traversal_context;
+using gpu_test::traversal_name;
 
 namespace {
 
@@ -34,27 +37,6 @@ glm::vec3 random_direction(math::Pcg32& rng) {
   const float z = 2.0f * rng.next_float() - 1.0f, phi = 6.2831853f * rng.next_float();
   const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
   return {r * std::cos(phi), r * std::sin(phi), z};
-}
-
-enum class Traversal { ComputeBvh, RayQuery };
-
-std::string traversal_name(const testing::TestParamInfo<Traversal>& info) {
-  return info.param == Traversal::RayQuery ? "RayQuery" : "ComputeBvh";
-}
-
-// The context that traces the parameter's way, or null with the reason.
-engine::gpu::VulkanContext* traversal_context(Traversal t, bool staging, std::string* why) {
-  engine::gpu::VulkanContext* ctx = gpu_test::context_with(staging, t == Traversal::RayQuery, why);
-  if (!ctx) {
-    *why = "no Vulkan device: " + *why;
-    return nullptr;
-  }
-  if (t == Traversal::RayQuery && !ctx->info().ray_query) {
-    *why = ctx->info().name + " (" + ctx->info().driver +
-           ") has no VK_KHR_ray_query; Mesa 25's lavapipe (bookworm-backports, scripts/setup-deps.sh) has it";
-    return nullptr;
-  }
-  return ctx;
 }
 
 class GpuRtTraversal : public testing::TestWithParam<Traversal> {};

@@ -30,13 +30,9 @@ using namespace engine;
 
 namespace {
 
-enum class Traversal { ComputeBvh, RayQuery };
+using gpu_test::Traversal;
 
 class VisibilityPassTest : public testing::TestWithParam<Traversal> {};
-
-std::string traversal_name(const testing::TestParamInfo<Traversal>& info) {
-  return info.param == Traversal::RayQuery ? "RayQuery" : "ComputeBvh";
-}
 
 struct Agreement {
   std::size_t pixels = 0, hits = 0, edge_ties = 0, silhouettes = 0, differ = 0, bad_depth = 0, bad_barycentrics = 0;
@@ -105,17 +101,11 @@ void expect_agreement(const Agreement& a) {
   EXPECT_GT(a.hits, a.pixels / 2);
 }
 
+// The traversal's context, or null with the reason (also where the queue
+// cannot rasterise).
 gpu::VulkanContext* context_for(Traversal t, std::string* why) {
-  gpu::VulkanContext* ctx = gpu_test::context_with(false, t == Traversal::RayQuery, why);
-  if (!ctx) {
-    *why = "no Vulkan device: " + *why;
-    return nullptr;
-  }
-  if (t == Traversal::RayQuery && !ctx->info().ray_query) {
-    *why = ctx->info().name + " has no VK_KHR_ray_query";
-    return nullptr;
-  }
-  if (!gpu::VisibilityPass::supported(*ctx, why)) return nullptr;
+  gpu::VulkanContext* ctx = gpu_test::traversal_context(t, false, why);
+  if (!ctx || !gpu::VisibilityPass::supported(*ctx, why)) return nullptr;
   return ctx;
 }
 
@@ -233,4 +223,4 @@ TEST_P(VisibilityPassTest, NothingNearerThanTheNearPlaneIsDrawn) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Traversals, VisibilityPassTest, testing::Values(Traversal::ComputeBvh, Traversal::RayQuery),
-                         traversal_name);
+                         gpu_test::traversal_name);

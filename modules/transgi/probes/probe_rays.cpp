@@ -82,8 +82,8 @@ PendingProbeRay begin_probe_ray(const engine::rt::RtScene& scene, const engine::
   p.takes_feedback = true;
   // The bounce: the previous frame's irradiance there, reflected as light
   // arriving evenly, by every lobe that reflects the next-event sample.
-  p.reflectance_over_pi = (lobes == HitLobes::Diffuse ? material::diffuse_albedo(s.brdf) : material::directional_albedo(s.brdf, wo.z)) *
-                          math::kInvPi;
+  const glm::vec3 albedo = lobes == HitLobes::Diffuse ? material::diffuse_albedo(s.brdf) : material::directional_albedo(s.brdf, wo.z);
+  p.reflectance_over_pi = albedo * math::kInvPi;
   p.shading_normal = s.shading_normal;
   p.to_probe = -dir;
   // The light sample is reflected by a lobe at least kProbeHitMinRoughness
@@ -93,8 +93,8 @@ PendingProbeRay begin_probe_ray(const engine::rt::RtScene& scene, const engine::
   glm::vec3 energy(1.0f);
   if (lobes == HitLobes::All && blurred.roughness < gpu::kProbeHitMinRoughness) {
     blurred.roughness = gpu::kProbeHitMinRoughness;
-    const glm::vec3 own = material::directional_albedo(s.brdf, wo.z), rough = material::directional_albedo(blurred, wo.z);
-    for (int k = 0; k < 3; ++k) energy[k] = rough[k] > 0 ? own[k] / rough[k] : 0.0f;
+    const glm::vec3 rough = material::directional_albedo(blurred, wo.z);
+    for (int k = 0; k < 3; ++k) energy[k] = rough[k] > 0 ? albedo[k] / rough[k] : 0.0f;
   }
   render::LightSample ls;
   const float u_sel = rng.next_float();
