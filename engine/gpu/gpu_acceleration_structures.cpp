@@ -1,6 +1,7 @@
 #include "engine/gpu/gpu_acceleration_structures.h"
 
 #include <algorithm>
+#include <memory>
 #include <string>
 #include <utility>
 
@@ -48,6 +49,7 @@ GpuAccelerationStructures::GpuAccelerationStructures(VulkanContext& ctx) : ctx_(
 }
 
 GpuAccelerationStructures::~GpuAccelerationStructures() {
+  ctx_.forget_deferred(this);
   for (auto& s : bottom_) destroy(s);
   destroy(top_);
 }
@@ -82,6 +84,8 @@ VkDeviceAddress GpuAccelerationStructures::scratch(VkDeviceSize bytes) {
 
 void GpuAccelerationStructures::build_bottom(std::span<const BlasInput> meshes, VkDeviceSize vertex_stride) {
   const AccelerationStructureApi& api = ctx_.acceleration_structures();
+  // A queued TLAS build names the BLAS this replaces.
+  if (ctx_.has_deferred(this)) ctx_.flush();
   for (auto& s : bottom_) destroy(s);
   bottom_.assign(meshes.size(), Structure{});
   bottom_storage_ = GpuBuffer();
@@ -142,6 +146,9 @@ void GpuAccelerationStructures::build_bottom(std::span<const BlasInput> meshes, 
 
 void GpuAccelerationStructures::build_top(std::span<const TlasInstance> instances) {
   const AccelerationStructureApi& api = ctx_.acceleration_structures();
+  // A queued build still reads the instances, the scratch and the TLAS this
+  // one rewrites: it runs first.
+  if (ctx_.has_deferred(this)) ctx_.flush();
   const auto count = static_cast<std::uint32_t>(instances.size());
   const std::size_t slots = std::max<std::size_t>(1, count);
   if (instances_.handle() == VK_NULL_HANDLE || instances_.size() < slots * sizeof(VkAccelerationStructureInstanceKHR))
@@ -167,12 +174,20 @@ void GpuAccelerationStructures::build_top(std::span<const TlasInstance> instance
     o.accelerationStructureReference = bottom_[in.blas].address;  // 0 (an empty mesh): inactive
   }
 
-  VkAccelerationStructureGeometryKHR g{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+  // What the queued recording reads: the build info points at the geometry,
+  // so both live with the recording.
+  struct TopBuild {
+    VkAccelerationStructureGeometryKHR g{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+    VkAccelerationStructureBuildGeometryInfoKHR b{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+    VkAccelerationStructureBuildRangeInfoKHR range{};
+  };
+  auto build = std::make_shared<TopBuild>();
+  VkAccelerationStructureGeometryKHR& g = build->g;
   g.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
   g.geometry.instances.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR;
   g.geometry.instances.arrayOfPointers = VK_FALSE;
   g.geometry.instances.data.deviceAddress = instances_.device_address();
-  VkAccelerationStructureBuildGeometryInfoKHR b{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+  VkAccelerationStructureBuildGeometryInfoKHR& b = build->b;
   b.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
   b.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
   b.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
@@ -189,11 +204,13 @@ void GpuAccelerationStructures::build_top(std::span<const TlasInstance> instance
   }
   b.dstAccelerationStructure = top_.handle;
   b.scratchData.deviceAddress = scratch(sizes.buildScratchSize);
-  const VkAccelerationStructureBuildRangeInfoKHR range{count, 0, 0, 0};
-  const VkAccelerationStructureBuildRangeInfoKHR* ranges = &range;
-  ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
+  build->range = {count, 0, 0, 0};
+  // Nothing on the host waits for the TLAS: it is built at the head of the
+  // next submission (the first that traces against it).
+  ctx_.record_before_next(this, [build, &api](VkCommandBuffer cmd) {
+    const VkAccelerationStructureBuildRangeInfoKHR* ranges = &build->range;
     inputs_visible_to_build(cmd);
-    api.cmd_build(cmd, 1, &b, &ranges);
+    api.cmd_build(cmd, 1, &build->b, &ranges);
     build_visible_to_queries(cmd);
   });
 }

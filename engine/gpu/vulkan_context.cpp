@@ -6,8 +6,10 @@
 #include <cstring>
 #include <initializer_list>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "engine/gpu/compute_pipeline.h"
 #include "engine/gpu/gpu_error.h"
 
 namespace engine::gpu {
@@ -409,6 +411,49 @@ std::vector<std::uint32_t> VulkanContext::buffer_memory_types(std::uint32_t type
   return rank_buffer_memory_types(mem, type_bits, mapped, info_.buffer_memory);
 }
 
+std::uint32_t VulkanContext::record_deferred(VkCommandBuffer cmd, std::vector<const void*>& owners) {
+  owners.clear();
+  if (deferred_.empty()) return 0;
+  // Taken first: a recording may queue nothing more, but must not see itself.
+  std::vector<Deferred> queued = std::move(deferred_);
+  deferred_.clear();
+  for (Deferred& d : queued) {
+    d.record(cmd);
+    owners.push_back(d.owner);
+    mark_stage(cmd);
+  }
+  // Whatever they wrote is ready for the submission's own commands.
+  record_memory_barrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
+                        VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
+  return marks_;
+}
+
+void VulkanContext::record_before_next(const void* owner, std::function<void(VkCommandBuffer)> record) {
+  deferred_.push_back({owner, std::move(record)});
+}
+
+void VulkanContext::flush() {
+  if (!deferred_.empty()) submit_and_wait([](VkCommandBuffer) {});
+}
+
+bool VulkanContext::has_deferred(const void* owner) const {
+  for (const Deferred& d : deferred_)
+    if (d.owner == owner) return true;
+  return false;
+}
+
+void VulkanContext::forget_deferred(const void* owner) {
+  std::erase_if(deferred_, [&](const Deferred& d) { return d.owner == owner; });
+  std::erase_if(deferred_ms_, [&](const std::pair<const void*, double>& t) { return t.first == owner; });
+}
+
+double VulkanContext::take_deferred_ms(const void* owner) {
+  double ms = 0.0;
+  for (auto& [who, t] : deferred_ms_)
+    if (who == owner) ms += std::exchange(t, 0.0);
+  return ms;
+}
+
 double VulkanContext::submit_and_wait(const std::function<void(VkCommandBuffer)>& record) {
   ENGINE_VK_CHECK(vkResetCommandBuffer(cmd_, 0));
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
@@ -419,6 +464,8 @@ double VulkanContext::submit_and_wait(const std::function<void(VkCommandBuffer)>
     vkCmdResetQueryPool(cmd_, timestamps_, 0, kMaxStageMarks + 2);
     vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, timestamps_, 0);
   }
+  std::vector<const void*> owners;
+  const std::uint32_t head = record_deferred(cmd_, owners);
   record(cmd_);
   // The CPU reads results straight from mapped memory after the fence:
   // make the kernels' and copies' writes visible to the host.
@@ -443,8 +490,18 @@ double VulkanContext::submit_and_wait(const std::function<void(VkCommandBuffer)>
   ENGINE_VK_CHECK(vkGetQueryPoolResults(device_, timestamps_, 0, last + 1, sizeof(ticks), ticks, sizeof(std::uint64_t),
                                         VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
   const double ms_per_tick = info_.timestamp_period_ns * 1e-6;
-  for (std::uint32_t i = 1; i <= last; ++i) last_stage_ms_.push_back(static_cast<double>(ticks[i] - ticks[i - 1]) * ms_per_tick);
-  return static_cast<double>(ticks[last] - ticks[0]) * ms_per_tick;
+  const auto span_ms = [&](std::uint32_t a, std::uint32_t b) { return static_cast<double>(ticks[b] - ticks[a]) * ms_per_tick; };
+  // The queued commands' marks first (when marks ran out, the rest of
+  // theirs counts as the submission's own).
+  for (std::uint32_t i = 1; i <= std::min(head, marks_); ++i) {
+    const void* owner = owners[i - 1];
+    auto at = std::find_if(deferred_ms_.begin(), deferred_ms_.end(), [&](const auto& t) { return t.first == owner; });
+    if (at == deferred_ms_.end()) at = deferred_ms_.insert(deferred_ms_.end(), {owner, 0.0});
+    at->second += span_ms(i - 1, i);
+  }
+  const std::uint32_t own_first = std::min(head, marks_);
+  for (std::uint32_t i = own_first + 1; i <= last; ++i) last_stage_ms_.push_back(span_ms(i - 1, i));
+  return span_ms(own_first, last);
 }
 
 void VulkanContext::mark_stage(VkCommandBuffer cmd) {

@@ -206,6 +206,25 @@ class VulkanContext {
   [[nodiscard]] const std::vector<double>& last_stage_ms() const { return last_stage_ms_; }
   static constexpr std::uint32_t kMaxStageMarks = 30;
 
+  // Commands whose results the host does not wait for (a TLAS rebuilt for
+  // the next traces, a query read later): recorded at the head of the next
+  // submission, whoever makes it, so that they cost no submission of their
+  // own (issue 36: one submission a frame). A barrier separates them from
+  // that submission's own commands, whose stage times and total exclude
+  // them; their device time is kept for `owner` (take_deferred_ms). An
+  // owner that frees what its recordings use first calls forget_deferred
+  // (its destructor) or flush (before it replaces a buffer they read).
+  void record_before_next(const void* owner, std::function<void(VkCommandBuffer)> record);
+  // Submits what record_before_next queued, alone, and waits; nothing
+  // where nothing is queued.
+  void flush();
+  // Whether `owner` has commands queued.
+  [[nodiscard]] bool has_deferred(const void* owner) const;
+  void forget_deferred(const void* owner);
+  // Device milliseconds of `owner`'s queued commands that ran since the
+  // last call.
+  double take_deferred_ms(const void* owner);
+
   // The traffic since the context was made (thread-safe); a frame's is the
   // difference of two readings.
   [[nodiscard]] GpuTraffic traffic() const {
@@ -243,6 +262,15 @@ class VulkanContext {
   int validation_errors_ = 0;
   std::atomic<std::uint64_t> submissions_{0}, host_to_device_{0}, device_to_host_{0};
   std::uint32_t marks_ = 0;  // stage marks recorded in the submission being recorded
+  struct Deferred {
+    const void* owner;
+    std::function<void(VkCommandBuffer)> record;
+  };
+  std::vector<Deferred> deferred_;
+  std::vector<std::pair<const void*, double>> deferred_ms_;  // by owner
+  // Records the queued commands at the head of `cmd` with a timestamp after
+  // each (their owners' times come from marks 1..n); returns n.
+  std::uint32_t record_deferred(VkCommandBuffer cmd, std::vector<const void*>& owners);
   std::vector<double> last_stage_ms_;
 };
 
