@@ -4,6 +4,8 @@
 #include <cmath>
 #include <utility>
 
+#include "engine/gpu/gpu_error.h"
+
 namespace engine::gpu {
 
 GpuRayTracer::GpuRayTracer(VulkanContext& ctx) : ctx_(ctx), raster_(ctx.info().raster_visibility) {}
@@ -57,6 +59,17 @@ bool GpuRayTracer::camera_hits(const rt::RtScene& scene, const render::CameraRay
 
 void GpuRayTracer::set_raster_visibility(bool enabled) { raster_ = enabled && VisibilityPass::supported(ctx_); }
 
-double GpuRayTracer::take_device_ms() { return std::exchange(gpu_ms_, 0.0); }
+bool GpuRayTracer::occluded_later(const rt::RtScene& scene, std::span<const rt::Ray> rays) {
+  if (!follow(scene)) return false;
+  rt_->occluded_later(rays);
+  return true;
+}
+
+void GpuRayTracer::take_occluded(std::span<std::uint8_t> blocked) {
+  if (!rt_) throw GpuError("GpuRayTracer::take_occluded: no batch queued");
+  rt_->take_occluded(blocked);
+}
+
+double GpuRayTracer::take_device_ms() { return std::exchange(gpu_ms_, 0.0) + (rt_ ? rt_->take_deferred_ms() : 0.0); }
 
 }  // namespace engine::gpu

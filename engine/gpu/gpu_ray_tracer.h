@@ -23,7 +23,12 @@ class GpuRayTracer : public rt::RayBatchTracer, public render::CameraHitTracer {
                  std::span<std::uint8_t> found) override;
   // Stops each ray's traversal at its first hit.
   bool occluded(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<std::uint8_t> blocked) override;
-  // GPU milliseconds of the traces since the last call (timestamps).
+  // Queued at the head of the device's next submission (GpuRtScene::
+  // occluded_later).
+  bool occluded_later(const rt::RtScene& scene, std::span<const rt::Ray> rays) override;
+  void take_occluded(std::span<std::uint8_t> blocked) override;
+  // GPU milliseconds of the traces since the last call (timestamps),
+  // the TLAS's rebuilds and the later batches with them.
   double take_device_ms() override;
   // The raster visibility pass (VisibilityPass) where the device's options
   // ask for it (DeviceInfo::raster_visibility) or set_raster_visibility

@@ -105,9 +105,11 @@ GpuRtScene::GpuRtScene(VulkanContext& ctx) : ctx_(ctx) {
   if (stats_.ray_query) structures_ = std::make_unique<GpuAccelerationStructures>(ctx);
 }
 
-GpuRtScene::~GpuRtScene() = default;
+GpuRtScene::~GpuRtScene() { ctx_.forget_deferred(this); }
 
 void GpuRtScene::sync(const rt::RtScene& rt) {
+  // A queued batch reads the instances and meshes this rewrites.
+  if (ctx_.has_deferred(this)) ctx_.flush();
   synced_ = &rt;
   const scene::SceneAssets* assets = rt.assets();
   if (assets && assets->generation != generation_) {
@@ -302,17 +304,64 @@ GpuRtRasterView GpuRtScene::raster_view() const {
   return v;
 }
 
-std::span<const HitGpu> GpuRtScene::run_query(std::span<const rt::Ray> rays, bool any_hit, double* gpu_ms) {
-  const std::size_t n = rays.size();
-  if (rays_.handle() == VK_NULL_HANDLE || rays_.size() < n * sizeof(RayGpu)) rays_ = GpuBuffer(ctx_, n * sizeof(RayGpu));
-  if (hits_.handle() == VK_NULL_HANDLE || hits_.size() < n * sizeof(HitGpu)) hits_ = GpuBuffer(ctx_, n * sizeof(HitGpu));
-  const std::span<RayGpu> in = rays_.mapped_as<RayGpu>(n);
-  jobs::parallel_for<std::size_t>(0, n, kRaysPerTask, [&](std::size_t b, std::size_t e) {
+namespace {
+// A ray as rt_query.comp reads it.
+void write_rays(std::span<const rt::Ray> rays, std::span<RayGpu> in) {
+  jobs::parallel_for<std::size_t>(0, rays.size(), kRaysPerTask, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       const rt::Ray& r = rays[i];
       in[i] = {r.origin.x, r.origin.y, r.origin.z, r.tmin, r.direction.x, r.direction.y, r.direction.z, r.tmax};
     }
   });
+}
+}  // namespace
+
+void GpuRtScene::occluded_later(std::span<const rt::Ray> rays) {
+  if (ctx_.has_deferred(this)) ctx_.flush();
+  const std::size_t n = rays.size();
+  later_count_ = static_cast<std::ptrdiff_t>(n);
+  if (n == 0) return;
+  if (later_rays_.handle() == VK_NULL_HANDLE || later_rays_.size() < n * sizeof(RayGpu))
+    later_rays_ = GpuBuffer(ctx_, n * sizeof(RayGpu));
+  if (later_hits_.handle() == VK_NULL_HANDLE || later_hits_.size() < n * sizeof(HitGpu))
+    later_hits_ = GpuBuffer(ctx_, n * sizeof(HitGpu));
+  write_rays(rays, later_rays_.mapped_as<RayGpu>(n));
+  // The kernel is bound when the submission is recorded: an immediate query
+  // (run_query) submits this batch first, so the two never share a command
+  // buffer's bindings.
+  ctx_.record_before_next(this, [this, n](VkCommandBuffer cmd) {
+    query_->bind(0, later_rays_);
+    query_->bind(1, later_hits_);
+    bind(*query_, 2);
+    const std::uint32_t push[2] = {static_cast<std::uint32_t>(n), 1u};
+    query_->record_dispatch(cmd, (push[0] + kRtGroupSize - 1) / kRtGroupSize, 1, 1, push);
+  });
+}
+
+void GpuRtScene::take_occluded(std::span<std::uint8_t> blocked) {
+  if (later_count_ < 0 || static_cast<std::size_t>(later_count_) != blocked.size())
+    throw GpuError("GpuRtScene::take_occluded: " + std::to_string(blocked.size()) + " flags for a batch of " +
+                   (later_count_ < 0 ? std::string("none") : std::to_string(later_count_)));
+  later_count_ = -1;
+  if (blocked.empty()) return;
+  if (ctx_.has_deferred(this)) ctx_.flush();
+  const std::span<const HitGpu> out = later_hits_.mapped_as<const HitGpu>(blocked.size());
+  jobs::parallel_for<std::size_t>(0, blocked.size(), kRaysPerTask, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) blocked[i] = out[i].instance != kRtNoHit ? 1 : 0;
+  });
+}
+
+double GpuRtScene::take_deferred_ms() {
+  return ctx_.take_deferred_ms(this) + (structures_ ? ctx_.take_deferred_ms(structures_.get()) : 0.0);
+}
+
+std::span<const HitGpu> GpuRtScene::run_query(std::span<const rt::Ray> rays, bool any_hit, double* gpu_ms) {
+  // A queued batch binds the same kernel: it goes first, alone.
+  if (ctx_.has_deferred(this)) ctx_.flush();
+  const std::size_t n = rays.size();
+  if (rays_.handle() == VK_NULL_HANDLE || rays_.size() < n * sizeof(RayGpu)) rays_ = GpuBuffer(ctx_, n * sizeof(RayGpu));
+  if (hits_.handle() == VK_NULL_HANDLE || hits_.size() < n * sizeof(HitGpu)) hits_ = GpuBuffer(ctx_, n * sizeof(HitGpu));
+  write_rays(rays, rays_.mapped_as<RayGpu>(n));
   query_->bind(0, rays_);
   query_->bind(1, hits_);
   bind(*query_, 2);

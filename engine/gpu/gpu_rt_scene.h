@@ -64,6 +64,8 @@ class GpuRtScene {
  public:
   explicit GpuRtScene(VulkanContext& ctx);
   ~GpuRtScene();
+  GpuRtScene(const GpuRtScene&) = delete;
+  GpuRtScene& operator=(const GpuRtScene&) = delete;
 
   // Mirrors rt's instances (and, for a new asset generation, its meshes).
   void sync(const rt::RtScene& rt);
@@ -90,6 +92,18 @@ class GpuRtScene {
   // (tmin, tmax]; traversal stops at the first hit.
   void occluded(std::span<const rt::Ray> rays, std::span<std::uint8_t> blocked, double* gpu_ms = nullptr);
 
+  // Shadow rays traced at the head of the device's next submission,
+  // whichever stage makes it (VulkanContext::record_before_next), so that
+  // they cost none of their own; take_occluded reads their answers (and
+  // submits them alone if nothing else did). One batch at a time: a second
+  // waits for the first.
+  void occluded_later(std::span<const rt::Ray> rays);
+  // blocked[i] for ray i of the batch occluded_later queued; throws GpuError
+  // for another count or none queued.
+  void take_occluded(std::span<std::uint8_t> blocked);
+  // Device milliseconds of this scene's queued work (the TLAS's builds,
+  // the later batches) since the last call.
+  double take_deferred_ms();
   // The entity of RtScene instance `id` as of the last sync (a hit's
   // Hit::entity), or none.
   [[nodiscard]] ecs::Entity entity_of(std::uint32_t id) const;
@@ -124,6 +138,9 @@ class GpuRtScene {
   GpuBuffer tlas_, instances_, blas_, triangles_;
   GpuBuffer triangle_uvs_, alpha_materials_, alpha_bytes_, alpha_textures_;
   GpuBuffer rays_, hits_;
+  // occluded_later's batch: its own buffers, its count (-1: none queued).
+  GpuBuffer later_rays_, later_hits_;
+  std::ptrdiff_t later_count_ = -1;
   std::unique_ptr<ComputePipeline> query_;
   std::unique_ptr<GpuAccelerationStructures> structures_;  // ray queries only
   GpuRtStats stats_;

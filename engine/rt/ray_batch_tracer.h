@@ -26,6 +26,13 @@ class RayBatchTracer {
   // Shadow rays: blocked[i] = whether anything lies on ray i within
   // (tmin, tmax]. Returns false, touching nothing, where it declines.
   virtual bool occluded(const RtScene& scene, std::span<const Ray> rays, std::span<std::uint8_t> blocked) = 0;
+  // Shadow rays whose answers the caller reads later (take_occluded),
+  // traced along with the backend's next piece of work instead of on their
+  // own (a device's next submission). Returns false, queuing nothing, where
+  // the backend declines; one batch at a time.
+  virtual bool occluded_later(const RtScene& /*scene*/, std::span<const Ray> /*rays*/) { return false; }
+  // blocked[i] for ray i of the batch occluded_later queued.
+  virtual void take_occluded(std::span<std::uint8_t> /*blocked*/) {}
   // Device milliseconds the traces took since the last call (0 where the
   // backend cannot time them), so each stage that traces can take its own.
   virtual double take_device_ms() { return 0.0; }

@@ -13,6 +13,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "engine/gpu/gpu_error.h"
 #include "engine/gpu/gpu_rt_scene.h"
 #include "engine/math/rng.h"
 #include "engine/rt/bvh_builder.h"
@@ -196,6 +197,75 @@ TEST_P(GpuRtTraversal, AnyHitShadowRaysGiveEmbreesOccludedAnswers) {
   EXPECT_LE(disagree, rays.size() / 500);
   EXPECT_GT(n_blocked, rays.size() / 4);
   EXPECT_LT(n_blocked, rays.size() * 3 / 4);
+  EXPECT_EQ(ctx->validation_errors(), 0);
+}
+
+// A later batch (occluded_later) gives occluded()'s answers, and rides with
+// the device's next submission: a moved instance's TLAS rebuild, the batch
+// and the next query cost one submission in all (issue 36: the frame's
+// submissions), and the query sees the move.
+TEST_P(GpuRtTraversal, ALaterShadowBatchAndATlasRebuildRideWithTheNextSubmission) {
+  TRAVERSAL_CONTEXT_OR_SKIP(ctx, false);
+  RtWorld w;
+  build_world(w);
+  math::Pcg32 rng(23, 5);
+  std::vector<rt::Ray> rays;
+  for (int i = 0; i < 4000; ++i) rays.push_back(rt::Ray{point_in_room(rng), random_direction(rng), 0.0f, 8.0f * rng.next_float()});
+  gpu::GpuRtScene gpu_rt(*ctx);
+  gpu_rt.sync(w.rt);
+  std::vector<std::uint8_t> now(rays.size()), later(rays.size());
+  gpu_rt.occluded(rays, now);
+  // The sphere to the back wall, then the batch queued after the move.
+  transform::Similarity s;
+  s.translation = glm::vec3(0.0f, 0.0f, -3.5f);
+  w.rt.upsert_instance(ecs::Entity{1, 0}, 1, s);
+  w.rt.commit();
+  const std::uint64_t before = ctx->traffic().submissions;
+  gpu_rt.sync(w.rt);
+  gpu_rt.occluded_later(rays);
+  EXPECT_EQ(ctx->traffic().submissions, before) << "a TLAS rebuild and a later batch submit nothing by themselves";
+  // Another stage's submission (the probe rays' in a frame) carries both.
+  ctx->submit_and_wait([](VkCommandBuffer) {});
+  EXPECT_EQ(ctx->traffic().submissions - before, 1u);
+  gpu_rt.take_occluded(later);
+  EXPECT_EQ(ctx->traffic().submissions - before, 1u) << "the answers came with that submission";
+  const std::vector<rt::Ray> probe = {rt::Ray{glm::vec3(0.0f), glm::vec3(0.0f, 0.0f, -1.0f)}};
+  std::vector<rt::Hit> h(1);
+  std::vector<std::uint8_t> found(1, 0);
+  gpu_rt.intersect(probe, h, found);
+  // Answers against the moved scene, from Embree.
+  std::size_t disagree = 0, n_blocked = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const bool want = w.rt.occluded(rays[i]);
+    n_blocked += want;
+    if (want != (later[i] != 0) && disagree++ < 5) ADD_FAILURE() << "ray " << i << ": Embree says " << want;
+  }
+  EXPECT_LE(disagree, rays.size() / 500);
+  EXPECT_GT(n_blocked, rays.size() / 10);
+  rt::Hit want;
+  ASSERT_TRUE(w.rt.intersect(probe[0], want));
+  ASSERT_TRUE(found[0]);
+  EXPECT_EQ(h[0].instance, want.instance) << "the query traced the rebuilt TLAS";
+  EXPECT_NEAR(h[0].t, want.t, 1e-4f * want.t);
+  EXPECT_EQ(ctx->traffic().submissions - before, 2u);
+
+  // Queued, then an immediate query: the batch is submitted first, alone
+  // (the two bind one kernel); queued with no submission after it:
+  // take_occluded submits it. The answers are occluded()'s either way.
+  std::vector<std::uint8_t> again(rays.size()), alone(rays.size());
+  gpu_rt.occluded(rays, now);
+  std::uint64_t at = ctx->traffic().submissions;
+  gpu_rt.occluded_later(rays);
+  gpu_rt.intersect(probe, h, found);
+  EXPECT_EQ(ctx->traffic().submissions - at, 2u);
+  gpu_rt.take_occluded(again);
+  EXPECT_EQ(again, now);
+  at = ctx->traffic().submissions;
+  gpu_rt.occluded_later(rays);
+  gpu_rt.take_occluded(alone);
+  EXPECT_EQ(ctx->traffic().submissions - at, 1u);
+  EXPECT_EQ(alone, now);
+  EXPECT_THROW(gpu_rt.take_occluded(again), engine::gpu::GpuError) << "nothing queued";
   EXPECT_EQ(ctx->validation_errors(), 0);
 }
 

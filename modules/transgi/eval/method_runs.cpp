@@ -136,6 +136,7 @@ MethodRun run_transgi(LoadedScene& scene, const std::shared_ptr<const model::Tra
   r.full = frame.full;
   r.shaded_samples = frame.shaded_samples;
   r.inferred_samples = frame.inferred_samples;
+  r.gpu_submissions = frame.gpu_submissions;
   r.backend = frame.backend + (frame.backend_fallback.empty() ? "" : "; " + frame.backend_fallback);
   r.stages = medians({"generate network input", "network inference", "collect shaded points", "probe raster",
                       "probe accumulation + SH projection", "SH multiplication", "GI upsampling", "reflections", "direct light"},

@@ -39,6 +39,8 @@ struct MethodRun {
   std::string probe_summary;   // a line about the probes' states
   std::size_t shaded_samples = 0, inferred_samples = 0;
   std::string backend;  // where the probe kernels ran (TransGI), with any fallback reason
+  // The last frame's command buffers submitted to the device (0 on the CPU).
+  std::uint64_t gpu_submissions = 0;
 };
 
 struct TransgiRunOptions {

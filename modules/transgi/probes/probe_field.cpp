@@ -270,6 +270,12 @@ struct ProbeField::UpdateWork {
   std::vector<float> direct_frame;                 // probes x 75: the sky and emitters its rays saw
   std::atomic<std::size_t> nonfinite_rays{0};      // rare
   std::vector<std::uint8_t> skip_this_frame;       // per probe: relocated, its rays left from elsewhere
+  // The emitters' light samples (tracing probe j's at j * emitter_samples)
+  // and their shadow rays, when the backend's tracer takes them along with
+  // the probe rays (queue_emitter_samples).
+  std::vector<engine::rt::Ray> emitter_rays;
+  std::vector<engine::render::LightSample> emitter_samples;
+  bool emitters_queued = false;
 };
 
 bool ProbeField::takes_frame(const UpdateWork& w, int q) const {
@@ -372,61 +378,97 @@ void ProbeField::trace_and_shade(const engine::rt::RtScene& scene, const engine:
                              [&](int j, int i, const ProbeRayHit& h) { consume(w.tracing[static_cast<std::size_t>(j)], i, h); });
 }
 
+namespace {
+
+// Probe j's K light samples of the emitters from `origin`, stratified in the
+// triangle-selection dimension, and their shadow rays; a failed sample gets
+// pdf 0 and an empty segment.
+void make_emitter_samples(const engine::render::LightSet& lights, const glm::vec3& origin, engine::math::Pcg32 rng, int K,
+                          engine::rt::Ray* rays, engine::render::LightSample* samples) {
+  using namespace engine;
+  for (int k = 0; k < K; ++k) {
+    const glm::vec2 u{(static_cast<float>(k) + rng.next_float()) / static_cast<float>(K), rng.next_float()};
+    render::LightSample& ls = samples[k];
+    if (!lights.sample_area_light(origin, glm::min(u, glm::vec2(0.99999994f)), ls) || !(ls.pdf > 0) ||
+        ls.radiance == glm::vec3(0.0f)) {
+      ls.pdf = 0;
+      rays[k] = rt::Ray{origin, glm::vec3(0, 0, 1), 0.0f, 0.0f};
+      continue;
+    }
+    rays[k] = rt::Ray{origin, ls.direction, 0.0f, ls.distance * (1.0f - 1e-4f)};
+  }
+}
+
+// The unblocked of K samples into a probe's direct SH.
+void project_emitter_samples(const engine::render::LightSample* samples, const std::uint8_t* blocked, int K, float* direct) {
+  for (int k = 0; k < K; ++k) {
+    const engine::render::LightSample& ls = samples[k];
+    if (!(ls.pdf > 0) || blocked[k]) continue;
+    const glm::vec3 light = ls.radiance / (ls.pdf * static_cast<float>(K));
+    if (std::isfinite(light.r + light.g + light.b)) add_radiance_sh(direct, ls.direction, light);
+  }
+}
+
+}  // namespace
+
+engine::math::Pcg32 ProbeField::emitter_rng(const UpdateWork& w, int q) const {
+  return engine::math::make_rng(w.seed ^ 0xE317u, static_cast<std::uint64_t>(q), frame_);
+}
+
+void ProbeField::queue_emitter_samples(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, UpdateWork& w) {
+  const int K = settings_.emitter_samples;
+  w.emitters_queued = false;
+  engine::rt::RayBatchTracer* tracer = kernels_->tracer();
+  if (K <= 0 || lights.emissive_triangle_count() == 0 || w.tracing.empty() || !tracer) return;
+  const std::size_t k_per_probe = static_cast<std::size_t>(K), n = w.tracing.size() * k_per_probe;
+  w.emitter_rays.resize(n);
+  w.emitter_samples.resize(n);
+  engine::jobs::parallel_for<std::size_t>(0, w.tracing.size(), 32, [&](std::size_t b, std::size_t e) {
+    for (std::size_t j = b; j < e; ++j) {
+      const int q = w.tracing[j];
+      make_emitter_samples(lights, grid_.position(q), emitter_rng(w, q), K, w.emitter_rays.data() + j * k_per_probe,
+                           w.emitter_samples.data() + j * k_per_probe);
+    }
+  });
+  w.emitters_queued = tracer->occluded_later(scene, w.emitter_rays);
+}
+
 void ProbeField::sample_emitters(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, UpdateWork& w) {
   using namespace engine;
   const int K = settings_.emitter_samples;
   if (K <= 0 || lights.emissive_triangle_count() == 0 || w.tracing.empty()) return;
   const std::size_t k_per_probe = static_cast<std::size_t>(K), n = w.tracing.size() * k_per_probe;
-  std::vector<rt::Ray> rays(n);
-  std::vector<render::LightSample> samples(n);
-  // Probe j's K samples, stratified in the triangle-selection dimension;
-  // a failed sample gets pdf 0 and an empty segment.
-  const auto make_samples = [&](std::size_t j) {
-    const int q = w.tracing[j];
-    const glm::vec3 origin = grid_.position(q);
-    math::Pcg32 rng = math::make_rng(w.seed ^ 0xE317u, static_cast<std::uint64_t>(q), frame_);
-    for (std::size_t k = 0; k < k_per_probe; ++k) {
-      const std::size_t i = j * k_per_probe + k;
-      const glm::vec2 u{(static_cast<float>(k) + rng.next_float()) / static_cast<float>(K), rng.next_float()};
-      render::LightSample& ls = samples[i];
-      if (!lights.sample_area_light(origin, glm::min(u, glm::vec2(0.99999994f)), ls) || !(ls.pdf > 0) ||
-          ls.radiance == glm::vec3(0.0f)) {
-        ls.pdf = 0;
-        rays[i] = rt::Ray{origin, glm::vec3(0, 0, 1), 0.0f, 0.0f};
-        continue;
-      }
-      rays[i] = rt::Ray{origin, ls.direction, 0.0f, ls.distance * (1.0f - 1e-4f)};
-    }
+  const auto project_all = [&](const std::vector<std::uint8_t>& blocked) {
+    for (std::size_t j = 0; j < w.tracing.size(); ++j)
+      project_emitter_samples(w.emitter_samples.data() + j * k_per_probe, blocked.data() + j * k_per_probe, K,
+                              w.direct_frame.data() + static_cast<std::size_t>(w.tracing[j]) * 75);
   };
-  // Probe j's unblocked samples into its direct SH.
-  const auto project = [&](std::size_t j, const std::uint8_t* blocked) {
-    float* direct = w.direct_frame.data() + static_cast<std::size_t>(w.tracing[j]) * 75;
-    for (std::size_t k = 0; k < k_per_probe; ++k) {
-      const render::LightSample& ls = samples[j * k_per_probe + k];
-      if (!(ls.pdf > 0) || blocked[k]) continue;
-      const glm::vec3 light = ls.radiance / (ls.pdf * static_cast<float>(K));
-      if (std::isfinite(light.r + light.g + light.b)) add_radiance_sh(direct, ls.direction, light);
-    }
-  };
-  // A backend's tracer takes every shadow ray in one batch; else each
-  // probe's samples are made, traced and projected in one pass.
-  if (rt::RayBatchTracer* tracer = kernels_->tracer()) {
-    for (std::size_t j = 0; j < w.tracing.size(); ++j) make_samples(j);
+  // Traced with the probe rays' submission (queue_emitter_samples).
+  if (w.emitters_queued) {
     std::vector<std::uint8_t> blocked(n, 1);
-    if (tracer->occluded(scene, rays, blocked)) {
-      for (std::size_t j = 0; j < w.tracing.size(); ++j) project(j, blocked.data() + j * k_per_probe);
+    kernels_->tracer()->take_occluded(blocked);
+    project_all(blocked);
+    return;
+  }
+  // A tracer that takes no later batch traces the samples
+  // queue_emitter_samples made in one batch now.
+  if (rt::RayBatchTracer* tracer = kernels_->tracer()) {
+    std::vector<std::uint8_t> blocked(n, 1);
+    if (tracer->occluded(scene, w.emitter_rays, blocked)) {
+      project_all(blocked);
       return;
     }
   }
+  // Else each probe's samples are made, traced and projected in one pass.
   jobs::parallel_for<std::size_t>(0, w.tracing.size(), 8, [&](std::size_t b, std::size_t e) {
+    std::vector<rt::Ray> rays(k_per_probe);
+    std::vector<render::LightSample> samples(k_per_probe);
     std::vector<std::uint8_t> blocked(k_per_probe);
     for (std::size_t j = b; j < e; ++j) {
-      make_samples(j);
-      for (std::size_t k = 0; k < k_per_probe; ++k) {
-        const std::size_t i = j * k_per_probe + k;
-        blocked[k] = samples[i].pdf > 0 && scene.occluded(rays[i]) ? 1 : 0;
-      }
-      project(j, blocked.data());
+      const int q = w.tracing[j];
+      make_emitter_samples(lights, grid_.position(q), emitter_rng(w, q), K, rays.data(), samples.data());
+      for (std::size_t k = 0; k < k_per_probe; ++k) blocked[k] = samples[k].pdf > 0 && scene.occluded(rays[k]) ? 1 : 0;
+      project_emitter_samples(samples.data(), blocked.data(), K, w.direct_frame.data() + static_cast<std::size_t>(q) * 75);
     }
   });
 }
@@ -582,6 +624,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   // 1. Scatter and shade (reads the previous frame's SH for the feedback
   // bounce), then classify what traced.
   auto t0 = Clock::now();
+  queue_emitter_samples(scene, lights, w);
   trace_and_shade(scene, lights, outer, w);
   sample_emitters(scene, lights, w);
   for (std::uint8_t t : w.traced) stats.traced += t;

@@ -28,6 +28,7 @@
 #include <optional>
 #include <vector>
 
+#include "engine/math/rng.h"
 #include "engine/render/light_set.h"
 #include "engine/rt/rt_scene.h"
 #include "probes/interpolation.h"
@@ -369,8 +370,10 @@ class ProbeField {
   //  plan_update: which probes trace, this frame's ray set;
   //  trace_and_shade: every tracing probe's shaded points, hit counts and
   //    the sky it saw (and the emitters, without emitter_samples);
-  //  sample_emitters: every tracing probe's light samples of the emitters
-  //    (emitter_samples), projected;
+  //  queue_emitter_samples: every tracing probe's light samples of the
+  //    emitters (emitter_samples) made, and where the backend's tracer takes
+  //    a later batch, their shadow rays queued to go with the probe rays;
+  //  sample_emitters: those samples traced (unless queued) and projected;
   //  classify_traced (classification and budgeted frames): buried, far and
   //    relocated probes marked, their light forgotten;
   //  share_accumulate_project: each updating probe's depth from its own
@@ -382,7 +385,10 @@ class ProbeField {
   void plan_update(UpdateWork& w);
   void trace_and_shade(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, const ProbeField* outer,
                        UpdateWork& w);
+  void queue_emitter_samples(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, UpdateWork& w);
   void sample_emitters(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, UpdateWork& w);
+  // Probe q's draws for its emitter samples this frame.
+  [[nodiscard]] engine::math::Pcg32 emitter_rng(const UpdateWork& w, int q) const;
   void classify_traced(const engine::rt::RtScene& scene, UpdateWork& w);
   struct LightIntoProbes {
     SharingStats sharing;
