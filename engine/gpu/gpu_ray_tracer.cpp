@@ -17,6 +17,8 @@ bool GpuRayTracer::follow(const rt::RtScene& scene) {
   if (!rt_) rt_ = std::make_unique<GpuRtScene>(ctx_);
   // Another scene, or a new commit (something moved): the TLAS follows.
   if (synced_ != &scene || commits_ != scene.stats().top_level_commits) {
+    // A queued view binds the buffers the sync may replace.
+    if (visibility_) visibility_->drop_queued();
     rt_->sync(scene);
     synced_ = &scene;
     commits_ = scene.stats().top_level_commits;
@@ -45,16 +47,27 @@ bool GpuRayTracer::camera_hits(const rt::RtScene& scene, const render::CameraRay
                                std::span<rt::Hit> hits, std::span<std::uint8_t> found) {
   if (!raster_ || !follow(scene)) return false;
   if (!visibility_) visibility_ = std::make_unique<VisibilityPass>(ctx_);
+  double ms = 0;
+  const float near = near_plane(scene);
+  if (!visibility_->take_queued(*rt_, camera, film_offset, near, hits, found, &ms))
+    visibility_->render(*rt_, camera, film_offset, near, hits, found, &ms);
+  gpu_ms_ += std::max(0.0, ms);
+  return true;
+}
+
+void GpuRayTracer::queue_camera_hits(const rt::RtScene& scene, const render::CameraRays& camera, glm::vec2 film_offset) {
+  if (!raster_ || !follow(scene)) return;
+  if (!visibility_) visibility_ = std::make_unique<VisibilityPass>(ctx_);
+  visibility_->queue(*rt_, camera, film_offset, near_plane(scene));
+}
+
+float GpuRayTracer::near_plane(const rt::RtScene& scene) {
   // A camera ray starts at the eye (tmin 0); the raster needs a near plane:
   // a millionth of the scene's size, where a reversed float depth keeps
   // its precision all the same.
   const glm::vec3 extent = scene.bounds_max() - scene.bounds_min();
   const float size = std::max({extent.x, extent.y, extent.z});
-  const float near_plane = std::isfinite(size) && size > 0 ? 1e-6f * size : 1e-6f;
-  double ms = 0;
-  visibility_->render(*rt_, camera, film_offset, near_plane, hits, found, &ms);
-  gpu_ms_ += std::max(0.0, ms);
-  return true;
+  return std::isfinite(size) && size > 0 ? 1e-6f * size : 1e-6f;
 }
 
 void GpuRayTracer::set_raster_visibility(bool enabled) { raster_ = enabled && VisibilityPass::supported(ctx_); }

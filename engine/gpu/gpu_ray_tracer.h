@@ -36,6 +36,10 @@ class GpuRayTracer : public rt::RayBatchTracer, public render::CameraHitTracer {
   render::CameraHitTracer* camera_hit_tracer() override { return raster_ ? this : nullptr; }
   bool camera_hits(const rt::RtScene& scene, const render::CameraRays& camera, glm::vec2 film_offset, std::span<rt::Hit> hits,
                    std::span<std::uint8_t> found) override;
+  // The view's visibility pass queued at the head of the device's next
+  // submission (VisibilityPass::queue); camera_hits takes it when it asks
+  // for the same view of the same scene.
+  void queue_camera_hits(const rt::RtScene& scene, const render::CameraRays& camera, glm::vec2 film_offset) override;
   // Whether the G-buffer takes its hits from the raster pass, where the
   // queue can rasterise, whatever the device's options say: a test or a
   // benchmark compares the two.
@@ -52,6 +56,8 @@ class GpuRayTracer : public rt::RayBatchTracer, public render::CameraHitTracer {
   const rt::RtScene* synced_ = nullptr;
   std::size_t commits_ = 0;
   bool follow(const rt::RtScene& scene);  // syncs when needed; false: declines the scene
+  // The raster's near plane for `scene`.
+  static float near_plane(const rt::RtScene& scene);
   double gpu_ms_ = 0.0;
 };
 

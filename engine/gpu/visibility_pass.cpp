@@ -185,6 +185,7 @@ VisibilityPass::VisibilityPass(VulkanContext& ctx) : ctx_(ctx), push_(sizeof(Vis
 }
 
 VisibilityPass::~VisibilityPass() {
+  ctx_.forget_deferred(this);
   const VkDevice d = ctx_.device();
   destroy_targets();
   if (pool_) vkDestroyDescriptorPool(d, pool_, nullptr);
@@ -249,12 +250,51 @@ void VisibilityPass::prepare(const GpuRtScene& scene, const render::CameraRays& 
   vkUpdateDescriptorSets(ctx_.device(), kSceneBindings, writes.data(), 0, nullptr);
   scene_ = &scene;
 
+  push_ = push_for(camera, sample, near_plane);
+}
+
+std::vector<std::uint8_t> VisibilityPass::push_for(const render::CameraRays& camera, glm::vec2 sample, float near_plane) {
+  const auto w = static_cast<std::uint32_t>(camera.width()), h = static_cast<std::uint32_t>(camera.height());
   // generate()'s rotation is the camera's to_world rotation.
   const glm::mat3 r = glm::mat3_cast(camera.to_world().rotation);
   const glm::vec3 o = camera.position();
   VisibilityPushGpu p{o.x, o.y, o.z, near_plane, r[0].x, r[0].y, r[0].z, camera.tan_half_x(), r[1].x, r[1].y, r[1].z,
                       camera.tan_half_y(), r[2].x, r[2].y, r[2].z, 0.0f, sample.x, sample.y, w, h};
-  std::memcpy(push_.data(), &p, sizeof(p));
+  std::vector<std::uint8_t> bytes(sizeof(p));
+  std::memcpy(bytes.data(), &p, sizeof(p));
+  return bytes;
+}
+
+void VisibilityPass::queue(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane) {
+  drop_queued();
+  prepare(scene, camera, sample, near_plane);
+  queued_scene_ = &scene;
+  queued_push_ = push_;
+  ctx_.record_before_next(this, [this](VkCommandBuffer cmd) { record(cmd); });
+}
+
+void VisibilityPass::drop_queued() {
+  ctx_.forget_deferred(this);
+  queued_scene_ = nullptr;
+}
+
+bool VisibilityPass::take_queued(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane,
+                                 std::span<rt::Hit> hits, std::span<std::uint8_t> found, double* gpu_ms) {
+  const bool match = queued_scene_ == &scene && queued_push_ == push_for(camera, sample, near_plane);
+  if (!match) {
+    drop_queued();
+    return false;
+  }
+  const std::size_t pixels = static_cast<std::size_t>(width_) * height_;
+  if (hits.size() != pixels || found.size() != pixels)
+    throw GpuError("VisibilityPass::take_queued: " + std::to_string(pixels) + " pixels, " + std::to_string(hits.size()) +
+                   " hits, " + std::to_string(found.size()) + " flags");
+  if (ctx_.has_deferred(this)) ctx_.flush();
+  queued_scene_ = nullptr;
+  const double ms = ctx_.take_deferred_ms(this);
+  if (gpu_ms) *gpu_ms = ms;
+  read_hits(scene, hits, found);
+  return true;
 }
 
 void VisibilityPass::record(VkCommandBuffer cmd) const {
@@ -296,9 +336,15 @@ void VisibilityPass::render(const GpuRtScene& scene, const render::CameraRays& c
   if (hits.size() != pixels || found.size() != pixels)
     throw GpuError("VisibilityPass::render: " + std::to_string(pixels) + " pixels, " + std::to_string(hits.size()) + " hits, " +
                    std::to_string(found.size()) + " flags");
+  drop_queued();  // its bindings and targets are rewritten here
   prepare(scene, camera, sample, near_plane);
   const double ms = ctx_.submit_and_wait([&](VkCommandBuffer cmd) { record(cmd); });
   if (gpu_ms) *gpu_ms = ms;
+  read_hits(scene, hits, found);
+}
+
+void VisibilityPass::read_hits(const GpuRtScene& scene, std::span<rt::Hit> hits, std::span<std::uint8_t> found) const {
+  const std::size_t pixels = hits.size();
   const std::span<const VisibilityHitGpu> out = hits_.mapped_as<const VisibilityHitGpu>(pixels);
   // In parallel, as GpuRtScene::intersect reads its hits: at 1080p a serial
   // pass over 2 M pixels costs more than the raster.

@@ -60,15 +60,34 @@ class VisibilityPass {
   // *gpu_ms: the submission's device time.
   void render(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane,
               std::span<rt::Hit> hits, std::span<std::uint8_t> found, double* gpu_ms = nullptr);
+  // prepare, and the pass queued at the head of the device's next
+  // submission (VulkanContext::record_before_next), whichever stage makes
+  // it: a frame draws its camera's view with its first submission.
+  void queue(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane);
+  // The queued pass's hits, as render() gives them, where it was queued for
+  // this scene, camera, sample and near plane (submitted now if no stage
+  // has yet); false, and the queued pass dropped, where it was not.
+  // *gpu_ms: its device time.
+  bool take_queued(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane,
+                   std::span<rt::Hit> hits, std::span<std::uint8_t> found, double* gpu_ms = nullptr);
+  // Drops a queued pass that has not run (its scene is about to change).
+  void drop_queued();
 
  private:
   void make_targets(std::uint32_t width, std::uint32_t height);
+  // The push constants for this view, as prepare writes them.
+  static std::vector<std::uint8_t> push_for(const render::CameraRays& camera, glm::vec2 sample, float near_plane);
+  // The hits in hits_ as GpuRtScene::intersect gives them.
+  void read_hits(const GpuRtScene& scene, std::span<rt::Hit> hits, std::span<std::uint8_t> found) const;
   void destroy_targets();
 
   VulkanContext& ctx_;
   const GpuRtScene* scene_ = nullptr;
   std::uint32_t width_ = 0, height_ = 0;
   std::vector<std::uint8_t> push_;  // VisibilityPushGpu
+  // What the queued pass (queue) was prepared for; null scene: none queued.
+  const GpuRtScene* queued_scene_ = nullptr;
+  std::vector<std::uint8_t> queued_push_;
   // The raster pipeline: its set binds rt_traversal.glsl's eight buffers.
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;

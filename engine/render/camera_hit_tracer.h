@@ -22,6 +22,11 @@ class CameraHitTracer {
   // backend cannot see the scene exactly.
   virtual bool camera_hits(const rt::RtScene& scene, const CameraRays& camera, glm::vec2 film_offset, std::span<rt::Hit> hits,
                            std::span<std::uint8_t> found) = 0;
+  // A hint that camera_hits will be asked for this view: a device starts on
+  // it with its next piece of work, so that the later call costs none of
+  // its own. A later call for another view (or after the scene changed)
+  // is answered as if no hint had come.
+  virtual void queue_camera_hits(const rt::RtScene& /*scene*/, const CameraRays& /*camera*/, glm::vec2 /*film_offset*/) {}
 };
 
 }  // namespace engine::render

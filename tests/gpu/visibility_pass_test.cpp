@@ -222,5 +222,60 @@ TEST_P(VisibilityPassTest, NothingNearerThanTheNearPlaneIsDrawn) {
   EXPECT_EQ(std::count(found.begin(), found.end(), 1), 0) << "the wall is nearer than a near plane at 0.6";
 }
 
+// A queued view (issue 36: drawn with the frame's first submission) gives
+// render()'s hits for the same view without a submission of its own when
+// another stage submitted; a request for another view or sample drops it
+// and is answered by render(), as is one after the scene changed.
+TEST_P(VisibilityPassTest, AQueuedViewIsTakenOnlyForTheSameViewAndGivesRendersHits) {
+  VISIBILITY_CONTEXT_OR_SKIP(ctx);
+  gpu_test::RtWorld world;
+  gpu_test::build_world(world);
+  gpu::GpuRtScene gpu_rt(*ctx);
+  gpu_rt.sync(world.rt);
+  scene::Camera lens;
+  lens.yfov_radians = 1.1f;
+  transform::Similarity at;
+  at.translation = glm::vec3(-3.5f, 1.0f, 3.0f);
+  at.rotation = glm::angleAxis(-0.7f, glm::vec3(0, 1, 0));
+  const render::CameraRays camera(lens, at, 96, 64);
+  const std::size_t n = 96 * 64;
+  gpu::VisibilityPass pass(*ctx);
+  std::vector<rt::Hit> want(n), got(n);
+  std::vector<std::uint8_t> want_found(n), got_found(n);
+  pass.render(gpu_rt, camera, {0.3f, 0.6f}, 0.01f, want, want_found);
+  ASSERT_GT(std::count(want_found.begin(), want_found.end(), 1), static_cast<long>(n / 2));
+
+  pass.queue(gpu_rt, camera, {0.3f, 0.6f}, 0.01f);
+  const std::uint64_t before = ctx->traffic().submissions;
+  ctx->submit_and_wait([](VkCommandBuffer) {});  // another stage's submission
+  double ms = -1;
+  ASSERT_TRUE(pass.take_queued(gpu_rt, camera, {0.3f, 0.6f}, 0.01f, got, got_found, &ms));
+  EXPECT_EQ(ctx->traffic().submissions - before, 1u) << "the queued view rode with the other stage's submission";
+  EXPECT_GE(ms, 0.0);
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    differ += want_found[i] != got_found[i] ||
+              (want_found[i] && (want[i].instance != got[i].instance || want[i].primitive != got[i].primitive ||
+                                 want[i].t != got[i].t || want[i].entity != got[i].entity));
+  EXPECT_EQ(differ, 0u);
+
+  // Queued for one sample, asked for another: not taken, and dropped.
+  pass.queue(gpu_rt, camera, {0.3f, 0.6f}, 0.01f);
+  EXPECT_FALSE(pass.take_queued(gpu_rt, camera, {0.5f, 0.5f}, 0.01f, got, got_found));
+  EXPECT_FALSE(ctx->has_deferred(&pass)) << "a view not taken is dropped";
+  // Queued and taken with no submission in between: submitted then.
+  pass.queue(gpu_rt, camera, {0.3f, 0.6f}, 0.01f);
+  const std::uint64_t alone = ctx->traffic().submissions;
+  ASSERT_TRUE(pass.take_queued(gpu_rt, camera, {0.3f, 0.6f}, 0.01f, got, got_found));
+  EXPECT_EQ(ctx->traffic().submissions - alone, 1u);
+  EXPECT_EQ(got_found, want_found);
+  // Another scene: not taken.
+  pass.queue(gpu_rt, camera, {0.3f, 0.6f}, 0.01f);
+  gpu::GpuRtScene other(*ctx);
+  other.sync(world.rt);
+  EXPECT_FALSE(pass.take_queued(other, camera, {0.3f, 0.6f}, 0.01f, got, got_found));
+  EXPECT_EQ(ctx->validation_errors(), 0);
+}
+
 INSTANTIATE_TEST_SUITE_P(Traversals, VisibilityPassTest, testing::Values(Traversal::ComputeBvh, Traversal::RayQuery),
                          gpu_test::traversal_name);

@@ -6,6 +6,7 @@
 
 #include "engine/gpu/gpu_error.h"
 #include "engine/jobs/parallel_for.h"
+#include "engine/render/camera_hit_tracer.h"
 #include "engine/render/camera_rays.h"
 #include "engine/render/light_plugin.h"
 #include "engine/render/path_tracer.h"
@@ -254,10 +255,30 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   }
 }
 
+// Before the probes update: the camera's view queued on the backend's
+// device (CameraHitTracer::queue_camera_hits), so that it is drawn with the
+// probe rays' submission rather than one of its own; the real-time
+// G-buffer then takes it (trace_gbuffer). Only a hint: a G-buffer that asks
+// for another view gets that one.
+void queue_camera_view(CameraView cameras, Res<rt::RtScene> rt, Res<TransGISettings> settings, Res<GiFrame> frame,
+                       ResMut<GiBackendChoice> backend, Res<PackedDecoder> packed) {
+  if (frame->width <= 0 || frame->height <= 0 || settings->gi_path != GiPath::Realtime) return;
+  choose_backend(*settings, *backend);
+  rt::RayBatchTracer* tracer = backend->active->tracer();
+  render::CameraHitTracer* raster = tracer ? tracer->camera_hit_tracer() : nullptr;
+  if (!raster) return;
+  const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
+  if (!rays) return;
+  // The jitter render_realtime will ask for (a camera cut clears the
+  // antialiasing's history, not its place in the jitter cycle).
+  const glm::vec2 jitter = settings->taa.enabled ? packed->taa.next_jitter(settings->taa) : glm::vec2(0.0f);
+  raster->queue_camera_hits(*rt, *rays, glm::vec2(0.5f) + jitter);
+}
+
 void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Get<const ProbeCascades>> cascades,
                View<Get<const LatentMesh>> latents,
                Res<rt::RtScene> rt, Res<scene::SceneAssets> assets, Res<render::SceneLights> lights,
-               Res<TransGISettings> settings, ResMut<GiFrame> frame, Res<GiBackendChoice> backend, Local<PackedDecoder> packed) {
+               Res<TransGISettings> settings, ResMut<GiFrame> frame, Res<GiBackendChoice> backend, ResMut<PackedDecoder> packed) {
   if (frame->width <= 0 || frame->height <= 0) return;
   const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
   if (!rays) throw std::runtime_error("transgi::render_gi: GiFrame asks for an image but the world has no camera");
@@ -407,9 +428,11 @@ void TransGIPlugin::build(app::App& app) {
   if (!w.has_resource<GiFrame>()) w.insert_resource<GiFrame>();
   if (!w.has_resource<GiBackendChoice>()) w.insert_resource<GiBackendChoice>();
   if (host_gpu_) w.resource<GiBackendChoice>().host = host_gpu_;
+  if (!w.has_resource<PackedDecoder>()) w.insert_resource<PackedDecoder>();
   app.add_system(Phase::PostUpdate, "transgi::request_light_settings", request_light_settings);
   app.add_system(Phase::PrepareRender, "transgi::sync_probe_volumes", sync_probe_volumes);
   app.add_system(Phase::PrepareRender, "transgi::sync_probe_cascades", sync_probe_cascades);
+  app.add_system(Phase::Render, "transgi::queue_camera_view", queue_camera_view);
   app.add_system(Phase::Render, "transgi::update_probes", update_probes);
   app.add_system(Phase::Render, "transgi::render_gi", render_gi);
 }

@@ -12,7 +12,10 @@
 //                 so settled probes wake and moved geometry is reclassified;
 //                 each field's viewer (its visibility test's view bias) is
 //                 the camera.
-//  Render         transgi::update_probes: probes traced, shared, accumulated
+//  Render         transgi::queue_camera_view: on a device that rasterises,
+//                 the real-time path's camera view (with this frame's
+//                 jitter) is queued to be drawn with the next submission.
+//                 transgi::update_probes: probes traced, shared, accumulated
 //                 and projected for this frame.
 //                 transgi::render_gi: if GiFrame has a size, its gi / direct
 //                 / full images and stage times are this frame's.
