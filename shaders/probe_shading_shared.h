@@ -68,6 +68,20 @@ struct ProbeRayHitGpu {
   float er, eg, eb, pad1;  // emitted
 };
 
+// probes::update_own_depth on the device (probe_own_depth.comp): batch
+// probe k's depth map in its store's slot, from its own rays in the
+// shading's hits.
+struct OwnDepthProbeGpu {
+  uint slot;       // its map: the store's depth from slot * texels
+  uint first_ray;  // its rays: the shading's hits from here, rays_per_probe of them
+  float unit;      // DepthMap::unit
+  float blend;     // the history's weight this frame (probes::own_depth_blend)
+};
+
+struct OwnDepthPush {
+  uint count, rays_per_probe, width, height;
+};
+
 // Where a probe ray's bounce light comes from: a field's interpolation
 // inside its box, the outer cascade's beyond it (`enabled` 0: no light).
 struct ProbeFeedbackGpu {
@@ -86,6 +100,7 @@ static_assert(sizeof(PendingProbeRayGpu) == 96 && offsetof(PendingProbeRayGpu, f
 static_assert(sizeof(ProbeRayHitGpu) == 64 && offsetof(ProbeRayHitGpu, flags) == 28 && offsetof(ProbeRayHitGpu, er) == 48,
               "ProbeRayHitGpu layout");
 static_assert(sizeof(ProbeFeedbackGpu) == 320, "ProbeFeedbackGpu layout");
+static_assert(sizeof(OwnDepthProbeGpu) == 16 && sizeof(OwnDepthPush) == 16, "OwnDepth layouts");
 static_assert(sizeof(ProbeRayBriefGpu) == 20 && offsetof(ProbeRayBriefGpu, er) == 8, "ProbeRayBriefGpu layout");
 }  // namespace transgi::gpu
 #endif

@@ -442,3 +442,103 @@ TEST(VulkanProbeKernels, ThePointsAreMadeOnTheDeviceFromTheShadedRays) {
   EXPECT_THROW(update(*kernels, fewer, brief_sh, brief_stats), std::logic_error);
   EXPECT_EQ(ctx->validation_errors(), 0);
 }
+
+// The batch's own depth maps updated on the device (probe_own_depth.comp)
+// in the field's store, from the probe rays' hits the shading left there,
+// while the host updates its own copy (probes::update_own_depth): over four
+// frames of the sample level's probe rays (64 rays into 32-texel maps, so
+// that texels take several rays a frame, in order), the device's copy of
+// every batch probe equals the host's bit for bit, the other probes' stay as
+// they were, and no updated map is sent up again (the store holds the
+// version the host stamped).
+TEST(VulkanProbeKernels, TheOwnDepthIsUpdatedOnTheDeviceBitForBitAndNotSentUp) {
+  GPU_TEST_CONTEXT_OR_SKIP(unused);
+  OWN_PROBE_KERNELS_OR_SKIP(own);
+  const std::shared_ptr<transgi::gpu::VulkanProbeKernels>& kernels = own.kernels;
+  eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
+  const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
+  const render::LightSet lights(scene, test_punctual(), nullptr);
+  const probes::ProbeGrid grid = probes::ProbeGrid::centred_in(scene.bounds_min(), scene.bounds_max(), glm::ivec3(4, 3, 4));
+  const probes::MapLayout layout{8, 4};
+  const int count = grid.count(), m = 64;
+  const std::size_t texels = static_cast<std::size_t>(layout.texel_count());
+  const std::vector<glm::vec3> directions = probes::spherical_fibonacci(m);
+  std::vector<glm::vec3> origins;
+  std::vector<int> tracing;
+  for (int q = 0; q < count; ++q) {
+    tracing.push_back(q);
+    origins.push_back(grid.position(q));
+  }
+  std::vector<probes::ProbeMapState> states(static_cast<std::size_t>(count));
+  for (auto& st : states) st.reset(layout.texel_count(), grid.min_spacing());
+  std::vector<const probes::DepthMap*> own_depth;
+  for (const auto& st : states) own_depth.push_back(&st.depth);
+  std::unique_ptr<probes::ProbeMapStore> store = kernels->make_map_store(layout, count);
+  auto* maps = dynamic_cast<transgi::gpu::VulkanMapStore*>(store.get());
+  ASSERT_NE(maps, nullptr);
+  probes::ProbeFeedbackSource self;
+  self.grid = &grid;
+  self.layout = layout;
+  self.lit = false;
+  const probes::MapProjector projector(layout);
+  const probes::SharingSettings sharing;
+  const probes::AccumulationSettings accumulation;
+  std::size_t collisions = 0;
+  for (int frame = 0; frame < 4; ++frame) {
+    // Every probe traces; a third of them (another third each frame) update.
+    std::vector<std::vector<probes::ShadedPoint>> points(static_cast<std::size_t>(count));
+    kernels->shade_probe_rays(scene, lights, origins, tracing, directions, 7, static_cast<std::uint64_t>(frame + 1), self, nullptr,
+                              [&](int j, int i, const probes::ProbeRayHit& h) {
+                                probes::ShadedPoint sp;
+                                sp.direction = directions[static_cast<std::size_t>(i)];
+                                sp.distance = h.distance;
+                                points[static_cast<std::size_t>(tracing[static_cast<std::size_t>(j)])].push_back(sp);
+                              });
+    std::vector<int> batch;
+    std::vector<probes::ProbeMapState*> batch_states;
+    for (int q = 0; q < count; ++q)
+      if (q % 3 != frame % 3) {
+        batch.push_back(q);
+        batch_states.push_back(&states[static_cast<std::size_t>(q)]);
+      }
+    if (frame == 0) {  // texels that take more than one ray: the update's order matters
+      std::vector<int> per(texels, 0);
+      for (const auto& pt : points[0])
+        if (std::isfinite(pt.distance)) collisions += ++per[static_cast<std::size_t>(layout.texel_of(pt.direction))] > 1;
+    }
+    const std::vector<probes::DepthMap> before = [&] {
+      std::vector<probes::DepthMap> d;
+      for (const auto& st : states) d.push_back(st.depth);
+      return d;
+    }();
+    std::vector<std::uint8_t> changed(batch.size());
+    std::vector<float> sh(batch.size() * 75);
+    probes::ShareAccumulateTimes times;
+    kernels->share_accumulate_project(grid, projector, points, own_depth, sharing, batch, batch_states, store.get(), accumulation,
+                                      changed, sh, times);
+    std::vector<std::uint32_t> device(static_cast<std::size_t>(count) * texels);
+    maps->depth().download(std::span<std::uint32_t>(device));
+    std::size_t differ = 0, updated = 0;
+    for (int q = 0; q < count; ++q) {
+      const probes::DepthMap& host = states[static_cast<std::size_t>(q)].depth;
+      for (std::size_t t = 0; t < texels; ++t) {
+        const std::uint32_t want = std::uint32_t{host.texels[t].mean} | std::uint32_t{host.texels[t].variance} << 16;
+        differ += device[static_cast<std::size_t>(q) * texels + t] != want;
+        const probes::DepthMap::Texel& was = before[static_cast<std::size_t>(q)].texels[t];
+        updated += was.mean != host.texels[t].mean || was.variance != host.texels[t].variance;
+      }
+    }
+    maps->stage_depth(own_depth);
+    std::printf("frame %d: %zu batch probes, %zu texels updated, %zu differ from the host's, %zu maps to send again\n", frame,
+                batch.size(), updated, differ, maps->depth_maps_staged());
+    EXPECT_EQ(differ, 0u) << "frame " << frame;
+    EXPECT_GT(updated, texels) << "frame " << frame;
+    EXPECT_EQ(maps->depth_maps_staged(), 0u) << "frame " << frame << ": the device holds every map the host has";
+    for (int q = frame % 3; q < count; q += 3)  // not in the batch: as it was
+      for (std::size_t t = 0; t < texels; ++t)
+        ASSERT_EQ(states[static_cast<std::size_t>(q)].depth.texels[t].mean, before[static_cast<std::size_t>(q)].texels[t].mean)
+            << "probe " << q << " frame " << frame;
+  }
+  EXPECT_GT(collisions, 0u) << "no texel took two rays: the test would not see the update's order";
+  EXPECT_EQ(own.ctx->validation_errors(), 0);
+}

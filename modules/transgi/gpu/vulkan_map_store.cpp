@@ -83,6 +83,13 @@ void VulkanMapStore::stage_depth(std::span<const probes::DepthMap* const> depth)
     depth_copies_.push_back({k * per, static_cast<VkDeviceSize>(send[k]) * per, per});
 }
 
+void VulkanMapStore::adopt_depth(std::size_t q, std::uint64_t version) {
+  if (q >= depth_version_.size())
+    throw std::out_of_range("VulkanMapStore::adopt_depth: slot " + std::to_string(q) + " of a field of " + std::to_string(probes_) +
+                            " probes");
+  depth_version_[q] = version;
+}
+
 void VulkanMapStore::record_depth_uploads(VkCommandBuffer cmd) const {
   if (depth_copies_.empty() && blank_depth_slots_.empty()) return;
   const std::size_t per = texels_ * kDepthBytes;

@@ -44,6 +44,12 @@ class VulkanMapStore final : public probes::ProbeMapStore {
   // never hit, with nothing sent), for record_depth_uploads.
   void stage_depth(std::span<const probes::DepthMap* const> depth);
   void record_depth_uploads(VkCommandBuffer cmd) const;
+  // How many maps the last stage_depth sends up (blank ones filled, not sent, excluded).
+  [[nodiscard]] std::size_t depth_maps_staged() const { return depth_copies_.size(); }
+  // After a kernel updated slot q's depth copy on the device to what the
+  // host's map now holds (the host made the same update): the copy is of
+  // `version`, and is not sent again.
+  void adopt_depth(std::size_t q, std::uint64_t version);
   // The depth copies, probe q's at q * texels, current once the uploads
   // recorded before have run.
   [[nodiscard]] const engine::gpu::GpuBuffer& depth() const { return depth_; }

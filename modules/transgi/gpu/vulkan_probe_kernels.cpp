@@ -42,7 +42,33 @@ probes::SharingStats VulkanProbeKernels::share_accumulate_project(
   // updates right after it shades): made on the device, not sent again.
   const VulkanRadianceRaster::DevicePoints rays{&shading_->hits_on_device(), &shading_->directions_on_device(), shaded_probes_,
                                                 shaded_rays_per_probe_};
+  const bool rays_on_device = shaded_rays_per_probe_ > 0 && VulkanRadianceRaster::takes_device_points(points, rays);
+  // The batch's own depth: where its rays are on the device and the field
+  // keeps its maps there, updated in the store's copies by a kernel (and
+  // the host's by the same arithmetic after the submission), so that no
+  // updated map goes up; else on the host first, the changed maps sent.
+  bool own_depth_on_device = maps && rays_on_device;
+  for (std::size_t i = 0; own_depth_on_device && i < batch.size(); ++i)
+    own_depth_on_device = own_depth[static_cast<std::size_t>(batch[i])] == &states[i]->depth;
+  if (!own_depth_on_device)
+    engine::jobs::parallel_for(0, static_cast<int>(batch.size()), 8, [&](int b, int e) {
+      for (int i = b; i < e; ++i)
+        probes::update_own_depth(*states[static_cast<std::size_t>(i)], layout, points[static_cast<std::size_t>(batch[static_cast<std::size_t>(i)])],
+                                 accumulation);
+    });
   r->prepare(grid, points, own_depth, sharing, targets, maps, shaded_rays_per_probe_ > 0 ? &rays : nullptr);
+  if (own_depth_on_device) {
+    std::vector<std::size_t> tracing_index(static_cast<std::size_t>(grid.count()), 0);
+    for (std::size_t j = 0; j < shaded_probes_.size(); ++j) tracing_index[static_cast<std::size_t>(shaded_probes_[j])] = j;
+    std::vector<OwnDepthProbeGpu> records(batch.size());
+    for (std::size_t i = 0; i < batch.size(); ++i)
+      records[i] = {static_cast<uint>(batch[i]),
+                    static_cast<uint>(tracing_index[static_cast<std::size_t>(batch[i])] * shaded_rays_per_probe_),
+                    states[i]->depth.unit, probes::own_depth_blend(*states[i], accumulation)};
+    if (!own_depth_) own_depth_ = std::make_unique<VulkanProbeOwnDepth>(*ctx_);
+    own_depth_->prepare(records, shading_->hits_on_device(), shading_->directions_on_device(), maps->depth(),
+                        shaded_rays_per_probe_, layout);
+  }
   if (shaded_brief_ && !r->points_made_on_device())
     throw std::logic_error("VulkanProbeKernels: the points are not the last shading's rays, whose hits came back brief "
                            "(set_brief_hits(false) for points of the caller's own)");
@@ -52,7 +78,7 @@ probes::SharingStats VulkanProbeKernels::share_accumulate_project(
   // One submission, a timestamp after each stage: the samples and the
   // filled maps never leave the device.
   ctx_->submit_and_wait([&](VkCommandBuffer cmd) {
-    r->record(cmd);
+    r->record(cmd, own_depth_on_device ? own_depth_.get() : nullptr);
     ctx_->mark_stage(cmd);
     engine::gpu::record_compute_barrier(cmd);
     a->record(cmd);
@@ -69,6 +95,14 @@ probes::SharingStats VulkanProbeKernels::share_accumulate_project(
   const probes::SharingStats stats = r->finish(nullptr);
   a->finish(states, changed, {});
   p->read(sh);
+  if (own_depth_on_device)
+    engine::jobs::parallel_for(0, static_cast<int>(batch.size()), 8, [&](int b, int e) {
+      for (int i = b; i < e; ++i) {
+        const auto k = static_cast<std::size_t>(i);
+        probes::update_own_depth(*states[k], layout, points[static_cast<std::size_t>(batch[k])], accumulation);
+        maps->adopt_depth(static_cast<std::size_t>(batch[k]), states[k]->depth.version);
+      }
+    });
   times.accumulate_ms = ms_since(t1);
   return stats;
 }

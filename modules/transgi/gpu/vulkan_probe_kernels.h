@@ -12,6 +12,7 @@
 #include "engine/gpu/vulkan_context.h"
 #include "gpu/vulkan_fused_decoder.h"
 #include "gpu/vulkan_probe_accumulator.h"
+#include "gpu/vulkan_probe_own_depth.h"
 #include "gpu/vulkan_probe_shading.h"
 #include "gpu/vulkan_radiance_raster.h"
 #include "model/transfer_model.h"
@@ -91,6 +92,7 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   std::map<std::pair<int, int>, std::unique_ptr<VulkanRadianceRaster>> rasters_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanShProjector>> projectors_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanProbeAccumulator>> accumulators_;
+  std::unique_ptr<VulkanProbeOwnDepth> own_depth_;  // made on first use
   engine::gpu::GpuRayTracer tracer_;
   std::shared_ptr<const model::TransferModel> decoder_model_;  // kept alive: the cache's key
   std::unique_ptr<VulkanFusedDecoder> decoder_;

@@ -161,8 +161,19 @@ void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vec
   push_.assign(reinterpret_cast<const std::uint8_t*>(&push), reinterpret_cast<const std::uint8_t*>(&push) + sizeof(push));
 }
 
-void VulkanRadianceRaster::record(VkCommandBuffer cmd) const {
+bool VulkanRadianceRaster::takes_device_points(const std::vector<std::vector<probes::ShadedPoint>>& points,
+                                               const DevicePoints& rays) {
+  std::vector<std::uint32_t> begin(points.size() + 1, 0), first;
+  for (std::size_t q = 0; q < points.size(); ++q) begin[q + 1] = begin[q] + static_cast<std::uint32_t>(points[q].size());
+  return points_from_rays(points, rays, begin, first);
+}
+
+void VulkanRadianceRaster::record(VkCommandBuffer cmd, const VulkanProbeOwnDepth* own_depth) const {
   if (store_) store_->record_depth_uploads(cmd);
+  if (own_depth) {
+    own_depth->record(cmd);
+    engine::gpu::record_compute_barrier(cmd);
+  }
   if (point_groups_ > 0) {
     points_pipeline_->record_dispatch(cmd, point_groups_, 1, 1, point_push_);
     engine::gpu::record_compute_barrier(cmd);

@@ -10,6 +10,7 @@
 #include "engine/gpu/gpu_buffer.h"
 #include "engine/gpu/vulkan_context.h"
 #include "gpu/vulkan_map_store.h"
+#include "gpu/vulkan_probe_own_depth.h"
 #include "probes/radiance_sharing.h"
 
 namespace transgi::gpu {
@@ -47,8 +48,13 @@ class VulkanRadianceRaster {
                const DevicePoints* device_points = nullptr);
   // Whether the last prepare made the points on the device.
   [[nodiscard]] bool points_made_on_device() const { return points_on_device_; }
-  // record: the store's depth uploads and the dispatch, into a command buffer being recorded.
-  void record(VkCommandBuffer cmd) const;
+  // Whether prepare would make these points on the device from `rays`.
+  [[nodiscard]] static bool takes_device_points(const std::vector<std::vector<probes::ShadedPoint>>& points,
+                                                const DevicePoints& rays);
+  // record: the store's depth uploads and the dispatch, into a command
+  // buffer being recorded; with `own_depth`, its update of the store's
+  // depth maps between the two.
+  void record(VkCommandBuffer cmd, const VulkanProbeOwnDepth* own_depth = nullptr) const;
   // The samples on the device after the submission: vec4 (sum, count) per
   // texel, one map per probe of the grid (the targets' written).
   [[nodiscard]] const engine::gpu::GpuBuffer& samples_on_device() const { return samples_; }

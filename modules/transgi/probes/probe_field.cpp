@@ -521,12 +521,7 @@ void ProbeField::classify_traced(const engine::rt::RtScene& scene, UpdateWork& w
 ProbeField::LightIntoProbes ProbeField::share_accumulate_project(UpdateWork& w) {
   using namespace engine;
   const int probes = grid_.count();
-  // Each probe's depth map from its own rays only: probes in parallel.
-  jobs::parallel_for(0, probes, 8, [&](int q0, int q1) {
-    for (int q = q0; q < q1; ++q)
-      if (takes_frame(w, q))
-        update_own_depth(probes_.maps[static_cast<std::size_t>(q)], settings_.map, w.points[static_cast<std::size_t>(q)], settings_.accumulation);
-  });
+  // The backend updates each batch probe's depth from its own rays first.
   std::vector<const DepthMap*> depth(static_cast<std::size_t>(probes));
   for (int q = 0; q < probes; ++q) depth[static_cast<std::size_t>(q)] = &probes_.maps[static_cast<std::size_t>(q)].depth;
   // Every updated probe in one batch for the backend.

@@ -112,9 +112,11 @@ class ProbeKernels {
                                 const ProbeFeedbackSource& self, const ProbeFeedbackSource* outer,
                                 const ProbeRayConsumer& consume) = 0;
   // This frame's light into the probes of `batch`, in one stage so that a
-  // device keeps its intermediate maps: each batch probe's samples from its
-  // own and its neighbours' points (rasterize_shared with the batch as its
-  // targets), accumulated into *states[i] (accumulate; its result in
+  // device keeps its intermediate maps: each batch probe's own depth from
+  // its own points (update_own_depth of *states[i] from points[batch[i]];
+  // own_depth[batch[i]] is that state's map, read after the update), then
+  // its samples from its own and its neighbours' points (rasterize_shared
+  // with the batch as its targets), accumulated into *states[i] (accumulate; its result in
   // changed[i]), filled (filled_radiance with accumulation.fill_passes) and
   // projected as projector.project into sh[i * 75, i * 75 + 75). `times`
   // gets the host time of the sharing and of the rest. `store`: this

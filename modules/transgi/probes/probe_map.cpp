@@ -187,13 +187,18 @@ bool accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSett
   return changed;
 }
 
-void update_own_depth(ProbeMapState& st, const MapLayout& layout, const std::vector<ShadedPoint>& own,
-                      const AccumulationSettings& s) {
+float own_depth_blend(const ProbeMapState& st, const AccumulationSettings& s) {
   // Like the radiance, the depth starts (and restarts after the geometry
   // moved) with a fast blend, so visibility follows a moved wall in a few
   // frames rather than ~20 per texel hit.
   const float ramp = std::min(1.0f, static_cast<float>(st.depth_frames) / static_cast<float>(std::max(1, s.warmup_frames)));
-  const float h = std::min(s.hysteresis, s.fast_hysteresis + (s.hysteresis - s.fast_hysteresis) * ramp);
+  return std::min(s.hysteresis, s.fast_hysteresis + (s.hysteresis - s.fast_hysteresis) * ramp);
+}
+
+void update_own_depth(ProbeMapState& st, const MapLayout& layout, const std::vector<ShadedPoint>& own,
+                      const AccumulationSettings& s) {
+  // shaders/probe_own_depth.comp is the device's twin, bit for bit.
+  const float h = own_depth_blend(st, s);
   ++st.depth_frames;
   for (const ShadedPoint& p : own) {
     if (!std::isfinite(p.distance)) continue;

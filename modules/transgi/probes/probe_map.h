@@ -93,6 +93,11 @@ bool accumulate(ProbeMapState& state, const FrameSamples& frame, const Accumulat
 // Updates the own-depth moments from this probe's own shaded points.
 void update_own_depth(ProbeMapState& state, const MapLayout& layout, const std::vector<ShadedPoint>& own,
                       const AccumulationSettings& settings);
+// The weight update_own_depth gives a texel's history this frame (the
+// exponential blend's h: fast for a map's first frames, so that visibility
+// follows a moved wall in a few frames). A device that updates the depth
+// itself takes it from here.
+float own_depth_blend(const ProbeMapState& state, const AccumulationSettings& settings);
 // The radiance to project: texels never sampled are filled from sampled
 // neighbours (then the map's solid-angle-weighted mean), never read as black.
 std::vector<glm::vec3> filled_radiance(const ProbeMapState& state, const MapLayout& layout, int passes);
