@@ -80,6 +80,17 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
                                std::uint64_t sample, const probes::ProbeFeedbackSource* self,
                                const probes::ProbeFeedbackSource* outer, std::vector<probes::ProbeRayHit>& out,
                                std::vector<BounceInput>* bounce_inputs, bool brief) {
+  if (!prepare(scene, lights, tracer, origins, probe_ids, directions, seed, sample, self, outer)) return false;
+  if (prepared_.rays > 0) gpu_ms_ += std::max(0.0, ctx_.submit_and_wait([&](VkCommandBuffer cmd) { record(cmd); }));
+  read(out, bounce_inputs, brief);
+  return true;
+}
+
+bool VulkanProbeShading::prepare(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+                                 engine::gpu::GpuRayTracer& tracer, std::span<const glm::vec3> origins,
+                                 std::span<const int> probe_ids, std::span<const glm::vec3> directions, std::uint64_t seed,
+                                 std::uint64_t sample, const probes::ProbeFeedbackSource* self,
+                                 const probes::ProbeFeedbackSource* outer) {
   using engine::gpu::HitGpu;
   using engine::gpu::RayGpu;
   if (probe_ids.size() != origins.size())
@@ -87,13 +98,13 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
                                 std::to_string(probe_ids.size()) + " probe indices");
   if (self) check_source(*self);
   if (outer) check_source(*outer);
-  if (brief && bounce_inputs) throw std::invalid_argument("VulkanProbeShading: brief hits carry no bounce inputs");
+  prepared_ = Prepared{};
   if (!scene.assets()) return false;
   scene_.sync(scene, lights);  // first: a scene the device cannot hold throws before out changes
   engine::gpu::GpuRtScene* rt = tracer.device_scene(scene);
   if (!rt) return false;
   const std::size_t m = directions.size(), n = origins.size() * m;
-  out.resize(n);
+  prepared_.rays = n;
   if (n == 0) return true;
 
   // The probes and the frame's directions in; every per-ray buffer sized for n.
@@ -126,8 +137,9 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
     depth_ = GpuBuffer(ctx_, texel_count * 4, GpuBuffer::Placement::DeviceOnly);
   // Fields without a store send their depth up through staging; those with
   // one have it staged into their store (only the changed maps).
-  std::vector<VkBufferCopy> host_depth, store_depth[2];
-  VulkanMapStore* stores[2] = {nullptr, nullptr};
+  std::vector<VkBufferCopy>& host_depth = prepared_.host_depth;
+  std::vector<VkBufferCopy>* store_depth = prepared_.store_depth;
+  VulkanMapStore** stores = prepared_.stores;
   std::size_t host_texels = 0;
   for (int which = 0; which < 2; ++which) {
     const probes::ProbeFeedbackSource* f = fields[which];
@@ -199,41 +211,54 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
   finish_->bind(5, probes_);
   finish_->bind(6, probe_sh_);
 
-  ProbeHitPush push{};
+  ProbeHitPush& push = prepared_.push;
   push.count = static_cast<uint>(n);
   push.seed_lo = static_cast<uint>(seed);
   push.seed_hi = static_cast<uint>(seed >> 32);
   push.sample_lo = static_cast<uint>(sample);
   push.sample_hi = static_cast<uint>(sample >> 32);
   push.offset_scale = scene.offset_scale();
+  prepared_.m = m;
+  return true;
+}
+
+void VulkanProbeShading::record(VkCommandBuffer cmd) const {
+  const Prepared& pr = prepared_;
+  const std::size_t n = pr.rays, m = pr.m;
+  if (n == 0) return;
   const std::uint32_t generate_push[2] = {static_cast<std::uint32_t>(n), static_cast<std::uint32_t>(m)};
   const std::uint32_t closest[2] = {static_cast<std::uint32_t>(n), 0u}, any_hit[2] = {static_cast<std::uint32_t>(n), 1u};
   const ProbeFinishPush finish_push{static_cast<uint>(n), 0, 0, 0};
   const auto groups = static_cast<std::uint32_t>((n + kProbeShadingGroupSize - 1) / kProbeShadingGroupSize);
   const auto rt_groups = static_cast<std::uint32_t>((n + engine::gpu::kRtGroupSize - 1) / engine::gpu::kRtGroupSize);
-  gpu_ms_ += std::max(0.0, ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
-    // The depth maps first: the stores' changed ones up, then both fields' into depth_.
-    for (int which = 0; which < 2; ++which)
-      if (stores[which]) stores[which]->record_depth_uploads(cmd);
-    for (int which = 0; which < 2; ++which)
-      if (stores[which])
-        vkCmdCopyBuffer(cmd, stores[which]->depth().handle(), depth_.handle(), static_cast<std::uint32_t>(store_depth[which].size()),
-                        store_depth[which].data());
-    if (!host_depth.empty())
-      vkCmdCopyBuffer(cmd, depth_staging_.handle(), depth_.handle(), static_cast<std::uint32_t>(host_depth.size()), host_depth.data());
-    engine::gpu::record_memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
-    generate_->record_dispatch(cmd, groups, 1, 1, generate_push);
-    engine::gpu::record_compute_barrier(cmd);
-    trace_->record_dispatch(cmd, rt_groups, 1, 1, closest);
-    engine::gpu::record_compute_barrier(cmd);
-    begin_->record_dispatch(cmd, groups, 1, 1, &push);
-    engine::gpu::record_compute_barrier(cmd);
-    shadow_trace_->record_dispatch(cmd, rt_groups, 1, 1, any_hit);
-    engine::gpu::record_compute_barrier(cmd);
-    finish_->record_dispatch(cmd, groups, 1, 1, &finish_push);
-  }));
+  // The depth maps first: the stores' changed ones up, then both fields' into depth_.
+  for (int which = 0; which < 2; ++which)
+    if (pr.stores[which]) pr.stores[which]->record_depth_uploads(cmd);
+  for (int which = 0; which < 2; ++which)
+    if (pr.stores[which])
+      vkCmdCopyBuffer(cmd, pr.stores[which]->depth().handle(), depth_.handle(), static_cast<std::uint32_t>(pr.store_depth[which].size()),
+                      pr.store_depth[which].data());
+  if (!pr.host_depth.empty())
+    vkCmdCopyBuffer(cmd, depth_staging_.handle(), depth_.handle(), static_cast<std::uint32_t>(pr.host_depth.size()),
+                    pr.host_depth.data());
+  engine::gpu::record_memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                                     VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+  generate_->record_dispatch(cmd, groups, 1, 1, generate_push);
+  engine::gpu::record_compute_barrier(cmd);
+  trace_->record_dispatch(cmd, rt_groups, 1, 1, closest);
+  engine::gpu::record_compute_barrier(cmd);
+  begin_->record_dispatch(cmd, groups, 1, 1, &pr.push);
+  engine::gpu::record_compute_barrier(cmd);
+  shadow_trace_->record_dispatch(cmd, rt_groups, 1, 1, any_hit);
+  engine::gpu::record_compute_barrier(cmd);
+  finish_->record_dispatch(cmd, groups, 1, 1, &finish_push);
+}
 
+void VulkanProbeShading::read(std::vector<probes::ProbeRayHit>& out, std::vector<BounceInput>* bounce_inputs, bool brief) const {
+  if (brief && bounce_inputs) throw std::invalid_argument("VulkanProbeShading: brief hits carry no bounce inputs");
+  const std::size_t n = prepared_.rays;
+  out.resize(n);
+  if (n == 0) return;
   if (brief) {
     const auto briefs = briefs_.mapped_as<const ProbeRayBriefGpu>(n);
     engine::jobs::parallel_for<std::size_t>(0, n, kRaysPerTask, [&](std::size_t b, std::size_t e) {
@@ -243,7 +268,7 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
         take_brief(g.flags, g.distance, vec_of(g.er, g.eg, g.eb), out[i]);
       }
     });
-    return true;
+    return;
   }
   const auto hits_out = out_.mapped_as<const ProbeRayHitGpu>(n);
   engine::jobs::parallel_for<std::size_t>(0, n, kRaysPerTask, [&](std::size_t b, std::size_t e) {
@@ -266,7 +291,6 @@ bool VulkanProbeShading::shade(const engine::rt::RtScene& scene, const engine::r
       }
     });
   }
-  return true;
 }
 
 }  // namespace transgi::gpu

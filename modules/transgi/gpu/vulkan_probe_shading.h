@@ -7,6 +7,7 @@
 // probe fields). Only the probes' origins go in and the shaded hits come
 // out. The CPU functions are the oracle (tests/gpu/probe_shading_test.cpp);
 // the light sample draws the same random numbers.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -21,10 +22,13 @@
 #include "engine/gpu/vulkan_context.h"
 #include "engine/render/light_set.h"
 #include "engine/rt/ray_batch_tracer.h"
+#include "probe_shading_shared.h"
 #include "probes/probe_kernels.h"
 #include "probes/probe_rays.h"
 
 namespace transgi::gpu {
+
+class VulkanMapStore;
 
 // What a probe ray's hit needs for a bounce light the caller computes (DDGI's
 // volumes): the hit's diffuse albedo / pi and shading normal, and whether it
@@ -77,6 +81,20 @@ class VulkanProbeShading {
              const probes::ProbeFeedbackSource* outer, std::vector<probes::ProbeRayHit>& out,
              std::vector<BounceInput>* bounce_inputs = nullptr, bool brief = false);
 
+  // shade() in three steps, for a submission that holds other stages too:
+  // prepare (false where the tracer declines the scene), record into the
+  // submission, then read once it ran (the brief and bounce_inputs as
+  // shade's).
+  bool prepare(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, engine::gpu::GpuRayTracer& tracer,
+               std::span<const glm::vec3> origins, std::span<const int> probe_ids, std::span<const glm::vec3> directions,
+               std::uint64_t seed, std::uint64_t sample, const probes::ProbeFeedbackSource* self,
+               const probes::ProbeFeedbackSource* outer);
+  void record(VkCommandBuffer cmd) const;
+  void read(std::vector<probes::ProbeRayHit>& out, std::vector<BounceInput>* bounce_inputs = nullptr, bool brief = false) const;
+  // Device milliseconds to count for the shading (a caller that records it
+  // in a submission of its own times it).
+  void add_gpu_ms(double ms) { gpu_ms_ += std::max(0.0, ms); }
+
   // The last shade()'s results on the device (ProbeRayHitGpu per ray, in
   // `out`'s order) and its directions (vec4 each), until the next shade().
   [[nodiscard]] const engine::gpu::GpuBuffer& hits_on_device() const { return out_; }
@@ -99,6 +117,14 @@ class VulkanProbeShading {
   // through depth_staging_.
   engine::gpu::GpuBuffer depth_, depth_staging_;
   double gpu_ms_ = 0;
+  // What prepare left for record and read.
+  struct Prepared {
+    std::size_t rays = 0, m = 0;
+    ProbeHitPush push{};
+    VulkanMapStore* stores[2] = {nullptr, nullptr};
+    std::vector<VkBufferCopy> host_depth, store_depth[2];
+  };
+  Prepared prepared_;
 };
 
 }  // namespace transgi::gpu
