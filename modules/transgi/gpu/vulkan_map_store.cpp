@@ -53,8 +53,15 @@ void VulkanMapStore::stage_depth(std::span<const probes::DepthMap* const> depth)
   if (depth.size() != static_cast<std::size_t>(probes_))
     throw std::invalid_argument("VulkanMapStore::stage_depth: " + std::to_string(depth.size()) + " depth maps for a field of " +
                                 std::to_string(probes_) + " probes");
-  depth_copies_.clear();
-  blank_depth_slots_.clear();
+  // What an earlier stage_depth left for the same submission stays staged
+  // (the probe rays' and the raster's both stage, and record in one
+  // submission): a map staged again is rewritten in its place.
+  if (depth_pending_at_.size() != depth.size()) depth_pending_at_.assign(depth.size(), -1);
+  const auto drop_pending_copy = [&](std::size_t q) {
+    if (depth_pending_at_[q] < 0) return;
+    std::erase_if(depth_copies_, [&](const VkBufferCopy& c) { return c.dstOffset == static_cast<VkDeviceSize>(q) * texels_ * kDepthBytes; });
+    depth_pending_at_[q] = -1;
+  };
   std::vector<std::size_t> send;
   for (std::size_t q = 0; q < depth.size(); ++q) {
     const probes::DepthMap* d = depth[q];
@@ -65,22 +72,40 @@ void VulkanMapStore::stage_depth(std::span<const probes::DepthMap* const> depth)
       blank = d->texels[t].mean == kNeverHit.mean && d->texels[t].variance == kNeverHit.variance;
     if (blank) {
       // Never hit, as DepthMap::reset leaves it; "blank" is a version of its own.
+      drop_pending_copy(q);
       if (depth_version_[q] != kBlankDepth) blank_depth_slots_.push_back(static_cast<int>(q));
       depth_version_[q] = kBlankDepth;
       continue;
     }
+    std::erase(blank_depth_slots_, static_cast<int>(q));
     send.push_back(q);
     depth_version_[q] = d->version;  // 0 (not stamped) goes up every time
   }
   if (send.empty()) return;
   const std::size_t per = texels_ * kDepthBytes;
-  if (depth_staging_.size() < send.size() * per) depth_staging_ = engine::gpu::GpuBuffer(*ctx_, send.size() * per);
-  const auto bytes = depth_staging_.mapped_as<std::uint8_t>(send.size() * per);
+  std::vector<std::size_t> at(send.size());
+  std::size_t slots = depth_staged_maps_;
+  for (std::size_t k = 0; k < send.size(); ++k) {
+    std::ptrdiff_t& pending = depth_pending_at_[send[k]];
+    if (pending < 0) {
+      pending = static_cast<std::ptrdiff_t>(slots++);
+      depth_copies_.push_back({static_cast<VkDeviceSize>(pending) * per, static_cast<VkDeviceSize>(send[k]) * per, per});
+    }
+    at[k] = static_cast<std::size_t>(pending);
+  }
+  if (depth_staging_.handle() == VK_NULL_HANDLE || depth_staging_.size() < slots * per) {
+    engine::gpu::GpuBuffer grown(*ctx_, slots * per);
+    if (depth_staged_maps_ > 0) {
+      const auto old = depth_staging_.mapped_as<const std::uint8_t>(depth_staged_maps_ * per);
+      std::memcpy(grown.mapped_as<std::uint8_t>(depth_staged_maps_ * per).data(), old.data(), depth_staged_maps_ * per);
+    }
+    depth_staging_ = std::move(grown);
+  }
+  depth_staged_maps_ = slots;
+  const auto bytes = depth_staging_.mapped_as<std::uint8_t>(slots * per);
   engine::jobs::parallel_for<std::size_t>(0, send.size(), 8, [&](std::size_t b, std::size_t e) {
-    for (std::size_t k = b; k < e; ++k) std::memcpy(bytes.data() + k * per, depth[send[k]]->texels.data(), per);
+    for (std::size_t k = b; k < e; ++k) std::memcpy(bytes.data() + at[k] * per, depth[send[k]]->texels.data(), per);
   });
-  for (std::size_t k = 0; k < send.size(); ++k)
-    depth_copies_.push_back({k * per, static_cast<VkDeviceSize>(send[k]) * per, per});
 }
 
 void VulkanMapStore::adopt_depth(std::size_t q, std::uint64_t version) {
@@ -90,7 +115,7 @@ void VulkanMapStore::adopt_depth(std::size_t q, std::uint64_t version) {
   depth_version_[q] = version;
 }
 
-void VulkanMapStore::record_depth_uploads(VkCommandBuffer cmd) const {
+void VulkanMapStore::record_depth_uploads(VkCommandBuffer cmd) {
   if (depth_copies_.empty() && blank_depth_slots_.empty()) return;
   const std::size_t per = texels_ * kDepthBytes;
   for (const int q : blank_depth_slots_) vkCmdFillBuffer(cmd, depth_.handle(), static_cast<VkDeviceSize>(q) * per, per, kNeverHitBits);
@@ -99,6 +124,12 @@ void VulkanMapStore::record_depth_uploads(VkCommandBuffer cmd) const {
   engine::gpu::record_memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT);
+  // Recorded: the next stage_depth starts afresh (the staging is read when
+  // the submission runs, before any later stage_depth writes it again).
+  depth_copies_.clear();
+  blank_depth_slots_.clear();
+  std::fill(depth_pending_at_.begin(), depth_pending_at_.end(), -1);
+  depth_staged_maps_ = 0;
 }
 
 void VulkanMapStore::stage(std::span<probes::ProbeMapState* const> states, std::span<const std::uint32_t> slots) {

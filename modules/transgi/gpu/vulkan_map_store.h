@@ -41,10 +41,12 @@ class VulkanMapStore final : public probes::ProbeMapStore {
   // Before a submission that reads depth[q] (one map a probe of the field,
   // null or of another size where the probe holds none): the maps whose
   // version this store does not hold are staged (a blank or missing one as
-  // never hit, with nothing sent), for record_depth_uploads.
+  // never hit, with nothing sent), for record_depth_uploads. Stages add up
+  // until recorded: two stages of one submission may each stage.
   void stage_depth(std::span<const probes::DepthMap* const> depth);
-  void record_depth_uploads(VkCommandBuffer cmd) const;
-  // How many maps the last stage_depth sends up (blank ones filled, not sent, excluded).
+  // The staged uploads into `cmd`, then a barrier; nothing is staged after.
+  void record_depth_uploads(VkCommandBuffer cmd);
+  // How many maps are staged to go up (blank ones, filled rather than sent, excluded).
   [[nodiscard]] std::size_t depth_maps_staged() const { return depth_copies_.size(); }
   // After a kernel updated slot q's depth copy on the device to what the
   // host's map now holds (the host made the same update): the copy is of
@@ -77,6 +79,10 @@ class VulkanMapStore final : public probes::ProbeMapStore {
   std::vector<std::uint64_t> depth_version_;
   std::vector<VkBufferCopy> depth_copies_;
   std::vector<int> blank_depth_slots_;
+  // Per slot, its map's place in depth_staging_ while staged (-1: none),
+  // and how many maps the staging holds.
+  std::vector<std::ptrdiff_t> depth_pending_at_;
+  std::size_t depth_staged_maps_ = 0;
 };
 
 }  // namespace transgi::gpu
