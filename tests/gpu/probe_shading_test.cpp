@@ -542,3 +542,142 @@ TEST(VulkanProbeKernels, TheOwnDepthIsUpdatedOnTheDeviceBitForBitAndNotSentUp) {
   EXPECT_GT(collisions, 0u) << "no texel took two rays: the test would not see the update's order";
   EXPECT_EQ(own.ctx->validation_errors(), 0);
 }
+
+// The probe rays and the light they carry into the probes in one submission
+// (shade_and_light, for a frame whose batch is known before its rays)
+// against the same two stages in two submissions, on the same device over
+// three frames of the sample level's probe rays, each path with its own
+// field maps in its own store: the same hits handed to the consumer, the
+// same SH, change flags and depth maps, bit for bit, in one submission
+// instead of two. From the second frame the rays' bounce light reads each
+// path's field (its SH, and its depth maps from its store, which both the
+// rays and the raster stage in the one submission); on the third, an
+// untraced probe's depth map changed on the host must reach the rays.
+TEST(VulkanProbeKernels, TheRaysAndTheirLightInOneSubmissionEqualTheTwoStages) {
+  GPU_TEST_CONTEXT_OR_SKIP(unused);
+  OWN_PROBE_KERNELS_OR_SKIP(own);
+  const std::shared_ptr<engine::gpu::VulkanContext>& ctx = own.ctx;
+  const std::shared_ptr<transgi::gpu::VulkanProbeKernels>& kernels = own.kernels;
+  eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
+  const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
+  const render::LightSet lights(scene, test_punctual(), nullptr);
+  const probes::ProbeGrid grid = probes::ProbeGrid::centred_in(scene.bounds_min(), scene.bounds_max(), glm::ivec3(4, 3, 4));
+  const probes::MapLayout layout{16, 8};
+  const int count = grid.count(), m = 48;
+  const std::size_t texels = static_cast<std::size_t>(layout.texel_count());
+  const std::vector<glm::vec3> directions = probes::spherical_fibonacci(m);
+  std::vector<glm::vec3> origins;
+  std::vector<int> tracing;
+  for (int q = 0; q < count; ++q)
+    if (q % 4 != 1) {
+      tracing.push_back(q);
+      origins.push_back(grid.position(q));
+    }
+  const probes::MapProjector projector(layout);
+  const probes::SharingSettings sharing;
+  const probes::AccumulationSettings accumulation;
+  struct Path {
+    std::vector<probes::ProbeMapState> states;
+    std::vector<const probes::DepthMap*> own_depth;
+    std::unique_ptr<probes::ProbeMapStore> store;
+    std::vector<float> sh;
+    std::vector<std::uint8_t> changed;
+    std::vector<probes::ProbeRayHit> hits;
+    // The field the rays' bounce light reads from the second frame on (its
+    // depth maps from the store: staged by both stages of one submission).
+    std::vector<float> field_sh;
+    std::vector<std::uint8_t> usable;
+  };
+  const auto make_path = [&] {
+    Path p;
+    p.states.resize(static_cast<std::size_t>(count));
+    for (auto& st : p.states) st.reset(layout.texel_count(), grid.min_spacing());
+    for (const auto& st : p.states) p.own_depth.push_back(&st.depth);
+    p.store = kernels->make_map_store(layout, count);
+    p.field_sh.assign(static_cast<std::size_t>(count) * 75, 0.0f);
+    p.usable.assign(static_cast<std::size_t>(count), 1);
+    return p;
+  };
+  Path two = make_path(), one = make_path();
+  {  // The scene's first upload and BLAS builds, outside the counts.
+    probes::ProbeFeedbackSource self;
+    self.grid = &grid;
+    self.layout = layout;
+    self.lit = false;
+    kernels->shade_probe_rays(scene, lights, origins, tracing, directions, 7, 99, self, nullptr, [](int, int, const probes::ProbeRayHit&) {});
+  }
+  for (int frame = 0; frame < 3; ++frame) {
+    std::vector<int> batch;
+    for (const int q : tracing)
+      if (q % 3 != frame) batch.push_back(q);
+    const auto run = [&](Path& p, bool together) {
+      std::vector<std::vector<probes::ShadedPoint>> points(static_cast<std::size_t>(count));
+      p.hits.assign(tracing.size() * static_cast<std::size_t>(m), probes::ProbeRayHit{});
+      const probes::ProbeRayConsumer consume = [&](int j, int i, const probes::ProbeRayHit& h) {
+        p.hits[static_cast<std::size_t>(j) * m + static_cast<std::size_t>(i)] = h;
+        probes::ShadedPoint sp;
+        sp.direction = directions[static_cast<std::size_t>(i)];
+        sp.distance = h.distance;
+        points[static_cast<std::size_t>(tracing[static_cast<std::size_t>(j)])].push_back(sp);
+      };
+      std::vector<probes::ProbeMapState*> states;
+      for (const int q : batch) states.push_back(&p.states[static_cast<std::size_t>(q)]);
+      p.sh.assign(batch.size() * 75, 0.0f);
+      p.changed.assign(batch.size(), 0);
+      probes::ShareAccumulateTimes times;
+      probes::ProbeFeedbackSource self;
+      self.grid = &grid;
+      self.layout = layout;
+      self.states = &p.states;
+      self.sh = p.field_sh;
+      self.usable = p.usable;
+      self.maps = p.store.get();
+      self.lit = frame > 0;
+      const engine::gpu::GpuTraffic before = ctx->traffic();
+      if (together) {
+        probes::ProbeRayRequest rays{&scene, &lights, origins, tracing, directions, 7, static_cast<std::uint64_t>(frame + 1), &self, nullptr};
+        probes::ProbeLightRequest light{&grid,    &projector, &points,   &p.own_depth, &sharing, batch, states,
+                                        p.store.get(), &accumulation, p.changed, p.sh, &times};
+        kernels->shade_and_light(rays, consume, light);
+      } else {
+        kernels->shade_probe_rays(scene, lights, origins, tracing, directions, 7, static_cast<std::uint64_t>(frame + 1), self, nullptr,
+                                  consume);
+        kernels->share_accumulate_project(grid, projector, points, p.own_depth, sharing, batch, states, p.store.get(), accumulation,
+                                          p.changed, p.sh, times);
+      }
+      const std::uint64_t submissions = (ctx->traffic() - before).submissions;
+      for (std::size_t k = 0; k < batch.size(); ++k)
+        std::copy_n(p.sh.data() + k * 75, 75, p.field_sh.data() + static_cast<std::size_t>(batch[k]) * 75);
+      return submissions;
+    };
+    if (frame == 2)  // an untraced probe's depth changed on the host: it must go up before the rays read it
+      for (Path* p : {&two, &one}) {
+        probes::DepthMap& d = p->states[1].depth;
+        for (std::size_t t = 0; t < texels; ++t) d.set(t, 0.05f * grid.min_spacing(), 0.0f);
+        d.stamp_version();
+      }
+    const std::uint64_t two_submissions = run(two, false), one_submission = run(one, true);
+    std::size_t hits_differ = 0, depth_differ = 0, sh_differ = 0;
+    for (std::size_t k = 0; k < two.hits.size(); ++k)
+      hits_differ += two.hits[k].hit != one.hits[k].hit || two.hits[k].distance != one.hits[k].distance ||
+                     two.hits[k].emitted != one.hits[k].emitted || two.hits[k].saw_light != one.hits[k].saw_light;
+    for (int q = 0; q < count; ++q)
+      for (std::size_t t = 0; t < texels; ++t) {
+        const auto& a = two.states[static_cast<std::size_t>(q)].depth.texels[t];
+        const auto& b = one.states[static_cast<std::size_t>(q)].depth.texels[t];
+        depth_differ += a.mean != b.mean || a.variance != b.variance;
+      }
+    for (std::size_t k = 0; k < two.sh.size(); ++k) sh_differ += two.sh[k] != one.sh[k];
+    std::printf("frame %d: %llu submissions as two stages, %llu as one; %zu hits, %zu depth texels, %zu SH values differ\n", frame,
+                static_cast<unsigned long long>(two_submissions), static_cast<unsigned long long>(one_submission), hits_differ,
+                depth_differ, sh_differ);
+    EXPECT_EQ(two_submissions, 2u);
+    EXPECT_EQ(one_submission, 1u);
+    EXPECT_EQ(hits_differ, 0u);
+    EXPECT_EQ(depth_differ, 0u);
+    EXPECT_EQ(sh_differ, 0u);
+    EXPECT_EQ(two.changed, one.changed);
+    EXPECT_GT(*std::max_element(one.sh.begin(), one.sh.end()), 0.0f) << "no light came into the probes: the test would prove nothing";
+  }
+  EXPECT_EQ(ctx->validation_errors(), 0);
+}

@@ -13,6 +13,78 @@ VulkanProbeKernels::VulkanProbeKernels(std::shared_ptr<engine::gpu::VulkanContex
     : ctx_(std::move(ctx)), tracer_(*ctx_), shading_(std::make_unique<VulkanProbeShading>(*ctx_)),
       name_(engine::gpu::describe(ctx_->info())) {}
 
+VulkanProbeKernels::LightStages VulkanProbeKernels::light_stages(const probes::MapProjector& projector) {
+  const auto& layout = projector.layout();
+  const std::pair<int, int> size{layout.width, layout.height};
+  auto& r = rasters_[size];
+  if (!r) r = std::make_unique<VulkanRadianceRaster>(*ctx_, layout);
+  auto& a = accumulators_[size];
+  if (!a) a = std::make_unique<VulkanProbeAccumulator>(*ctx_, layout);
+  auto& p = projectors_[size];
+  if (!p) p = std::make_unique<VulkanShProjector>(*ctx_, projector);
+  return {r.get(), a.get(), p.get()};
+}
+
+void VulkanProbeKernels::prepare_own_depth(const probes::ProbeGrid& grid, std::span<const int> batch,
+                                           std::span<probes::ProbeMapState* const> states,
+                                           const probes::AccumulationSettings& accumulation, const probes::MapLayout& layout,
+                                           const VulkanMapStore& maps) {
+  std::vector<std::size_t> tracing_index(static_cast<std::size_t>(grid.count()), 0);
+  for (std::size_t j = 0; j < shaded_probes_.size(); ++j) tracing_index[static_cast<std::size_t>(shaded_probes_[j])] = j;
+  std::vector<OwnDepthProbeGpu> records(batch.size());
+  for (std::size_t i = 0; i < batch.size(); ++i)
+    records[i] = {static_cast<uint>(batch[i]), static_cast<uint>(tracing_index[static_cast<std::size_t>(batch[i])] * shaded_rays_per_probe_),
+                  states[i]->depth.unit, probes::own_depth_blend(*states[i], accumulation)};
+  if (!own_depth_) own_depth_ = std::make_unique<VulkanProbeOwnDepth>(*ctx_);
+  own_depth_->prepare(records, shading_->hits_on_device(), shading_->directions_on_device(), maps.depth(), shaded_rays_per_probe_,
+                      layout);
+}
+
+namespace {
+// The batch's own depth on the host (update_own_depth); with `adopted`, the
+// store is told its copies, which a kernel updated the same way, are of
+// the host's new versions.
+void update_own_depth_on_host(std::span<const int> batch, std::span<probes::ProbeMapState* const> states,
+                              const std::vector<std::vector<probes::ShadedPoint>>& points, const probes::MapLayout& layout,
+                              const probes::AccumulationSettings& accumulation, VulkanMapStore* adopted) {
+  engine::jobs::parallel_for(0, static_cast<int>(batch.size()), 8, [&](int b, int e) {
+    for (int i = b; i < e; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      probes::update_own_depth(*states[k], layout, points[static_cast<std::size_t>(batch[k])], accumulation);
+      if (adopted) adopted->adopt_depth(static_cast<std::size_t>(batch[k]), states[k]->depth.version);
+    }
+  });
+}
+
+// Whether each batch state's depth map is the one own_depth lists for its
+// probe (the field's own): only then may a kernel update the copy the
+// raster reads in place.
+bool batch_depth_is_own(std::span<const int> batch, std::span<probes::ProbeMapState* const> states,
+                        const std::vector<const probes::DepthMap*>& own_depth) {
+  for (std::size_t i = 0; i < batch.size(); ++i)
+    if (own_depth[static_cast<std::size_t>(batch[i])] != &states[i]->depth) return false;
+  return true;
+}
+}  // namespace
+
+void VulkanProbeKernels::record_light(VkCommandBuffer cmd, const LightStages& stages, bool own_depth, std::size_t probes) const {
+  stages.raster->record(cmd, own_depth ? own_depth_.get() : nullptr);
+  ctx_->mark_stage(cmd);
+  engine::gpu::record_compute_barrier(cmd);
+  stages.accumulator->record(cmd);
+  ctx_->mark_stage(cmd);
+  engine::gpu::record_compute_barrier(cmd);
+  stages.projector->record(cmd, stages.accumulator->filled_on_device(), probes);
+}
+
+void VulkanProbeKernels::take_light_stage_ms(std::size_t first) {
+  const std::vector<double>& stage_ms = ctx_->last_stage_ms();
+  if (stage_ms.size() != first + 3) return;
+  raster_ms_ += stage_ms[first];
+  accumulate_ms_ += stage_ms[first + 1];
+  project_ms_ += stage_ms[first + 2];
+}
+
 probes::SharingStats VulkanProbeKernels::share_accumulate_project(
     const probes::ProbeGrid& grid, const probes::MapProjector& projector,
     const std::vector<std::vector<probes::ShadedPoint>>& points, const std::vector<const probes::DepthMap*>& own_depth,
@@ -23,13 +95,7 @@ probes::SharingStats VulkanProbeKernels::share_accumulate_project(
   const auto ms_since = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
   const auto t0 = Clock::now();
   const auto& layout = projector.layout();
-  const std::pair<int, int> size{layout.width, layout.height};
-  auto& r = rasters_[size];
-  if (!r) r = std::make_unique<VulkanRadianceRaster>(*ctx_, layout);
-  auto& a = accumulators_[size];
-  if (!a) a = std::make_unique<VulkanProbeAccumulator>(*ctx_, layout);
-  auto& p = projectors_[size];
-  if (!p) p = std::make_unique<VulkanShProjector>(*ctx_, projector);
+  const LightStages stages = light_stages(projector);
   std::vector<std::uint8_t> targets(static_cast<std::size_t>(grid.count()), 0);
   std::vector<std::uint32_t> frame_maps(batch.size());
   for (std::size_t i = 0; i < batch.size(); ++i) {
@@ -47,63 +113,87 @@ probes::SharingStats VulkanProbeKernels::share_accumulate_project(
   // keeps its maps there, updated in the store's copies by a kernel (and
   // the host's by the same arithmetic after the submission), so that no
   // updated map goes up; else on the host first, the changed maps sent.
-  bool own_depth_on_device = maps && rays_on_device;
-  for (std::size_t i = 0; own_depth_on_device && i < batch.size(); ++i)
-    own_depth_on_device = own_depth[static_cast<std::size_t>(batch[i])] == &states[i]->depth;
-  if (!own_depth_on_device)
-    engine::jobs::parallel_for(0, static_cast<int>(batch.size()), 8, [&](int b, int e) {
-      for (int i = b; i < e; ++i)
-        probes::update_own_depth(*states[static_cast<std::size_t>(i)], layout, points[static_cast<std::size_t>(batch[static_cast<std::size_t>(i)])],
-                                 accumulation);
-    });
-  r->prepare(grid, points, own_depth, sharing, targets, maps, shaded_rays_per_probe_ > 0 ? &rays : nullptr);
-  if (own_depth_on_device) {
-    std::vector<std::size_t> tracing_index(static_cast<std::size_t>(grid.count()), 0);
-    for (std::size_t j = 0; j < shaded_probes_.size(); ++j) tracing_index[static_cast<std::size_t>(shaded_probes_[j])] = j;
-    std::vector<OwnDepthProbeGpu> records(batch.size());
-    for (std::size_t i = 0; i < batch.size(); ++i)
-      records[i] = {static_cast<uint>(batch[i]),
-                    static_cast<uint>(tracing_index[static_cast<std::size_t>(batch[i])] * shaded_rays_per_probe_),
-                    states[i]->depth.unit, probes::own_depth_blend(*states[i], accumulation)};
-    if (!own_depth_) own_depth_ = std::make_unique<VulkanProbeOwnDepth>(*ctx_);
-    own_depth_->prepare(records, shading_->hits_on_device(), shading_->directions_on_device(), maps->depth(),
-                        shaded_rays_per_probe_, layout);
-  }
-  if (shaded_brief_ && !r->points_made_on_device())
+  const bool own_depth_on_device = maps && rays_on_device && batch_depth_is_own(batch, states, own_depth);
+  if (!own_depth_on_device) update_own_depth_on_host(batch, states, points, layout, accumulation, nullptr);
+  stages.raster->prepare(grid, points, own_depth, sharing, targets, maps, shaded_rays_per_probe_ > 0 ? &rays : nullptr);
+  if (own_depth_on_device) prepare_own_depth(grid, batch, states, accumulation, layout, *maps);
+  if (shaded_brief_ && !stages.raster->points_made_on_device())
     throw std::logic_error("VulkanProbeKernels: the points are not the last shading's rays, whose hits came back brief "
                            "(set_brief_hits(false) for points of the caller's own)");
-  a->prepare(states, r->samples_on_device(), frame_maps, accumulation, maps);
+  stages.accumulator->prepare(states, stages.raster->samples_on_device(), frame_maps, accumulation, maps);
   times.share_ms = ms_since(t0);
   const auto t1 = Clock::now();
   // One submission, a timestamp after each stage: the samples and the
   // filled maps never leave the device.
-  ctx_->submit_and_wait([&](VkCommandBuffer cmd) {
-    r->record(cmd, own_depth_on_device ? own_depth_.get() : nullptr);
-    ctx_->mark_stage(cmd);
-    engine::gpu::record_compute_barrier(cmd);
-    a->record(cmd);
-    ctx_->mark_stage(cmd);
-    engine::gpu::record_compute_barrier(cmd);
-    p->record(cmd, a->filled_on_device(), states.size());
-  });
-  const std::vector<double>& stage_ms = ctx_->last_stage_ms();
-  if (stage_ms.size() == 3) {
-    raster_ms_ += stage_ms[0];
-    accumulate_ms_ += stage_ms[1];
-    project_ms_ += stage_ms[2];
-  }
-  const probes::SharingStats stats = r->finish(nullptr);
-  a->finish(states, changed, {});
-  p->read(sh);
-  if (own_depth_on_device)
-    engine::jobs::parallel_for(0, static_cast<int>(batch.size()), 8, [&](int b, int e) {
-      for (int i = b; i < e; ++i) {
-        const auto k = static_cast<std::size_t>(i);
-        probes::update_own_depth(*states[k], layout, points[static_cast<std::size_t>(batch[k])], accumulation);
-        maps->adopt_depth(static_cast<std::size_t>(batch[k]), states[k]->depth.version);
-      }
-    });
+  ctx_->submit_and_wait([&](VkCommandBuffer cmd) { record_light(cmd, stages, own_depth_on_device, states.size()); });
+  take_light_stage_ms(0);
+  const probes::SharingStats stats = stages.raster->finish(nullptr);
+  stages.accumulator->finish(states, changed, {});
+  stages.projector->read(sh);
+  if (own_depth_on_device) update_own_depth_on_host(batch, states, points, layout, accumulation, maps);
   times.accumulate_ms = ms_since(t1);
+  return stats;
+}
+
+probes::SharingStats VulkanProbeKernels::shade_and_light(const probes::ProbeRayRequest& rays, const probes::ProbeRayConsumer& consume,
+                                                         const probes::ProbeLightRequest& light) {
+  using Clock = std::chrono::steady_clock;
+  const auto ms_since = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
+  auto* maps = dynamic_cast<VulkanMapStore*>(light.store);
+  if (light.store && !maps) throw std::invalid_argument("VulkanProbeKernels: a map store from another backend");
+  // One submission needs the maps and the own depth kept on the device;
+  // else the two stages in turn, each as it runs alone.
+  if (!maps || !batch_depth_is_own(light.batch, light.states, *light.own_depth)) return ProbeKernels::shade_and_light(rays, consume, light);
+  const auto t0 = Clock::now();
+  shaded_rays_per_probe_ = 0;  // the device's hits are this batch's only once it is prepared
+  shaded_brief_ = false;
+  if (!shading_->prepare(*rays.scene, *rays.lights, tracer_, rays.origins, rays.probe_ids, rays.directions, rays.seed, rays.sample,
+                         rays.self->lit ? rays.self : nullptr, rays.outer))
+    throw engine::gpu::GpuError("the Vulkan backend traces only scenes built with their assets (RtScene::assets())");
+  const std::size_t m = rays.directions.size();
+  shaded_probes_.assign(rays.probe_ids.begin(), rays.probe_ids.end());
+  shaded_rays_per_probe_ = static_cast<std::uint32_t>(m);
+  shaded_brief_ = brief_hits_;
+
+  // The light stages over the rays' points, which exist on the host only
+  // once the submission ran.
+  const probes::ProbeGrid& grid = *light.grid;
+  const auto& layout = light.projector->layout();
+  const LightStages stages = light_stages(*light.projector);
+  std::vector<std::uint8_t> targets(static_cast<std::size_t>(grid.count()), 0);
+  std::vector<std::uint32_t> frame_maps(light.batch.size());
+  for (std::size_t i = 0; i < light.batch.size(); ++i) {
+    targets[static_cast<std::size_t>(light.batch[i])] = 1;
+    frame_maps[i] = static_cast<std::uint32_t>(light.batch[i]);
+  }
+  const VulkanRadianceRaster::DevicePoints points{&shading_->hits_on_device(), &shading_->directions_on_device(), shaded_probes_,
+                                                  shaded_rays_per_probe_};
+  stages.raster->prepare_from_rays(grid, *light.own_depth, *light.sharing, targets, maps, points);
+  prepare_own_depth(grid, light.batch, light.states, *light.accumulation, layout, *maps);
+  stages.accumulator->prepare(light.states, stages.raster->samples_on_device(), frame_maps, *light.accumulation, maps);
+  light.times->share_ms = ms_since(t0);
+  const auto t1 = Clock::now();
+  // The probe rays, then the light they carry into the probes: one
+  // submission, a timestamp after each stage.
+  ctx_->submit_and_wait([&](VkCommandBuffer cmd) {
+    shading_->record(cmd);
+    ctx_->mark_stage(cmd);
+    engine::gpu::record_compute_barrier(cmd);
+    record_light(cmd, stages, true, light.states.size());
+  });
+  if (ctx_->last_stage_ms().size() == 4) shading_->add_gpu_ms(ctx_->last_stage_ms()[0]);
+  take_light_stage_ms(1);
+  std::vector<probes::ProbeRayHit> out;
+  shading_->read(out, nullptr, brief_hits_);
+  engine::jobs::parallel_for(0, static_cast<int>(rays.origins.size()), 1, [&](int b, int e) {
+    for (int j = b; j < e; ++j)
+      for (std::size_t i = 0; i < m; ++i) consume(j, static_cast<int>(i), out[static_cast<std::size_t>(j) * m + i]);
+  });
+  const probes::SharingStats stats = stages.raster->finish(nullptr);
+  stages.accumulator->finish(light.states, light.changed, {});
+  stages.projector->read(light.sh);
+  update_own_depth_on_host(light.batch, light.states, *light.points, layout, *light.accumulation, maps);
+  light.times->accumulate_ms = ms_since(t1);
   return stats;
 }
 

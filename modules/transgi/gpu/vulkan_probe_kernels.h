@@ -46,6 +46,12 @@ class VulkanProbeKernels : public probes::ProbeKernels {
                                                 const probes::AccumulationSettings& accumulation,
                                                 std::span<std::uint8_t> changed, std::span<float> sh,
                                                 probes::ShareAccumulateTimes& times) override;
+  // Where the field keeps its maps here (a VulkanMapStore) and its own
+  // depth is the batch's: the probe rays, the own depth, the raster, the
+  // accumulation and the projection in one submission; the rays' hits are
+  // handed to `consume` after it. Else the two stages in turn.
+  probes::SharingStats shade_and_light(const probes::ProbeRayRequest& rays, const probes::ProbeRayConsumer& consume,
+                                       const probes::ProbeLightRequest& light) override;
   // The maps on this device between updates (VulkanMapStore).
   [[nodiscard]] std::unique_ptr<probes::ProbeMapStore> make_map_store(const probes::MapLayout& layout, int probes) override;
   engine::rt::RayBatchTracer* tracer() override { return &tracer_; }
@@ -93,6 +99,21 @@ class VulkanProbeKernels : public probes::ProbeKernels {
   std::map<std::pair<int, int>, std::unique_ptr<VulkanShProjector>> projectors_;
   std::map<std::pair<int, int>, std::unique_ptr<VulkanProbeAccumulator>> accumulators_;
   std::unique_ptr<VulkanProbeOwnDepth> own_depth_;  // made on first use
+  // The light's stages for a map size, made on first use.
+  struct LightStages {
+    VulkanRadianceRaster* raster;
+    VulkanProbeAccumulator* accumulator;
+    VulkanShProjector* projector;
+  };
+  LightStages light_stages(const probes::MapProjector& projector);
+  // The own-depth kernel prepared for the batch, its rays the last shading's.
+  void prepare_own_depth(const probes::ProbeGrid& grid, std::span<const int> batch, std::span<probes::ProbeMapState* const> states,
+                         const probes::AccumulationSettings& accumulation, const probes::MapLayout& layout, const VulkanMapStore& maps);
+  // The raster (with the own depth first), the accumulation and the
+  // projection of `probes` maps into `cmd`, a timestamp after the first two.
+  void record_light(VkCommandBuffer cmd, const LightStages& stages, bool own_depth, std::size_t probes) const;
+  // The three light stages' device times, from the last submission's stage `first` on.
+  void take_light_stage_ms(std::size_t first);
   engine::gpu::GpuRayTracer tracer_;
   std::shared_ptr<const model::TransferModel> decoder_model_;  // kept alive: the cache's key
   std::unique_ptr<VulkanFusedDecoder> decoder_;

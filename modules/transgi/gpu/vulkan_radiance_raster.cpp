@@ -50,6 +50,13 @@ bool VulkanRadianceRaster::bind_device_points(const std::vector<std::vector<prob
   std::vector<std::uint32_t> first;
   points_on_device_ = points_from_rays(points, rays, begin, first);
   if (!points_on_device_) return false;
+  bind_rays_as_points(rays, begin, first);
+  return true;
+}
+
+void VulkanRadianceRaster::bind_rays_as_points(const DevicePoints& rays, const std::vector<std::uint32_t>& begin,
+                                               const std::vector<std::uint32_t>& first) {
+  points_on_device_ = true;
   if (!points_pipeline_)
     points_pipeline_ = std::make_unique<engine::gpu::ComputePipeline>(ctx_, compile_module_shader("probe_points.comp"), 4,
                                                                       static_cast<std::uint32_t>(sizeof(point_push_)));
@@ -66,7 +73,6 @@ bool VulkanRadianceRaster::bind_device_points(const std::vector<std::vector<prob
   point_push_[0] = static_cast<std::uint32_t>(first.size()) * rays.rays_per_probe;
   point_push_[1] = rays.rays_per_probe;
   point_groups_ = (point_push_[0] + kProbeShadingGroupSize - 1) / kProbeShadingGroupSize;
-  return true;
 }
 
 void VulkanRadianceRaster::bind_depth(const std::vector<const probes::DepthMap*>& own_depth, std::size_t host_texels) {
@@ -83,12 +89,37 @@ void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vec
                                    const std::vector<const probes::DepthMap*>& own_depth, const probes::SharingSettings& s,
                                    std::span<const std::uint8_t> targets, VulkanMapStore* store,
                                    const DevicePoints* device_points) {
+  std::vector<std::uint32_t> begin(points.size() + 1, 0);
+  for (std::size_t q = 0; q < points.size(); ++q) begin[q + 1] = begin[q] + static_cast<std::uint32_t>(points[q].size());
+  prepare_with(grid, begin, &points, own_depth, s, targets, store, device_points);
+}
+
+void VulkanRadianceRaster::prepare_from_rays(const probes::ProbeGrid& grid, const std::vector<const probes::DepthMap*>& own_depth,
+                                             const probes::SharingSettings& s, std::span<const std::uint8_t> targets,
+                                             VulkanMapStore* store, const DevicePoints& rays) {
+  const auto count = static_cast<std::size_t>(grid.count());
+  std::vector<std::uint32_t> per(count, 0), begin(count + 1, 0);
+  for (const int q : rays.tracing) {
+    if (q < 0 || static_cast<std::size_t>(q) >= count || per[static_cast<std::size_t>(q)] != 0)
+      throw std::invalid_argument("VulkanRadianceRaster::prepare_from_rays: probe " + std::to_string(q) +
+                                  " out of the grid or traced twice");
+    per[static_cast<std::size_t>(q)] = rays.rays_per_probe;
+  }
+  for (std::size_t q = 0; q < count; ++q) begin[q + 1] = begin[q] + per[q];
+  prepare_with(grid, begin, nullptr, own_depth, s, targets, store, &rays);
+}
+
+void VulkanRadianceRaster::prepare_with(const probes::ProbeGrid& grid, const std::vector<std::uint32_t>& begin,
+                                        const std::vector<std::vector<probes::ShadedPoint>>* host_points,
+                                        const std::vector<const probes::DepthMap*>& own_depth, const probes::SharingSettings& s,
+                                        std::span<const std::uint8_t> targets, VulkanMapStore* store,
+                                        const DevicePoints* device_points) {
   const auto count = static_cast<std::size_t>(grid.count());
   const auto texels = static_cast<std::size_t>(layout_.texel_count());
-  if (points.size() != count || (!own_depth.empty() && own_depth.size() != count) ||
+  if (begin.size() != count + 1 || (!own_depth.empty() && own_depth.size() != count) ||
       (!targets.empty() && targets.size() != count) || (!grid.offsets.empty() && grid.offsets.size() != count))
     throw std::invalid_argument("VulkanRadianceRaster: " + std::to_string(count) + " probes but points for " +
-                                std::to_string(points.size()) + ", depth for " + std::to_string(own_depth.size()) +
+                                std::to_string(begin.size() - 1) + ", depth for " + std::to_string(own_depth.size()) +
                                 ", " + std::to_string(targets.size()) + " target flags");
   count_ = count;
   if (store && (static_cast<std::size_t>(store->probes()) != count || store->layout().texel_count() != layout_.texel_count()))
@@ -99,8 +130,6 @@ void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vec
   // Inputs go straight into the mapped buffers and results come straight out,
   // in parallel over probes: tens of MB of depth maps and samples a frame,
   // which serial copies made cost several times the kernel on an H100.
-  std::vector<std::uint32_t> begin(count + 1, 0);
-  for (std::size_t q = 0; q < count; ++q) begin[q + 1] = begin[q] + static_cast<std::uint32_t>(points[q].size());
   // A depth guard needs every probe's map; a probe without one (null) reads
   // as "never hit" (NaN), which the guard lets through, as the CPU does.
   const bool has_depth = !own_depth.empty();
@@ -119,7 +148,15 @@ void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vec
   using DepthTexel = probes::DepthMap::Texel;
   point_groups_ = 0;
   points_on_device_ = false;
-  const bool on_device = device_points && bind_device_points(points, *device_points, begin);
+  bool on_device = false;
+  if (!host_points) {
+    std::vector<std::uint32_t> first;
+    for (const int q : device_points->tracing) first.push_back(begin[static_cast<std::size_t>(q)]);
+    bind_rays_as_points(*device_points, begin, first);
+    on_device = true;
+  } else {
+    on_device = device_points && bind_device_points(*host_points, *device_points, begin);
+  }
   if (!on_device) {
     engine::gpu::bind_at_least(ctx_, *pipeline_, 0, points_, std::max<std::size_t>(1, begin[count]) * sizeof(ShadedPointGpu));
     pipeline_->bind(0, points_);  // device_points_ may have been bound since
@@ -130,7 +167,7 @@ void VulkanRadianceRaster::prepare(const probes::ProbeGrid& grid, const std::vec
   engine::jobs::parallel_for<std::size_t>(0, count, 8, [&](std::size_t q0, std::size_t q1) {
     for (std::size_t q = q0; q < q1; ++q) {
       std::size_t i = begin[q];
-      for (const auto& pt : on_device ? std::span<const probes::ShadedPoint>() : std::span<const probes::ShadedPoint>(points[q]))
+      for (const auto& pt : on_device ? std::span<const probes::ShadedPoint>() : std::span<const probes::ShadedPoint>((*host_points)[q]))
         flat[i++] = {pt.position.x, pt.position.y, pt.position.z, pt.distance, pt.radiance.x, pt.radiance.y,
                      pt.radiance.z, 0, pt.direction.x, pt.direction.y, pt.direction.z, 0, pt.normal.x, pt.normal.y,
                      pt.normal.z, 0};

@@ -46,6 +46,13 @@ class VulkanRadianceRaster {
                const std::vector<const probes::DepthMap*>& own_depth, const probes::SharingSettings& settings,
                std::span<const std::uint8_t> targets = {}, VulkanMapStore* store = nullptr,
                const DevicePoints* device_points = nullptr);
+  // prepare where the points are, by construction, the rays' (every
+  // tracing probe's rays_per_probe, no other probe's): nothing is read of
+  // the host's points, which need not exist yet (a submission that traces
+  // the rays and rasterises their points at once).
+  void prepare_from_rays(const probes::ProbeGrid& grid, const std::vector<const probes::DepthMap*>& own_depth,
+                         const probes::SharingSettings& settings, std::span<const std::uint8_t> targets,
+                         VulkanMapStore* store, const DevicePoints& rays);
   // Whether the last prepare made the points on the device.
   [[nodiscard]] bool points_made_on_device() const { return points_on_device_; }
   // Whether prepare would make these points on the device from `rays`.
@@ -68,6 +75,14 @@ class VulkanRadianceRaster {
   // false: not, nothing bound.
   bool bind_device_points(const std::vector<std::vector<probes::ShadedPoint>>& points, const DevicePoints& rays,
                           const std::vector<std::uint32_t>& begin);
+  // probe_points.comp bound for `rays`, tracing probe j's points from first[j].
+  void bind_rays_as_points(const DevicePoints& rays, const std::vector<std::uint32_t>& begin, const std::vector<std::uint32_t>& first);
+  // prepare's body: probe q's points at begin[q], from `host_points` (null:
+  // made from `device_points`, which are then the points).
+  void prepare_with(const probes::ProbeGrid& grid, const std::vector<std::uint32_t>& begin,
+                    const std::vector<std::vector<probes::ShadedPoint>>* host_points,
+                    const std::vector<const probes::DepthMap*>& own_depth, const probes::SharingSettings& settings,
+                    std::span<const std::uint8_t> targets, VulkanMapStore* store, const DevicePoints* device_points);
   // The depth maps the raster reads: the store's copies (the changed ones
   // staged), or host_texels texels written here.
   void bind_depth(const std::vector<const probes::DepthMap*>& own_depth, std::size_t host_texels);

@@ -331,7 +331,7 @@ ProbeFeedbackSource ProbeField::feedback_source() const {
 }
 
 void ProbeField::trace_and_shade(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
-                                 const ProbeField* outer, UpdateWork& w) {
+                                 const ProbeField* outer, UpdateWork& w, LightBatch* light) {
   using namespace engine;
   const int M = settings_.rays_per_probe;
   // Emitters are light-sampled instead (sample_emitters).
@@ -373,9 +373,23 @@ void ProbeField::trace_and_shade(const engine::rt::RtScene& scene, const engine:
   const ProbeFeedbackSource self_source = feedback_source();
   const ProbeFeedbackSource outer_source = outer ? outer->feedback_source() : ProbeFeedbackSource{};
   // One probe's rays on one thread, in order: consume writes its data unlocked.
-  kernels_->shade_probe_rays(scene, lights, origins, w.tracing, w.directions, w.seed, frame_ + 1, self_source,
-                             outer ? &outer_source : nullptr,
-                             [&](int j, int i, const ProbeRayHit& h) { consume(w.tracing[static_cast<std::size_t>(j)], i, h); });
+  const ProbeRayConsumer by_probe = [&](int j, int i, const ProbeRayHit& h) { consume(w.tracing[static_cast<std::size_t>(j)], i, h); };
+  if (!light) {
+    kernels_->shade_probe_rays(scene, lights, origins, w.tracing, w.directions, w.seed, frame_ + 1, self_source,
+                               outer ? &outer_source : nullptr, by_probe);
+    return;
+  }
+  ProbeRayRequest rays;
+  rays.scene = &scene;
+  rays.lights = &lights;
+  rays.origins = origins;
+  rays.probe_ids = w.tracing;
+  rays.directions = w.directions;
+  rays.seed = w.seed;
+  rays.sample = frame_ + 1;
+  rays.self = &self_source;
+  rays.outer = outer ? &outer_source : nullptr;
+  light->result.sharing = kernels_->shade_and_light(rays, by_probe, light_request(w, *light));
 }
 
 namespace {
@@ -518,24 +532,49 @@ void ProbeField::classify_traced(const engine::rt::RtScene& scene, UpdateWork& w
   classify_pending_ = false;
 }
 
-ProbeField::LightIntoProbes ProbeField::share_accumulate_project(UpdateWork& w) {
-  using namespace engine;
+ProbeField::LightBatch ProbeField::light_batch(const UpdateWork& w) {
   const int probes = grid_.count();
+  LightBatch b;
   // The backend updates each batch probe's depth from its own rays first.
-  std::vector<const DepthMap*> depth(static_cast<std::size_t>(probes));
-  for (int q = 0; q < probes; ++q) depth[static_cast<std::size_t>(q)] = &probes_.maps[static_cast<std::size_t>(q)].depth;
+  b.depth.resize(static_cast<std::size_t>(probes));
+  for (int q = 0; q < probes; ++q) b.depth[static_cast<std::size_t>(q)] = &probes_.maps[static_cast<std::size_t>(q)].depth;
   // Every updated probe in one batch for the backend.
-  std::vector<int> batch;
   for (int q = 0; q < probes; ++q)
-    if (takes_frame(w, q)) batch.push_back(q);
-  std::vector<ProbeMapState*> batch_states;
-  for (const int q : batch) batch_states.push_back(&probes_.maps[static_cast<std::size_t>(q)]);
-  std::vector<std::uint8_t> batch_changed(batch.size());
-  std::vector<float> projected(batch.size() * 75);
-  LightIntoProbes result;
-  result.sharing = kernels_->share_accumulate_project(grid_, projector_, w.points, depth, settings_.sharing, batch, batch_states,
-                                                      map_store_.get(), settings_.accumulation, batch_changed, projected, result.times);
+    if (takes_frame(w, q)) b.batch.push_back(q);
+  for (const int q : b.batch) b.states.push_back(&probes_.maps[static_cast<std::size_t>(q)]);
+  b.changed.assign(b.batch.size(), 0);
+  b.projected.assign(b.batch.size() * 75, 0.0f);
+  return b;
+}
 
+ProbeLightRequest ProbeField::light_request(const UpdateWork& w, LightBatch& b) {
+  ProbeLightRequest r;
+  r.grid = &grid_;
+  r.projector = &projector_;
+  r.points = &w.points;
+  r.own_depth = &b.depth;
+  r.sharing = &settings_.sharing;
+  r.batch = b.batch;
+  r.states = b.states;
+  r.store = map_store_.get();
+  r.accumulation = &settings_.accumulation;
+  r.changed = b.changed;
+  r.sh = b.projected;
+  r.times = &b.result.times;
+  return r;
+}
+
+ProbeField::LightIntoProbes ProbeField::share_accumulate_project(UpdateWork& w) {
+  LightBatch b = light_batch(w);
+  const ProbeLightRequest r = light_request(w, b);
+  b.result.sharing = kernels_->share_accumulate_project(*r.grid, *r.projector, *r.points, *r.own_depth, *r.sharing, r.batch, r.states,
+                                                        r.store, *r.accumulation, r.changed, r.sh, *r.times);
+  finish_light(w, b);
+  return b.result;
+}
+
+void ProbeField::finish_light(const UpdateWork& w, LightBatch& b) {
+  using namespace engine;
   std::atomic<int> bad_probes{0};
   // After probe q's map took its frame (changed: it detected a change of
   // light): its convergence and its direct-light mean.
@@ -567,17 +606,26 @@ ProbeField::LightIntoProbes ProbeField::share_accumulate_project(UpdateWork& w) 
     }
   };
   const auto t0 = Clock::now();
-  jobs::parallel_for(0, static_cast<int>(batch.size()), 1, [&](int b, int e) {
-    for (int i = b; i < e; ++i) {
-      const int q = batch[static_cast<std::size_t>(i)];
-      after_accumulation(q, batch_changed[static_cast<std::size_t>(i)] != 0);
-      std::copy_n(projected.data() + static_cast<std::size_t>(i) * 75, 75, probes_.sh.data() + static_cast<std::size_t>(q) * 75);
+  jobs::parallel_for(0, static_cast<int>(b.batch.size()), 1, [&](int lo, int hi) {
+    for (int i = lo; i < hi; ++i) {
+      const int q = b.batch[static_cast<std::size_t>(i)];
+      after_accumulation(q, b.changed[static_cast<std::size_t>(i)] != 0);
+      std::copy_n(b.projected.data() + static_cast<std::size_t>(i) * 75, 75, probes_.sh.data() + static_cast<std::size_t>(q) * 75);
       finish_probe(q);
     }
   });
-  result.times.accumulate_ms += ms_since(t0);
-  result.nonfinite_probes = bad_probes.load();
-  return result;
+  b.result.times.accumulate_ms += ms_since(t0);
+  b.result.nonfinite_probes = bad_probes.load();
+}
+
+bool ProbeField::batch_known_before_rays(const UpdateWork& w) const {
+  // classify_traced runs on classification and budgeted frames; on a
+  // budgeted one it changes only the probes queued for it.
+  if (w.classify) return false;
+  if (!w.budgeted) return true;
+  for (std::size_t q = 0; q < w.traced.size(); ++q)
+    if (w.traced[q] && probes_.needs_classify[q]) return false;
+  return true;
 }
 
 void ProbeField::update_means_and_counts(ProbeFrameStats& stats) {
@@ -618,9 +666,15 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
 
   // 1. Scatter and shade (reads the previous frame's SH for the feedback
   // bounce), then classify what traced.
+  // Where no classification waits on the rays, the batch is known now and
+  // the backend takes the rays and the light as one stage (on a device, one
+  // submission); the light's set-up and read-back then count as sharing
+  // and projection, the rest as scattering.
   auto t0 = Clock::now();
+  std::optional<LightBatch> together;
+  if (!w.tracing.empty() && batch_known_before_rays(w)) together = light_batch(w);
   queue_emitter_samples(scene, lights, w);
-  trace_and_shade(scene, lights, outer, w);
+  trace_and_shade(scene, lights, outer, w, together ? &*together : nullptr);
   sample_emitters(scene, lights, w);
   for (std::uint8_t t : w.traced) stats.traced += t;
   stats.rays = static_cast<std::size_t>(stats.traced) * static_cast<std::size_t>(settings_.rays_per_probe);
@@ -632,13 +686,21 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
 
   // 2. Share, accumulate, fill, project.
   t0 = Clock::now();
-  const LightIntoProbes light = share_accumulate_project(w);
+  LightIntoProbes light;
+  if (together) {
+    finish_light(w, *together);
+    light = together->result;
+    stats.scatter_ms -= light.times.share_ms + light.times.accumulate_ms;
+    light.times.accumulate_ms += ms_since(t0);
+  } else {
+    light = share_accumulate_project(w);
+  }
   stats.shared_accepted = light.sharing.accepted;
   stats.shared_rejected = light.sharing.rejected_by_guard;
   stats.nonfinite_probes = light.nonfinite_probes;
   // The own depth maps' update and the batch's set-up count as sharing.
   stats.project_ms = light.times.accumulate_ms;
-  stats.raster_ms = ms_since(t0) - stats.project_ms;
+  stats.raster_ms = together ? light.times.share_ms : ms_since(t0) - stats.project_ms;
   if (sky_changed)
     engine::jobs::parallel_for(0, grid_.count(), 64, [&](int b, int e) {
       for (int q = b; q < e; ++q)

@@ -383,8 +383,11 @@ class ProbeField {
   //  update_means_and_counts: the ambient means and the state counts.
   struct UpdateWork;
   void plan_update(UpdateWork& w);
+  struct LightBatch;
+  // With `light`, the light stage too (ProbeKernels::shade_and_light), its
+  // result in light->result.sharing.
   void trace_and_shade(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, const ProbeField* outer,
-                       UpdateWork& w);
+                       UpdateWork& w, LightBatch* light = nullptr);
   void queue_emitter_samples(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, UpdateWork& w);
   void sample_emitters(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, UpdateWork& w);
   // Probe q's draws for its emitter samples this frame.
@@ -396,6 +399,23 @@ class ProbeField {
     int nonfinite_probes = 0;
   };
   LightIntoProbes share_accumulate_project(UpdateWork& w);
+  // share_accumulate_project in parts: the batch and its buffers, the
+  // backend's request over them, and what follows the backend's stage
+  // (each batch probe's convergence, direct light, SH and finiteness).
+  struct LightBatch {
+    std::vector<const DepthMap*> depth;
+    std::vector<int> batch;
+    std::vector<ProbeMapState*> states;
+    std::vector<std::uint8_t> changed;
+    std::vector<float> projected;
+    LightIntoProbes result;
+  };
+  LightBatch light_batch(const UpdateWork& w);
+  ProbeLightRequest light_request(const UpdateWork& w, LightBatch& b);
+  void finish_light(const UpdateWork& w, LightBatch& b);
+  // Whether no probe's classification waits on this frame's rays, so that
+  // the batch is known before they are traced.
+  [[nodiscard]] bool batch_known_before_rays(const UpdateWork& w) const;
   void update_means_and_counts(ProbeFrameStats& stats);
   // Whether probe q's maps take this frame (untraced probes, outside the
   // budget, and relocated ones keep their state).

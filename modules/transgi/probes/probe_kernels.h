@@ -97,6 +97,35 @@ class ProbeMapStore {
 // thread, so it may write that probe's data without locks.
 using ProbeRayConsumer = std::function<void(int j, int i, const ProbeRayHit& hit)>;
 
+// shade_probe_rays's arguments, for shade_and_light.
+struct ProbeRayRequest {
+  const engine::rt::RtScene* scene = nullptr;
+  const engine::render::LightSet* lights = nullptr;
+  std::span<const glm::vec3> origins;
+  std::span<const int> probe_ids;
+  std::span<const glm::vec3> directions;
+  std::uint64_t seed = 0, sample = 0;
+  const ProbeFeedbackSource* self = nullptr;
+  const ProbeFeedbackSource* outer = nullptr;
+};
+
+// share_accumulate_project's arguments, for shade_and_light (`points` is
+// what the rays' consumer fills).
+struct ProbeLightRequest {
+  const ProbeGrid* grid = nullptr;
+  const MapProjector* projector = nullptr;
+  const std::vector<std::vector<ShadedPoint>>* points = nullptr;
+  const std::vector<const DepthMap*>* own_depth = nullptr;
+  const SharingSettings* sharing = nullptr;
+  std::span<const int> batch;
+  std::span<ProbeMapState* const> states;
+  ProbeMapStore* store = nullptr;
+  const AccumulationSettings* accumulation = nullptr;
+  std::span<std::uint8_t> changed;
+  std::span<float> sh;
+  ShareAccumulateTimes* times = nullptr;
+};
+
 class ProbeKernels {
  public:
   virtual ~ProbeKernels() = default;
@@ -131,6 +160,18 @@ class ProbeKernels {
                                                 std::span<ProbeMapState* const> states, ProbeMapStore* store,
                                                 const AccumulationSettings& accumulation, std::span<std::uint8_t> changed,
                                                 std::span<float> sh, ShareAccumulateTimes& times) = 0;
+  // shade_probe_rays (`consume` filling *light.points: every traced probe's
+  // rays, in order, no other points), then share_accumulate_project, as one
+  // stage: for a frame whose batch does not depend on what its rays find
+  // (no classification between them), so that a device traces, shades,
+  // rasterises, accumulates and projects in one submission. The CPU runs
+  // the two in turn.
+  virtual SharingStats shade_and_light(const ProbeRayRequest& rays, const ProbeRayConsumer& consume, const ProbeLightRequest& light) {
+    shade_probe_rays(*rays.scene, *rays.lights, rays.origins, rays.probe_ids, rays.directions, rays.seed, rays.sample, *rays.self,
+                     rays.outer, consume);
+    return share_accumulate_project(*light.grid, *light.projector, *light.points, *light.own_depth, *light.sharing, light.batch,
+                                    light.states, light.store, *light.accumulation, light.changed, light.sh, *light.times);
+  }
   // A store for the maps of a field of `probes` probes laid out as
   // `layout`, kept on this backend's device; null where the maps live in
   // the ProbeMapStates themselves (the CPU).
