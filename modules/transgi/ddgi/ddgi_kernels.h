@@ -15,6 +15,7 @@
 #include <glm/mat2x3.hpp>
 
 #include "ddgi/ddgi_blend.h"
+#include "engine/gpu/vulkan_context.h"
 #include "engine/image/image.h"
 #include "engine/render/camera_rays.h"
 #include "engine/render/light_set.h"
@@ -69,6 +70,9 @@ class DdgiKernels {
                                             const engine::render::CameraRays& camera, int width, int height,
                                             const DdgiRenderSettings& settings) = 0;
   [[nodiscard]] virtual const char* name() const = 0;
+  // Submissions and bytes between host and device since the last call
+  // (engine::gpu::GpuTraffic); none on the CPU.
+  virtual engine::gpu::GpuTraffic take_traffic() { return {}; }
 };
 
 }  // namespace transgi::ddgi

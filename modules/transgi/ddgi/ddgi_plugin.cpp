@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "ddgi/ddgi_renderer.h"
+#include "engine/render/camera_hit_tracer.h"
 #include "engine/render/light_plugin.h"
 #include "engine/render/temporal_accumulation.h"
 #include "engine/render/path_tracer.h"
@@ -183,13 +184,39 @@ void render_realtime(const rt::RtScene& rt, const scene::SceneAssets& assets, co
   frame.times.antialiasing = ms_since(t0);
 }
 
+// Before the probes update: the real-time camera view queued on the
+// backend's device, drawn with the probe rays' submission rather than one
+// of its own (TransGI's transgi::queue_camera_view). Only a hint.
+void queue_camera_view(CameraView cameras, Res<rt::RtScene> rt, Res<DdgiRenderOptions> options, Res<DdgiFrame> frame,
+                       ResMut<DdgiBackend> backend, Res<DdgiRealtimeScratch> scratch) {
+  if (frame->width <= 0 || frame->height <= 0 || !options->realtime) return;
+  rt::RayBatchTracer* tracer = backend->kernels->tracer();
+  render::CameraHitTracer* raster = tracer ? tracer->camera_hit_tracer() : nullptr;
+  if (!raster) return;
+  const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
+  if (!rays) return;
+  const glm::vec2 jitter = options->taa.enabled ? scratch->taa.next_jitter(options->taa) : glm::vec2(0.0f);
+  raster->queue_camera_hits(*rt, *rays, glm::vec2(0.5f) + jitter);
+}
+
 void render_frame(CameraView cameras, View<Get<const DdgiProbeVolume>> volumes, View<Get<const DdgiCascades>> cascades,
                   Res<rt::RtScene> rt, Res<scene::SceneAssets> assets, Res<render::SceneLights> lights,
                   Res<DdgiRenderOptions> options, ResMut<DdgiFrame> frame, ResMut<DdgiBackend> backend,
-                  Local<render::TemporalAccumulation> history, Local<DdgiRealtimeScratch> scratch) {
+                  Local<render::TemporalAccumulation> history, ResMut<DdgiRealtimeScratch> scratch) {
   if (frame->width <= 0 || frame->height <= 0) return;
   const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
   if (!rays) throw std::runtime_error("ddgi::render: DdgiFrame asks for an image but the world has no camera");
+  // The traffic of the probe updates and this image, whichever way it returns.
+  struct RecordTraffic {
+    DdgiFrame& frame;
+    DdgiBackend& backend;
+    ~RecordTraffic() {
+      const engine::gpu::GpuTraffic t = backend.kernels->take_traffic();
+      frame.gpu_submissions = t.submissions;
+      frame.gpu_upload_bytes = t.host_to_device_bytes;
+      frame.gpu_download_bytes = t.device_to_host_bytes;
+    }
+  } record_traffic{*frame, *backend};
   // Authored (and scene) volumes first, then cascades finest first.
   std::vector<const DdgiVolume*> all;
   volumes.each([&](const DdgiProbeVolume& v) {
@@ -228,7 +255,9 @@ void DdgiPlugin::build(app::App& app) {
   if (!w.has_resource<DdgiRenderOptions>()) w.insert_resource<DdgiRenderOptions>(options_);
   if (!w.has_resource<DdgiFrame>()) w.insert_resource<DdgiFrame>();
   if (!w.has_resource<DdgiBackend>()) w.insert_resource<DdgiBackend>();
+  if (!w.has_resource<DdgiRealtimeScratch>()) w.insert_resource<DdgiRealtimeScratch>();
   app.add_system(Phase::PrepareRender, "ddgi::sync_volumes", sync_volumes);
+  app.add_system(Phase::Render, "ddgi::queue_camera_view", queue_camera_view);
   app.add_system(Phase::Render, "ddgi::update_volumes", update_volumes);
   app.add_system(Phase::Render, "ddgi::render", render_frame);
 }

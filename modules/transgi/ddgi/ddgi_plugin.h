@@ -6,7 +6,10 @@
 //  PrepareRender  ddgi::sync_volumes: each DdgiProbeVolume has a volume for the
 //                 current settings and bounds (fitted to the scene once), and
 //                 each DdgiCascades one per cascade on the camera (scrolled).
-//  Render         ddgi::update_volumes: rays traced, irradiance and distance blended.
+//  Render         ddgi::queue_camera_view: on a device that rasterises, the
+//                 real-time camera view queued to be drawn with the next
+//                 submission (the probe rays').
+//                 ddgi::update_volumes: rays traced, irradiance and distance blended.
 //                 ddgi::render: if DdgiFrame has a size, its gi / direct / full
 //                 images and stage times are this frame's.
 #include <memory>
@@ -102,6 +105,9 @@ struct DdgiFrame {
   DdgiStageTimes times;
   DdgiFrameStats probe_stats;
   std::uint64_t frames = 0;
+  // Host-device traffic since the last image (the probe updates and this
+  // image; engine::gpu::GpuTraffic says how it is counted). 0 on the CPU.
+  std::uint64_t gpu_submissions = 0, gpu_upload_bytes = 0, gpu_download_bytes = 0;
 };
 
 class DdgiPlugin final : public engine::app::Plugin {

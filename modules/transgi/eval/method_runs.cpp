@@ -245,6 +245,7 @@ MethodRun run_ddgi(LoadedScene& scene, int width, int height, const DdgiRunOptio
     r.probe_summary += line;
   }
   r.backend = world.resource<ddgi::DdgiBackend>().describe();
+  r.gpu_submissions = frame.gpu_submissions;
   return r;
 }
 

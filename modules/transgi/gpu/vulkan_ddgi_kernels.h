@@ -76,9 +76,15 @@ class VulkanDdgiKernels : public ddgi::DdgiKernels {
     return ddgi::render_ddgi_gi_batched(scene, volumes, camera, width, height, settings, tracer_, *this);
   }
   [[nodiscard]] const char* name() const override { return name_.c_str(); }
+  engine::gpu::GpuTraffic take_traffic() override {
+    const engine::gpu::GpuTraffic now = ctx_->traffic(), since = now - traffic_taken_;
+    traffic_taken_ = now;
+    return since;
+  }
 
  private:
   std::shared_ptr<engine::gpu::VulkanContext> ctx_;
+  engine::gpu::GpuTraffic traffic_taken_;
   engine::gpu::GpuRayTracer tracer_;
   VulkanDdgiBlend blend_;
   VulkanProbeShading shading_;
