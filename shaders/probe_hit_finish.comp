@@ -17,6 +17,7 @@ layout(std430, set = 0, binding = 4) readonly buffer Depth { uint depth[]; };   
 layout(std430, set = 0, binding = 5) readonly buffer Probes { ProbeGpu probes[]; };  // both fields' probes
 layout(std430, set = 0, binding = 6) readonly buffer ProbeSh { float probe_sh[]; };  // both fields' probes x 75
 layout(std430, set = 0, binding = 7) writeonly buffer Briefs { ProbeRayBriefGpu briefs[]; };  // Out's fields the host needs
+layout(std430, set = 0, binding = 8) writeonly buffer Emission { float emission[]; };     // and its emission, 3 a ray
 layout(push_constant) uniform PushBlock { ProbeFinishPush p; };
 
 #include "probe_interpolation.glsl"
@@ -83,5 +84,8 @@ void main() {
   o.rg = radiance.g;
   o.rb = radiance.b;
   out_hits[i] = o;
-  briefs[i] = ProbeRayBriefGpu(o.distance, o.flags, o.er, o.eg, o.eb);
+  briefs[i] = ProbeRayBriefGpu(o.distance, o.flags);
+  emission[3u * i] = o.er;
+  emission[3u * i + 1u] = o.eg;
+  emission[3u * i + 2u] = o.eb;
 }

@@ -51,12 +51,17 @@ struct PendingProbeRayGpu {
 };
 
 // What the host reads of a probe ray when the raster's points are made on
-// the device (probe_points.comp): enough to classify the probe, update its
-// depth and sky cells and project its emitters, 20 bytes instead of 64.
+// the device (probe_points.comp): enough to classify the probe and update
+// its depth and sky cells, 8 bytes instead of 64; what it emitted (for a
+// field that projects its emitters from its rays rather than sampling
+// them) in a buffer of its own, read only where needed.
 struct ProbeRayBriefGpu {
   float distance;
   uint flags;
-  float er, eg, eb;  // emitted
+};
+
+struct ProbeRayEmissionGpu {
+  float er, eg, eb;
 };
 
 // probes::ProbeRayHit.
@@ -101,7 +106,7 @@ static_assert(sizeof(ProbeRayHitGpu) == 64 && offsetof(ProbeRayHitGpu, flags) ==
               "ProbeRayHitGpu layout");
 static_assert(sizeof(ProbeFeedbackGpu) == 320, "ProbeFeedbackGpu layout");
 static_assert(sizeof(OwnDepthProbeGpu) == 16 && sizeof(OwnDepthPush) == 16, "OwnDepth layouts");
-static_assert(sizeof(ProbeRayBriefGpu) == 20 && offsetof(ProbeRayBriefGpu, er) == 8, "ProbeRayBriefGpu layout");
+static_assert(sizeof(ProbeRayBriefGpu) == 8 && sizeof(ProbeRayEmissionGpu) == 12, "ProbeRayBriefGpu layouts");
 }  // namespace transgi::gpu
 #endif
 

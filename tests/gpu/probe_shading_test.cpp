@@ -587,6 +587,7 @@ TEST(VulkanProbeKernels, TheRaysAndTheirLightInOneSubmissionEqualTheTwoStages) {
     // depth maps from the store: staged by both stages of one submission).
     std::vector<float> field_sh;
     std::vector<std::uint8_t> usable;
+    std::uint64_t bytes_back = 0;
   };
   const auto make_path = [&] {
     Path p;
@@ -636,6 +637,7 @@ TEST(VulkanProbeKernels, TheRaysAndTheirLightInOneSubmissionEqualTheTwoStages) {
       const engine::gpu::GpuTraffic before = ctx->traffic();
       if (together) {
         probes::ProbeRayRequest rays{&scene, &lights, origins, tracing, directions, 7, static_cast<std::uint64_t>(frame + 1), &self, nullptr};
+        rays.emission = frame != 1;  // the second frame's consumer reads no emission
         probes::ProbeLightRequest light{&grid,    &projector, &points,   &p.own_depth, &sharing, batch, states,
                                         p.store.get(), &accumulation, p.changed, p.sh, &times};
         kernels->shade_and_light(rays, consume, light);
@@ -645,7 +647,9 @@ TEST(VulkanProbeKernels, TheRaysAndTheirLightInOneSubmissionEqualTheTwoStages) {
         kernels->share_accumulate_project(grid, projector, points, p.own_depth, sharing, batch, states, p.store.get(), accumulation,
                                           p.changed, p.sh, times);
       }
-      const std::uint64_t submissions = (ctx->traffic() - before).submissions;
+      const engine::gpu::GpuTraffic spent = ctx->traffic() - before;
+      p.bytes_back = spent.device_to_host_bytes;
+      const std::uint64_t submissions = spent.submissions;
       for (std::size_t k = 0; k < batch.size(); ++k)
         std::copy_n(p.sh.data() + k * 75, 75, p.field_sh.data() + static_cast<std::size_t>(batch[k]) * 75);
       return submissions;
@@ -658,9 +662,15 @@ TEST(VulkanProbeKernels, TheRaysAndTheirLightInOneSubmissionEqualTheTwoStages) {
       }
     const std::uint64_t two_submissions = run(two, false), one_submission = run(one, true);
     std::size_t hits_differ = 0, depth_differ = 0, sh_differ = 0;
-    for (std::size_t k = 0; k < two.hits.size(); ++k)
+    std::size_t emitting = 0;
+    for (std::size_t k = 0; k < two.hits.size(); ++k) {
+      emitting += two.hits[k].emitted != glm::vec3(0.0f);
       hits_differ += two.hits[k].hit != one.hits[k].hit || two.hits[k].distance != one.hits[k].distance ||
-                     two.hits[k].emitted != one.hits[k].emitted || two.hits[k].saw_light != one.hits[k].saw_light;
+                     (frame != 1 && two.hits[k].emitted != one.hits[k].emitted) || two.hits[k].saw_light != one.hits[k].saw_light ||
+                     (frame == 1 && one.hits[k].emitted != glm::vec3(0.0f));
+    }
+    // Without the emission, 12 bytes a ray fewer come back; else the same bytes.
+    EXPECT_EQ(two.bytes_back - one.bytes_back, frame == 1 ? 12u * two.hits.size() : 0u) << "frame " << frame;
     for (int q = 0; q < count; ++q)
       for (std::size_t t = 0; t < texels; ++t) {
         const auto& a = two.states[static_cast<std::size_t>(q)].depth.texels[t];
@@ -678,6 +688,7 @@ TEST(VulkanProbeKernels, TheRaysAndTheirLightInOneSubmissionEqualTheTwoStages) {
     EXPECT_EQ(sh_differ, 0u);
     EXPECT_EQ(two.changed, one.changed);
     EXPECT_GT(*std::max_element(one.sh.begin(), one.sh.end()), 0.0f) << "no light came into the probes: the test would prove nothing";
+    EXPECT_GT(emitting, 0u) << "no ray met an emitter: the emission's read would prove nothing";
   }
   EXPECT_EQ(ctx->validation_errors(), 0);
 }

@@ -184,7 +184,7 @@ probes::SharingStats VulkanProbeKernels::shade_and_light(const probes::ProbeRayR
   if (ctx_->last_stage_ms().size() == 4) shading_->add_gpu_ms(ctx_->last_stage_ms()[0]);
   take_light_stage_ms(1);
   std::vector<probes::ProbeRayHit> out;
-  shading_->read(out, nullptr, brief_hits_);
+  shading_->read(out, nullptr, brief_hits_, rays.emission);
   engine::jobs::parallel_for(0, static_cast<int>(rays.origins.size()), 1, [&](int b, int e) {
     for (int j = b; j < e; ++j)
       for (std::size_t i = 0; i < m; ++i) consume(j, static_cast<int>(i), out[static_cast<std::size_t>(j) * m + i]);

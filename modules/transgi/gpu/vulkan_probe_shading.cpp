@@ -62,7 +62,7 @@ VulkanProbeShading::VulkanProbeShading(engine::gpu::VulkanContext& ctx) : ctx_(c
   begin_ = std::make_unique<ComputePipeline>(ctx, compile_module_shader("probe_hit_begin.comp"),
                                              5 + engine::gpu::GpuShadingScene::kBindings, static_cast<std::uint32_t>(sizeof(ProbeHitPush)));
   shadow_trace_ = std::make_unique<ComputePipeline>(ctx, query, query_bindings, 2 * sizeof(std::uint32_t));
-  finish_ = std::make_unique<ComputePipeline>(ctx, compile_module_shader("probe_hit_finish.comp"), 8,
+  finish_ = std::make_unique<ComputePipeline>(ctx, compile_module_shader("probe_hit_finish.comp"), 9,
                                               static_cast<std::uint32_t>(sizeof(ProbeFinishPush)));
 }
 
@@ -121,6 +121,7 @@ bool VulkanProbeShading::prepare(const engine::rt::RtScene& scene, const engine:
   at_least(ctx_, shadow_hits_, n * sizeof(HitGpu));
   at_least(ctx_, out_, n * sizeof(ProbeRayHitGpu));
   at_least(ctx_, briefs_, n * sizeof(ProbeRayBriefGpu));
+  at_least(ctx_, emission_, n * sizeof(ProbeRayEmissionGpu));
 
   // The bounce light from the fields' probes, both fields in one set of buffers.
   const probes::ProbeFeedbackSource* fields[2] = {self, outer};
@@ -206,6 +207,7 @@ bool VulkanProbeShading::prepare(const engine::rt::RtScene& scene, const engine:
   finish_->bind(1, shadow_hits_);
   finish_->bind(2, out_);
   finish_->bind(7, briefs_);
+  finish_->bind(8, emission_);
   finish_->bind(3, feedback_);
   finish_->bind(4, depth_);
   finish_->bind(5, probes_);
@@ -254,18 +256,20 @@ void VulkanProbeShading::record(VkCommandBuffer cmd) const {
   finish_->record_dispatch(cmd, groups, 1, 1, &finish_push);
 }
 
-void VulkanProbeShading::read(std::vector<probes::ProbeRayHit>& out, std::vector<BounceInput>* bounce_inputs, bool brief) const {
+void VulkanProbeShading::read(std::vector<probes::ProbeRayHit>& out, std::vector<BounceInput>* bounce_inputs, bool brief,
+                              bool emission) const {
   if (brief && bounce_inputs) throw std::invalid_argument("VulkanProbeShading: brief hits carry no bounce inputs");
   const std::size_t n = prepared_.rays;
   out.resize(n);
   if (n == 0) return;
   if (brief) {
     const auto briefs = briefs_.mapped_as<const ProbeRayBriefGpu>(n);
+    const auto emitted = emission ? emission_.mapped_as<const ProbeRayEmissionGpu>(n) : std::span<const ProbeRayEmissionGpu>();
     engine::jobs::parallel_for<std::size_t>(0, n, kRaysPerTask, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         const ProbeRayBriefGpu& g = briefs[i];
         out[i] = probes::ProbeRayHit{};
-        take_brief(g.flags, g.distance, vec_of(g.er, g.eg, g.eb), out[i]);
+        take_brief(g.flags, g.distance, emission ? vec_of(emitted[i].er, emitted[i].eg, emitted[i].eb) : glm::vec3(0.0f), out[i]);
       }
     });
     return;

@@ -90,7 +90,10 @@ class VulkanProbeShading {
                std::uint64_t seed, std::uint64_t sample, const probes::ProbeFeedbackSource* self,
                const probes::ProbeFeedbackSource* outer);
   void record(VkCommandBuffer cmd) const;
-  void read(std::vector<probes::ProbeRayHit>& out, std::vector<BounceInput>* bounce_inputs = nullptr, bool brief = false) const;
+  // With `brief`, `emission` false leaves each hit's emission zero and
+  // reads 8 bytes a ray instead of 20.
+  void read(std::vector<probes::ProbeRayHit>& out, std::vector<BounceInput>* bounce_inputs = nullptr, bool brief = false,
+            bool emission = true) const;
   // Device milliseconds to count for the shading (a caller that records it
   // in a submission of its own times it).
   void add_gpu_ms(double ms) { gpu_ms_ += std::max(0.0, ms); }
@@ -111,7 +114,7 @@ class VulkanProbeShading {
   engine::gpu::GpuShadingScene scene_;
   std::unique_ptr<engine::gpu::ComputePipeline> generate_, trace_, begin_, shadow_trace_, finish_;
   engine::gpu::GpuBuffer origins_, directions_, rays_, hits_, items_, pending_, shadows_, shadow_hits_;
-  engine::gpu::GpuBuffer out_, briefs_, feedback_, probes_, probe_sh_;
+  engine::gpu::GpuBuffer out_, briefs_, emission_, feedback_, probes_, probe_sh_;
   // Both fields' depth maps on the device, filled in the submission: from
   // a field's VulkanMapStore (a copy on the device) or from the host
   // through depth_staging_.

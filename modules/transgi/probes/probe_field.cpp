@@ -389,6 +389,7 @@ void ProbeField::trace_and_shade(const engine::rt::RtScene& scene, const engine:
   rays.sample = frame_ + 1;
   rays.self = &self_source;
   rays.outer = outer ? &outer_source : nullptr;
+  rays.emission = !emitters_sampled;
   light->result.sharing = kernels_->shade_and_light(rays, by_probe, light_request(w, *light));
 }
 

@@ -107,6 +107,9 @@ struct ProbeRayRequest {
   std::uint64_t seed = 0, sample = 0;
   const ProbeFeedbackSource* self = nullptr;
   const ProbeFeedbackSource* outer = nullptr;
+  // Whether the consumer reads each hit's emission (ProbeRayHit::emitted);
+  // false: it may be left zero (a field that samples its emitters instead).
+  bool emission = true;
 };
 
 // share_accumulate_project's arguments, for shade_and_light (`points` is
