@@ -119,6 +119,27 @@ std::vector<render::PunctualInstance> test_punctual() {
   return out;
 }
 
+// The sample level lit by test_punctual, a 4 x 3 x 4 probe grid over it,
+// and a probe-ray batch from `tracing` along m Fibonacci directions: the
+// probe-kernel tests' setting.
+struct SampleLevelRays {
+  eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
+  const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
+  const render::LightSet lights{scene, test_punctual(), nullptr};
+  const probes::ProbeGrid grid = probes::ProbeGrid::centred_in(scene.bounds_min(), scene.bounds_max(), glm::ivec3(4, 3, 4));
+  std::vector<glm::vec3> directions, origins;
+  std::vector<int> tracing;
+  // Every probe q with traced(q) traces m rays.
+  template <class Traced>
+  SampleLevelRays(int m, Traced traced) : directions(probes::spherical_fibonacci(m)) {
+    for (int q = 0; q < grid.count(); ++q)
+      if (traced(q)) {
+        tracing.push_back(q);
+        origins.push_back(grid.position(q));
+      }
+  }
+};
+
 struct Compared {
   int rays = 0, hits = 0, shadowed = 0, lit = 0, outside = 0;
   int flag_mismatch = 0, value_mismatch = 0;
@@ -315,19 +336,11 @@ TEST(VulkanProbeKernels, ThePointsAreMadeOnTheDeviceFromTheShadedRays) {
   OWN_PROBE_KERNELS_OR_SKIP(own);
   const std::shared_ptr<engine::gpu::VulkanContext>& ctx = own.ctx;
   const std::shared_ptr<transgi::gpu::VulkanProbeKernels>& kernels = own.kernels;
-  eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
-  const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
-  const render::LightSet lights(scene, test_punctual(), nullptr);
-  const probes::ProbeGrid grid = probes::ProbeGrid::centred_in(scene.bounds_min(), scene.bounds_max(), glm::ivec3(4, 3, 4));
+  const int m = 32;
+  const SampleLevelRays level(m, [](int q) { return q % 5 != 3; });  // a few probes not traced this frame
+  const auto& [loaded, scene, lights, grid, directions, origins, tracing] = level;
   const probes::MapLayout layout{16, 8};
-  const int count = grid.count(), m = 32;
-  std::vector<glm::vec3> origins, directions = probes::spherical_fibonacci(m);
-  std::vector<int> tracing;
-  for (int q = 0; q < count; ++q)
-    if (q % 5 != 3) {  // a few probes not traced this frame
-      tracing.push_back(q);
-      origins.push_back(grid.position(q));
-    }
+  const int count = grid.count();
   probes::ProbeFeedbackSource self;
   self.grid = &grid;
   self.layout = layout;
@@ -455,20 +468,11 @@ TEST(VulkanProbeKernels, TheOwnDepthIsUpdatedOnTheDeviceBitForBitAndNotSentUp) {
   GPU_TEST_CONTEXT_OR_SKIP(unused);
   OWN_PROBE_KERNELS_OR_SKIP(own);
   const std::shared_ptr<transgi::gpu::VulkanProbeKernels>& kernels = own.kernels;
-  eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
-  const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
-  const render::LightSet lights(scene, test_punctual(), nullptr);
-  const probes::ProbeGrid grid = probes::ProbeGrid::centred_in(scene.bounds_min(), scene.bounds_max(), glm::ivec3(4, 3, 4));
+  const SampleLevelRays level(64, [](int) { return true; });
+  const auto& [loaded, scene, lights, grid, directions, origins, tracing] = level;
   const probes::MapLayout layout{8, 4};
-  const int count = grid.count(), m = 64;
+  const int count = grid.count();
   const std::size_t texels = static_cast<std::size_t>(layout.texel_count());
-  const std::vector<glm::vec3> directions = probes::spherical_fibonacci(m);
-  std::vector<glm::vec3> origins;
-  std::vector<int> tracing;
-  for (int q = 0; q < count; ++q) {
-    tracing.push_back(q);
-    origins.push_back(grid.position(q));
-  }
   std::vector<probes::ProbeMapState> states(static_cast<std::size_t>(count));
   for (auto& st : states) st.reset(layout.texel_count(), grid.min_spacing());
   std::vector<const probes::DepthMap*> own_depth;
@@ -558,21 +562,12 @@ TEST(VulkanProbeKernels, TheRaysAndTheirLightInOneSubmissionEqualTheTwoStages) {
   OWN_PROBE_KERNELS_OR_SKIP(own);
   const std::shared_ptr<engine::gpu::VulkanContext>& ctx = own.ctx;
   const std::shared_ptr<transgi::gpu::VulkanProbeKernels>& kernels = own.kernels;
-  eval::LoadedScene loaded = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
-  const rt::RtScene& scene = loaded.app->world().resource<rt::RtScene>();
-  const render::LightSet lights(scene, test_punctual(), nullptr);
-  const probes::ProbeGrid grid = probes::ProbeGrid::centred_in(scene.bounds_min(), scene.bounds_max(), glm::ivec3(4, 3, 4));
+  const int m = 48;
+  const SampleLevelRays level(m, [](int q) { return q % 4 != 1; });
+  const auto& [loaded, scene, lights, grid, directions, origins, tracing] = level;
   const probes::MapLayout layout{16, 8};
-  const int count = grid.count(), m = 48;
+  const int count = grid.count();
   const std::size_t texels = static_cast<std::size_t>(layout.texel_count());
-  const std::vector<glm::vec3> directions = probes::spherical_fibonacci(m);
-  std::vector<glm::vec3> origins;
-  std::vector<int> tracing;
-  for (int q = 0; q < count; ++q)
-    if (q % 4 != 1) {
-      tracing.push_back(q);
-      origins.push_back(grid.position(q));
-    }
   const probes::MapProjector projector(layout);
   const probes::SharingSettings sharing;
   const probes::AccumulationSettings accumulation;

@@ -109,6 +109,16 @@ gpu::VulkanContext* context_for(Traversal t, std::string* why) {
   return ctx;
 }
 
+// A camera inside build_world's room, looking across it.
+render::CameraRays room_camera(int width, int height) {
+  scene::Camera lens;
+  lens.yfov_radians = 1.1f;
+  transform::Similarity at;
+  at.translation = glm::vec3(-3.5f, 1.0f, 3.0f);
+  at.rotation = glm::angleAxis(-0.7f, glm::vec3(0, 1, 0)) * glm::angleAxis(-0.2f, glm::vec3(1, 0, 0));
+  return render::CameraRays(lens, at, width, height);
+}
+
 }  // namespace
 
 #define VISIBILITY_CONTEXT_OR_SKIP(name)                                 \
@@ -124,12 +134,8 @@ TEST_P(VisibilityPassTest, SeesWhatTheCameraRaysHitInARoomOfObjects) {
   gpu_test::build_world(world);
   gpu::GpuRtScene gpu_rt(*ctx);
   gpu_rt.sync(world.rt);
-  scene::Camera lens;
-  lens.yfov_radians = 1.1f;
-  transform::Similarity at;
-  at.translation = glm::vec3(-3.5f, 1.0f, 3.0f);
-  at.rotation = glm::angleAxis(-0.7f, glm::vec3(0, 1, 0)) * glm::angleAxis(-0.2f, glm::vec3(1, 0, 0));
-  const render::CameraRays camera(lens, at, 160, 90);
+  const render::CameraRays camera = room_camera(160, 90);
+  const transform::Similarity at = camera.to_world();
   gpu::VisibilityPass pass(*ctx);
   expect_agreement(compare("room, pixel centres", pass, gpu_rt, camera, {0.5f, 0.5f}, 0.01f));
   expect_agreement(compare("room, offset (0.2, 0.7)", pass, gpu_rt, camera, {0.2f, 0.7f}, 0.01f));
@@ -232,12 +238,7 @@ TEST_P(VisibilityPassTest, AQueuedViewIsTakenOnlyForTheSameViewAndGivesRendersHi
   gpu_test::build_world(world);
   gpu::GpuRtScene gpu_rt(*ctx);
   gpu_rt.sync(world.rt);
-  scene::Camera lens;
-  lens.yfov_radians = 1.1f;
-  transform::Similarity at;
-  at.translation = glm::vec3(-3.5f, 1.0f, 3.0f);
-  at.rotation = glm::angleAxis(-0.7f, glm::vec3(0, 1, 0));
-  const render::CameraRays camera(lens, at, 96, 64);
+  const render::CameraRays camera = room_camera(96, 64);
   const std::size_t n = 96 * 64;
   gpu::VisibilityPass pass(*ctx);
   std::vector<rt::Hit> want(n), got(n);
