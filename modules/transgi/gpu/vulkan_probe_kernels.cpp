@@ -172,7 +172,6 @@ probes::SharingStats VulkanProbeKernels::shade_and_light(const probes::ProbeRayR
   prepare_own_depth(grid, light.batch, light.states, *light.accumulation, layout, *maps);
   stages.accumulator->prepare(light.states, stages.raster->samples_on_device(), frame_maps, *light.accumulation, maps);
   light.times->share_ms = ms_since(t0);
-  const auto t1 = Clock::now();
   // The probe rays, then the light they carry into the probes: one
   // submission, a timestamp after each stage.
   ctx_->submit_and_wait([&](VkCommandBuffer cmd) {
@@ -189,11 +188,14 @@ probes::SharingStats VulkanProbeKernels::shade_and_light(const probes::ProbeRayR
     for (int j = b; j < e; ++j)
       for (std::size_t i = 0; i < m; ++i) consume(j, static_cast<int>(i), out[static_cast<std::size_t>(j) * m + i]);
   });
+  // The submission and the consumer are neither sharing nor accumulation:
+  // the caller counts them as its rays' time.
+  const auto t2 = Clock::now();
   const probes::SharingStats stats = stages.raster->finish(nullptr);
   stages.accumulator->finish(light.states, light.changed, {});
   stages.projector->read(light.sh);
   update_own_depth_on_host(light.batch, light.states, *light.points, layout, *light.accumulation, maps);
-  light.times->accumulate_ms = ms_since(t1);
+  light.times->accumulate_ms = ms_since(t2);
   return stats;
 }
 
