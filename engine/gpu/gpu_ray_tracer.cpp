@@ -12,8 +12,8 @@ GpuRayTracer::GpuRayTracer(VulkanContext& ctx) : ctx_(ctx), raster_(ctx.info().r
 
 GpuRayTracer::~GpuRayTracer() = default;
 
-bool GpuRayTracer::follow(const rt::RtScene& scene) {
-  if (!scene.assets()) return false;
+void GpuRayTracer::follow(const rt::RtScene& scene) {
+  if (!scene.assets()) throw GpuError("the Vulkan backend traces only scenes built with their assets (RtScene::assets())");
   if (!rt_) rt_ = std::make_unique<GpuRtScene>(ctx_);
   // Another scene, or a new commit (something moved): the TLAS follows.
   if (synced_ != &scene || commits_ != scene.stats().top_level_commits) {
@@ -23,42 +23,46 @@ bool GpuRayTracer::follow(const rt::RtScene& scene) {
     synced_ = &scene;
     commits_ = scene.stats().top_level_commits;
   }
-  return true;
 }
 
-bool GpuRayTracer::intersect(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<rt::Hit> hits,
+void GpuRayTracer::intersect(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<rt::Hit> hits,
                              std::span<std::uint8_t> found) {
-  if (!follow(scene)) return false;
+  follow(scene);
   double ms = 0;
   rt_->intersect(rays, hits, found, &ms);
   gpu_ms_ += std::max(0.0, ms);
-  return true;
 }
 
-bool GpuRayTracer::occluded(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<std::uint8_t> blocked) {
-  if (!follow(scene)) return false;
+void GpuRayTracer::occluded(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<std::uint8_t> blocked) {
+  follow(scene);
   double ms = 0;
   rt_->occluded(rays, blocked, &ms);
   gpu_ms_ += std::max(0.0, ms);
-  return true;
 }
 
-bool GpuRayTracer::camera_hits(const rt::RtScene& scene, const render::CameraRays& camera, glm::vec2 film_offset,
+void GpuRayTracer::camera_hits(const rt::RtScene& scene, const render::CameraRays& camera, glm::vec2 film_offset,
                                std::span<rt::Hit> hits, std::span<std::uint8_t> found) {
-  if (!raster_ || !follow(scene)) return false;
+  if (!raster_) throw GpuError("GpuRayTracer::camera_hits: the device's queue does not rasterise here (camera_hit_tracer() is null)");
+  follow(scene);
   if (!visibility_) visibility_ = std::make_unique<VisibilityPass>(ctx_);
   double ms = 0;
   const float near = near_plane(scene);
   if (!visibility_->take_queued(*rt_, camera, film_offset, near, hits, found, &ms))
     visibility_->render(*rt_, camera, film_offset, near, hits, found, &ms);
   gpu_ms_ += std::max(0.0, ms);
-  return true;
 }
 
 void GpuRayTracer::queue_camera_hits(const rt::RtScene& scene, const render::CameraRays& camera, glm::vec2 film_offset) {
-  if (!raster_ || !follow(scene)) return;
-  if (!visibility_) visibility_ = std::make_unique<VisibilityPass>(ctx_);
-  visibility_->queue(*rt_, camera, film_offset, near_plane(scene));
+  if (!raster_ || !scene.assets()) return;
+  // Only a hint: where the device cannot hold the scene, camera_hits meets
+  // the same error in the frame, whose owner falls back and says why.
+  try {
+    follow(scene);
+    if (!visibility_) visibility_ = std::make_unique<VisibilityPass>(ctx_);
+    visibility_->queue(*rt_, camera, film_offset, near_plane(scene));
+  } catch (const GpuError&) {
+    if (visibility_) visibility_->drop_queued();
+  }
 }
 
 float GpuRayTracer::near_plane(const rt::RtScene& scene) {
@@ -72,10 +76,9 @@ float GpuRayTracer::near_plane(const rt::RtScene& scene) {
 
 void GpuRayTracer::set_raster_visibility(bool enabled) { raster_ = enabled && VisibilityPass::supported(ctx_); }
 
-bool GpuRayTracer::occluded_later(const rt::RtScene& scene, std::span<const rt::Ray> rays) {
-  if (!follow(scene)) return false;
+void GpuRayTracer::occluded_later(const rt::RtScene& scene, std::span<const rt::Ray> rays) {
+  follow(scene);
   rt_->occluded_later(rays);
-  return true;
 }
 
 void GpuRayTracer::take_occluded(std::span<std::uint8_t> blocked) {

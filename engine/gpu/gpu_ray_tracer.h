@@ -3,7 +3,8 @@
 // RtScene (synced whenever its top level was committed again) and traces
 // each batch in one dispatch, alpha-masked materials cut out as Embree's
 // filter does; and a camera's hits from a raster visibility pass where the
-// device's queue can rasterise. Declines only a scene without assets.
+// device's queue can rasterise. Throws GpuError for a scene without its
+// assets, as for one the device cannot hold.
 #include <memory>
 #include <vector>
 
@@ -19,13 +20,13 @@ class GpuRayTracer : public rt::RayBatchTracer, public render::CameraHitTracer {
   explicit GpuRayTracer(VulkanContext& ctx);
   ~GpuRayTracer() override;
 
-  bool intersect(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<rt::Hit> hits,
+  void intersect(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<rt::Hit> hits,
                  std::span<std::uint8_t> found) override;
   // Stops each ray's traversal at its first hit.
-  bool occluded(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<std::uint8_t> blocked) override;
+  void occluded(const rt::RtScene& scene, std::span<const rt::Ray> rays, std::span<std::uint8_t> blocked) override;
   // Queued at the head of the device's next submission (GpuRtScene::
   // occluded_later).
-  bool occluded_later(const rt::RtScene& scene, std::span<const rt::Ray> rays) override;
+  void occluded_later(const rt::RtScene& scene, std::span<const rt::Ray> rays) override;
   void take_occluded(std::span<std::uint8_t> blocked) override;
   // GPU milliseconds of the traces since the last call (timestamps),
   // the TLAS's rebuilds and the later batches with them.
@@ -34,7 +35,7 @@ class GpuRayTracer : public rt::RayBatchTracer, public render::CameraHitTracer {
   // ask for it (DeviceInfo::raster_visibility) or set_raster_visibility
   // did; else null, and the camera's rays are traced.
   render::CameraHitTracer* camera_hit_tracer() override { return raster_ ? this : nullptr; }
-  bool camera_hits(const rt::RtScene& scene, const render::CameraRays& camera, glm::vec2 film_offset, std::span<rt::Hit> hits,
+  void camera_hits(const rt::RtScene& scene, const render::CameraRays& camera, glm::vec2 film_offset, std::span<rt::Hit> hits,
                    std::span<std::uint8_t> found) override;
   // The view's visibility pass queued at the head of the device's next
   // submission (VisibilityPass::queue); camera_hits takes it when it asks
@@ -45,8 +46,11 @@ class GpuRayTracer : public rt::RayBatchTracer, public render::CameraHitTracer {
   // benchmark compares the two.
   void set_raster_visibility(bool enabled);
   // The device's copy of `scene`, synced, for kernels that trace in their
-  // own submissions (GpuRtScene::bind); null where it declines the scene.
-  GpuRtScene* device_scene(const rt::RtScene& scene) { return follow(scene) ? rt_.get() : nullptr; }
+  // own submissions (GpuRtScene::bind).
+  GpuRtScene* device_scene(const rt::RtScene& scene) {
+    follow(scene);
+    return rt_.get();
+  }
 
  private:
   VulkanContext& ctx_;
@@ -55,7 +59,9 @@ class GpuRayTracer : public rt::RayBatchTracer, public render::CameraHitTracer {
   bool raster_ = false;
   const rt::RtScene* synced_ = nullptr;
   std::size_t commits_ = 0;
-  bool follow(const rt::RtScene& scene);  // syncs when needed; false: declines the scene
+  // Syncs when needed; throws GpuError for a scene without its assets
+  // (nothing to upload).
+  void follow(const rt::RtScene& scene);
   // The raster's near plane for `scene`.
   static float near_plane(const rt::RtScene& scene);
   double gpu_ms_ = 0.0;

@@ -18,9 +18,8 @@ class CameraHitTracer {
   // The hits of camera.generate((x, y) + film_offset) for every pixel,
   // row by row from the top-left, as RtScene::intersect gives them (a
   // rasteriser and a ray may round a pixel on an edge apart); found[i]:
-  // pixel i saw a surface. Returns false, touching nothing, where this
-  // backend cannot see the scene exactly.
-  virtual bool camera_hits(const rt::RtScene& scene, const CameraRays& camera, glm::vec2 film_offset, std::span<rt::Hit> hits,
+  // pixel i saw a surface. Throws where it cannot (RayBatchTracer's rule).
+  virtual void camera_hits(const rt::RtScene& scene, const CameraRays& camera, glm::vec2 film_offset, std::span<rt::Hit> hits,
                            std::span<std::uint8_t> found) = 0;
   // A hint that camera_hits will be asked for this view: a device starts on
   // it with its next piece of work, so that the later call costs none of

@@ -1,10 +1,15 @@
 #pragma once
 // A backend that traces a batch of rays against an RtScene somewhere other
-// than Embree (engine/gpu/gpu_ray_tracer: a BVH in a compute shader). Callers
-// that hold one trace a frame's rays in one call and fall back to the
-// RtScene's own queries when it declines.
+// than Embree (engine/gpu/gpu_ray_tracer: a BVH in a compute shader or ray
+// queries). A caller that holds one traces a frame's rays through it, in one
+// call; one that holds none (the CPU backend) asks the RtScene. A tracer
+// never declines a batch it was given: where it cannot trace (a device that
+// cannot hold the scene, or a scene without its assets) it throws, and its
+// owner runs the frame on the CPU backend whole.
+#include <algorithm>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "engine/rt/rt_scene.h"
 
@@ -19,26 +24,32 @@ class RayBatchTracer {
   virtual ~RayBatchTracer() = default;
   // Closest hits of `rays` in `scene` as it is now; found[i] says whether ray
   // i hit, and a hit carries what RtScene::intersect's does (entity,
-  // instance, mesh, primitive, barycentrics, t). Returns false, touching
-  // nothing, where this backend cannot trace the scene exactly.
-  virtual bool intersect(const RtScene& scene, std::span<const Ray> rays, std::span<Hit> hits,
-                         std::span<std::uint8_t> found) = 0;
+  // instance, mesh, primitive, barycentrics, t).
+  virtual void intersect(const RtScene& scene, std::span<const Ray> rays, std::span<Hit> hits, std::span<std::uint8_t> found) = 0;
   // Shadow rays: blocked[i] = whether anything lies on ray i within
-  // (tmin, tmax]. Returns false, touching nothing, where it declines.
-  virtual bool occluded(const RtScene& scene, std::span<const Ray> rays, std::span<std::uint8_t> blocked) = 0;
+  // (tmin, tmax].
+  virtual void occluded(const RtScene& scene, std::span<const Ray> rays, std::span<std::uint8_t> blocked) = 0;
   // Shadow rays whose answers the caller reads later (take_occluded),
   // traced along with the backend's next piece of work instead of on their
-  // own (a device's next submission). Returns false, queuing nothing, where
-  // the backend declines; one batch at a time.
-  virtual bool occluded_later(const RtScene& /*scene*/, std::span<const Ray> /*rays*/) { return false; }
+  // own (a device's next submission); one batch at a time. A backend
+  // without such work traces them now.
+  virtual void occluded_later(const RtScene& scene, std::span<const Ray> rays) {
+    later_.assign(rays.size(), 0);
+    occluded(scene, rays, later_);
+  }
   // blocked[i] for ray i of the batch occluded_later queued.
-  virtual void take_occluded(std::span<std::uint8_t> /*blocked*/) {}
+  virtual void take_occluded(std::span<std::uint8_t> blocked) {
+    std::copy_n(later_.begin(), std::min(later_.size(), blocked.size()), blocked.begin());
+  }
   // Device milliseconds the traces took since the last call (0 where the
   // backend cannot time them), so each stage that traces can take its own.
   virtual double take_device_ms() { return 0.0; }
   // The same backend's way to see a camera's pixels without tracing their
   // rays (a raster pass), or null where it has none.
   virtual render::CameraHitTracer* camera_hit_tracer() { return nullptr; }
+
+ private:
+  std::vector<std::uint8_t> later_;  // the default occluded_later's answers
 };
 
 }  // namespace engine::rt

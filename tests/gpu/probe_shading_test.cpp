@@ -202,7 +202,7 @@ TEST(VulkanProbeShading, EqualsTheCpuStagesOnTheSampleLevelWithEveryKindOfLight)
     }
   std::vector<rt::Hit> hits(rays.size());
   std::vector<std::uint8_t> found(rays.size());
-  ASSERT_TRUE(tracer.intersect(scene, rays, hits, found));
+  tracer.intersect(scene, rays, hits, found);
   Compared c;
   for (int i = 0; i < n; ++i) {
     const auto k = static_cast<std::size_t>(i);
@@ -317,6 +317,41 @@ TEST(VulkanProbeShading, ASceneTooBigForTheDeviceRunsTheWholeFrameOnTheCpuBacken
   };
   const eval::MethodRun capped = run(runtime::Backend::Vulkan, ctx), cpu = run(runtime::Backend::Cpu, nullptr);
   gpu_test::expect_cpu_fallback_frame(capped.backend, capped.gi, cpu.backend, cpu.gi);
+}
+
+// The same device with the probes frozen (an editor's still view): the
+// first device work of a frame is then the real-time G-buffer's, in
+// render_gi, which must fall back as the probe update does: the CPU
+// backend makes the image whole, says why, and its full frame is the CPU
+// backend's own, bit for bit.
+TEST(VulkanProbeShading, ASceneTooBigForTheDeviceWithTheProbesFrozenRendersOnTheCpuBackend) {
+  GPU_TEST_CONTEXT_OR_SKIP(unused);
+  engine::gpu::GpuOptions options;
+  options.storage_buffer_range_cap = 64 * 1024;  // the level's triangles and texels take more
+  std::string why;
+  std::shared_ptr<engine::gpu::VulkanContext> ctx(engine::gpu::VulkanContext::create(options, &why));
+  ASSERT_TRUE(ctx) << why;
+  if (!transgi::gpu::VulkanProbeShading::supported(*ctx, &why)) GTEST_SKIP() << why;
+  const auto run = [&](runtime::Backend backend, std::shared_ptr<engine::gpu::VulkanContext> host) {
+    eval::TransgiRunOptions t;
+    t.frames = 3;
+    t.progress = false;
+    t.settings = runtime::realtime_preset();
+    t.settings.backend = backend;
+    t.settings.freeze_probes = true;
+    t.placement.mode = runtime::ProbeVolumeMode::Scene;
+    t.placement.scene_dims = glm::ivec3(4);
+    t.host_gpu = std::move(host);
+    eval::LoadedScene scene = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
+    return eval::run_transgi(scene, std::make_shared<const model::TransferModel>(), 32, 18, t);
+  };
+  const eval::MethodRun capped = run(runtime::Backend::Vulkan, ctx), cpu = run(runtime::Backend::Cpu, nullptr);
+  EXPECT_EQ(capped.backend.rfind("cpu; the CPU backend runs the frame (scene too large): ", 0), 0u) << capped.backend;
+  EXPECT_EQ(cpu.backend, "cpu");
+  ASSERT_GT(gpu_test::mean_rgb(cpu.full), 1e-3) << "the frame should not be black";
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < cpu.full.pixels.size(); ++i) differ += capped.full.pixels[i] != cpu.full.pixels[i] ? 1 : 0;
+  EXPECT_EQ(differ, 0u) << "expected the CPU backend's frame exactly";
 }
 
 // The raster's points made on the device from the probe rays' hits

@@ -26,14 +26,15 @@ bool inside_grid(const ProbeGrid& grid, glm::ivec3 c) {
 // it; each pass only uses probes linked before it, so the order of the probes
 // does not matter.
 // Each segment's closest hit distance (infinity: clear), through the
-// backend's tracer in one batch where it takes the scene, else Embree.
+// backend's tracer in one batch where it has one, else Embree.
 std::vector<float> hit_distances(const engine::rt::RtScene& scene, engine::rt::RayBatchTracer* tracer,
                                  std::span<const engine::rt::Ray> rays) {
   using namespace engine;
   std::vector<float> t(rays.size(), std::numeric_limits<float>::infinity());
   std::vector<rt::Hit> hits(rays.size());
   std::vector<std::uint8_t> found(rays.size());
-  if (tracer && tracer->intersect(scene, rays, hits, found)) {
+  if (tracer) {
+    tracer->intersect(scene, rays, hits, found);
     for (std::size_t i = 0; i < rays.size(); ++i)
       if (found[i]) t[i] = hits[i].t;
     return t;
@@ -175,7 +176,9 @@ OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& gri
       segment_of.push_back(static_cast<int>(slot));
     }
   std::vector<std::uint8_t> blocked(segments.size(), 0);
-  if (!tracer || !tracer->occluded(scene, segments, blocked))
+  if (tracer)
+    tracer->occluded(scene, segments, blocked);
+  else
     jobs::parallel_for<std::size_t>(0, segments.size(), 64, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) blocked[i] = scene.occluded(segments[i]) ? 1 : 0;
     });

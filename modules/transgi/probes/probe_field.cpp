@@ -445,7 +445,8 @@ void ProbeField::queue_emitter_samples(const engine::rt::RtScene& scene, const e
                            w.emitter_samples.data() + j * k_per_probe);
     }
   });
-  w.emitters_queued = tracer->occluded_later(scene, w.emitter_rays);
+  tracer->occluded_later(scene, w.emitter_rays);
+  w.emitters_queued = true;
 }
 
 void ProbeField::sample_emitters(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, UpdateWork& w) {
@@ -458,23 +459,14 @@ void ProbeField::sample_emitters(const engine::rt::RtScene& scene, const engine:
       project_emitter_samples(w.emitter_samples.data() + j * k_per_probe, blocked.data() + j * k_per_probe, K,
                               w.direct_frame.data() + static_cast<std::size_t>(w.tracing[j]) * 75);
   };
-  // Traced with the probe rays' submission (queue_emitter_samples).
+  // The backend's tracer took them with the probe rays (queue_emitter_samples).
   if (w.emitters_queued) {
     std::vector<std::uint8_t> blocked(n, 1);
     kernels_->tracer()->take_occluded(blocked);
     project_all(blocked);
     return;
   }
-  // A tracer that takes no later batch traces the samples
-  // queue_emitter_samples made in one batch now.
-  if (rt::RayBatchTracer* tracer = kernels_->tracer()) {
-    std::vector<std::uint8_t> blocked(n, 1);
-    if (tracer->occluded(scene, w.emitter_rays, blocked)) {
-      project_all(blocked);
-      return;
-    }
-  }
-  // Else each probe's samples are made, traced and projected in one pass.
+  // Without one, each probe's samples are made, traced and projected in one pass.
   jobs::parallel_for<std::size_t>(0, w.tracing.size(), 8, [&](std::size_t b, std::size_t e) {
     std::vector<rt::Ray> rays(k_per_probe);
     std::vector<render::LightSample> samples(k_per_probe);

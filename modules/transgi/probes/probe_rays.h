@@ -121,16 +121,15 @@ ProbeRayHit trace_probe_ray(const engine::rt::RtScene& scene, const engine::rend
 
 // A batch of probe rays traced by `tracer`: their closest hits in one call,
 // each hit's first half of the shading, the shadow rays in a second call,
-// then the rest. rng_of(k) is ray k's generator. Returns false, out
-// untouched, where the tracer declines the scene.
+// then the rest. rng_of(k) is ray k's generator.
 template <class RngOf, class Feedback>
-bool shade_probe_rays_batched(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
+void shade_probe_rays_batched(const engine::rt::RtScene& scene, const engine::render::LightSet& lights,
                               engine::rt::RayBatchTracer& tracer, std::span<const engine::rt::Ray> rays, RngOf&& rng_of,
                               Feedback&& feedback, std::vector<ProbeRayHit>& out) {
   using namespace engine;
   std::vector<rt::Hit> hits(rays.size());
   std::vector<std::uint8_t> found(rays.size());
-  if (!tracer.intersect(scene, rays, hits, found)) return false;
+  tracer.intersect(scene, rays, hits, found);
   std::vector<PendingProbeRay> pending(rays.size());
   jobs::parallel_for<std::size_t>(0, rays.size(), 64, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
@@ -146,15 +145,13 @@ bool shade_probe_rays_batched(const engine::rt::RtScene& scene, const engine::re
       shadow_of.push_back(k);
     }
   std::vector<std::uint8_t> blocked(shadows.size());
-  if (!tracer.occluded(scene, shadows, blocked))
-    for (std::size_t j = 0; j < shadows.size(); ++j) blocked[j] = scene.occluded(shadows[j]) ? 1 : 0;
+  tracer.occluded(scene, shadows, blocked);
   std::vector<std::uint8_t> blocked_at(pending.size(), 0);
   for (std::size_t j = 0; j < shadows.size(); ++j) blocked_at[shadow_of[j]] = blocked[j];
   out.resize(pending.size());
   jobs::parallel_for<std::size_t>(0, pending.size(), 256, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) out[k] = finish_probe_ray(pending[k], blocked_at[k] != 0, feedback);
   });
-  return true;
 }
 
 
@@ -163,8 +160,8 @@ bool shade_probe_rays_batched(const engine::rt::RtScene& scene, const engine::re
 // generator rng_of(q, i). One probe's rays are consumed in order, on one
 // thread, so consume may write that probe's data without locks. With
 // `tracer` (a backend's, e.g. the GPU's) the rays and then their shadow
-// rays go to it in two batches; without one, or where it declines the
-// scene, Embree traces them ray by ray and each is consumed as it is shaded.
+// rays go to it in two batches; without one Embree traces them ray by ray
+// and each is consumed as it is shaded.
 // A ray's result is trace_probe_ray's for the same hit either way. TransGI's
 // probe field and the DDGI baseline both trace through here.
 template <class OriginOf, class RngOf, class Feedback, class Consume>
@@ -180,14 +177,13 @@ void trace_probe_rays(const engine::rt::RtScene& scene, const engine::render::Li
       for (const glm::vec3& d : directions) rays.push_back(engine::rt::Ray{origin_of(q), d});
     const auto rng_of_ray = [&](std::size_t k) { return rng_of(probes[k / m], static_cast<int>(k % m)); };
     std::vector<ProbeRayHit> shaded;
-    if (shade_probe_rays_batched(scene, lights, *tracer, rays, rng_of_ray, feedback, shaded)) {
-      engine::jobs::parallel_for(0, n, 1, [&](int b, int e) {
-        for (int j = b; j < e; ++j)
-          for (std::size_t i = 0; i < m; ++i)
-            consume(probes[static_cast<std::size_t>(j)], static_cast<int>(i), shaded[static_cast<std::size_t>(j) * m + i]);
-      });
-      return;
-    }
+    shade_probe_rays_batched(scene, lights, *tracer, rays, rng_of_ray, feedback, shaded);
+    engine::jobs::parallel_for(0, n, 1, [&](int b, int e) {
+      for (int j = b; j < e; ++j)
+        for (std::size_t i = 0; i < m; ++i)
+          consume(probes[static_cast<std::size_t>(j)], static_cast<int>(i), shaded[static_cast<std::size_t>(j) * m + i]);
+    });
+    return;
   }
   engine::jobs::parallel_for(0, n, 1, [&](int b, int e) {
     for (int j = b; j < e; ++j) {

@@ -73,6 +73,16 @@ void choose_backend(const TransGISettings& settings, GiBackendChoice& chosen) {
   else chosen.fall_back(reason, why);
 }
 
+// Which backend runs the frame, and why the CPU's where a device was asked for.
+void report_backend(const GiBackendChoice& backend, GiFrame& frame) {
+  frame.backend = backend.active->name();
+  frame.backend_fallback_reason = backend.fallback;
+  frame.backend_fallback = backend.fallback == probes::BackendFallback::None
+                               ? std::string()
+                               : std::string("the CPU backend runs the frame (") + probes::to_string(backend.fallback) +
+                                     "): " + backend.fallback_why;
+}
+
 // Every probe volume's and cascade's update on `kernels`.
 probes::ProbeFrameStats update_all_fields(View<Get<ProbeVolume>>& volumes, View<Get<ProbeCascades>>& cascades,
                                           const rt::RtScene& rt, const render::LightSet& lights,
@@ -117,12 +127,7 @@ void update_probes(View<Get<ProbeVolume>> volumes, View<Get<ProbeCascades>> casc
     backend->fall_back(probes::BackendFallback::SceneTooLarge, e.what());
     total = update_all_fields(volumes, cascades, *rt, lights->set, backend->active->probe_kernels(), frame->cascade_stats);
   }
-  frame->backend = backend->active->name();
-  frame->backend_fallback_reason = backend->fallback;
-  frame->backend_fallback = backend->fallback == probes::BackendFallback::None
-                                ? std::string()
-                                : std::string("the CPU backend runs the frame (") + probes::to_string(backend->fallback) +
-                                      "): " + backend->fallback_why;
+  report_backend(*backend, *frame);
   frame->probe_stats = total;
   for (const DeviceStageTime& stage : backend->active->take_probe_stage_times()) frame->set_device_stage(stage.name, stage.ms);
   ++frame->probe_frames;
@@ -278,7 +283,7 @@ void queue_camera_view(CameraView cameras, Res<rt::RtScene> rt, Res<TransGISetti
 void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Get<const ProbeCascades>> cascades,
                View<Get<const LatentMesh>> latents,
                Res<rt::RtScene> rt, Res<scene::SceneAssets> assets, Res<render::SceneLights> lights,
-               Res<TransGISettings> settings, ResMut<GiFrame> frame, Res<GiBackendChoice> backend, ResMut<PackedDecoder> packed) {
+               Res<TransGISettings> settings, ResMut<GiFrame> frame, ResMut<GiBackendChoice> backend, ResMut<PackedDecoder> packed) {
   if (frame->width <= 0 || frame->height <= 0) return;
   const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
   if (!rays) throw std::runtime_error("transgi::render_gi: GiFrame asks for an image but the world has no camera");
@@ -341,8 +346,19 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
     const bool light_changed = lights->version != packed->lights_version || lights->geometry_version != packed->geometry_version;
     packed->lights_version = lights->version;
     packed->geometry_version = lights->geometry_version;
-    render_realtime(*rays, model, rs.has_transfer, fields, *rt, *assets, lights->set, *settings, rs.seed, *packed, *frame,
-                    backend->active->tracer(), batch_decoder, light_changed);
+    try {
+      render_realtime(*rays, model, rs.has_transfer, fields, *rt, *assets, lights->set, *settings, rs.seed, *packed, *frame,
+                      backend->active->tracer(), batch_decoder, light_changed);
+    } catch (const engine::gpu::GpuError& e) {
+      if (backend->active == cpu_gi_backend()) throw;
+      // The device could not make this image (its first use this frame, the
+      // probes frozen): the CPU backend makes it, and every frame after it,
+      // whole; nothing of the failed image is kept.
+      backend->fall_back(probes::BackendFallback::SceneTooLarge, e.what());
+      report_backend(*backend, *frame);
+      render_realtime(*rays, model, rs.has_transfer, fields, *rt, *assets, lights->set, *settings, rs.seed, *packed, *frame,
+                      nullptr, nullptr, light_changed);
+    }
     frame->times.collect_points = frame->probe_stats.scatter_ms;
     frame->times.probe_raster = frame->probe_stats.raster_ms;
     frame->times.probe_projection = frame->probe_stats.project_ms;

@@ -465,18 +465,10 @@ engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt
     std::vector<engine::rt::Hit> hits(rays.size());
     std::vector<std::uint8_t> found(rays.size());
     distances.resize(rays.size());
-    if (tracer->intersect(scene, rays, hits, found)) {
-      engine::jobs::parallel_for<std::size_t>(0, rays.size(), 4096, [&](std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) distances[i] = found[i] ? hits[i].t : kInf;
-      });
-    } else {
-      engine::jobs::parallel_for<std::size_t>(0, rays.size(), 256, [&](std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) {
-          engine::rt::Hit hit;
-          distances[i] = scene.intersect(rays[i], hit) ? hit.t : kInf;
-        }
-      });
-    }
+    tracer->intersect(scene, rays, hits, found);
+    engine::jobs::parallel_for<std::size_t>(0, rays.size(), 4096, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) distances[i] = found[i] ? hits[i].t : kInf;
+    });
     shader.set_batch({nullptr, &distances, &first});
   }
   each_tile();

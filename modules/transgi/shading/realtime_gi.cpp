@@ -198,7 +198,8 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
   if (engine::render::CameraHitTracer* raster = tracer ? tracer->camera_hit_tracer() : nullptr) {
     batch_hits.resize(g.samples.size());
     batch_found.resize(g.samples.size());
-    by_pixel = raster->camera_hits(scene, camera, glm::vec2(0.5f) + jitter, batch_hits, batch_found);
+    raster->camera_hits(scene, camera, glm::vec2(0.5f) + jitter, batch_hits, batch_found);
+    by_pixel = true;
   }
   if (tracer && !by_pixel) {
     // Where each tile's rays start, then the rays in parallel (serially,
@@ -222,7 +223,7 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
     });
     batch_hits.resize(batch_rays.size());
     batch_found.resize(batch_rays.size());
-    if (!tracer->intersect(scene, batch_rays, batch_hits, batch_found)) tile_first.clear();
+    tracer->intersect(scene, batch_rays, batch_hits, batch_found);
   }
   engine::jobs::parallel_for(0, tiles_x * tiles_y, 16, [&](int t0, int t1) {
     engine::rt::Ray rays[16];
