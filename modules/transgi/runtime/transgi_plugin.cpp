@@ -287,17 +287,18 @@ void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Ge
   if (frame->width <= 0 || frame->height <= 0) return;
   const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
   if (!rays) throw std::runtime_error("transgi::render_gi: GiFrame asks for an image but the world has no camera");
-  // The traffic of the probe updates and this image, whichever path returns.
+  // The traffic of the probe updates and this image, whichever path returns;
+  // the backend is held, as a fallback below replaces the active one.
   struct RecordTraffic {
     GiFrame& frame;
-    GiBackend& backend;
+    std::shared_ptr<GiBackend> backend;
     ~RecordTraffic() {
-      const engine::gpu::GpuTraffic t = backend.take_traffic();
+      const engine::gpu::GpuTraffic t = backend->take_traffic();
       frame.gpu_submissions = t.submissions;
       frame.gpu_upload_bytes = t.host_to_device_bytes;
       frame.gpu_download_bytes = t.device_to_host_bytes;
     }
-  } record_traffic{*frame, *backend->active};
+  } record_traffic{*frame, backend->active};
 
   // One scene decoder: the model of the first LatentMesh found.
   std::shared_ptr<const model::TransferModel> model;
