@@ -265,6 +265,16 @@ TEST(VulkanProbeShading, EqualsTheCpuStagesOnTheSampleLevelWithEveryKindOfLight)
   EXPECT_NEAR(c.mean_gpu, c.mean_cpu, 2e-3 * c.mean_cpu) << "expected the mean radiance within 0.2 %";
 }
 
+namespace {
+// A device whose largest storage buffer cannot hold the sample level's
+// triangles and texels; null, with *why, where none can be made.
+std::shared_ptr<engine::gpu::VulkanContext> capped_device(std::string* why) {
+  engine::gpu::GpuOptions options;
+  options.storage_buffer_range_cap = 64 * 1024;
+  return std::shared_ptr<engine::gpu::VulkanContext>(engine::gpu::VulkanContext::create(options, why));
+}
+}  // namespace
+
 // A device whose largest buffer cannot hold the level's shading data: the
 // kernels throw, naming what did not fit, and the plugin runs that frame and
 // every later one on the CPU backend whole, saying why: the frame is the CPU
@@ -272,10 +282,8 @@ TEST(VulkanProbeShading, EqualsTheCpuStagesOnTheSampleLevelWithEveryKindOfLight)
 // field changed).
 TEST(VulkanProbeShading, ASceneTooBigForTheDeviceRunsTheWholeFrameOnTheCpuBackend) {
   GPU_TEST_CONTEXT_OR_SKIP(unused);
-  engine::gpu::GpuOptions options;
-  options.storage_buffer_range_cap = 64 * 1024;  // the level's triangles and texels take more
   std::string why;
-  std::shared_ptr<engine::gpu::VulkanContext> ctx(engine::gpu::VulkanContext::create(options, &why));
+  const std::shared_ptr<engine::gpu::VulkanContext> ctx = capped_device(&why);
   ASSERT_TRUE(ctx) << why;
   if (!transgi::gpu::VulkanProbeShading::supported(*ctx, &why)) GTEST_SKIP() << why;
   const std::string level = std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf";
@@ -326,10 +334,8 @@ TEST(VulkanProbeShading, ASceneTooBigForTheDeviceRunsTheWholeFrameOnTheCpuBacken
 // backend's own, bit for bit.
 TEST(VulkanProbeShading, ASceneTooBigForTheDeviceWithTheProbesFrozenRendersOnTheCpuBackend) {
   GPU_TEST_CONTEXT_OR_SKIP(unused);
-  engine::gpu::GpuOptions options;
-  options.storage_buffer_range_cap = 64 * 1024;  // the level's triangles and texels take more
   std::string why;
-  std::shared_ptr<engine::gpu::VulkanContext> ctx(engine::gpu::VulkanContext::create(options, &why));
+  const std::shared_ptr<engine::gpu::VulkanContext> ctx = capped_device(&why);
   ASSERT_TRUE(ctx) << why;
   if (!transgi::gpu::VulkanProbeShading::supported(*ctx, &why)) GTEST_SKIP() << why;
   const auto run = [&](runtime::Backend backend, std::shared_ptr<engine::gpu::VulkanContext> host) {
