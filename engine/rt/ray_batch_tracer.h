@@ -6,10 +6,8 @@
 // never declines a batch it was given: where it cannot trace (a device that
 // cannot hold the scene, or a scene without its assets) it throws, and its
 // owner runs the frame on the CPU backend whole.
-#include <algorithm>
 #include <cstdint>
 #include <span>
-#include <vector>
 
 #include "engine/rt/rt_scene.h"
 
@@ -31,25 +29,16 @@ class RayBatchTracer {
   virtual void occluded(const RtScene& scene, std::span<const Ray> rays, std::span<std::uint8_t> blocked) = 0;
   // Shadow rays whose answers the caller reads later (take_occluded),
   // traced along with the backend's next piece of work instead of on their
-  // own (a device's next submission); one batch at a time. A backend
-  // without such work traces them now.
-  virtual void occluded_later(const RtScene& scene, std::span<const Ray> rays) {
-    later_.assign(rays.size(), 0);
-    occluded(scene, rays, later_);
-  }
+  // own (a device's next submission); one batch at a time.
+  virtual void occluded_later(const RtScene& scene, std::span<const Ray> rays) = 0;
   // blocked[i] for ray i of the batch occluded_later queued.
-  virtual void take_occluded(std::span<std::uint8_t> blocked) {
-    std::copy_n(later_.begin(), std::min(later_.size(), blocked.size()), blocked.begin());
-  }
+  virtual void take_occluded(std::span<std::uint8_t> blocked) = 0;
   // Device milliseconds the traces took since the last call (0 where the
   // backend cannot time them), so each stage that traces can take its own.
   virtual double take_device_ms() { return 0.0; }
   // The same backend's way to see a camera's pixels without tracing their
   // rays (a raster pass), or null where it has none.
   virtual render::CameraHitTracer* camera_hit_tracer() { return nullptr; }
-
- private:
-  std::vector<std::uint8_t> later_;  // the default occluded_later's answers
 };
 
 }  // namespace engine::rt

@@ -41,19 +41,27 @@ void VulkanProbeKernels::prepare_own_depth(const probes::ProbeGrid& grid, std::s
 }
 
 namespace {
-// The batch's own depth on the host (update_own_depth); with `adopted`, the
-// store is told its copies, which a kernel updated the same way, are of
-// the host's new versions.
-void update_own_depth_on_host(std::span<const int> batch, std::span<probes::ProbeMapState* const> states,
-                              const std::vector<std::vector<probes::ShadedPoint>>& points, const probes::MapLayout& layout,
-                              const probes::AccumulationSettings& accumulation, VulkanMapStore* adopted) {
-  engine::jobs::parallel_for(0, static_cast<int>(batch.size()), 8, [&](int b, int e) {
-    for (int i = b; i < e; ++i) {
-      const auto k = static_cast<std::size_t>(i);
-      probes::update_own_depth(*states[k], layout, points[static_cast<std::size_t>(batch[k])], accumulation);
-      if (adopted) adopted->adopt_depth(static_cast<std::size_t>(batch[k]), states[k]->depth.version);
-    }
-  });
+// The batch's own depth on the host, after the kernel updated the store's
+// copies the same way: the store holds the host's new versions.
+void update_own_depths_as_the_device(std::span<const int> batch, std::span<probes::ProbeMapState* const> states,
+                                     const std::vector<std::vector<probes::ShadedPoint>>& points, const probes::MapLayout& layout,
+                                     const probes::AccumulationSettings& accumulation, VulkanMapStore& maps) {
+  probes::update_own_depths(batch, states, points, layout, accumulation);
+  for (std::size_t k = 0; k < batch.size(); ++k) maps.adopt_depth(static_cast<std::size_t>(batch[k]), states[k]->depth.version);
+}
+
+// Which probes of the grid the batch updates, and their map slots.
+struct BatchTargets {
+  std::vector<std::uint8_t> targets;    // per grid probe
+  std::vector<std::uint32_t> frame_maps;  // per batch probe
+};
+BatchTargets batch_targets(const probes::ProbeGrid& grid, std::span<const int> batch) {
+  BatchTargets t{std::vector<std::uint8_t>(static_cast<std::size_t>(grid.count()), 0), std::vector<std::uint32_t>(batch.size())};
+  for (std::size_t i = 0; i < batch.size(); ++i) {
+    t.targets[static_cast<std::size_t>(batch[i])] = 1;
+    t.frame_maps[i] = static_cast<std::uint32_t>(batch[i]);
+  }
+  return t;
 }
 
 // Whether each batch state's depth map is the one own_depth lists for its
@@ -96,12 +104,7 @@ probes::SharingStats VulkanProbeKernels::share_accumulate_project(
   const auto t0 = Clock::now();
   const auto& layout = projector.layout();
   const LightStages stages = light_stages(projector);
-  std::vector<std::uint8_t> targets(static_cast<std::size_t>(grid.count()), 0);
-  std::vector<std::uint32_t> frame_maps(batch.size());
-  for (std::size_t i = 0; i < batch.size(); ++i) {
-    targets[static_cast<std::size_t>(batch[i])] = 1;
-    frame_maps[i] = static_cast<std::uint32_t>(batch[i]);
-  }
+  const BatchTargets bt = batch_targets(grid, batch);
   auto* maps = dynamic_cast<VulkanMapStore*>(store);
   if (store && !maps) throw std::invalid_argument("VulkanProbeKernels: a map store from another backend");
   // The points are the last shading's rays where they match (the field
@@ -114,13 +117,13 @@ probes::SharingStats VulkanProbeKernels::share_accumulate_project(
   // the host's by the same arithmetic after the submission), so that no
   // updated map goes up; else on the host first, the changed maps sent.
   const bool own_depth_on_device = maps && rays_on_device && batch_depth_is_own(batch, states, own_depth);
-  if (!own_depth_on_device) update_own_depth_on_host(batch, states, points, layout, accumulation, nullptr);
-  stages.raster->prepare(grid, points, own_depth, sharing, targets, maps, shaded_rays_per_probe_ > 0 ? &rays : nullptr);
+  if (!own_depth_on_device) probes::update_own_depths(batch, states, points, layout, accumulation);
+  stages.raster->prepare(grid, points, own_depth, sharing, bt.targets, maps, shaded_rays_per_probe_ > 0 ? &rays : nullptr);
   if (own_depth_on_device) prepare_own_depth(grid, batch, states, accumulation, layout, *maps);
   if (shaded_brief_ && !stages.raster->points_made_on_device())
     throw std::logic_error("VulkanProbeKernels: the points are not the last shading's rays, whose hits came back brief "
                            "(set_brief_hits(false) for points of the caller's own)");
-  stages.accumulator->prepare(states, stages.raster->samples_on_device(), frame_maps, accumulation, maps);
+  stages.accumulator->prepare(states, stages.raster->samples_on_device(), bt.frame_maps, accumulation, maps);
   times.share_ms = ms_since(t0);
   const auto t1 = Clock::now();
   // One submission, a timestamp after each stage: the samples and the
@@ -130,7 +133,7 @@ probes::SharingStats VulkanProbeKernels::share_accumulate_project(
   const probes::SharingStats stats = stages.raster->finish(nullptr);
   stages.accumulator->finish(states, changed, {});
   stages.projector->read(sh);
-  if (own_depth_on_device) update_own_depth_on_host(batch, states, points, layout, accumulation, maps);
+  if (own_depth_on_device) update_own_depths_as_the_device(batch, states, points, layout, accumulation, *maps);
   times.accumulate_ms = ms_since(t1);
   return stats;
 }
@@ -160,17 +163,12 @@ probes::SharingStats VulkanProbeKernels::shade_and_light(const probes::ProbeRayR
   const probes::ProbeGrid& grid = *light.grid;
   const auto& layout = light.projector->layout();
   const LightStages stages = light_stages(*light.projector);
-  std::vector<std::uint8_t> targets(static_cast<std::size_t>(grid.count()), 0);
-  std::vector<std::uint32_t> frame_maps(light.batch.size());
-  for (std::size_t i = 0; i < light.batch.size(); ++i) {
-    targets[static_cast<std::size_t>(light.batch[i])] = 1;
-    frame_maps[i] = static_cast<std::uint32_t>(light.batch[i]);
-  }
+  const BatchTargets bt = batch_targets(grid, light.batch);
   const VulkanRadianceRaster::DevicePoints points{&shading_->hits_on_device(), &shading_->directions_on_device(), shaded_probes_,
                                                   shaded_rays_per_probe_};
-  stages.raster->prepare_from_rays(grid, *light.own_depth, *light.sharing, targets, maps, points);
+  stages.raster->prepare_from_rays(grid, *light.own_depth, *light.sharing, bt.targets, maps, points);
   prepare_own_depth(grid, light.batch, light.states, *light.accumulation, layout, *maps);
-  stages.accumulator->prepare(light.states, stages.raster->samples_on_device(), frame_maps, *light.accumulation, maps);
+  stages.accumulator->prepare(light.states, stages.raster->samples_on_device(), bt.frame_maps, *light.accumulation, maps);
   light.times->share_ms = ms_since(t0);
   // The probe rays, then the light they carry into the probes: one
   // submission, a timestamp after each stage.
@@ -194,7 +192,7 @@ probes::SharingStats VulkanProbeKernels::shade_and_light(const probes::ProbeRayR
   const probes::SharingStats stats = stages.raster->finish(nullptr);
   stages.accumulator->finish(light.states, light.changed, {});
   stages.projector->read(light.sh);
-  update_own_depth_on_host(light.batch, light.states, *light.points, layout, *light.accumulation, maps);
+  update_own_depths_as_the_device(light.batch, light.states, *light.points, layout, *light.accumulation, *maps);
   light.times->accumulate_ms = ms_since(t2);
   return stats;
 }

@@ -66,12 +66,7 @@ SharingStats CpuProbeKernels::share_accumulate_project(const ProbeGrid& grid, co
       throw std::logic_error("CpuProbeKernels: probe " + std::to_string(batch[i]) +
                              "'s maps are held on a device; read them back first (ProbeMapStore::read_back)");
   auto t0 = Clock::now();
-  // Each batch probe's depth from its own rays only: probes in parallel.
-  engine::jobs::parallel_for(0, static_cast<int>(batch.size()), 8, [&](int b, int e) {
-    for (int i = b; i < e; ++i)
-      update_own_depth(*states[static_cast<std::size_t>(i)], projector.layout(), points[static_cast<std::size_t>(batch[static_cast<std::size_t>(i)])],
-                       accumulation);
-  });
+  update_own_depths(batch, states, points, projector.layout(), accumulation);
   std::vector<std::uint8_t> targets(static_cast<std::size_t>(grid.count()), 0);
   for (const int q : batch) targets[static_cast<std::size_t>(q)] = 1;
   // Only the batch's maps are filled (and allocated).

@@ -681,10 +681,10 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   t0 = Clock::now();
   LightIntoProbes light;
   if (together) {
+    // Its light stage ran inside the scattering's time; what follows it counts as projection.
+    stats.scatter_ms -= together->result.times.share_ms + together->result.times.accumulate_ms;
     finish_light(w, *together);
     light = together->result;
-    stats.scatter_ms -= light.times.share_ms + light.times.accumulate_ms;
-    light.times.accumulate_ms += ms_since(t0);
   } else {
     light = share_accumulate_project(w);
   }

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "engine/jobs/parallel_for.h"
+
 namespace transgi::probes {
 
 void ProbeMapState::reset(int texels, float depth_unit) {
@@ -185,6 +187,17 @@ bool accumulate(ProbeMapState& st, const FrameSamples& f, const AccumulationSett
   st.radiance_scale = fitted_scale(old_scale, peak);
   store_history(st, next, st.radiance_scale == old_scale ? &history : nullptr);
   return changed;
+}
+
+void update_own_depths(std::span<const int> batch, std::span<ProbeMapState* const> states,
+                       const std::vector<std::vector<ShadedPoint>>& points, const MapLayout& layout,
+                       const AccumulationSettings& settings) {
+  engine::jobs::parallel_for(0, static_cast<int>(batch.size()), 8, [&](int b, int e) {
+    for (int i = b; i < e; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      update_own_depth(*states[k], layout, points[static_cast<std::size_t>(batch[k])], settings);
+    }
+  });
 }
 
 float own_depth_blend(const ProbeMapState& st, const AccumulationSettings& s) {

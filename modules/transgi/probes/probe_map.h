@@ -3,6 +3,7 @@
 // hit-distance moments (for the sharing depth guard and Chebyshev
 // visibility), and the SH projection shading reads.
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -93,6 +94,11 @@ bool accumulate(ProbeMapState& state, const FrameSamples& frame, const Accumulat
 // Updates the own-depth moments from this probe's own shaded points.
 void update_own_depth(ProbeMapState& state, const MapLayout& layout, const std::vector<ShadedPoint>& own,
                       const AccumulationSettings& settings);
+// update_own_depth of each *states[i] from points[batch[i]], probes in
+// parallel (a backend's light stage for its batch).
+void update_own_depths(std::span<const int> batch, std::span<ProbeMapState* const> states,
+                       const std::vector<std::vector<ShadedPoint>>& points, const MapLayout& layout,
+                       const AccumulationSettings& settings);
 // The weight update_own_depth gives a texel's history this frame (the
 // exponential blend's h: fast for a map's first frames, so that visibility
 // follows a moved wall in a few frames). A device that updates the depth
