@@ -43,18 +43,7 @@ Frame frame_from_normal(vec3 n) {
 vec3 to_local(Frame f, vec3 v) { return vec3(dot(v, f.t), dot(v, f.b), dot(v, f.n)); }
 vec3 to_world(Frame f, vec3 v) { return v.x * f.t + v.y * f.b + v.z * f.n; }
 
-// rt::offset_ray_origin (Waechter and Binder 2019).
-vec3 offset_ray_origin(vec3 p, vec3 n, float scale) {
-  const float origin = scale / 32.0, float_scale = scale / 65536.0, int_scale = 256.0;
-  vec3 out_p;
-  for (int i = 0; i < 3; ++i) {
-    const int of_i = int(int_scale * n[i]);
-    const float p_i = intBitsToFloat(floatBitsToInt(p[i]) + (p[i] < 0.0 ? -of_i : of_i));
-    out_p[i] = abs(p[i]) < origin ? p[i] + float_scale * n[i] : p_i;
-  }
-  return out_p;
-}
-
+#include "ray_offset.glsl"
 #include "texture_wrap.glsl"
 
 vec4 texel_at(TextureGpu t, int x, int y, bool srgb) {

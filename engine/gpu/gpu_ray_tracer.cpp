@@ -52,17 +52,22 @@ void GpuRayTracer::camera_hits(const rt::RtScene& scene, const render::CameraRay
   gpu_ms_ += std::max(0.0, ms);
 }
 
-void GpuRayTracer::queue_camera_hits(const rt::RtScene& scene, const render::CameraRays& camera, glm::vec2 film_offset) {
+void GpuRayTracer::queue_camera_hits(const rt::RtScene& scene, const render::CameraRays& camera, glm::vec2 film_offset,
+                                     const render::ViewShadowRequest* shadows) {
   if (!raster_ || !scene.assets()) return;
   // Only a hint: where the device cannot hold the scene, camera_hits meets
   // the same error in the frame, whose owner falls back and says why.
   try {
     follow(scene);
     if (!visibility_) visibility_ = std::make_unique<VisibilityPass>(ctx_);
-    visibility_->queue(*rt_, camera, film_offset, near_plane(scene));
+    visibility_->queue(*rt_, camera, film_offset, near_plane(scene), shadows);
   } catch (const GpuError&) {
     if (visibility_) visibility_->drop_queued();
   }
+}
+
+bool GpuRayTracer::take_view_shadows(const render::ViewShadowRequest& request, std::vector<float>& answers) {
+  return visibility_ && visibility_->take_shadows(request, answers);
 }
 
 float GpuRayTracer::near_plane(const rt::RtScene& scene) {

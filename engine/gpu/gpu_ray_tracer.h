@@ -40,7 +40,11 @@ class GpuRayTracer : public rt::RayBatchTracer, public render::CameraHitTracer {
   // The view's visibility pass queued at the head of the device's next
   // submission (VisibilityPass::queue); camera_hits takes it when it asks
   // for the same view of the same scene.
-  void queue_camera_hits(const rt::RtScene& scene, const render::CameraRays& camera, glm::vec2 film_offset) override;
+  // With `shadows`, the view's shadow rays are traced right after it
+  // (VisibilityPass::queue).
+  void queue_camera_hits(const rt::RtScene& scene, const render::CameraRays& camera, glm::vec2 film_offset,
+                         const render::ViewShadowRequest* shadows) override;
+  bool take_view_shadows(const render::ViewShadowRequest& request, std::vector<float>& answers) override;
   // Whether the G-buffer takes its hits from the raster pass, where the
   // queue can rasterise, whatever the device's options say: a test or a
   // benchmark compares the two.

@@ -9,6 +9,7 @@
 #include "engine/gpu/shader_compiler.h"
 #include "engine/gpu/vulkan_context.h"
 #include "engine/jobs/parallel_for.h"
+#include "view_shadows_shared.h"
 #include "visibility_shared.h"
 
 namespace engine::gpu {
@@ -224,6 +225,10 @@ void VisibilityPass::make_targets(std::uint32_t width, std::uint32_t height) {
   hits_ = GpuBuffer(ctx_, pixels * sizeof(VisibilityHitGpu));
   resolve_->bind(0, visibility_);
   resolve_->bind(1, hits_);
+  if (shadows_) {
+    shadows_->bind(0, visibility_);
+    shadows_->bind(1, hits_);
+  }
   width_ = width;
   height_ = height;
 }
@@ -251,6 +256,45 @@ void VisibilityPass::prepare(const GpuRtScene& scene, const render::CameraRays& 
   scene_ = &scene;
 
   push_ = push_for(camera, sample, near_plane);
+  shadow_push_.clear();
+}
+
+void VisibilityPass::prepare_shadows(const GpuRtScene& scene, const render::ViewShadowRequest& request) {
+  if (!shadows_) {
+    ShaderCompileOptions options = engine_shader_options();
+    options.defines = GpuRtScene::shader_defines(ctx_);
+    constexpr std::uint32_t kFirstSceneBinding = 4;
+    shadows_ = std::make_unique<ComputePipeline>(ctx_, compile_shader(engine_shader_dir() / "view_shadows.comp", options),
+                                                 GpuRtScene::binding_types(ctx_, kFirstSceneBinding, kFirstSceneBinding + GpuRtScene::kBindings),
+                                                 static_cast<std::uint32_t>(sizeof(VisibilityPushGpu) + sizeof(ViewShadowPushGpu)));
+    shadows_->bind(0, visibility_);
+    shadows_->bind(1, hits_);
+  }
+  const std::size_t lights = request.lights.size(), pixels = static_cast<std::size_t>(width_) * height_;
+  bind_at_least(ctx_, *shadows_, 2, shadow_lights_, lights * sizeof(ViewShadowLightGpu));
+  bind_at_least(ctx_, *shadows_, 3, shadow_answers_, lights * pixels * sizeof(float));
+  scene.bind(*shadows_, 4);
+  const std::span<ViewShadowLightGpu> out = shadow_lights_.mapped_as<ViewShadowLightGpu>(lights);
+  for (std::size_t l = 0; l < lights; ++l) {
+    const render::ViewShadowLight& light = request.lights[l];
+    ViewShadowLightGpu& g = out[l];
+    g.position_x = light.position.x;
+    g.position_y = light.position.y;
+    g.position_z = light.position.z;
+    g.flags = (light.directional ? kViewShadowDirectional : 0u) | (light.nearest ? kViewShadowNearest : 0u);
+    for (std::uint32_t c = 0; c < kViewShadowCells; ++c) {
+      const glm::vec3 d = light.directional ? light.directions[c] : glm::vec3(0.0f);
+      g.directions[4 * c] = d.x;
+      g.directions[4 * c + 1] = d.y;
+      g.directions[4 * c + 2] = d.z;
+      g.directions[4 * c + 3] = 0.0f;
+    }
+  }
+  const ViewShadowPushGpu extra{request.pattern_shift.x, request.pattern_shift.y, static_cast<std::uint32_t>(lights),
+                                request.offset_scale};
+  shadow_push_ = push_;
+  shadow_push_.resize(push_.size() + sizeof(extra));
+  std::memcpy(shadow_push_.data() + push_.size(), &extra, sizeof(extra));
 }
 
 std::vector<std::uint8_t> VisibilityPass::push_for(const render::CameraRays& camera, glm::vec2 sample, float near_plane) {
@@ -265,9 +309,14 @@ std::vector<std::uint8_t> VisibilityPass::push_for(const render::CameraRays& cam
   return bytes;
 }
 
-void VisibilityPass::queue(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane) {
+void VisibilityPass::queue(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane,
+                           const render::ViewShadowRequest* shadows) {
   drop_queued();
   prepare(scene, camera, sample, near_plane);
+  if (shadows && !shadows->lights.empty()) {
+    prepare_shadows(scene, *shadows);
+    queued_shadows_ = *shadows;
+  }
   queued_scene_ = &scene;
   queued_push_ = push_;
   ctx_.record_before_next(this, [this](VkCommandBuffer cmd) { record(cmd); });
@@ -276,6 +325,14 @@ void VisibilityPass::queue(const GpuRtScene& scene, const render::CameraRays& ca
 void VisibilityPass::drop_queued() {
   ctx_.forget_deferred(this);
   queued_scene_ = nullptr;
+  queued_shadows_.reset();
+}
+
+bool VisibilityPass::take_shadows(const render::ViewShadowRequest& request, std::vector<float>& answers) {
+  const bool match = taken_shadows_ && *taken_shadows_ == request;
+  taken_shadows_.reset();
+  if (match) answers = std::move(taken_answers_);
+  return match;
 }
 
 bool VisibilityPass::take_queued(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane,
@@ -294,6 +351,12 @@ bool VisibilityPass::take_queued(const GpuRtScene& scene, const render::CameraRa
   const double ms = ctx_.take_deferred_ms(this);
   if (gpu_ms) *gpu_ms = ms;
   read_hits(scene, hits, found);
+  taken_shadows_ = std::move(queued_shadows_);
+  queued_shadows_.reset();
+  if (taken_shadows_) {
+    const std::span<const float> answers = shadow_answers_.mapped_as<const float>(taken_shadows_->lights.size() * pixels);
+    taken_answers_.assign(answers.begin(), answers.end());
+  }
   return true;
 }
 
@@ -328,6 +391,9 @@ void VisibilityPass::record(VkCommandBuffer cmd) const {
                         VK_ACCESS_SHADER_READ_BIT);
   const std::uint32_t pixels = width_ * height_;
   resolve_->record_dispatch(cmd, (pixels + kVisibilityGroupSize - 1) / kVisibilityGroupSize, 1, 1, push_.data());
+  if (shadow_push_.empty()) return;
+  record_compute_barrier(cmd);
+  shadows_->record_dispatch(cmd, (pixels + kVisibilityGroupSize - 1) / kVisibilityGroupSize, 1, 1, shadow_push_.data());
 }
 
 void VisibilityPass::render(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane,
@@ -337,6 +403,7 @@ void VisibilityPass::render(const GpuRtScene& scene, const render::CameraRays& c
     throw GpuError("VisibilityPass::render: " + std::to_string(pixels) + " pixels, " + std::to_string(hits.size()) + " hits, " +
                    std::to_string(found.size()) + " flags");
   drop_queued();  // its bindings and targets are rewritten here
+  taken_shadows_.reset();
   prepare(scene, camera, sample, near_plane);
   const double ms = ctx_.submit_and_wait([&](VkCommandBuffer cmd) { record(cmd); });
   if (gpu_ms) *gpu_ms = ms;

@@ -17,6 +17,7 @@
 // (supported()).
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -27,6 +28,7 @@
 #include "engine/gpu/device_image.h"
 #include "engine/gpu/gpu_buffer.h"
 #include "engine/render/camera_rays.h"
+#include "engine/render/view_shadows.h"
 #include "engine/rt/ray.h"
 
 namespace engine::gpu {
@@ -62,14 +64,25 @@ class VisibilityPass {
               std::span<rt::Hit> hits, std::span<std::uint8_t> found, double* gpu_ms = nullptr);
   // prepare, and the pass queued at the head of the device's next
   // submission (VulkanContext::record_before_next), whichever stage makes
-  // it: a frame draws its camera's view with its first submission.
-  void queue(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane);
+  // it: a frame draws its camera's view with its first submission. With
+  // `shadows` (lights to test), the view's shadow rays
+  // (shaders/view_shadows.comp) are traced right after the resolve, in the
+  // same commands.
+  void queue(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane,
+             const render::ViewShadowRequest* shadows = nullptr);
   // The queued pass's hits, as render() gives them, where it was queued for
   // this scene, camera, sample and near plane (submitted now if no stage
   // has yet); false, and the queued pass dropped, where it was not.
-  // *gpu_ms: its device time.
+  // *gpu_ms: its device time. Its shadow rays' answers, if it had any, are
+  // kept for take_shadows.
   bool take_queued(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane,
                    std::span<rt::Hit> hits, std::span<std::uint8_t> found, double* gpu_ms = nullptr);
+  // The shadow rays' answers of the view take_queued last took
+  // (render::ViewShadowRequest's layout: lights x pixels), moved into
+  // `answers`, where they were queued for exactly `request`; false
+  // otherwise (none, or for other lights or another pattern). Each view's
+  // answers are taken once.
+  bool take_shadows(const render::ViewShadowRequest& request, std::vector<float>& answers);
   // Drops a queued pass that has not run (its scene is about to change).
   void drop_queued();
 
@@ -80,6 +93,9 @@ class VisibilityPass {
   // The hits in hits_ as GpuRtScene::intersect gives them.
   void read_hits(const GpuRtScene& scene, std::span<rt::Hit> hits, std::span<std::uint8_t> found) const;
   void destroy_targets();
+  // The shadow kernel's lights and answers for this view (after prepare);
+  // record() then dispatches it after the resolve.
+  void prepare_shadows(const GpuRtScene& scene, const render::ViewShadowRequest& request);
 
   VulkanContext& ctx_;
   const GpuRtScene* scene_ = nullptr;
@@ -101,6 +117,13 @@ class VisibilityPass {
   VkFramebuffer framebuffer_ = VK_NULL_HANDLE;
   GpuBuffer visibility_, hits_;
   std::unique_ptr<ComputePipeline> resolve_;
+  // The view's shadow rays: made on the first queue that asks for them,
+  // compiled for the device's traversal (GpuRtScene::shader_defines).
+  std::unique_ptr<ComputePipeline> shadows_;
+  GpuBuffer shadow_lights_, shadow_answers_;
+  std::vector<std::uint8_t> shadow_push_;  // VisibilityPushGpu then ViewShadowPushGpu; empty: none this view
+  std::optional<render::ViewShadowRequest> queued_shadows_, taken_shadows_;
+  std::vector<float> taken_answers_;
 };
 
 }  // namespace engine::gpu
