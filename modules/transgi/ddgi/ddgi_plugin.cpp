@@ -155,11 +155,19 @@ void render_realtime(const rt::RtScene& rt, const scene::SceneAssets& assets, co
   auto t0 = Clock::now();
   // The sun's disk pattern shifts with the jitter phase, as TransGI's frame does (realtime_direct.h).
   const int pattern_phase = options.taa.enabled ? scratch.taa.next_phase(options.taa) : 0;
-  shading::DirectTileShader direct(rt, lights, rays, frame.width, frame.height, {}, pattern_phase);
   const glm::vec2 jitter = options.taa.enabled ? scratch.taa.next_jitter(options.taa) : glm::vec2(0.0f);
-  shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, g, &direct, kernels.tracer(),
-                         jitter, options.taa.texture_lod_bias_in_use());
-  frame.direct = direct.take(g);
+  if (rt::RayBatchTracer* tracer = kernels.tracer()) {
+    // A device's: the shadow rays traced with the queued view
+    // (queue_camera_view), or in one batch after the G-buffer.
+    shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, g, nullptr, tracer, jitter,
+                           options.taa.texture_lod_bias_in_use());
+    frame.direct = shading::shade_direct_realtime(g, rt, lights, rays, nullptr, tracer, pattern_phase);
+  } else {
+    shading::DirectTileShader direct(rt, lights, rays, frame.width, frame.height, {}, pattern_phase);
+    shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, g, &direct, nullptr, jitter,
+                           options.taa.texture_lod_bias_in_use());
+    frame.direct = direct.take(g);
+  }
   frame.times.direct = ms_since(t0);
   t0 = Clock::now();
   DdgiPixels pixels = shade_ddgi_gbuffer(g, volumes, options.upsampling, scratch.plan, kernels);
@@ -187,8 +195,8 @@ void render_realtime(const rt::RtScene& rt, const scene::SceneAssets& assets, co
 // Before the probes update: the real-time camera view queued on the
 // backend's device, drawn with the probe rays' submission rather than one
 // of its own (TransGI's transgi::queue_camera_view). Only a hint.
-void queue_camera_view(CameraView cameras, Res<rt::RtScene> rt, Res<DdgiRenderOptions> options, Res<DdgiFrame> frame,
-                       ResMut<DdgiBackend> backend, Res<DdgiRealtimeScratch> scratch) {
+void queue_camera_view(CameraView cameras, Res<rt::RtScene> rt, Res<render::SceneLights> lights, Res<DdgiRenderOptions> options,
+                       Res<DdgiFrame> frame, ResMut<DdgiBackend> backend, Res<DdgiRealtimeScratch> scratch) {
   if (frame->width <= 0 || frame->height <= 0 || !options->realtime) return;
   rt::RayBatchTracer* tracer = backend->kernels->tracer();
   render::CameraHitTracer* raster = tracer ? tracer->camera_hit_tracer() : nullptr;
@@ -196,7 +204,10 @@ void queue_camera_view(CameraView cameras, Res<rt::RtScene> rt, Res<DdgiRenderOp
   const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
   if (!rays) return;
   const glm::vec2 jitter = options->taa.enabled ? scratch->taa.next_jitter(options->taa) : glm::vec2(0.0f);
-  raster->queue_camera_hits(*rt, *rays, glm::vec2(0.5f) + jitter);
+  // With it, the direct light's shadow rays, for the phase render_realtime shades with.
+  const render::ViewShadowRequest shadows =
+      shading::view_shadow_request(lights->set, options->taa.enabled ? scratch->taa.next_phase(options->taa) : 0, rt->offset_scale());
+  raster->queue_camera_hits(*rt, *rays, glm::vec2(0.5f) + jitter, &shadows);
 }
 
 void render_frame(CameraView cameras, View<Get<const DdgiProbeVolume>> volumes, View<Get<const DdgiCascades>> cascades,

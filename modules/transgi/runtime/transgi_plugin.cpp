@@ -204,6 +204,8 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
   shading::trace_gbuffer(rt, assets, rays, frame.width, frame.height, packed.gbuffer, direct ? &*direct : nullptr, tracer,
                          jitter, settings.taa.texture_lod_bias_in_use());
   std::optional<engine::image::ImageRGB> batched_direct;
+  // The shadow rays were traced with the queued view (queue_camera_view)
+  // where the G-buffer took that view; else they are traced here in one batch.
   if (deterministic && tracer)
     batched_direct = shading::shade_direct_realtime(packed.gbuffer, rt, lights, rays, &frame.direct_stats, tracer, pattern_phase);
   // The device's time for the camera and shadow rays just traced; the probe
@@ -265,8 +267,8 @@ void render_realtime(const render::CameraRays& rays, const std::shared_ptr<const
 // probe rays' submission rather than one of its own; the real-time
 // G-buffer then takes it (trace_gbuffer). Only a hint: a G-buffer that asks
 // for another view gets that one.
-void queue_camera_view(CameraView cameras, Res<rt::RtScene> rt, Res<TransGISettings> settings, Res<GiFrame> frame,
-                       ResMut<GiBackendChoice> backend, Res<PackedDecoder> packed) {
+void queue_camera_view(CameraView cameras, Res<rt::RtScene> rt, Res<render::SceneLights> lights, Res<TransGISettings> settings,
+                       Res<GiFrame> frame, ResMut<GiBackendChoice> backend, Res<PackedDecoder> packed) {
   if (frame->width <= 0 || frame->height <= 0 || settings->gi_path != GiPath::Realtime) return;
   choose_backend(*settings, *backend);
   rt::RayBatchTracer* tracer = backend->active->tracer();
@@ -277,7 +279,13 @@ void queue_camera_view(CameraView cameras, Res<rt::RtScene> rt, Res<TransGISetti
   // The jitter render_realtime will ask for (a camera cut clears the
   // antialiasing's history, not its place in the jitter cycle).
   const glm::vec2 jitter = settings->taa.enabled ? packed->taa.next_jitter(settings->taa) : glm::vec2(0.0f);
-  raster->queue_camera_hits(*rt, *rays, glm::vec2(0.5f) + jitter);
+  // With it, the direct light's shadow rays, for the pattern phase
+  // render_realtime will shade with.
+  std::optional<render::ViewShadowRequest> shadows;
+  if (deterministic_direct(*settings))
+    shadows = shading::view_shadow_request(lights->set, settings->taa.enabled ? packed->taa.next_phase(settings->taa) : 0,
+                                           rt->offset_scale());
+  raster->queue_camera_hits(*rt, *rays, glm::vec2(0.5f) + jitter, shadows ? &*shadows : nullptr);
 }
 
 void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Get<const ProbeCascades>> cascades,

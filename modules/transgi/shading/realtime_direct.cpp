@@ -8,9 +8,11 @@
 #include <memory>
 #include <span>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "engine/jobs/parallel_for.h"
+#include "engine/render/camera_hit_tracer.h"
 #include "engine/math/sampling.h"
 
 namespace transgi::shading {
@@ -141,7 +143,18 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty, Scratch& scr
       (*batch_.collect)[tile].insert((*batch_.collect)[tile].end(), rays, rays + n);
       continue;
     }
-    if (batch_.distances) {
+    if (batch_.view) {
+      const std::size_t pixels = static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height);
+      std::size_t untraced = 0;
+      for (int i = 0; i < n; ++i) {
+        distance[i] = (*batch_.view)[l * pixels + pixel[i]];
+        if (std::isnan(distance[i])) {
+          distance[i] = 0.0f;
+          ++untraced;
+        }
+      }
+      if (untraced) untraced_.fetch_add(untraced, std::memory_order_relaxed);
+    } else if (batch_.distances) {
       for (int i = 0; i < n; ++i) distance[i] = (*batch_.distances)[answer++];
     } else if (soft) {
       scene_.intersect16(rays, n, hits, found);
@@ -426,6 +439,7 @@ engine::image::ImageRGB DirectTileShader::take(const GBuffer& g, RealtimeDirectS
     for (const std::uint32_t n : rays_per_tile_) stats->shadow_rays += n;
     stats->lights = n_lights_;
     stats->nonfinite_pixels = nonfinite_.load();
+    stats->untraced_answers = untraced_.load();
   }
   return std::move(out_);
 }
@@ -447,7 +461,16 @@ engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt
   std::vector<engine::rt::Ray> rays;
   std::vector<std::size_t> first;
   std::vector<float> distances;
-  if (tracer) {
+  engine::render::CameraHitTracer* raster = tracer ? tracer->camera_hit_tracer() : nullptr;
+  const bool with_view =
+      raster && raster->take_view_shadows(view_shadow_request(lights, pattern_phase, scene.offset_scale()), distances);
+  if (with_view) {
+    const std::size_t want = lights.punctual_count() * static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height);
+    if (distances.size() != want)
+      throw std::invalid_argument("shade_direct_realtime: " + std::to_string(distances.size()) + " answers from the view for " +
+                                  std::to_string(want) + " (a G-buffer of another size than the view?)");
+    shader.set_batch({nullptr, nullptr, nullptr, &distances});
+  } else if (tracer) {
     std::vector<std::vector<engine::rt::Ray>> per_tile(static_cast<std::size_t>(tiles_x) * tiles_y);
     shader.set_batch({&per_tile, nullptr, nullptr});
     each_tile();
@@ -472,7 +495,34 @@ engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt
     shader.set_batch({nullptr, &distances, &first});
   }
   each_tile();
-  return shader.take(g, stats);
+  engine::image::ImageRGB out = shader.take(g, stats);
+  if (stats) stats->traced_with_view = with_view;
+  return out;
+}
+
+engine::render::ViewShadowRequest view_shadow_request(const engine::render::LightSet& lights, int pattern_phase,
+                                                      float offset_scale) {
+  engine::render::ViewShadowRequest request;
+  request.pattern_shift = disk_pattern_shift(pattern_phase);
+  request.offset_scale = offset_scale;
+  request.lights.resize(lights.punctual_count());
+  for (std::size_t l = 0; l < request.lights.size(); ++l) {
+    const engine::render::PunctualInstance& light = lights.punctual_lights()[l];
+    engine::render::ViewShadowLight& out = request.lights[l];
+    if (light.light.type != engine::scene::PunctualLight::Type::Directional) {
+      out.position = light.position;
+      continue;
+    }
+    // DirectTileShader's table: cell i holds the sample at disk_pattern(i & 7, i >> 3).
+    out.directional = true;
+    out.nearest = light.angular_radius > 0.0f;
+    for (int i = 0; i < engine::render::kViewShadowPatternCells; ++i) {
+      engine::render::LightSample ls;
+      lights.sample_punctual(l, glm::vec3(0.0f), disk_pattern(i & 7, i >> 3), ls);
+      out.directions[static_cast<std::size_t>(i)] = ls.direction;
+    }
+  }
+  return request;
 }
 
 void add_image(engine::image::ImageRGB& to, const engine::image::ImageRGB& from) {

@@ -26,6 +26,7 @@
 #include "engine/image/image.h"
 #include "engine/render/camera_rays.h"
 #include "engine/render/light_set.h"
+#include "engine/render/view_shadows.h"
 #include "shading/realtime_gi.h"
 
 namespace transgi::shading {
@@ -36,6 +37,11 @@ struct RealtimeDirectStats {
   // Pixels whose seen emission, background or light came out non-finite and
   // were set to zero (issue 13's NaN containment).
   std::size_t nonfinite_pixels = 0;
+  // Shadow rays the shader asked the view's answers for (traced_with_view)
+  // and found none traced: a light the device found below the surface where the
+  // host's rounding put it just above. Shaded as blocked.
+  std::size_t untraced_answers = 0;
+  bool traced_with_view = false;  // the shadow rays were the view's (shade_direct_realtime)
 };
 
 // The pass one 4x4 tile at a time: shade_direct_realtime runs it over the
@@ -84,10 +90,13 @@ class DirectTileShader {
   // a second pass with `distances` set shades, reading tile t's answers
   // (the distance to the first hit, infinity for none) from
   // distances[first[t]] on, in the order the first pass gathered them.
+  // Or one pass with `view` set: the answers the device traced with the
+  // camera's view for view_shadow_request (render/view_shadows.h's layout).
   struct Batch {
     std::vector<std::vector<engine::rt::Ray>>* collect = nullptr;
     const std::vector<float>* distances = nullptr;
     const std::vector<std::size_t>* first = nullptr;
+    const std::vector<float>* view = nullptr;
   };
   void set_batch(const Batch& batch) { batch_ = batch; }
 
@@ -116,19 +125,30 @@ class DirectTileShader {
   // by every tile is a cache line bouncing between the cores all frame.
   std::vector<std::uint32_t> rays_per_tile_;
   std::atomic<std::size_t> nonfinite_{0};  // rare: only a bad pixel adds
+  std::atomic<std::size_t> untraced_{0};   // rare too
   Batch batch_;
 };
 
 // to += from, pixel by pixel (same size), in parallel.
 void add_image(engine::image::ImageRGB& to, const engine::image::ImageRGB& from);
 
-// With `tracer` (a GPU backend) the shadow rays of the whole image go to it
-// in one batch; Embree's packets trace them tile by tile where it declines.
+// With `tracer` (a GPU backend) the shadow rays of the whole image are the
+// answers the device traced with the camera's view, where the G-buffer took
+// a view queued with view_shadow_request for these lights and this phase
+// (CameraHitTracer::take_view_shadows); else they go to it in one batch.
+// Without a tracer, Embree's packets trace them tile by tile.
 engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt::RtScene& scene,
                                               const engine::render::LightSet& lights,
                                               const engine::render::CameraRays& camera,
                                               RealtimeDirectStats* stats = nullptr,
                                               engine::rt::RayBatchTracer* tracer = nullptr, int pattern_phase = 0);
+
+// The shadow rays DirectTileShader asks for, as a request a device traces
+// with the camera's view: every punctual light, a directional one with its
+// 8x8 pattern shifted for `pattern_phase` (the nearest blocker's distance
+// where it has a disk), a point or spot light towards its position.
+engine::render::ViewShadowRequest view_shadow_request(const engine::render::LightSet& lights, int pattern_phase,
+                                                      float offset_scale);
 
 // The fixed point on [0, 1)^2 that pixel (x, y) uses for disk lights: an
 // R2 low-discrepancy sequence over each 8x8 block.
