@@ -98,8 +98,8 @@ GpuRtScene::GpuRtScene(VulkanContext& ctx) : ctx_(ctx) {
   const auto dir = engine_shader_dir();
   ShaderCompileOptions options = engine_shader_options();
   options.defines = shader_defines(ctx);
-  query_ = std::make_unique<ComputePipeline>(ctx, compile_compute_shader(dir / "rt_query.comp", options),
-                                             binding_types(ctx, 2, 2 + kBindings),
+  query_spirv_ = compile_compute_shader(dir / "rt_query.comp", options);
+  query_ = std::make_unique<ComputePipeline>(ctx, query_spirv_, binding_types(ctx, 2, 2 + kBindings),
                                              static_cast<std::uint32_t>(2 * sizeof(std::uint32_t)));
   stats_.ray_query = ctx.info().ray_query;
   if (stats_.ray_query) structures_ = std::make_unique<GpuAccelerationStructures>(ctx);
@@ -316,39 +316,68 @@ void write_rays(std::span<const rt::Ray> rays, std::span<RayGpu> in) {
 }
 }  // namespace
 
-void GpuRtScene::occluded_later(std::span<const rt::Ray> rays) {
-  if (ctx_.has_deferred(this)) ctx_.flush();
+void GpuRtScene::queue_later(LaterBatch& batch, std::span<const rt::Ray> rays, bool any_hit) {
+  // One batch a slot: a second waits for the first.
+  if (batch.count >= 0 && ctx_.has_deferred(this)) ctx_.flush();
   const std::size_t n = rays.size();
-  later_count_ = static_cast<std::ptrdiff_t>(n);
+  batch.count = static_cast<std::ptrdiff_t>(n);
   if (n == 0) return;
-  if (later_rays_.handle() == VK_NULL_HANDLE || later_rays_.size() < n * sizeof(RayGpu))
-    later_rays_ = GpuBuffer(ctx_, n * sizeof(RayGpu));
-  if (later_hits_.handle() == VK_NULL_HANDLE || later_hits_.size() < n * sizeof(HitGpu))
-    later_hits_ = GpuBuffer(ctx_, n * sizeof(HitGpu));
-  write_rays(rays, later_rays_.mapped_as<RayGpu>(n));
-  // The kernel is bound when the submission is recorded: an immediate query
-  // (run_query) submits this batch first, so the two never share a command
-  // buffer's bindings.
-  ctx_.record_before_next(this, [this, n](VkCommandBuffer cmd) {
-    query_->bind(0, later_rays_);
-    query_->bind(1, later_hits_);
-    bind(*query_, 2);
-    const std::uint32_t push[2] = {static_cast<std::uint32_t>(n), 1u};
-    query_->record_dispatch(cmd, (push[0] + kRtGroupSize - 1) / kRtGroupSize, 1, 1, push);
+  if (!batch.kernel)
+    batch.kernel = std::make_unique<ComputePipeline>(ctx_, query_spirv_, binding_types(ctx_, 2, 2 + kBindings),
+                                                     static_cast<std::uint32_t>(2 * sizeof(std::uint32_t)));
+  if (batch.rays.handle() == VK_NULL_HANDLE || batch.rays.size() < n * sizeof(RayGpu)) batch.rays = GpuBuffer(ctx_, n * sizeof(RayGpu));
+  if (batch.hits.handle() == VK_NULL_HANDLE || batch.hits.size() < n * sizeof(HitGpu)) batch.hits = GpuBuffer(ctx_, n * sizeof(HitGpu));
+  write_rays(rays, batch.rays.mapped_as<RayGpu>(n));
+  // Bound when the submission is recorded, after any sync before it.
+  ctx_.record_before_next(this, [this, &batch, n, any_hit](VkCommandBuffer cmd) {
+    batch.kernel->bind(0, batch.rays);
+    batch.kernel->bind(1, batch.hits);
+    bind(*batch.kernel, 2);
+    const std::uint32_t push[2] = {static_cast<std::uint32_t>(n), any_hit ? 1u : 0u};
+    batch.kernel->record_dispatch(cmd, (push[0] + kRtGroupSize - 1) / kRtGroupSize, 1, 1, push);
   });
 }
 
-void GpuRtScene::take_occluded(std::span<std::uint8_t> blocked) {
-  if (later_count_ < 0 || static_cast<std::size_t>(later_count_) != blocked.size())
-    throw GpuError("GpuRtScene::take_occluded: " + std::to_string(blocked.size()) + " flags for a batch of " +
-                   (later_count_ < 0 ? std::string("none") : std::to_string(later_count_)));
-  later_count_ = -1;
-  if (blocked.empty()) return;
+std::span<const HitGpu> GpuRtScene::take_later(LaterBatch& batch, std::size_t count, const char* what) {
+  if (batch.count < 0 || static_cast<std::size_t>(batch.count) != count)
+    throw GpuError(std::string("GpuRtScene::") + what + ": " + std::to_string(count) + " answers for a batch of " +
+                   (batch.count < 0 ? std::string("none") : std::to_string(batch.count)));
+  batch.count = -1;
+  if (count == 0) return {};
   if (ctx_.has_deferred(this)) ctx_.flush();
-  const std::span<const HitGpu> out = later_hits_.mapped_as<const HitGpu>(blocked.size());
-  jobs::parallel_for<std::size_t>(0, blocked.size(), kRaysPerTask, [&](std::size_t b, std::size_t e) {
+  return batch.hits.mapped_as<const HitGpu>(count);
+}
+
+void GpuRtScene::occluded_later(std::span<const rt::Ray> rays) { queue_later(later_occluded_, rays, true); }
+
+void GpuRtScene::take_occluded(std::span<std::uint8_t> blocked) {
+  const std::span<const HitGpu> out = take_later(later_occluded_, blocked.size(), "take_occluded");
+  jobs::parallel_for<std::size_t>(0, out.size(), kRaysPerTask, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) blocked[i] = out[i].instance != kRtNoHit ? 1 : 0;
   });
+}
+
+void GpuRtScene::intersect_later(std::span<const rt::Ray> rays) { queue_later(later_intersected_, rays, false); }
+
+void GpuRtScene::take_intersected(std::span<rt::Hit> hits, std::span<std::uint8_t> found) {
+  if (hits.size() != found.size())
+    throw GpuError("GpuRtScene::take_intersected: " + std::to_string(hits.size()) + " hits, " + std::to_string(found.size()) + " flags");
+  const std::span<const HitGpu> out = take_later(later_intersected_, hits.size(), "take_intersected");
+  jobs::parallel_for<std::size_t>(0, out.size(), kRaysPerTask, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      found[i] = out[i].instance != kRtNoHit ? 1 : 0;
+      if (found[i]) to_hit(out[i], hits[i]);
+    }
+  });
+}
+
+void GpuRtScene::to_hit(const HitGpu& h, rt::Hit& out) const {
+  out.entity = entity_of(h.instance);
+  out.instance = h.instance;
+  out.mesh = h.mesh;
+  out.primitive = h.primitive;
+  out.barycentric = {h.u, h.v};
+  out.t = h.t;
 }
 
 double GpuRtScene::take_deferred_ms() {
@@ -356,8 +385,8 @@ double GpuRtScene::take_deferred_ms() {
 }
 
 std::span<const HitGpu> GpuRtScene::run_query(std::span<const rt::Ray> rays, bool any_hit, double* gpu_ms) {
-  // A queued batch binds the same kernel: it goes first, alone.
-  if (ctx_.has_deferred(this)) ctx_.flush();
+  // Queued batches have kernels of their own: they ride at the head of this
+  // submission.
   const std::size_t n = rays.size();
   if (rays_.handle() == VK_NULL_HANDLE || rays_.size() < n * sizeof(RayGpu)) rays_ = GpuBuffer(ctx_, n * sizeof(RayGpu));
   if (hits_.handle() == VK_NULL_HANDLE || hits_.size() < n * sizeof(HitGpu)) hits_ = GpuBuffer(ctx_, n * sizeof(HitGpu));
@@ -384,13 +413,7 @@ void GpuRtScene::intersect(std::span<const rt::Ray> rays, std::span<rt::Hit> hit
     for (std::size_t i = b; i < e; ++i) {
       const HitGpu h = out[i];
       found[i] = h.instance != kRtNoHit ? 1 : 0;
-      if (!found[i]) continue;
-      hits[i].entity = entity_of(h.instance);
-      hits[i].instance = h.instance;
-      hits[i].mesh = h.mesh;
-      hits[i].primitive = h.primitive;
-      hits[i].barycentric = {h.u, h.v};
-      hits[i].t = h.t;
+      if (found[i]) to_hit(h, hits[i]);
     }
   });
 }

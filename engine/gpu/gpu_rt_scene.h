@@ -101,6 +101,11 @@ class GpuRtScene {
   // blocked[i] for ray i of the batch occluded_later queued; throws GpuError
   // for another count or none queued.
   void take_occluded(std::span<std::uint8_t> blocked);
+  // Closest hits queued the same way (a batch of their own, beside
+  // occluded_later's: both may ride with one submission), read by
+  // take_intersected as intersect gives them.
+  void intersect_later(std::span<const rt::Ray> rays);
+  void take_intersected(std::span<rt::Hit> hits, std::span<std::uint8_t> found);
   // Device milliseconds of this scene's queued work (the TLAS's builds,
   // the later batches) since the last call.
   double take_deferred_ms();
@@ -138,9 +143,22 @@ class GpuRtScene {
   GpuBuffer tlas_, instances_, blas_, triangles_;
   GpuBuffer triangle_uvs_, alpha_materials_, alpha_bytes_, alpha_textures_;
   GpuBuffer rays_, hits_;
-  // occluded_later's batch: its own buffers, its count (-1: none queued).
-  GpuBuffer later_rays_, later_hits_;
-  std::ptrdiff_t later_count_ = -1;
+  // A batch queued for the next submission: its own kernel (its own
+  // descriptor set, so that two batches can share a command buffer),
+  // buffers and count (-1: none queued).
+  struct LaterBatch {
+    std::unique_ptr<ComputePipeline> kernel;
+    GpuBuffer rays, hits;
+    std::ptrdiff_t count = -1;
+  };
+  void queue_later(LaterBatch& batch, std::span<const rt::Ray> rays, bool any_hit);
+  // The queued batch's hits (submitted now if nothing else did), or throws
+  // GpuError for another count or none queued.
+  std::span<const HitGpu> take_later(LaterBatch& batch, std::size_t count, const char* what);
+  // A query's hit as RtScene's.
+  void to_hit(const HitGpu& in, rt::Hit& out) const;
+  LaterBatch later_occluded_, later_intersected_;
+  std::vector<std::uint32_t> query_spirv_;
   std::unique_ptr<ComputePipeline> query_;
   std::unique_ptr<GpuAccelerationStructures> structures_;  // ray queries only
   GpuRtStats stats_;

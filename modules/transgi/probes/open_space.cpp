@@ -3,7 +3,11 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <optional>
 #include <span>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "engine/jobs/parallel_for.h"
@@ -20,6 +24,58 @@ glm::ivec3 forward_offset(int k) { return {k % 3 - 1, k / 3 % 3 - 1, k / 9 - 1};
 bool inside_grid(const ProbeGrid& grid, glm::ivec3 c) {
   return glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c, grid.dims));
 }
+
+// The link segment from probe q's grid point to its neighbour n's.
+std::optional<engine::rt::Ray> link_segment(const ProbeGrid& grid, int q, int n) {
+  const glm::vec3 from = grid.grid_point(q);
+  const glm::vec3 d = grid.grid_point(n) - from;
+  const float len = glm::length(d);
+  if (!(len > 0)) return std::nullopt;
+  return engine::rt::Ray{from, d / len, 0.0f, len};
+}
+
+// The relocation segment from neighbour n's grid point moved by `offset`
+// to probe q's grid point.
+std::optional<engine::rt::Ray> relocation_segment(const ProbeGrid& grid, int n, glm::vec3 offset, int q) {
+  const glm::vec3 from = grid.grid_point(n) + offset;
+  const glm::vec3 d = grid.grid_point(q) - from;
+  const float len = glm::length(d);
+  if (!(len > 0)) return std::nullopt;
+  return engine::rt::Ray{from, d / len, 0.0f, len};
+}
+
+// The answers of segments traced ahead, by key.
+class AheadAnswers {
+ public:
+  AheadAnswers(const OpenSpaceSegments* ahead, int probes) : ahead_(ahead), probes_(probes) {
+    if (!ahead_) return;
+    if (ahead_->hit_t.size() != ahead_->keys.size() || ahead_->rays.size() != ahead_->keys.size())
+      throw std::invalid_argument("find_open_space: segments traced ahead have " + std::to_string(ahead_->keys.size()) +
+                                  " keys, " + std::to_string(ahead_->rays.size()) + " rays and " +
+                                  std::to_string(ahead_->hit_t.size()) + " answers");
+    for (std::size_t i = 0; i < ahead_->keys.size(); ++i) index_[pair(ahead_->keys[i].from, ahead_->keys[i].to)].push_back(i);
+  }
+  // The closest hit's distance of that segment (infinity: clear), or none
+  // where it was not traced ahead.
+  [[nodiscard]] std::optional<float> find(int from, int to, glm::vec3 offset, bool link) const {
+    if (!ahead_) return std::nullopt;
+    const auto it = index_.find(pair(from, to));
+    if (it == index_.end()) return std::nullopt;
+    for (const std::size_t i : it->second) {
+      const OpenSpaceSegments::Key& k = ahead_->keys[i];
+      if (k.link == link && k.offset == offset) return ahead_->hit_t[i];
+    }
+    return std::nullopt;
+  }
+
+ private:
+  [[nodiscard]] std::uint64_t pair(int from, int to) const {
+    return static_cast<std::uint64_t>(from) * static_cast<std::uint64_t>(probes_) + static_cast<std::uint64_t>(to);
+  }
+  const OpenSpaceSegments* ahead_;
+  int probes_;
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> index_;
+};
 
 // Moves unlinked probes towards linked neighbours (see the header). Passes
 // repeat, so a probe in a corner can follow one moved out of the wall beside
@@ -53,12 +109,12 @@ std::vector<float> hit_distances(const engine::rt::RtScene& scene, engine::rt::R
 // it; each pass only uses probes linked before it, so the order of the probes
 // does not matter, and a pass's segments are traced in one batch.
 void relocate(const engine::rt::RtScene& scene, engine::rt::RayBatchTracer* tracer, const ProbeGrid& grid,
-              const RelocationSettings& s, OpenSpace& r) {
+              const RelocationSettings& s, const AheadAnswers& ahead, OpenSpace& r) {
   using namespace engine;
   const glm::vec3 limit = s.max_offset * grid.spacing();
   const float margin = s.margin * grid.min_spacing(), min_margin = s.min_margin * grid.min_spacing();
   struct Candidate {
-    int q;
+    int q, n;
     glm::vec3 from, d;
     float len;
   };
@@ -71,15 +127,29 @@ void relocate(const engine::rt::RtScene& scene, engine::rt::RayBatchTracer* trac
       const glm::vec3 target = grid.grid_point(q);
       grid.for_each_neighbour(q, [&](int n) {
         if (n == q || !linked[static_cast<std::size_t>(n)]) return;
-        const glm::vec3 from = grid.grid_point(n) + r.offsets[static_cast<std::size_t>(n)];
-        const glm::vec3 d = target - from;
-        const float len = glm::length(d);
-        if (!(len > 0)) return;
-        candidates.push_back({q, from, d, len});
-        rays.push_back(rt::Ray{from, d / len, 0.0f, len});
+        const std::optional<rt::Ray> ray = relocation_segment(grid, n, r.offsets[static_cast<std::size_t>(n)], q);
+        if (!ray) return;
+        candidates.push_back({q, n, ray->origin, target - ray->origin, ray->tmax});
+        rays.push_back(*ray);
       });
     }
-    const std::vector<float> hit_t = hit_distances(scene, tracer, rays);
+    // The segments traced ahead answer; the rest are traced now.
+    std::vector<float> hit_t(rays.size(), std::numeric_limits<float>::infinity());
+    std::vector<std::size_t> missing;
+    std::vector<rt::Ray> missing_rays;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      const Candidate& c = candidates[i];
+      if (const std::optional<float> t = ahead.find(c.n, c.q, r.offsets[static_cast<std::size_t>(c.n)], false)) {
+        hit_t[i] = *t;
+      } else {
+        missing.push_back(i);
+        missing_rays.push_back(rays[i]);
+      }
+    }
+    if (!missing.empty()) {
+      const std::vector<float> traced = hit_distances(scene, tracer, missing_rays);
+      for (std::size_t j = 0; j < missing.size(); ++j) hit_t[missing[j]] = traced[j];
+    }
     int moved = 0;
     // Candidates come grouped by probe, in neighbour order.
     for (std::size_t i = 0; i < candidates.size();) {
@@ -121,10 +191,41 @@ void relocate(const engine::rt::RtScene& scene, engine::rt::RayBatchTracer* trac
 
 }  // namespace
 
+OpenSpaceSegments open_space_segments(const ProbeGrid& grid, std::span<const std::uint8_t> expected_unlinked) {
+  OpenSpaceSegments out;
+  const int probes = grid.count();
+  const auto add = [&](const OpenSpaceSegments::Key& key, const std::optional<engine::rt::Ray>& ray) {
+    if (!ray) return;
+    out.keys.push_back(key);
+    out.rays.push_back(*ray);
+  };
+  for (int q = 0; q < probes; ++q) {
+    const glm::ivec3 c = grid.coords(q);
+    for (int k = 0; k < kForward; ++k) {
+      const glm::ivec3 n = c + forward_offset(k);
+      if (!inside_grid(grid, n)) continue;
+      const int m = grid.index(n);
+      add({q, m, glm::vec3(0.0f), true}, link_segment(grid, q, m));
+    }
+  }
+  for (int q = 0; q < probes && q < static_cast<int>(expected_unlinked.size()); ++q) {
+    if (!expected_unlinked[static_cast<std::size_t>(q)]) continue;
+    grid.for_each_neighbour(q, [&](int n) {
+      if (n == q) return;
+      add({n, q, glm::vec3(0.0f), false}, relocation_segment(grid, n, glm::vec3(0.0f), q));
+      const glm::vec3 moved = grid.offsets.empty() ? glm::vec3(0.0f) : grid.offsets[static_cast<std::size_t>(n)];
+      if (moved != glm::vec3(0.0f)) add({n, q, moved, false}, relocation_segment(grid, n, moved, q));
+    });
+  }
+  return out;
+}
+
 OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& grid, std::span<const std::uint8_t> saw_light,
-                          const RelocationSettings& relocation, engine::rt::RayBatchTracer* tracer) {
+                          const RelocationSettings& relocation, engine::rt::RayBatchTracer* tracer,
+                          const OpenSpaceSegments* traced_ahead) {
   using namespace engine;
   const int probes = grid.count();
+  const AheadAnswers answers(traced_ahead, probes);
   OpenSpace r;
   r.open.assign(static_cast<std::size_t>(probes), 0);
   r.offsets.assign(static_cast<std::size_t>(probes), glm::vec3(0.0f));
@@ -153,15 +254,13 @@ OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& gri
   jobs::parallel_for(0, probes, 64, [&](int q0, int q1) {
     for (int q = q0; q < q1; ++q) {
       const glm::ivec3 c = grid.coords(q);
-      const glm::vec3 from = grid.grid_point(q);
       for (int k = 0; k < kForward; ++k) {
         const glm::ivec3 n = c + forward_offset(k);
         if (!inside_grid(grid, n)) continue;
-        const glm::vec3 d = grid.grid_point(grid.index(n)) - from;
-        const float len = glm::length(d);
-        if (!(len > 0)) continue;
+        const std::optional<rt::Ray> ray = link_segment(grid, q, grid.index(n));
+        if (!ray) continue;
         const std::size_t slot = static_cast<std::size_t>(q) * kForward + static_cast<std::size_t>(k);
-        candidate[slot] = rt::Ray{from, d / len, 0.0f, len};
+        candidate[slot] = *ray;
         exists[slot] = 1;
       }
     }
@@ -176,12 +275,31 @@ OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& gri
       segment_of.push_back(static_cast<int>(slot));
     }
   std::vector<std::uint8_t> blocked(segments.size(), 0);
-  if (tracer)
-    tracer->occluded(scene, segments, blocked);
+  // The segments traced ahead answer (a closest hit within the segment
+  // blocks it); the rest are traced now.
+  std::vector<std::size_t> missing;
+  std::vector<rt::Ray> missing_rays;
+  if (traced_ahead) {
+    for (std::size_t i = 0; i < segments.size(); ++i) {
+      const int q = segment_of[i] / kForward;
+      const int n = grid.index(grid.coords(q) + forward_offset(segment_of[i] % kForward));
+      if (const std::optional<float> t = answers.find(q, n, glm::vec3(0.0f), true)) {
+        blocked[i] = std::isfinite(*t) ? 1 : 0;
+      } else {
+        missing.push_back(i);
+        missing_rays.push_back(segments[i]);
+      }
+    }
+  }
+  const std::span<const rt::Ray> to_trace = traced_ahead ? std::span<const rt::Ray>(missing_rays) : std::span<const rt::Ray>(segments);
+  std::vector<std::uint8_t> traced(to_trace.size(), 0);
+  if (tracer && !to_trace.empty())
+    tracer->occluded(scene, to_trace, traced);
   else
-    jobs::parallel_for<std::size_t>(0, segments.size(), 64, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) blocked[i] = scene.occluded(segments[i]) ? 1 : 0;
+    jobs::parallel_for<std::size_t>(0, to_trace.size(), 64, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) traced[i] = scene.occluded(to_trace[i]) ? 1 : 0;
     });
+  for (std::size_t j = 0; j < to_trace.size(); ++j) blocked[traced_ahead ? missing[j] : j] = traced[j];
   for (std::size_t i = 0; i < segments.size(); ++i)
     if (!blocked[i])
       links[static_cast<std::size_t>(segment_of[i] / kForward)] |= std::uint16_t(1u << (segment_of[i] % kForward));
@@ -206,7 +324,7 @@ OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& gri
       }
     }
   }
-  if (relocation.enabled) relocate(scene, tracer, grid, relocation, r);
+  if (relocation.enabled) relocate(scene, tracer, grid, relocation, answers, r);
   for (std::uint8_t o : r.open) r.open_count += o;
   return r;
 }

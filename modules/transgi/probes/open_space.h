@@ -55,6 +55,34 @@ struct RelocationSettings {
   bool operator==(const RelocationSettings&) const = default;
 };
 
+// Segments traced ahead of a search (find_open_space's `traced_ahead`): on a device
+// they ride with the frame's probe rays instead of taking submissions of
+// their own, since which segments a search traces hardly changes from one
+// search to the next. Each is named by the probe it starts from, the probe it
+// goes to and how it was made: a forward link segment between grid points,
+// or a relocation segment from a neighbour's grid point moved by `offset`.
+// The search looks up each segment it needs and traces only those missing,
+// so its answer is the same with or without them.
+struct OpenSpaceSegments {
+  struct Key {
+    int from = 0, to = 0;
+    glm::vec3 offset{0.0f};
+    bool link = false;
+  };
+  std::vector<Key> keys;
+  std::vector<engine::rt::Ray> rays;
+  // Per ray, the closest hit's distance, infinity where clear: the caller
+  // fills it once they are traced.
+  std::vector<float> hit_t;
+};
+
+// The segments a search over `grid` traces where the probes no chain reaches
+// are those `expected_unlinked` flags (the last search's): every forward link
+// segment, and the relocation segments towards each flagged probe from its
+// neighbours' grid points and, for a neighbour that stands moved
+// (grid.offsets), from where it stands.
+OpenSpaceSegments open_space_segments(const ProbeGrid& grid, std::span<const std::uint8_t> expected_unlinked);
+
 // saw_light: per probe, 1 if one of its rays escaped, met an emitter or met a
 // directly lit surface. Where no probe saw light (a dark scene, nothing to
 // link to), every probe counts as open: darkness is no evidence of a wall.
@@ -64,7 +92,10 @@ struct RelocationSettings {
 // classification would move it back into the wall and out again.
 // With `tracer` (a GPU backend's) the segments are traced by it, a batch per
 // step; without one, or where it declines the scene, by Embree.
+// `traced_ahead`: segments already traced (open_space_segments), looked up before
+// any is traced again.
 OpenSpace find_open_space(const engine::rt::RtScene& scene, const ProbeGrid& grid, std::span<const std::uint8_t> saw_light,
-                          const RelocationSettings& relocation = {}, engine::rt::RayBatchTracer* tracer = nullptr);
+                          const RelocationSettings& relocation = {}, engine::rt::RayBatchTracer* tracer = nullptr,
+                          const OpenSpaceSegments* traced_ahead = nullptr);
 
 }  // namespace transgi::probes

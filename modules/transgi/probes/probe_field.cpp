@@ -6,6 +6,7 @@
 #include <chrono>
 #include <exception>
 #include <limits>
+#include <optional>
 #include <cmath>
 
 #include <glm/gtc/quaternion.hpp>
@@ -276,6 +277,9 @@ struct ProbeField::UpdateWork {
   std::vector<engine::rt::Ray> emitter_rays;
   std::vector<engine::render::LightSample> emitter_samples;
   bool emitters_queued = false;
+  // The open-space search's segments, queued on the backend's tracer to go
+  // with the probe rays where this frame classifies (queue_open_space_segments).
+  std::optional<OpenSpaceSegments> open_space_ahead;
 };
 
 bool ProbeField::takes_frame(const UpdateWork& w, int q) const {
@@ -480,13 +484,45 @@ void ProbeField::sample_emitters(const engine::rt::RtScene& scene, const engine:
   });
 }
 
+bool ProbeField::searches_open_space(const UpdateWork& w) const {
+  // classify_traced's condition: a classification frame, or a budgeted one
+  // where a traced probe is queued for classification.
+  if (!settings_.skip.open_space || !(w.classify || w.budgeted)) return false;
+  bool any_pending = w.classify;
+  for (std::size_t q = 0; q < probes_.state.size() && !any_pending; ++q) any_pending = w.traced[q] && probes_.needs_classify[q];
+  return any_pending;
+}
+
+void ProbeField::queue_open_space_segments(const engine::rt::RtScene& scene, UpdateWork& w) {
+  engine::rt::RayBatchTracer* tracer = kernels_->tracer();
+  if (!tracer || !searches_open_space(w)) return;
+  // The search's segments do not depend on this frame's rays; which
+  // relocation segments it traces depends on which probes no chain reaches,
+  // guessed from the last search (buried or moved probes) and from where the
+  // geometry changed (urgent probes: notify_region_changed).
+  std::vector<std::uint8_t> expected_unlinked(probes_.state.size(), 0);
+  for (std::size_t q = 0; q < expected_unlinked.size(); ++q)
+    expected_unlinked[q] = probes_.state[q] == ProbeState::Buried || probes_.urgent[q] ||
+                           (!grid_.offsets.empty() && grid_.offsets[q] != glm::vec3(0.0f));
+  w.open_space_ahead = open_space_segments(grid_, expected_unlinked);
+  tracer->intersect_later(scene, w.open_space_ahead->rays);
+}
+
 void ProbeField::classify_traced(const engine::rt::RtScene& scene, UpdateWork& w) {
   const int M = settings_.rays_per_probe;
   const float far = settings_.skip.far_cells * glm::length(grid_.spacing());
-  bool any_pending = w.classify;
-  for (std::size_t q = 0; q < probes_.state.size() && !any_pending; ++q) any_pending = w.traced[q] && probes_.needs_classify[q];
-  const OpenSpace open =
-      settings_.skip.open_space && any_pending ? find_open_space(scene, grid_, probes_.saw_light, settings_.skip.relocation, kernels_->tracer()) : OpenSpace{};
+  if (w.open_space_ahead) {
+    OpenSpaceSegments& ahead = *w.open_space_ahead;
+    std::vector<engine::rt::Hit> hits(ahead.rays.size());
+    std::vector<std::uint8_t> found(ahead.rays.size());
+    kernels_->tracer()->take_intersected(hits, found);
+    ahead.hit_t.assign(ahead.rays.size(), std::numeric_limits<float>::infinity());
+    for (std::size_t i = 0; i < found.size(); ++i)
+      if (found[i]) ahead.hit_t[i] = hits[i].t;
+  }
+  const OpenSpace open = searches_open_space(w) ? find_open_space(scene, grid_, probes_.saw_light, settings_.skip.relocation,
+                                                                  kernels_->tracer(), w.open_space_ahead ? &*w.open_space_ahead : nullptr)
+                                                : OpenSpace{};
   if (!open.open.empty() && grid_.offsets.empty()) grid_.offsets.assign(probes_.state.size(), glm::vec3(0.0f));
   for (std::size_t q = 0; q < probes_.state.size(); ++q) {
     if (w.traced[q]) {
@@ -666,6 +702,7 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   auto t0 = Clock::now();
   std::optional<LightBatch> together;
   if (!w.tracing.empty() && batch_known_before_rays(w)) together = light_batch(w);
+  queue_open_space_segments(scene, w);
   queue_emitter_samples(scene, lights, w);
   trace_and_shade(scene, lights, outer, w, together ? &*together : nullptr);
   sample_emitters(scene, lights, w);

@@ -370,6 +370,9 @@ class ProbeField {
   //  plan_update: which probes trace, this frame's ray set;
   //  trace_and_shade: every tracing probe's shaded points, hit counts and
   //    the sky it saw (and the emitters, without emitter_samples);
+  //  queue_open_space_segments: where the frame searches for open space and
+  //    the backend's tracer takes a later batch, the search's segments
+  //    queued to go with the probe rays;
   //  queue_emitter_samples: every tracing probe's light samples of the
   //    emitters (emitter_samples) made, and where the backend's tracer takes
   //    a later batch, their shadow rays queued to go with the probe rays;
@@ -392,6 +395,11 @@ class ProbeField {
   void sample_emitters(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, UpdateWork& w);
   // Probe q's draws for its emitter samples this frame.
   [[nodiscard]] engine::math::Pcg32 emitter_rng(const UpdateWork& w, int q) const;
+  // Whether classify_traced searches for open space this frame.
+  [[nodiscard]] bool searches_open_space(const UpdateWork& w) const;
+  // Where the backend's tracer takes a later batch and this frame searches
+  // for open space: the search's segments queued to go with the probe rays.
+  void queue_open_space_segments(const engine::rt::RtScene& scene, UpdateWork& w);
   void classify_traced(const engine::rt::RtScene& scene, UpdateWork& w);
   struct LightIntoProbes {
     SharingStats sharing;
