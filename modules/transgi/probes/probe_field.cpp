@@ -648,13 +648,12 @@ void ProbeField::finish_light(const UpdateWork& w, LightBatch& b) {
 }
 
 bool ProbeField::batch_known_before_rays(const UpdateWork& w) const {
-  // classify_traced runs on classification and budgeted frames; on a
-  // budgeted one it changes only the probes queued for it.
-  if (w.classify) return false;
-  if (!w.budgeted) return true;
-  for (std::size_t q = 0; q < w.traced.size(); ++q)
-    if (w.traced[q] && probes_.needs_classify[q]) return false;
-  return true;
+  // A classification frame decides every probe's state from its rays before
+  // any takes light (the first frame's buried probes must not leak into
+  // their neighbours). A budgeted frame classifies only the few probes
+  // queued for it (a moved object's neighbourhood) and they take the change
+  // from the next frame: the light goes with the rays.
+  return !w.classify;
 }
 
 void ProbeField::update_means_and_counts(ProbeFrameStats& stats) {
@@ -711,6 +710,9 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   stats.hits = 0;
   for (const int n : w.hits) stats.hits += static_cast<std::size_t>(n);
   stats.nonfinite_rays = w.nonfinite_rays.load();
+  // The light that went with the rays is kept before this frame's
+  // classification, which may forget some of it.
+  if (together) finish_light(w, *together);
   if (w.classify || w.budgeted) classify_traced(scene, w);
   stats.scatter_ms = ms_since(t0);
 
@@ -718,9 +720,8 @@ ProbeFrameStats ProbeField::update(const engine::rt::RtScene& scene, const engin
   t0 = Clock::now();
   LightIntoProbes light;
   if (together) {
-    // Its light stage ran inside the scattering's time; what follows it counts as projection.
+    // Its light stage and what followed it ran inside the scattering's time.
     stats.scatter_ms -= together->result.times.share_ms + together->result.times.accumulate_ms;
-    finish_light(w, *together);
     light = together->result;
   } else {
     light = share_accumulate_project(w);

@@ -378,7 +378,9 @@ class ProbeField {
   //    a later batch, their shadow rays queued to go with the probe rays;
   //  sample_emitters: those samples traced (unless queued) and projected;
   //  classify_traced (classification and budgeted frames): buried, far and
-  //    relocated probes marked, their light forgotten;
+  //    relocated probes marked, their light forgotten; on a budgeted frame
+  //    after the light stage below, which then went with the rays
+  //    (batch_known_before_rays), so its changes count from the next frame;
   //  share_accumulate_project: each updating probe's depth from its own
   //    rays, this frame's samples from its own and its neighbours' points
   //    accumulated into its maps, its SH and direct-light mean; counts the
@@ -421,8 +423,9 @@ class ProbeField {
   LightBatch light_batch(const UpdateWork& w);
   ProbeLightRequest light_request(const UpdateWork& w, LightBatch& b);
   void finish_light(const UpdateWork& w, LightBatch& b);
-  // Whether no probe's classification waits on this frame's rays, so that
-  // the batch is known before they are traced.
+  // Whether the batch is known before this frame's rays are traced: every
+  // frame but a classification frame (a budgeted frame's classification
+  // takes effect from the next frame).
   [[nodiscard]] bool batch_known_before_rays(const UpdateWork& w) const;
   void update_means_and_counts(ProbeFrameStats& stats);
   // Whether probe q's maps take this frame (untraced probes, outside the
