@@ -70,6 +70,26 @@ TEST(GpuGBuffer, EqualsEmbreesPacketsOnTheCornellBox) {
   }
 }
 
+namespace {
+
+// The sample level with its light set: its sun is a punctual light.
+struct SunlitLevel {
+  eval::LoadedScene scene = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
+  SunlitLevel() {
+    scene.app->add_plugin<render::LightPlugin>();
+    scene.app->update();
+  }
+  ecs::World& world() { return scene.app->world(); }
+  const rt::RtScene& rt() { return world().resource<rt::RtScene>(); }
+  const scene::SceneAssets& assets() { return world().resource<scene::SceneAssets>(); }
+  const render::LightSet& lights() { return world().resource<render::SceneLights>().set; }
+  render::CameraRays camera(int width, int height) {
+    return {world().get<scene::Camera>(scene.camera), world().get<transform::WorldTransform>(scene.camera), width, height};
+  }
+};
+
+}  // namespace
+
 // The real-time deterministic direct light with its shadow rays in one batch
 // through the GPU tracer, against Embree's packets tile by tile: the sample
 // level's sun through its window at 160 x 90. The second pass must read each
@@ -78,21 +98,18 @@ TEST(GpuGBuffer, EqualsEmbreesPacketsOnTheCornellBox) {
 // number of shadow rays is traced.
 TEST(GpuGBuffer, BatchedShadowRaysGiveEmbreesDirectLight) {
   GPU_TEST_CONTEXT_OR_SKIP(ctx);
-  eval::LoadedScene s = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
-  auto& w = s.app->world();
-  s.app->add_plugin<render::LightPlugin>();
-  s.app->update();
-  const auto& rt = w.resource<rt::RtScene>();
-  const auto& assets = w.resource<scene::SceneAssets>();
-  const auto& lights = w.resource<render::SceneLights>().set;
+  SunlitLevel level;
+  const auto& rt = level.rt();
+  const auto& assets = level.assets();
+  const auto& lights = level.lights();
   ASSERT_GT(lights.punctual_count(), 0u) << "the level's sun should be a punctual light";
   const int width = 160, height = 90;
-  const render::CameraRays rays(w.get<scene::Camera>(s.camera), w.get<transform::WorldTransform>(s.camera), width, height);
+  const render::CameraRays rays = level.camera(width, height);
   gpu::GpuRayTracer tracer(*ctx);
   shading::GBuffer g;
   shading::RealtimeDirectStats want_stats, got_stats;
   image::ImageRGB want, got;
-  s.app->jobs().run([&] {
+  level.scene.app->jobs().run([&] {
     shading::trace_gbuffer(rt, assets, rays, width, height, g);
     want = shading::shade_direct_realtime(g, rt, lights, rays, &want_stats);
     got = shading::shade_direct_realtime(g, rt, lights, rays, &got_stats, &tracer);
@@ -120,16 +137,13 @@ TEST(GpuGBuffer, BatchedShadowRaysGiveEmbreesDirectLight) {
 TEST(GpuGBuffer, ShadowRaysTracedWithTheQueuedViewGiveEmbreesDirectLight) {
   GPU_TEST_CONTEXT_OR_SKIP(ctx);
   if (!gpu::VisibilityPass::supported(*ctx)) GTEST_SKIP() << "the device's queue cannot rasterise";
-  eval::LoadedScene s = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
-  auto& w = s.app->world();
-  s.app->add_plugin<render::LightPlugin>();
-  s.app->update();
-  const auto& rt = w.resource<rt::RtScene>();
-  const auto& assets = w.resource<scene::SceneAssets>();
-  const auto& lights = w.resource<render::SceneLights>().set;
+  SunlitLevel level;
+  const auto& rt = level.rt();
+  const auto& assets = level.assets();
+  const auto& lights = level.lights();
   ASSERT_GT(lights.punctual_count(), 0u) << "the level's sun should be a punctual light";
   const int width = 160, height = 90, phase = 5;
-  const render::CameraRays rays(w.get<scene::Camera>(s.camera), w.get<transform::WorldTransform>(s.camera), width, height);
+  const render::CameraRays rays = level.camera(width, height);
   gpu::GpuRayTracer tracer(*ctx);
   tracer.set_raster_visibility(true);
   render::CameraHitTracer* raster = tracer.camera_hit_tracer();
@@ -138,7 +152,7 @@ TEST(GpuGBuffer, ShadowRaysTracedWithTheQueuedViewGiveEmbreesDirectLight) {
   shading::RealtimeDirectStats want_stats, got_stats;
   image::ImageRGB want, got;
   std::uint64_t shading_submissions = 0;
-  s.app->jobs().run([&] {
+  level.scene.app->jobs().run([&] {
     const render::ViewShadowRequest request = shading::view_shadow_request(lights, phase, rt.offset_scale());
     raster->queue_camera_hits(rt, rays, glm::vec2(0.5f), &request);
     shading::trace_gbuffer(rt, assets, rays, width, height, g, nullptr, &tracer);
