@@ -91,14 +91,14 @@ void GpuRayTracer::take_occluded(std::span<std::uint8_t> blocked) {
   rt_->take_occluded(blocked);
 }
 
-void GpuRayTracer::intersect_later(const rt::RtScene& scene, std::span<const rt::Ray> rays) {
+void GpuRayTracer::distances_later(const rt::RtScene& scene, std::span<const rt::Ray> rays) {
   follow(scene);
-  rt_->intersect_later(rays);
+  rt_->distances_later(rays);
 }
 
-void GpuRayTracer::take_intersected(std::span<rt::Hit> hits, std::span<std::uint8_t> found) {
-  if (!rt_) throw GpuError("GpuRayTracer::take_intersected: no batch queued");
-  rt_->take_intersected(hits, found);
+void GpuRayTracer::take_distances(std::span<float> distances) {
+  if (!rt_) throw GpuError("GpuRayTracer::take_distances: no batch queued");
+  rt_->take_distances(distances);
 }
 
 double GpuRayTracer::take_device_ms() { return std::exchange(gpu_ms_, 0.0) + (rt_ ? rt_->take_deferred_ms() : 0.0); }

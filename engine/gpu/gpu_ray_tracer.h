@@ -28,8 +28,8 @@ class GpuRayTracer : public rt::RayBatchTracer, public render::CameraHitTracer {
   // occluded_later).
   void occluded_later(const rt::RtScene& scene, std::span<const rt::Ray> rays) override;
   void take_occluded(std::span<std::uint8_t> blocked) override;
-  void intersect_later(const rt::RtScene& scene, std::span<const rt::Ray> rays) override;
-  void take_intersected(std::span<rt::Hit> hits, std::span<std::uint8_t> found) override;
+  void distances_later(const rt::RtScene& scene, std::span<const rt::Ray> rays) override;
+  void take_distances(std::span<float> distances) override;
   // GPU milliseconds of the traces since the last call (timestamps),
   // the TLAS's rebuilds and the later batches with them.
   double take_device_ms() override;

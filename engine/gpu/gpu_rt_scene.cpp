@@ -1,5 +1,7 @@
 #include "engine/gpu/gpu_rt_scene.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdlib>
 #include <limits>
@@ -98,9 +100,10 @@ GpuRtScene::GpuRtScene(VulkanContext& ctx) : ctx_(ctx) {
   const auto dir = engine_shader_dir();
   ShaderCompileOptions options = engine_shader_options();
   options.defines = shader_defines(ctx);
-  query_spirv_ = compile_compute_shader(dir / "rt_query.comp", options);
-  query_ = std::make_unique<ComputePipeline>(ctx, query_spirv_, binding_types(ctx, 2, 2 + kBindings),
+  query_ = std::make_unique<ComputePipeline>(ctx, compile_compute_shader(dir / "rt_query.comp", options),
+                                             binding_types(ctx, 2, 2 + kBindings),
                                              static_cast<std::uint32_t>(2 * sizeof(std::uint32_t)));
+  distances_spirv_ = compile_compute_shader(dir / "rt_distances.comp", options);
   stats_.ray_query = ctx.info().ray_query;
   if (stats_.ray_query) structures_ = std::make_unique<GpuAccelerationStructures>(ctx);
 }
@@ -323,52 +326,46 @@ void GpuRtScene::queue_later(LaterBatch& batch, std::span<const rt::Ray> rays, b
   batch.count = static_cast<std::ptrdiff_t>(n);
   if (n == 0) return;
   if (!batch.kernel)
-    batch.kernel = std::make_unique<ComputePipeline>(ctx_, query_spirv_, binding_types(ctx_, 2, 2 + kBindings),
+    batch.kernel = std::make_unique<ComputePipeline>(ctx_, distances_spirv_, binding_types(ctx_, 2, 2 + kBindings),
                                                      static_cast<std::uint32_t>(2 * sizeof(std::uint32_t)));
   if (batch.rays.handle() == VK_NULL_HANDLE || batch.rays.size() < n * sizeof(RayGpu)) batch.rays = GpuBuffer(ctx_, n * sizeof(RayGpu));
-  if (batch.hits.handle() == VK_NULL_HANDLE || batch.hits.size() < n * sizeof(HitGpu)) batch.hits = GpuBuffer(ctx_, n * sizeof(HitGpu));
+  if (batch.distances.handle() == VK_NULL_HANDLE || batch.distances.size() < n * sizeof(float))
+    batch.distances = GpuBuffer(ctx_, n * sizeof(float));
   write_rays(rays, batch.rays.mapped_as<RayGpu>(n));
   // Bound when the submission is recorded, after any sync before it.
   ctx_.record_before_next(this, [this, &batch, n, any_hit](VkCommandBuffer cmd) {
     batch.kernel->bind(0, batch.rays);
-    batch.kernel->bind(1, batch.hits);
+    batch.kernel->bind(1, batch.distances);
     bind(*batch.kernel, 2);
     const std::uint32_t push[2] = {static_cast<std::uint32_t>(n), any_hit ? 1u : 0u};
     batch.kernel->record_dispatch(cmd, (push[0] + kRtGroupSize - 1) / kRtGroupSize, 1, 1, push);
   });
 }
 
-std::span<const HitGpu> GpuRtScene::take_later(LaterBatch& batch, std::size_t count, const char* what) {
+std::span<const float> GpuRtScene::take_later(LaterBatch& batch, std::size_t count, const char* what) {
   if (batch.count < 0 || static_cast<std::size_t>(batch.count) != count)
     throw GpuError(std::string("GpuRtScene::") + what + ": " + std::to_string(count) + " answers for a batch of " +
                    (batch.count < 0 ? std::string("none") : std::to_string(batch.count)));
   batch.count = -1;
   if (count == 0) return {};
   if (ctx_.has_deferred(this)) ctx_.flush();
-  return batch.hits.mapped_as<const HitGpu>(count);
+  return batch.distances.mapped_as<const float>(count);
 }
 
 void GpuRtScene::occluded_later(std::span<const rt::Ray> rays) { queue_later(later_occluded_, rays, true); }
 
 void GpuRtScene::take_occluded(std::span<std::uint8_t> blocked) {
-  const std::span<const HitGpu> out = take_later(later_occluded_, blocked.size(), "take_occluded");
+  const std::span<const float> out = take_later(later_occluded_, blocked.size(), "take_occluded");
   jobs::parallel_for<std::size_t>(0, out.size(), kRaysPerTask, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) blocked[i] = out[i].instance != kRtNoHit ? 1 : 0;
+    for (std::size_t i = b; i < e; ++i) blocked[i] = std::isinf(out[i]) ? 0 : 1;
   });
 }
 
-void GpuRtScene::intersect_later(std::span<const rt::Ray> rays) { queue_later(later_intersected_, rays, false); }
+void GpuRtScene::distances_later(std::span<const rt::Ray> rays) { queue_later(later_distances_, rays, false); }
 
-void GpuRtScene::take_intersected(std::span<rt::Hit> hits, std::span<std::uint8_t> found) {
-  if (hits.size() != found.size())
-    throw GpuError("GpuRtScene::take_intersected: " + std::to_string(hits.size()) + " hits, " + std::to_string(found.size()) + " flags");
-  const std::span<const HitGpu> out = take_later(later_intersected_, hits.size(), "take_intersected");
-  jobs::parallel_for<std::size_t>(0, out.size(), kRaysPerTask, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) {
-      found[i] = out[i].instance != kRtNoHit ? 1 : 0;
-      if (found[i]) to_hit(out[i], hits[i]);
-    }
-  });
+void GpuRtScene::take_distances(std::span<float> distances) {
+  const std::span<const float> out = take_later(later_distances_, distances.size(), "take_distances");
+  std::copy(out.begin(), out.end(), distances.begin());
 }
 
 void GpuRtScene::to_hit(const HitGpu& h, rt::Hit& out) const {

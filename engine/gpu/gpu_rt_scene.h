@@ -101,11 +101,12 @@ class GpuRtScene {
   // blocked[i] for ray i of the batch occluded_later queued; throws GpuError
   // for another count or none queued.
   void take_occluded(std::span<std::uint8_t> blocked);
-  // Closest hits queued the same way (a batch of their own, beside
-  // occluded_later's: both may ride with one submission), read by
-  // take_intersected as intersect gives them.
-  void intersect_later(std::span<const rt::Ray> rays);
-  void take_intersected(std::span<rt::Hit> hits, std::span<std::uint8_t> found);
+  // Closest hits' distances queued the same way (a batch of their own,
+  // beside occluded_later's: both may ride with one submission), read by
+  // take_distances: +infinity where a ray hits nothing up to its tmax.
+  // Queued batches bring back 4 bytes a ray (shaders/rt_distances.comp).
+  void distances_later(std::span<const rt::Ray> rays);
+  void take_distances(std::span<float> distances);
   // Device milliseconds of this scene's queued work (the TLAS's builds,
   // the later batches) since the last call.
   double take_deferred_ms();
@@ -148,17 +149,17 @@ class GpuRtScene {
   // buffers and count (-1: none queued).
   struct LaterBatch {
     std::unique_ptr<ComputePipeline> kernel;
-    GpuBuffer rays, hits;
+    GpuBuffer rays, distances;
     std::ptrdiff_t count = -1;
   };
   void queue_later(LaterBatch& batch, std::span<const rt::Ray> rays, bool any_hit);
-  // The queued batch's hits (submitted now if nothing else did), or throws
-  // GpuError for another count or none queued.
-  std::span<const HitGpu> take_later(LaterBatch& batch, std::size_t count, const char* what);
+  // The queued batch's distances (submitted now if nothing else did), or
+  // throws GpuError for another count or none queued.
+  std::span<const float> take_later(LaterBatch& batch, std::size_t count, const char* what);
   // A query's hit as RtScene's.
   void to_hit(const HitGpu& in, rt::Hit& out) const;
-  LaterBatch later_occluded_, later_intersected_;
-  std::vector<std::uint32_t> query_spirv_;
+  LaterBatch later_occluded_, later_distances_;
+  std::vector<std::uint32_t> distances_spirv_;  // rt_distances.comp, for each queued batch's kernel
   std::unique_ptr<ComputePipeline> query_;
   std::unique_ptr<GpuAccelerationStructures> structures_;  // ray queries only
   GpuRtStats stats_;

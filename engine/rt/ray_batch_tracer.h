@@ -33,10 +33,11 @@ class RayBatchTracer {
   virtual void occluded_later(const RtScene& scene, std::span<const Ray> rays) = 0;
   // blocked[i] for ray i of the batch occluded_later queued.
   virtual void take_occluded(std::span<std::uint8_t> blocked) = 0;
-  // Closest hits the same way (a batch of their own, beside
-  // occluded_later's), read by take_intersected as intersect gives them.
-  virtual void intersect_later(const RtScene& scene, std::span<const Ray> rays) = 0;
-  virtual void take_intersected(std::span<Hit> hits, std::span<std::uint8_t> found) = 0;
+  // The closest hits' distances the same way (a batch of their own,
+  // beside occluded_later's), read by take_distances: +infinity where a ray
+  // hits nothing up to its tmax.
+  virtual void distances_later(const RtScene& scene, std::span<const Ray> rays) = 0;
+  virtual void take_distances(std::span<float> distances) = 0;
   // Device milliseconds the traces took since the last call (0 where the
   // backend cannot time them), so each stage that traces can take its own.
   virtual double take_device_ms() { return 0.0; }

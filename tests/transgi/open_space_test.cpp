@@ -312,8 +312,8 @@ struct CountingTracer : rt::RayBatchTracer {
   }
   void occluded_later(const rt::RtScene&, std::span<const rt::Ray>) override { ADD_FAILURE() << "not used"; }
   void take_occluded(std::span<std::uint8_t>) override { ADD_FAILURE() << "not used"; }
-  void intersect_later(const rt::RtScene&, std::span<const rt::Ray>) override { ADD_FAILURE() << "not used"; }
-  void take_intersected(std::span<rt::Hit>, std::span<std::uint8_t>) override { ADD_FAILURE() << "not used"; }
+  void distances_later(const rt::RtScene&, std::span<const rt::Ray>) override { ADD_FAILURE() << "not used"; }
+  void take_distances(std::span<float>) override { ADD_FAILURE() << "not used"; }
 };
 
 // `segments` with their answers traced by Embree, keeping every `keep`-th.

@@ -505,7 +505,7 @@ void ProbeField::queue_open_space_segments(const engine::rt::RtScene& scene, Upd
     expected_unlinked[q] = probes_.state[q] == ProbeState::Buried || probes_.urgent[q] ||
                            (!grid_.offsets.empty() && grid_.offsets[q] != glm::vec3(0.0f));
   w.open_space_ahead = open_space_segments(grid_, expected_unlinked);
-  tracer->intersect_later(scene, w.open_space_ahead->rays);
+  tracer->distances_later(scene, w.open_space_ahead->rays);
 }
 
 void ProbeField::classify_traced(const engine::rt::RtScene& scene, UpdateWork& w) {
@@ -513,12 +513,8 @@ void ProbeField::classify_traced(const engine::rt::RtScene& scene, UpdateWork& w
   const float far = settings_.skip.far_cells * glm::length(grid_.spacing());
   if (w.open_space_ahead) {
     OpenSpaceSegments& ahead = *w.open_space_ahead;
-    std::vector<engine::rt::Hit> hits(ahead.rays.size());
-    std::vector<std::uint8_t> found(ahead.rays.size());
-    kernels_->tracer()->take_intersected(hits, found);
-    ahead.hit_t.assign(ahead.rays.size(), std::numeric_limits<float>::infinity());
-    for (std::size_t i = 0; i < found.size(); ++i)
-      if (found[i]) ahead.hit_t[i] = hits[i].t;
+    ahead.hit_t.resize(ahead.rays.size());
+    kernels_->tracer()->take_distances(ahead.hit_t);
   }
   const OpenSpace open = searches_open_space(w) ? find_open_space(scene, grid_, probes_.saw_light, settings_.skip.relocation,
                                                                   kernels_->tracer(), w.open_space_ahead ? &*w.open_space_ahead : nullptr)
