@@ -257,6 +257,8 @@ void VisibilityPass::prepare(const GpuRtScene& scene, const render::CameraRays& 
 
   push_ = push_for(camera, sample, near_plane);
   shadow_push_.clear();
+  // The answers of the view taken before are overwritten by this one's.
+  taken_shadows_.reset();
 }
 
 void VisibilityPass::prepare_shadows(const GpuRtScene& scene, const render::ViewShadowRequest& request) {
@@ -331,8 +333,13 @@ void VisibilityPass::drop_queued() {
 bool VisibilityPass::take_shadows(const render::ViewShadowRequest& request, std::vector<float>& answers) {
   const bool match = taken_shadows_ && *taken_shadows_ == request;
   taken_shadows_.reset();
-  if (match) answers = std::move(taken_answers_);
-  return match;
+  if (!match) return false;
+  // Read here, not when the view was taken: answers nobody asks for stay on
+  // the device. The buffer holds them until the next view is prepared.
+  const std::span<const float> out =
+      shadow_answers_.mapped_as<const float>(request.lights.size() * static_cast<std::size_t>(width_) * height_);
+  answers.assign(out.begin(), out.end());
+  return true;
 }
 
 bool VisibilityPass::take_queued(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane,
@@ -353,10 +360,6 @@ bool VisibilityPass::take_queued(const GpuRtScene& scene, const render::CameraRa
   read_hits(scene, hits, found);
   taken_shadows_ = std::move(queued_shadows_);
   queued_shadows_.reset();
-  if (taken_shadows_) {
-    const std::span<const float> answers = shadow_answers_.mapped_as<const float>(taken_shadows_->lights.size() * pixels);
-    taken_answers_.assign(answers.begin(), answers.end());
-  }
   return true;
 }
 
@@ -403,7 +406,6 @@ void VisibilityPass::render(const GpuRtScene& scene, const render::CameraRays& c
     throw GpuError("VisibilityPass::render: " + std::to_string(pixels) + " pixels, " + std::to_string(hits.size()) + " hits, " +
                    std::to_string(found.size()) + " flags");
   drop_queued();  // its bindings and targets are rewritten here
-  taken_shadows_.reset();
   prepare(scene, camera, sample, near_plane);
   const double ms = ctx_.submit_and_wait([&](VkCommandBuffer cmd) { record(cmd); });
   if (gpu_ms) *gpu_ms = ms;

@@ -78,7 +78,7 @@ class VisibilityPass {
   bool take_queued(const GpuRtScene& scene, const render::CameraRays& camera, glm::vec2 sample, float near_plane,
                    std::span<rt::Hit> hits, std::span<std::uint8_t> found, double* gpu_ms = nullptr);
   // The shadow rays' answers of the view take_queued last took
-  // (render::ViewShadowRequest's layout: lights x pixels), moved into
+  // (render::ViewShadowRequest's layout: lights x pixels), copied into
   // `answers`, where they were queued for exactly `request`; false
   // otherwise (none, or for other lights or another pattern). Each view's
   // answers are taken once.
@@ -123,7 +123,6 @@ class VisibilityPass {
   GpuBuffer shadow_lights_, shadow_answers_;
   std::vector<std::uint8_t> shadow_push_;  // VisibilityPushGpu then ViewShadowPushGpu; empty: none this view
   std::optional<render::ViewShadowRequest> queued_shadows_, taken_shadows_;
-  std::vector<float> taken_answers_;
 };
 
 }  // namespace engine::gpu

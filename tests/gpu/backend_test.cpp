@@ -187,6 +187,17 @@ namespace {
 // budget, emitted maps if asked) instead of eval's.
 // `raster`: on the Vulkan backend, the camera's view rasterised (the
 // default, GpuOptions::raster_visibility) or its rays traced.
+// DDGI's Vulkan backend on a device of its own; `raster`: the camera's view
+// rasterised (GpuOptions::raster_visibility) or its rays traced.
+ddgi::DdgiBackend vulkan_ddgi_backend(bool raster = true) {
+  engine::gpu::GpuOptions options;
+  options.raster_visibility = raster;
+  std::string why;
+  std::shared_ptr<engine::gpu::VulkanContext> device = engine::gpu::VulkanContext::create(options, &why);
+  EXPECT_TRUE(device) << why;
+  return gpu::make_ddgi_backend("vulkan", "", std::move(device));
+}
+
 eval::MethodRun cornell_ddgi(bool gpu, const runtime::ProbePlacement& placement, bool realtime = false, int width = 48,
                              bool emitted_maps = false, bool raster = true) {
   eval::DdgiRunOptions d;
@@ -199,14 +210,7 @@ eval::MethodRun cornell_ddgi(bool gpu, const runtime::ProbePlacement& placement,
   d.settings.rays_per_probe = 64;
   d.settings.warmup_frames = 8;
   d.placement = placement;
-  if (gpu) {
-    engine::gpu::GpuOptions options;
-    options.raster_visibility = raster;
-    std::string why;
-    std::shared_ptr<engine::gpu::VulkanContext> device = engine::gpu::VulkanContext::create(options, &why);
-    EXPECT_TRUE(device) << why;
-    d.backend = gpu::make_ddgi_backend("vulkan", "", std::move(device));
-  }
+  if (gpu) d.backend = vulkan_ddgi_backend(raster);
   EXPECT_EQ(d.backend.fallback, probes::BackendFallback::None) << d.backend.fallback_why;
   eval::LoadedScene scene = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/test_scenes/cornell_box/scene.gltf", "", 2);
   return eval::run_ddgi(scene, width, 48, d);
@@ -300,14 +304,7 @@ TEST(VulkanBackend, TheSampleLevelsRealtimeDdgiDirectLightIsTracedWithTheView) {
     d.settings.warmup_frames = 4;
     d.placement.mode = runtime::ProbeVolumeMode::Scene;
     d.placement.scene_dims = glm::ivec3(4);
-    if (gpu) {
-      engine::gpu::GpuOptions options;
-      options.raster_visibility = true;
-      std::string why;
-      std::shared_ptr<engine::gpu::VulkanContext> device = engine::gpu::VulkanContext::create(options, &why);
-      EXPECT_TRUE(device) << why;
-      d.backend = gpu::make_ddgi_backend("vulkan", "", std::move(device));
-    }
+    if (gpu) d.backend = vulkan_ddgi_backend();
     eval::LoadedScene scene = eval::load_scene(std::string(TRANSGI_CONTENT_DIR) + "/levels/living_room/scene.gltf", "", 2);
     return eval::run_ddgi(scene, 64, 36, d);
   };

@@ -5,7 +5,6 @@
 #include <chrono>
 
 #include "ddgi/ddgi_renderer.h"
-#include "engine/render/camera_hit_tracer.h"
 #include "engine/render/light_plugin.h"
 #include "engine/render/temporal_accumulation.h"
 #include "engine/render/path_tracer.h"
@@ -198,16 +197,9 @@ void render_realtime(const rt::RtScene& rt, const scene::SceneAssets& assets, co
 void queue_camera_view(CameraView cameras, Res<rt::RtScene> rt, Res<render::SceneLights> lights, Res<DdgiRenderOptions> options,
                        Res<DdgiFrame> frame, ResMut<DdgiBackend> backend, Res<DdgiRealtimeScratch> scratch) {
   if (frame->width <= 0 || frame->height <= 0 || !options->realtime) return;
-  rt::RayBatchTracer* tracer = backend->kernels->tracer();
-  render::CameraHitTracer* raster = tracer ? tracer->camera_hit_tracer() : nullptr;
-  if (!raster) return;
   const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
   if (!rays) return;
-  const glm::vec2 jitter = options->taa.enabled ? scratch->taa.next_jitter(options->taa) : glm::vec2(0.0f);
-  // With it, the direct light's shadow rays, for the phase render_realtime shades with.
-  const render::ViewShadowRequest shadows =
-      shading::view_shadow_request(lights->set, options->taa.enabled ? scratch->taa.next_phase(options->taa) : 0, rt->offset_scale());
-  raster->queue_camera_hits(*rt, *rays, glm::vec2(0.5f) + jitter, &shadows);
+  shading::queue_realtime_view(backend->kernels->tracer(), *rt, *rays, scratch->taa, options->taa, &lights->set);
 }
 
 void render_frame(CameraView cameras, View<Get<const DdgiProbeVolume>> volumes, View<Get<const DdgiCascades>> cascades,

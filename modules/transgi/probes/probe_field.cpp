@@ -277,8 +277,10 @@ struct ProbeField::UpdateWork {
   std::vector<engine::rt::Ray> emitter_rays;
   std::vector<engine::render::LightSample> emitter_samples;
   bool emitters_queued = false;
-  // The open-space search's segments, queued on the backend's tracer to go
-  // with the probe rays where this frame classifies (queue_open_space_segments).
+  // Whether classify_traced searches for open space this frame (plan_update),
+  // and its segments, queued on the backend's tracer to go with the probe
+  // rays (queue_open_space_segments).
+  bool searches_open_space = false;
   std::optional<OpenSpaceSegments> open_space_ahead;
 };
 
@@ -320,6 +322,7 @@ void ProbeField::plan_update(UpdateWork& w) {
       w.points[static_cast<std::size_t>(q)].reserve(static_cast<std::size_t>(M));
       probes_.saw_light[static_cast<std::size_t>(q)] = 0;
     }
+  w.searches_open_space = searches_open_space(w);
 }
 
 ProbeFeedbackSource ProbeField::feedback_source() const {
@@ -485,8 +488,8 @@ void ProbeField::sample_emitters(const engine::rt::RtScene& scene, const engine:
 }
 
 bool ProbeField::searches_open_space(const UpdateWork& w) const {
-  // classify_traced's condition: a classification frame, or a budgeted one
-  // where a traced probe is queued for classification.
+  // A classification frame, or a budgeted one where a traced probe is queued
+  // for classification.
   if (!settings_.skip.open_space || !(w.classify || w.budgeted)) return false;
   bool any_pending = w.classify;
   for (std::size_t q = 0; q < probes_.state.size() && !any_pending; ++q) any_pending = w.traced[q] && probes_.needs_classify[q];
@@ -495,7 +498,7 @@ bool ProbeField::searches_open_space(const UpdateWork& w) const {
 
 void ProbeField::queue_open_space_segments(const engine::rt::RtScene& scene, UpdateWork& w) {
   engine::rt::RayBatchTracer* tracer = kernels_->tracer();
-  if (!tracer || !searches_open_space(w)) return;
+  if (!tracer || !w.searches_open_space) return;
   // The search's segments do not depend on this frame's rays; which
   // relocation segments it traces depends on which probes no chain reaches,
   // guessed from the last search (buried or moved probes) and from where the
@@ -516,7 +519,7 @@ void ProbeField::classify_traced(const engine::rt::RtScene& scene, UpdateWork& w
     ahead.hit_t.resize(ahead.rays.size());
     kernels_->tracer()->take_distances(ahead.hit_t);
   }
-  const OpenSpace open = searches_open_space(w) ? find_open_space(scene, grid_, probes_.saw_light, settings_.skip.relocation,
+  const OpenSpace open = w.searches_open_space ? find_open_space(scene, grid_, probes_.saw_light, settings_.skip.relocation,
                                                                   kernels_->tracer(), w.open_space_ahead ? &*w.open_space_ahead : nullptr)
                                                 : OpenSpace{};
   if (!open.open.empty() && grid_.offsets.empty()) grid_.offsets.assign(probes_.state.size(), glm::vec3(0.0f));

@@ -397,7 +397,8 @@ class ProbeField {
   void sample_emitters(const engine::rt::RtScene& scene, const engine::render::LightSet& lights, UpdateWork& w);
   // Probe q's draws for its emitter samples this frame.
   [[nodiscard]] engine::math::Pcg32 emitter_rng(const UpdateWork& w, int q) const;
-  // Whether classify_traced searches for open space this frame.
+  // Whether classify_traced searches for open space this frame (plan_update
+  // keeps the answer in the frame's work).
   [[nodiscard]] bool searches_open_space(const UpdateWork& w) const;
   // Where the backend's tracer takes a later batch and this frame searches
   // for open space: the search's segments queued to go with the probe rays.

@@ -6,7 +6,6 @@
 
 #include "engine/gpu/gpu_error.h"
 #include "engine/jobs/parallel_for.h"
-#include "engine/render/camera_hit_tracer.h"
 #include "engine/render/camera_rays.h"
 #include "engine/render/light_plugin.h"
 #include "engine/render/path_tracer.h"
@@ -271,21 +270,10 @@ void queue_camera_view(CameraView cameras, Res<rt::RtScene> rt, Res<render::Scen
                        Res<GiFrame> frame, ResMut<GiBackendChoice> backend, Res<PackedDecoder> packed) {
   if (frame->width <= 0 || frame->height <= 0 || settings->gi_path != GiPath::Realtime) return;
   choose_backend(*settings, *backend);
-  rt::RayBatchTracer* tracer = backend->active->tracer();
-  render::CameraHitTracer* raster = tracer ? tracer->camera_hit_tracer() : nullptr;
-  if (!raster) return;
   const auto rays = render::camera_rays_for(cameras, frame->camera, frame->width, frame->height);
   if (!rays) return;
-  // The jitter render_realtime will ask for (a camera cut clears the
-  // antialiasing's history, not its place in the jitter cycle).
-  const glm::vec2 jitter = settings->taa.enabled ? packed->taa.next_jitter(settings->taa) : glm::vec2(0.0f);
-  // With it, the direct light's shadow rays, for the pattern phase
-  // render_realtime will shade with.
-  std::optional<render::ViewShadowRequest> shadows;
-  if (deterministic_direct(*settings))
-    shadows = shading::view_shadow_request(lights->set, settings->taa.enabled ? packed->taa.next_phase(settings->taa) : 0,
-                                           rt->offset_scale());
-  raster->queue_camera_hits(*rt, *rays, glm::vec2(0.5f) + jitter, shadows ? &*shadows : nullptr);
+  shading::queue_realtime_view(backend->active->tracer(), *rt, *rays, packed->taa, settings->taa,
+                               deterministic_direct(*settings) ? &lights->set : nullptr);
 }
 
 void render_gi(CameraView cameras, View<Get<const ProbeVolume>> volumes, View<Get<const ProbeCascades>> cascades,

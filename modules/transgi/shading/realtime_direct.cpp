@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -29,6 +30,14 @@ glm::vec2 disk_pattern(int x, int y) {
   unsigned r = 0;
   for (int b = 0; b < 6; ++b) r |= ((i >> b) & 1u) << (5 - b);
   return engine::math::r2_point(r);
+}
+
+std::array<engine::render::LightSample, kDiskPatternCells> directional_pattern(const engine::render::LightSet& lights,
+                                                                               std::size_t light) {
+  std::array<engine::render::LightSample, kDiskPatternCells> out;
+  for (int i = 0; i < kDiskPatternCells; ++i)
+    lights.sample_punctual(light, glm::vec3(0.0f), disk_pattern(i & 7, i >> 3), out[static_cast<std::size_t>(i)]);
+  return out;
 }
 
 glm::ivec2 disk_pattern_shift(int phase) {
@@ -59,7 +68,7 @@ DirectTileShader::DirectTileShader(const engine::rt::RtScene& scene, const engin
     const render::PunctualInstance& light = lights.punctual_lights()[l];
     if (light.light.type != scene::PunctualLight::Type::Directional) continue;
     is_directional_[l] = 1;
-    for (int i = 0; i < 64; ++i) lights.sample_punctual(l, glm::vec3(0.0f), disk_pattern(i & 7, i >> 3), directional_[l][static_cast<std::size_t>(i)]);
+    directional_[l] = directional_pattern(lights, l);
     if (!(light.angular_radius > 0.0f)) continue;
     SoftLight soft;
     soft.light = l;
@@ -132,8 +141,11 @@ void DirectTileShader::shade_tile(const GBuffer& g, int tx, int ty, Scratch& scr
           local[n] = {wo, wi};
           light[n] = ls.radiance;
         }
-        const float tmax = std::isinf(ls.distance) ? kInf : ls.distance * (1.0f - 1e-4f);
-        rays[n] = rt::Ray{rt::offset_ray_origin(s.position, s.geometric_normal, scene_.offset_scale()), ls.direction, 0.0f, tmax};
+        // The view's answers need no ray of their own.
+        if (!batch_.view) {
+          const float tmax = std::isinf(ls.distance) ? kInf : ls.distance * (1.0f - 1e-4f);
+          rays[n] = rt::Ray{rt::offset_ray_origin(s.position, s.geometric_normal, scene_.offset_scale()), ls.direction, 0.0f, tmax};
+        }
         pixel[n] = p;
         samples[n] = &s;
         ++n;
@@ -513,16 +525,24 @@ engine::render::ViewShadowRequest view_shadow_request(const engine::render::Ligh
       out.position = light.position;
       continue;
     }
-    // DirectTileShader's table: cell i holds the sample at disk_pattern(i & 7, i >> 3).
     out.directional = true;
     out.nearest = light.angular_radius > 0.0f;
-    for (int i = 0; i < engine::render::kViewShadowPatternCells; ++i) {
-      engine::render::LightSample ls;
-      lights.sample_punctual(l, glm::vec3(0.0f), disk_pattern(i & 7, i >> 3), ls);
-      out.directions[static_cast<std::size_t>(i)] = ls.direction;
-    }
+    const std::array<engine::render::LightSample, kDiskPatternCells> pattern = directional_pattern(lights, l);
+    for (std::size_t i = 0; i < pattern.size(); ++i) out.directions[i] = pattern[i].direction;
   }
   return request;
+}
+
+void queue_realtime_view(engine::rt::RayBatchTracer* tracer, const engine::rt::RtScene& scene,
+                         const engine::render::CameraRays& camera, const engine::render::TemporalAntialiasing& taa,
+                         const engine::render::TemporalAaSettings& taa_settings, const engine::render::LightSet* lights) {
+  engine::render::CameraHitTracer* raster = tracer ? tracer->camera_hit_tracer() : nullptr;
+  if (!raster) return;
+  // A camera cut clears the antialiasing's history, not its place in the cycle.
+  const glm::vec2 jitter = taa_settings.enabled ? taa.next_jitter(taa_settings) : glm::vec2(0.0f);
+  std::optional<engine::render::ViewShadowRequest> shadows;
+  if (lights) shadows = view_shadow_request(*lights, taa_settings.enabled ? taa.next_phase(taa_settings) : 0, scene.offset_scale());
+  raster->queue_camera_hits(scene, camera, glm::vec2(0.5f) + jitter, shadows ? &*shadows : nullptr);
 }
 
 void add_image(engine::image::ImageRGB& to, const engine::image::ImageRGB& from) {

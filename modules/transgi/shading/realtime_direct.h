@@ -26,10 +26,15 @@
 #include "engine/image/image.h"
 #include "engine/render/camera_rays.h"
 #include "engine/render/light_set.h"
+#include "engine/render/temporal_aa.h"
 #include "engine/render/view_shadows.h"
 #include "shading/realtime_gi.h"
 
 namespace transgi::shading {
+
+// Points of the disk pattern (disk_pattern): one 8 x 8 block, the view's
+// shadow pattern (render/view_shadows.h).
+inline constexpr int kDiskPatternCells = engine::render::kViewShadowPatternCells;
 
 struct RealtimeDirectStats {
   std::size_t shadow_rays = 0;
@@ -107,7 +112,7 @@ class DirectTileShader {
   engine::image::ImageRGB out_;
   std::size_t n_lights_ = 0;
   glm::ivec2 pattern_shift_{0};  // disk_pattern_shift(pattern_phase)
-  std::vector<std::array<engine::render::LightSample, 64>> directional_;
+  std::vector<std::array<engine::render::LightSample, kDiskPatternCells>> directional_;
   std::vector<std::uint8_t> is_directional_;
   // A directional light with a disk: per pixel, how far along the pixel's
   // pattern direction the first blocker is (infinity: lit; NaN: the light
@@ -150,9 +155,24 @@ engine::image::ImageRGB shade_direct_realtime(const GBuffer& g, const engine::rt
 engine::render::ViewShadowRequest view_shadow_request(const engine::render::LightSet& lights, int pattern_phase,
                                                       float offset_scale);
 
+// Before the probes update: the real-time frame's camera view queued on
+// `tracer`'s device (CameraHitTracer::queue_camera_hits), so that it is
+// drawn with the probe rays' submission rather than one of its own, at the
+// jitter the frame will take (taa's next; none where it is disabled) and,
+// with `lights`, with the deterministic direct light's shadow rays for the
+// pattern phase it will shade with. Only a hint; nothing where the tracer
+// is null or cannot rasterise.
+void queue_realtime_view(engine::rt::RayBatchTracer* tracer, const engine::rt::RtScene& scene,
+                         const engine::render::CameraRays& camera, const engine::render::TemporalAntialiasing& taa,
+                         const engine::render::TemporalAaSettings& taa_settings, const engine::render::LightSet* lights);
+
 // The fixed point on [0, 1)^2 that pixel (x, y) uses for disk lights: an
 // R2 low-discrepancy sequence over each 8x8 block.
 glm::vec2 disk_pattern(int x, int y);
+// Directional light `light`'s samples over that pattern: cell i holds the
+// sample at disk_pattern(i & 7, i >> 3) (it does not depend on the point).
+std::array<engine::render::LightSample, kDiskPatternCells> directional_pattern(const engine::render::LightSet& lights,
+                                                                               std::size_t light);
 // Phases of the pattern's shift: pixel (x, y) takes disk_pattern(x + s.x,
 // y + s.y) in phase k, s = disk_pattern_shift(k). The 16 shifts are the
 // even offsets of the 8x8 block, in an order that spreads each run of
