@@ -106,17 +106,32 @@ class MpiBake : public ::testing::Test {
 
 }  // namespace
 
-TEST_F(MpiBake, TwoRanksBakeAModelWithinTwoPercentOfOneProcess) {
+// The gradients are summed in one fixed tree whatever the rank count
+// (bake/trainer.h), so 2 and 4 ranks bake the one process's model, every
+// weight equal to the bit (issue 35 asks for validation RMSE within 2 %).
+TEST_F(MpiBake, TwoAndFourRanksBakeTheOneProcessModelBitForBit) {
   ASSERT_EQ(wait_exit(spawn(bake_args(dir_ / "one.tgm", 1200, false), dir_ / "one.log")), 0) << text_of(dir_ / "one.log");
   ASSERT_EQ(wait_exit(spawn(on_ranks(2, bake_args(dir_ / "two.tgm", 1200, false)), dir_ / "two.log")), 0)
       << text_of(dir_ / "two.log");
+  ASSERT_EQ(wait_exit(spawn(on_ranks(4, bake_args(dir_ / "four.tgm", 1200, false)), dir_ / "four.log")), 0)
+      << text_of(dir_ / "four.log");
   const std::string log = text_of(dir_ / "two.log");
   EXPECT_NE(log.find("baking on 2 ranks"), std::string::npos) << log;
   EXPECT_EQ(log.find("baked "), log.rfind("baked ")) << "rank 0 alone reports: " << log;
   EXPECT_NE(log.find("ranks:    2;"), std::string::npos) << log;
-  const double one = validation_rmse(dir_ / "one.tgm"), two = validation_rmse(dir_ / "two.tgm");
-  std::printf("[ measured ] validation RMSE: one process %.5f, two ranks %.5f\n", one, two);
-  EXPECT_NEAR(two, one, 0.02 * one);
+  const double one = validation_rmse(dir_ / "one.tgm"), two = validation_rmse(dir_ / "two.tgm"),
+               four = validation_rmse(dir_ / "four.tgm");
+  std::printf("[ measured ] validation RMSE: one process %.7f, two ranks %.7f, four ranks %.7f\n", one, two, four);
+  const auto weights = [](const fs::path& p) {
+    const auto m = transgi::model::load_model(p);
+    std::vector<float> w = m.decoder.params();
+    for (const auto& mesh : m.meshes) w.insert(w.end(), mesh.latents.values.begin(), mesh.latents.values.end());
+    return w;
+  };
+  const auto w1 = weights(dir_ / "one.tgm");
+  EXPECT_EQ(weights(dir_ / "two.tgm"), w1) << "2 ranks trained another model";
+  EXPECT_EQ(weights(dir_ / "four.tgm"), w1) << "4 ranks trained another model";
+  EXPECT_NEAR(two, one, 1e-9 * one);
   EXPECT_NO_THROW(transgi::model::validate_model(transgi::model::load_model(dir_ / "two.tgm"), scene_assets(), dir_ / "two.tgm"));
   EXPECT_FALSE(fs::exists(transgi::bake::dataset_cache_path(dir_ / "two.tgm", {0, 2})));
   EXPECT_FALSE(fs::exists(transgi::bake::dataset_cache_path(dir_ / "two.tgm", {1, 2})));

@@ -67,13 +67,14 @@ bool get_vec(std::istream& in, std::vector<T>& v, std::uint64_t max_count) {
 }
 
 void save_dataset(const fs::path& p, std::uint64_t key, const TransferDataset& d) {
-  std::string out = "TGD2";
+  std::string out = "TGD3";
   put(out, key);
   put<std::uint64_t>(out, d.training_count);
   put(out, d.seconds);
   put<std::uint64_t>(out, d.all_training_samples);
   put<std::int32_t>(out, d.outgoing);
   put_vec(out, d.training_points);
+  put_vec(out, d.training_point_hashes);
   put_vec(out, d.samples);
   put_vec(out, d.targets);
   put(out, fnv(out.data(), out.size()));
@@ -95,18 +96,20 @@ std::optional<std::string> read_checked(const fs::path& p, const char* magic) {
 
 // A cache that is missing, damaged or for other inputs is simply not used.
 bool load_dataset(const fs::path& p, std::uint64_t key, TransferDataset& d) {
-  const auto body = read_checked(p, "TGD2");
+  const auto body = read_checked(p, "TGD3");
   if (!body) return false;
   std::istringstream s(*body);
   std::uint64_t k = 0, training = 0;
   if (!get(s, k) || k != key || !get(s, training) || !get(s, d.seconds) || !get(s, d.all_training_samples) ||
       !get(s, d.outgoing) || d.outgoing < 1)
     return false;
-  if (!get_vec(s, d.training_points, 1ull << 36) || !get_vec(s, d.samples, 1ull << 36) || !get_vec(s, d.targets, 1ull << 40))
+  if (!get_vec(s, d.training_points, 1ull << 36) || !get_vec(s, d.training_point_hashes, 1ull << 36) ||
+      !get_vec(s, d.samples, 1ull << 36) || !get_vec(s, d.targets, 1ull << 40))
     return false;
   d.training_count = training;
   return d.targets.size() == d.samples.size() * kTransferValues && training <= d.samples.size() &&
-         training == d.training_points.size() * static_cast<std::uint64_t>(d.outgoing);
+         training == d.training_points.size() * static_cast<std::uint64_t>(d.outgoing) &&
+         d.training_point_hashes.size() == d.training_points.size();
 }
 
 // The optimiser's state and the model in one file, written atomically, so a

@@ -24,7 +24,12 @@ class Communicator {
   [[nodiscard]] virtual int rank() const = 0;
   [[nodiscard]] virtual int size() const = 0;
 
-  // In-place element-wise sums over the ranks.
+  // In-place element-wise sums over the ranks. Where the rank count N is a
+  // power of two the sums are a fixed binary tree over the ranks, whatever
+  // the transport: rank r's value plus rank r + N/2's first, then those
+  // partial sums at distance N/4, ..., 1 (bake/trainer.h relies on it: its
+  // steps are the one process's, bit for bit). Otherwise in an order the
+  // transport chooses, the same on every rank.
   virtual void sum(std::span<float> values) = 0;
   virtual void sum(std::span<double> values) = 0;
   // Every rank's bytes, in rank order, on every rank (the ranks may send

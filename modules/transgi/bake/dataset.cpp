@@ -44,10 +44,13 @@ std::vector<int> points_per_mesh(const std::vector<double>& area, const std::vec
   return points;
 }
 
+std::uint32_t point_hash(std::uint64_t seed, std::size_t point) {
+  return engine::math::hash32(engine::math::hash_combine(seed ^ 0x5eed5a4dULL, point));
+}
+
 int shard_of_point(std::uint64_t seed, std::size_t point, int shard_count) {
   if (shard_count <= 1) return 0;
-  return static_cast<int>(engine::math::hash32(engine::math::hash_combine(seed ^ 0x5eed5a4dULL, point)) %
-                          static_cast<std::uint32_t>(shard_count));
+  return static_cast<int>(point_hash(seed, point) % static_cast<std::uint32_t>(shard_count));
 }
 
 std::int64_t TransferDataset::local_training_sample(std::uint64_t global) const {
@@ -165,7 +168,10 @@ TransferDataset generate_dataset(const engine::scene::SceneAssets& assets, const
     for (std::size_t i = 0; i < mine.size(); ++i) {
       const std::size_t p = mine[i];
       if (is_validation(p) != (pass == 1)) continue;
-      if (pass == 0) d.training_points.push_back(p - (stride ? p / stride : 0));
+      if (pass == 0) {
+        d.training_points.push_back(p - (stride ? p / stride : 0));
+        d.training_point_hashes.push_back(point_hash(s.seed, p));
+      }
       d.samples.insert(d.samples.end(), results[i].samples.begin(), results[i].samples.end());
       d.targets.insert(d.targets.end(), results[i].targets.begin(), results[i].targets.end());
     }

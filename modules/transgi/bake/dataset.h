@@ -59,9 +59,16 @@ struct DatasetShard {
   int count = 1;
 };
 
-// The rank that owns a point: a hash of the seed and the point's index over
-// the whole scene, so the points, their rays and their targets are the same
-// whatever the number of ranks; only who computes them changes.
+// A hash of the seed and a point's index over the whole scene. It decides
+// which rank samples the point (shard_of_point) and which of the trainer's
+// gradient blocks its samples fall in (TrainSettings::gradient_blocks): the
+// same residue, so with N ranks and N dividing the block count, block b is
+// rank b mod N's.
+std::uint32_t point_hash(std::uint64_t seed, std::size_t point);
+
+// The rank that owns a point: point_hash mod the rank count, so the points,
+// their rays and their targets are the same whatever the number of ranks;
+// only who computes them changes.
 int shard_of_point(std::uint64_t seed, std::size_t point, int shard_count);
 
 // A rank's share of the training data (with one rank: all of it).
@@ -78,6 +85,7 @@ struct TransferDataset {
   // trainer draws each batch from all ranks' samples alike and each rank
   // computes the ones it holds, so the batches do not depend on the rank count.
   std::vector<std::uint64_t> training_points;
+  std::vector<std::uint32_t> training_point_hashes;  // point_hash of each, in the same order
   std::uint64_t all_training_samples = 0;  // over every rank
   int outgoing = 1;
   DatasetShard shard;  // whose share this is

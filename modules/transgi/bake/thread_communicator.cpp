@@ -21,8 +21,8 @@ class ThreadCommunicator final : public Communicator {
   ThreadCommunicator(std::shared_ptr<Exchange> x, int rank) : x_(std::move(x)), rank_(rank) {}
   [[nodiscard]] int rank() const override { return rank_; }
   [[nodiscard]] int size() const override { return static_cast<int>(x_->slots.size()); }
-  void sum(std::span<float> v) override { sum_in_rank_order(v); }
-  void sum(std::span<double> v) override { sum_in_rank_order(v); }
+  void sum(std::span<float> v) override { sum_in_tree_order(v); }
+  void sum(std::span<double> v) override { sum_in_tree_order(v); }
 
   std::vector<std::vector<std::byte>> all_gather(std::span<const std::byte> mine) override {
     x_->slots[static_cast<std::size_t>(rank_)].assign(mine.begin(), mine.end());
@@ -35,16 +35,27 @@ class ThreadCommunicator final : public Communicator {
 
  private:
   // Every rank adds the same values in the same order, so every rank gets
-  // the same bits, as MPI_Allreduce gives.
+  // the same bits: Communicator::sum's tree where the rank count is a power
+  // of two, rank order otherwise.
   template <class T>
-  void sum_in_rank_order(std::span<T> v) {
+  void sum_in_tree_order(std::span<T> v) {
     const auto all = all_gather(std::as_bytes(std::span<const T>(v.data(), v.size())));
-    std::fill(v.begin(), v.end(), T(0));
-    for (const auto& part : all) {
-      if (part.size() != v.size_bytes()) throw std::logic_error("thread communicator: ranks summed spans of different sizes");
-      const T* p = reinterpret_cast<const T*>(part.data());
-      for (std::size_t i = 0; i < v.size(); ++i) v[i] += p[i];
+    std::vector<std::vector<T>> parts(all.size(), std::vector<T>(v.size()));
+    for (std::size_t r = 0; r < all.size(); ++r) {
+      if (all[r].size() != v.size_bytes()) throw std::logic_error("thread communicator: ranks summed spans of different sizes");
+      std::memcpy(parts[r].data(), all[r].data(), all[r].size());
     }
+    const std::size_t n = parts.size();
+    const auto add = [&](std::size_t into, std::size_t from) {
+      for (std::size_t i = 0; i < v.size(); ++i) parts[into][i] += parts[from][i];
+    };
+    if ((n & (n - 1)) == 0) {
+      for (std::size_t d = n / 2; d >= 1; d /= 2)
+        for (std::size_t r = 0; r < d; ++r) add(r, r + d);
+    } else {
+      for (std::size_t r = 1; r < n; ++r) add(0, r);
+    }
+    std::copy(parts[0].begin(), parts[0].end(), v.begin());
   }
 
   std::shared_ptr<Exchange> x_;

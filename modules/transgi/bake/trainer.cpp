@@ -15,6 +15,8 @@ namespace {
 constexpr float kBeta1 = 0.9f, kBeta2 = 0.999f, kEps = 1e-8f;
 constexpr int kSnapshotEvery = 100;
 
+bool power_of_two(int n) { return n > 0 && (n & (n - 1)) == 0; }
+
 int band_of(int k) { return k < 1 ? 0 : k < 4 ? 1 : k < 9 ? 2 : k < 16 ? 3 : 4; }
 
 // Squared errors summed per SH band (over RGB) and overall.
@@ -88,6 +90,14 @@ Trainer::Trainer(const TransferDataset& data, const engine::scene::SceneAssets& 
     latent_offset_.push_back(latent_count_);
     latent_count_ += m.latents.values.size();
   }
+  const int blocks = settings_.gradient_blocks;
+  if (blocks < 1 || blocks > 256 || !power_of_two(blocks))
+    throw std::invalid_argument("gradient_blocks must be a power of two from 1 to 256, not " + std::to_string(blocks));
+  if (data.training_point_hashes.size() * static_cast<std::size_t>(data.outgoing) != data.training_count)
+    throw std::invalid_argument("the dataset's training points have no hashes (a dataset from before gradient blocks)");
+  for (std::uint32_t h : data.training_point_hashes) block_of_point_.push_back(static_cast<std::uint8_t>(h % static_cast<std::uint32_t>(blocks)));
+  block_samples_.resize(static_cast<std::size_t>(blocks));
+  blocks_.resize(static_cast<std::size_t>(blocks));
   m_.assign(parameter_count(), 0.0f);
   v_.assign(parameter_count(), 0.0f);
   grad_.assign(parameter_count(), 0.0f);
@@ -123,63 +133,123 @@ void Trainer::predict(std::span<const std::size_t> idx, std::vector<float>& x, s
   model_.decoder.forward(x.data(), static_cast<int>(idx.size()), y.data(), ws, settings_.backend);
 }
 
-std::vector<std::size_t> Trainer::draw_local_batch() {
-  std::vector<std::size_t> local;
-  local.reserve(static_cast<std::size_t>(settings_.batch / std::max(1, comm_.size()) + 64));
+void Trainer::Gradients::clear(std::size_t decoder_size) {
+  loss = 0;
+  decoder.assign(decoder_size, 0.0f);
+  rows.clear();
+  row_values.clear();
+}
+
+void Trainer::draw_local_blocks() {
+  for (auto& b : block_samples_) b.clear();
+  const auto k = static_cast<std::uint64_t>(data_.outgoing);
   for (int i = 0; i < settings_.batch; ++i) {
     const std::uint64_t global = rng_.next_u32() % data_.all_training_samples;
     const std::int64_t mine = comm_.size() == 1 ? static_cast<std::int64_t>(global) : data_.local_training_sample(global);
-    if (mine >= 0) local.push_back(static_cast<std::size_t>(mine));
+    if (mine < 0) continue;
+    const auto local = static_cast<std::uint64_t>(mine);
+    block_samples_[block_of_point_[local / k]].push_back(static_cast<std::size_t>(local));
   }
-  return local;
 }
 
-float Trainer::step() {
-  const auto t0 = std::chrono::steady_clock::now();
-  const std::vector<std::size_t> idx = draw_local_batch();
-  const int rows = static_cast<int>(idx.size());
+void Trainer::compute_block(std::span<const std::size_t> idx, Gradients& out) {
+  const std::size_t n_dec = model_.decoder.params().size();
+  out.clear(n_dec);
+  if (idx.empty()) return;
   std::vector<float> x, y;
-  if (rows > 0) predict(idx, x, y, ws_);
+  predict(idx, x, y, ws_);
 
-  // L1 loss and its gradient, over the whole batch of every rank.
+  // L1 loss and its gradient, scaled by the whole batch of every rank.
   const float scale = 1.0f / static_cast<float>(static_cast<std::size_t>(settings_.batch) * kTransferValues);
   std::vector<float> dy(y.size());
-  double loss = 0;
   for (std::size_t i = 0; i < idx.size(); ++i) {
     const float* t = data_.target(idx[i]);
     for (int k = 0; k < kTransferValues; ++k) {
       const float diff = y[i * kTransferValues + static_cast<std::size_t>(k)] - t[k];
-      loss += std::abs(diff);
+      out.loss += std::abs(diff);
       dy[i * kTransferValues + static_cast<std::size_t>(k)] = diff > 0 ? scale : diff < 0 ? -scale : 0.0f;
     }
   }
-
-  const std::size_t n_dec = model_.decoder.params().size();
-  const auto d = static_cast<std::size_t>(model_.latent_dim);
-  const bool lazy = settings_.latent_updates == LatentUpdates::Touched;
-  if (lazy) {  // only the last step's rows can hold gradients
-    std::fill(grad_.begin(), grad_.begin() + static_cast<std::ptrdiff_t>(n_dec), 0.0f);
-    for (std::uint64_t r : touched_rows_) std::fill_n(grad_.begin() + static_cast<std::ptrdiff_t>(n_dec + r * d), d, 0.0f);
-  } else {
-    std::fill(grad_.begin(), grad_.end(), 0.0f);
-  }
   const int in = model_.decoder.layout().inputs;
-  if (rows > 0) {
-    std::vector<float> dx(x.size());
-    model_.decoder.backward(x.data(), rows, dy.data(), ws_, std::span(grad_).first(n_dec), dx.data(), settings_.backend);
-    for (std::size_t i = 0; i < idx.size(); ++i) {
-      const TransferSample& s = data_.samples[idx[i]];
-      model_.meshes[s.mesh].latents.scatter_gradient(*assets_.meshes[s.mesh], s.triangle, s.barycentric,
-                                                     dx.data() + i * static_cast<std::size_t>(in),
-                                                     std::span(grad_).subspan(n_dec + latent_offset_[s.mesh]));
-    }
+  std::vector<float> dx(x.size());
+  model_.decoder.backward(x.data(), static_cast<int>(idx.size()), dy.data(), ws_, out.decoder, dx.data(), settings_.backend);
+
+  // The block's latent rows, summed in its samples' order in grad_'s latent
+  // part (zero there outside the last step's rows), read out and zeroed again.
+  const auto d = static_cast<std::size_t>(model_.latent_dim);
+  if (d == 0) return;
+  for (std::size_t i = 0; i < idx.size(); ++i) {
+    const TransferSample& s = data_.samples[idx[i]];
+    model_.meshes[s.mesh].latents.scatter_gradient(*assets_.meshes[s.mesh], s.triangle, s.barycentric,
+                                                   dx.data() + i * static_cast<std::size_t>(in),
+                                                   std::span(grad_).subspan(n_dec + latent_offset_[s.mesh]));
   }
-  times_.samples += idx.size();
-  if (lazy || comm_.size() > 1) touched_rows_ = latent_rows_of(idx);
+  out.rows = latent_rows_of(idx);
+  out.row_values.resize(out.rows.size() * d);
+  for (std::size_t r = 0; r < out.rows.size(); ++r) {
+    float* g = grad_.data() + n_dec + out.rows[r] * d;
+    std::copy_n(g, d, out.row_values.data() + r * d);
+    std::fill_n(g, d, 0.0f);
+  }
+}
+
+void Trainer::add_rows(Gradients& into, const Gradients& from) const {
+  if (from.rows.empty()) return;
+  const auto d = static_cast<std::size_t>(model_.latent_dim);
+  Gradients merged;
+  merged.rows.reserve(into.rows.size() + from.rows.size());
+  merged.row_values.reserve((into.rows.size() + from.rows.size()) * d);
+  std::size_t a = 0, b = 0;
+  while (a < into.rows.size() || b < from.rows.size()) {
+    const bool take_a = b == from.rows.size() || (a < into.rows.size() && into.rows[a] <= from.rows[b]);
+    const bool take_b = a == into.rows.size() || (b < from.rows.size() && from.rows[b] <= into.rows[a]);
+    merged.rows.push_back(take_a ? into.rows[a] : from.rows[b]);
+    for (std::size_t k = 0; k < d; ++k) {
+      const float va = take_a ? into.row_values[a * d + k] : 0.0f;
+      const float vb = take_b ? from.row_values[b * d + k] : 0.0f;
+      merged.row_values.push_back(take_a && take_b ? va + vb : take_a ? va : vb);
+    }
+    a += take_a;
+    b += take_b;
+  }
+  into.rows = std::move(merged.rows);
+  into.row_values = std::move(merged.row_values);
+}
+
+void Trainer::add(Gradients& into, const Gradients& from) const {
+  into.loss += from.loss;
+  for (std::size_t i = 0; i < into.decoder.size(); ++i) into.decoder[i] += from.decoder[i];
+  add_rows(into, from);
+}
+
+// The tree: block v takes block v + d for d = blocks / 2, blocks / 4, ..., 1.
+// With N ranks (a power of two, at most the block count) block v is rank
+// v mod N's, so every level with d >= N sums one rank's blocks, and the
+// levels below it pair rank r with rank r + d: what Communicator::sum does.
+Trainer::Gradients& Trainer::sum_own_blocks() {
+  const int n = comm_.size(), rank = comm_.rank(), blocks = settings_.gradient_blocks;
+  const bool aligned = power_of_two(n) && n <= blocks;
+  const int stop = aligned ? n : 1;
+  for (int d = blocks / 2; d >= stop; d /= 2)
+    for (int v = 0; v < d; ++v)
+      if (!aligned || v % n == rank) add(blocks_[static_cast<std::size_t>(v)], blocks_[static_cast<std::size_t>(v + d)]);
+  return blocks_[static_cast<std::size_t>(aligned ? rank : 0)];
+}
+
+float Trainer::step() {
+  const auto t0 = std::chrono::steady_clock::now();
+  clear_latent_gradients();
+  draw_local_blocks();
+  for (std::size_t b = 0; b < blocks_.size(); ++b) {
+    compute_block(block_samples_[b], blocks_[b]);
+    times_.samples += block_samples_[b].size();
+  }
+  Gradients& sum = sum_own_blocks();
   const auto t1 = std::chrono::steady_clock::now();
-  if (comm_.size() > 1) exchange_gradients(loss);
+  if (comm_.size() > 1) exchange_gradients(sum);
   const auto t2 = std::chrono::steady_clock::now();
-  loss *= scale;
+  take_gradients(sum);
+  const double loss = sum.loss / (static_cast<double>(settings_.batch) * kTransferValues);
 
   if (!gradients_finite(loss)) rollback();
   else adam_step();
@@ -187,6 +257,22 @@ float Trainer::step() {
   times_.compute_seconds += std::chrono::duration<double>((t1 - t0) + (t3 - t2)).count();
   times_.exchange_seconds += std::chrono::duration<double>(t2 - t1).count();
   return static_cast<float>(loss);
+}
+
+void Trainer::clear_latent_gradients() {
+  const std::size_t n_dec = model_.decoder.params().size();
+  const auto d = static_cast<std::size_t>(model_.latent_dim);
+  for (std::uint64_t r : touched_rows_) std::fill_n(grad_.begin() + static_cast<std::ptrdiff_t>(n_dec + r * d), d, 0.0f);
+  touched_rows_.clear();
+}
+
+void Trainer::take_gradients(const Gradients& sum) {
+  const std::size_t n_dec = model_.decoder.params().size();
+  const auto d = static_cast<std::size_t>(model_.latent_dim);
+  std::copy(sum.decoder.begin(), sum.decoder.end(), grad_.begin());
+  touched_rows_ = sum.rows;
+  for (std::size_t r = 0; r < touched_rows_.size(); ++r)
+    std::copy_n(sum.row_values.data() + r * d, d, grad_.data() + n_dec + touched_rows_[r] * d);
 }
 
 std::vector<std::uint64_t> Trainer::latent_rows_of(std::span<const std::size_t> batch) const {
@@ -225,43 +311,44 @@ bool Trainer::gradients_finite(double loss) const {
 // step however large the level, so the ranks exchange only the rows they
 // touched (a row index and its values): for a 10 M-vertex level that is
 // about 200 KB a step where the dense table would be 280 MB (docs/bake.md).
-void Trainer::exchange_gradients(double& loss) {
-  const std::size_t n_dec = model_.decoder.params().size();
-  comm_.sum(std::span(grad_).first(n_dec));
-  comm_.sum(std::span(&loss, 1));
+// The rows are summed in the same tree as the dense sums.
+void Trainer::exchange_gradients(Gradients& mine) {
+  comm_.sum(std::span(mine.decoder));
+  comm_.sum(std::span(&mine.loss, 1));
   const auto d = static_cast<std::size_t>(model_.latent_dim);
   if (d == 0) return;
 
-  const std::vector<std::uint64_t>& touched = touched_rows_;
   const std::size_t row_bytes = sizeof(std::uint64_t) + d * sizeof(float);
-  std::vector<std::byte> mine(touched.size() * row_bytes);
-  for (std::size_t r = 0; r < touched.size(); ++r) {
-    std::memcpy(mine.data() + r * row_bytes, &touched[r], sizeof(std::uint64_t));
-    std::memcpy(mine.data() + r * row_bytes + sizeof(std::uint64_t), grad_.data() + n_dec + touched[r] * d, d * sizeof(float));
+  std::vector<std::byte> packed(mine.rows.size() * row_bytes);
+  for (std::size_t r = 0; r < mine.rows.size(); ++r) {
+    std::memcpy(packed.data() + r * row_bytes, &mine.rows[r], sizeof(std::uint64_t));
+    std::memcpy(packed.data() + r * row_bytes + sizeof(std::uint64_t), mine.row_values.data() + r * d, d * sizeof(float));
   }
-  const auto all = comm_.all_gather(mine);
-  // Every rank adds the same rows in rank order: the same sums on every rank.
-  float* latent_grad = grad_.data() + n_dec;
-  std::vector<float> row_values(d);
-  std::vector<std::uint64_t> every_rank_rows;
-  for (int add = 0; add < 2; ++add)
-    for (const auto& part : all)
-      for (std::size_t at = 0; at + row_bytes <= part.size(); at += row_bytes) {
-        std::uint64_t row = 0;
-        std::memcpy(&row, part.data() + at, sizeof(row));
-        if (row * d + d > latent_count_) throw std::runtime_error("bake: a rank sent a latent row outside the model");
-        float* g = latent_grad + row * d;
-        if (add == 0) {
-          std::fill_n(g, d, 0.0f);
-          every_rank_rows.push_back(row);
-        } else {
-          std::memcpy(row_values.data(), part.data() + at + sizeof(row), d * sizeof(float));
-          for (std::size_t k = 0; k < d; ++k) g[k] += row_values[k];
-        }
-      }
-  std::sort(every_rank_rows.begin(), every_rank_rows.end());
-  every_rank_rows.erase(std::unique(every_rank_rows.begin(), every_rank_rows.end()), every_rank_rows.end());
-  touched_rows_ = std::move(every_rank_rows);
+  const auto all = comm_.all_gather(packed);
+  std::vector<Gradients> parts(all.size());
+  for (std::size_t p = 0; p < all.size(); ++p) {
+    if (all[p].size() % row_bytes != 0) throw std::runtime_error("bake: a rank sent a torn latent row");
+    const std::size_t count = all[p].size() / row_bytes;
+    parts[p].rows.resize(count);
+    parts[p].row_values.resize(count * d);
+    for (std::size_t r = 0; r < count; ++r) {
+      std::uint64_t row = 0;
+      std::memcpy(&row, all[p].data() + r * row_bytes, sizeof(row));
+      if (row * d + d > latent_count_ || (r > 0 && row <= parts[p].rows[r - 1]))
+        throw std::runtime_error("bake: a rank sent a latent row outside the model or out of order");
+      parts[p].rows[r] = row;
+      std::memcpy(parts[p].row_values.data() + r * d, all[p].data() + r * row_bytes + sizeof(row), d * sizeof(float));
+    }
+  }
+  const int n = comm_.size();
+  if (power_of_two(n)) {
+    for (int step = n / 2; step >= 1; step /= 2)
+      for (int r = 0; r < step; ++r) add_rows(parts[static_cast<std::size_t>(r)], parts[static_cast<std::size_t>(r + step)]);
+  } else {
+    for (int r = 1; r < n; ++r) add_rows(parts[0], parts[static_cast<std::size_t>(r)]);
+  }
+  mine.rows = std::move(parts[0].rows);
+  mine.row_values = std::move(parts[0].row_values);
 }
 
 // Adam with bias correction; the latents get their own rate.

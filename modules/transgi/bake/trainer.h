@@ -36,6 +36,13 @@ struct TrainSettings {
   float decay = 0.33f;                   // learning-rate factor at each milestone
   std::uint64_t seed = 7;
   LatentUpdates latent_updates = LatentUpdates::All;
+  // A batch's gradients are summed as a fixed binary tree over this many
+  // blocks of its samples (a sample's block: its point's point_hash mod the
+  // count), so that a bake on any power-of-two number of ranks up to this
+  // count takes the one process's steps bit for bit (docs/bake.md). Higher =
+  // the same bits on more ranks, at the cost of smaller matrix products. A
+  // power of two from 1 to 256.
+  int gradient_blocks = 8;
   model::GemmBackend backend = model::default_gemm_backend();
 };
 
@@ -47,10 +54,12 @@ struct BandErrors {
 // Data-parallel over the ranks of `comm` (docs/bake.md, "Baking on many
 // machines"): every rank holds the whole model and draws the same batches
 // from all ranks' samples; each computes the gradients of the samples its
-// shard holds; the decoder's gradients are summed over the ranks and the
-// latents' as sparse rows (only the rows the batch touched), so every rank
-// takes the same optimiser step. With one rank nothing is exchanged and the
-// steps are the one-process bake's, bit for bit.
+// shard holds, block by block (TrainSettings::gradient_blocks); the blocks'
+// gradients are summed in a fixed tree, the decoder's densely and the
+// latents' as sparse rows (only the rows the batch touched), first the
+// rank's own blocks, then over the ranks, so every rank takes the same
+// optimiser step. On a power-of-two number of ranks up to the block count
+// the tree is the one process's, and so are the steps, bit for bit.
 class Trainer {
  public:
   // The model must already hold a decoder of the right input size and
@@ -91,11 +100,36 @@ class Trainer {
                model::MlpWorkspace& ws) const;
   float* latent_ptr(std::size_t flat);
   std::size_t parameter_count() const;
-  // This rank's share of a batch drawn over every rank's training samples.
-  std::vector<std::size_t> draw_local_batch();
+
+  // One block's (or a subtree's) share of a step: its samples' summed L1
+  // loss, the decoder's gradients and the latent rows its samples touched
+  // (ascending) with their gradients, latent_dim floats a row.
+  struct Gradients {
+    double loss = 0;
+    std::vector<float> decoder;
+    std::vector<std::uint64_t> rows;
+    std::vector<float> row_values;
+    void clear(std::size_t decoder_size);
+  };
+  // The step's stages, in order.
+  // grad_'s latent part back to zero (only last step's rows held values).
+  void clear_latent_gradients();
+  // This rank's share of a batch drawn over every rank's training samples,
+  // sorted into blocks (each in draw order).
+  void draw_local_blocks();
+  void compute_block(std::span<const std::size_t> idx, Gradients& out);
+  // The rank's blocks summed in the tree's order, up to the level where the
+  // ranks' partial sums meet; returns the rank's partial sum.
+  Gradients& sum_own_blocks();
+  // The ranks' partial sums summed over the ranks, in the tree's order.
+  void exchange_gradients(Gradients& mine);
+  // grad_ and touched_rows_ from the step's sum.
+  void take_gradients(const Gradients& sum);
+
+  void add_rows(Gradients& into, const Gradients& from) const;
+  void add(Gradients& into, const Gradients& from) const;
   // The flat latent rows (over every mesh) that these samples interpolate, sorted, once each.
   std::vector<std::uint64_t> latent_rows_of(std::span<const std::size_t> batch) const;
-  void exchange_gradients(double& loss);
   [[nodiscard]] bool gradients_finite(double loss) const;
   void adam_step();
   void snapshot();
@@ -110,9 +144,12 @@ class Trainer {
   std::vector<std::size_t> latent_offset_;  // per mesh, into the flat latent index space
   std::size_t latent_count_ = 0;
   std::vector<float> m_, v_, grad_;
-  // This step's latent rows (LatentUpdates::Touched, or several ranks): this
-  // rank's before the exchange, every rank's after it.
+  // The latent rows the last step's batch touched on every rank: the only
+  // rows of grad_'s latent part that are not zero.
   std::vector<std::uint64_t> touched_rows_;
+  std::vector<std::uint8_t> block_of_point_;           // per local training point
+  std::vector<std::vector<std::size_t>> block_samples_;  // this step's, per block
+  std::vector<Gradients> blocks_;
   int iteration_ = 0;
   float lr_scale_ = 1.0f;
   int rollbacks_ = 0;

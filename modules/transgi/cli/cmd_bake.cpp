@@ -67,6 +67,9 @@ BakeCommand parse_bake_command(const Args& args) {
   s.keep_dataset = args.has("keep-dataset");
   if (args.choice("latent-updates", {"all", "touched"}, std::string("all")) == "touched")
     s.train.latent_updates = bake::LatentUpdates::Touched;
+  s.train.gradient_blocks = static_cast<int>(args.integer("gradient-blocks", 1, 256, s.train.gradient_blocks));
+  if ((s.train.gradient_blocks & (s.train.gradient_blocks - 1)) != 0)
+    throw UsageError("--gradient-blocks must be a power of two, not " + std::to_string(s.train.gradient_blocks));
 
   return c;
 }
@@ -172,7 +175,8 @@ void bake_as_rank(const BakeCommand& c, const BakeProcesses& processes) {
 int run_bake(const std::vector<std::string>& argv) {
   const Args args("bake", argv,
                   {"scene", "out", "points", "dirs", "outgoing", "iters", "batch", "lr", "latent-dim", "width", "depth",
-                   "threads", "seed", "curve", "max-points-per-vertex", "latent-updates"},
+                   "threads", "seed", "curve", "max-points-per-vertex", "latent-updates",
+                   "gradient-blocks"},
                   {"resume", "keep-dataset"});
   const BakeCommand command = parse_bake_command(args);
   const BakeProcesses processes = join_bake_processes();

@@ -20,6 +20,7 @@ constexpr const char* kUsage =
     "           [--max-points-per-vertex P (default 8192; 0 = by area alone)]\n"
     "           [--lr R] [--latent-dim K] [--width W] [--depth L] [--threads T] [--seed S] [--resume] [--keep-dataset]\n"
     "           [--latent-updates all|touched (default all; touched: Adam moves only the latent rows a step touched)]\n"
+    "           [--gradient-blocks G (default 8, a power of two: bakes on 1, 2, 4, ... G ranks are bit for bit alike)]\n"
     "           under mpirun or srun (a build with MPI): one bake on every rank, --threads each (default: the\n"
     "           machine's cores shared by its ranks)\n"
     "  transfer-study --scene S.gltf [--points N] [--outgoing K] [--reference-rays R]\n"
