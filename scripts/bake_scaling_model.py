@@ -10,7 +10,7 @@ assumption, and says which. The model:
   sampling  = points * seconds_per_point / cores              (no exchange at all)
   a step    = batch * seconds_per_sample / cores              (forward, backward)
             + latent_floats * seconds_per_latent_float        (every rank, every step)
-            + allreduce(decoder gradients) + allgather(latent rows)
+            + tree sum(decoder gradients) + allgather(latent rows)
   training  = steps * a step
 """
 import argparse
@@ -43,12 +43,14 @@ SAMPLE_BYTES = 48 + 75 * 4         # a training sample in memory
 
 
 def exchange_seconds(ranks: int) -> float:
-    """Ring allreduce of the decoder gradients + allgather of the latent rows."""
+    """The decoder's gradients summed by recursive doubling (log2 N exchanges of
+    the whole vector: the fixed tree that makes the bake's bits independent of
+    N) + allgather of the latent rows."""
     if ranks == 1:
         return 0.0
     nodes = max(1, math.ceil(ranks / CORES_PER_NODE))
     lat, bw = (LATENCY, BANDWIDTH) if nodes > 1 else (SHARED_LATENCY, SHARED_BANDWIDTH)
-    allreduce = 2 * math.log2(ranks) * lat + 2 * (ranks - 1) / ranks * DECODER_BYTES / bw
+    allreduce = math.log2(ranks) * (lat + DECODER_BYTES / bw)
     rows = 3 * BATCH * ROW_BYTES  # every rank receives every rank's rows
     allgather = math.log2(ranks) * lat + (ranks - 1) / ranks * rows / bw
     return allreduce + allgather

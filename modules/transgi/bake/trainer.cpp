@@ -91,11 +91,11 @@ Trainer::Trainer(const TransferDataset& data, const engine::scene::SceneAssets& 
     latent_count_ += m.latents.values.size();
   }
   const int blocks = settings_.gradient_blocks;
-  if (blocks < 1 || blocks > 256 || !power_of_two(blocks))
-    throw std::invalid_argument("gradient_blocks must be a power of two from 1 to 256, not " + std::to_string(blocks));
+  if (blocks < 1 || blocks > 4096 || !power_of_two(blocks))
+    throw std::invalid_argument("gradient_blocks must be a power of two from 1 to 4096, not " + std::to_string(blocks));
   if (data.training_point_hashes.size() * static_cast<std::size_t>(data.outgoing) != data.training_count)
     throw std::invalid_argument("the dataset's training points have no hashes (a dataset from before gradient blocks)");
-  for (std::uint32_t h : data.training_point_hashes) block_of_point_.push_back(static_cast<std::uint8_t>(h % static_cast<std::uint32_t>(blocks)));
+  for (std::uint32_t h : data.training_point_hashes) block_of_point_.push_back(static_cast<std::uint16_t>(h % static_cast<std::uint32_t>(blocks)));
   block_samples_.resize(static_cast<std::size_t>(blocks));
   blocks_.resize(static_cast<std::size_t>(blocks));
   m_.assign(parameter_count(), 0.0f);
@@ -152,9 +152,20 @@ void Trainer::draw_local_blocks() {
   }
 }
 
-void Trainer::compute_block(std::span<const std::size_t> idx, Gradients& out) {
+// One forward and one backward pass over the rank's samples, block after
+// block; each block's parameter gradients and latent rows are kept apart.
+// A matrix product's row does not depend on the other rows, so only the
+// blocks' sums over their rows need blocks of their own.
+void Trainer::compute_blocks() {
   const std::size_t n_dec = model_.decoder.params().size();
-  out.clear(n_dec);
+  std::vector<std::size_t> idx;
+  std::vector<int> start{0};
+  for (const auto& b : block_samples_) {
+    idx.insert(idx.end(), b.begin(), b.end());
+    start.push_back(static_cast<int>(idx.size()));
+  }
+  for (auto& b : blocks_) b.clear(n_dec);
+  times_.samples += idx.size();
   if (idx.empty()) return;
   std::vector<float> x, y;
   predict(idx, x, y, ws_);
@@ -162,34 +173,42 @@ void Trainer::compute_block(std::span<const std::size_t> idx, Gradients& out) {
   // L1 loss and its gradient, scaled by the whole batch of every rank.
   const float scale = 1.0f / static_cast<float>(static_cast<std::size_t>(settings_.batch) * kTransferValues);
   std::vector<float> dy(y.size());
-  for (std::size_t i = 0; i < idx.size(); ++i) {
-    const float* t = data_.target(idx[i]);
-    for (int k = 0; k < kTransferValues; ++k) {
-      const float diff = y[i * kTransferValues + static_cast<std::size_t>(k)] - t[k];
-      out.loss += std::abs(diff);
-      dy[i * kTransferValues + static_cast<std::size_t>(k)] = diff > 0 ? scale : diff < 0 ? -scale : 0.0f;
+  for (std::size_t b = 0; b < blocks_.size(); ++b)
+    for (auto i = static_cast<std::size_t>(start[b]); i < static_cast<std::size_t>(start[b + 1]); ++i) {
+      const float* t = data_.target(idx[i]);
+      for (int k = 0; k < kTransferValues; ++k) {
+        const float diff = y[i * kTransferValues + static_cast<std::size_t>(k)] - t[k];
+        blocks_[b].loss += std::abs(diff);
+        dy[i * kTransferValues + static_cast<std::size_t>(k)] = diff > 0 ? scale : diff < 0 ? -scale : 0.0f;
+      }
     }
-  }
   const int in = model_.decoder.layout().inputs;
   std::vector<float> dx(x.size());
-  model_.decoder.backward(x.data(), static_cast<int>(idx.size()), dy.data(), ws_, out.decoder, dx.data(), settings_.backend);
+  std::vector<std::span<float>> grads;
+  for (auto& b : blocks_) grads.emplace_back(b.decoder);
+  model_.decoder.backward_by_blocks(x.data(), start, dy.data(), ws_, grads, dx.data(), settings_.backend);
 
-  // The block's latent rows, summed in its samples' order in grad_'s latent
-  // part (zero there outside the last step's rows), read out and zeroed again.
+  // Each block's latent rows, summed in its samples' order in grad_'s latent
+  // part (zero there: clear_latent_gradients), read out and zeroed again.
   const auto d = static_cast<std::size_t>(model_.latent_dim);
   if (d == 0) return;
-  for (std::size_t i = 0; i < idx.size(); ++i) {
-    const TransferSample& s = data_.samples[idx[i]];
-    model_.meshes[s.mesh].latents.scatter_gradient(*assets_.meshes[s.mesh], s.triangle, s.barycentric,
-                                                   dx.data() + i * static_cast<std::size_t>(in),
-                                                   std::span(grad_).subspan(n_dec + latent_offset_[s.mesh]));
-  }
-  out.rows = latent_rows_of(idx);
-  out.row_values.resize(out.rows.size() * d);
-  for (std::size_t r = 0; r < out.rows.size(); ++r) {
-    float* g = grad_.data() + n_dec + out.rows[r] * d;
-    std::copy_n(g, d, out.row_values.data() + r * d);
-    std::fill_n(g, d, 0.0f);
+  for (std::size_t b = 0; b < blocks_.size(); ++b) {
+    const auto first = static_cast<std::size_t>(start[b]), end = static_cast<std::size_t>(start[b + 1]);
+    if (first == end) continue;
+    for (std::size_t i = first; i < end; ++i) {
+      const TransferSample& s = data_.samples[idx[i]];
+      model_.meshes[s.mesh].latents.scatter_gradient(*assets_.meshes[s.mesh], s.triangle, s.barycentric,
+                                                     dx.data() + i * static_cast<std::size_t>(in),
+                                                     std::span(grad_).subspan(n_dec + latent_offset_[s.mesh]));
+    }
+    Gradients& out = blocks_[b];
+    out.rows = latent_rows_of(std::span(idx).subspan(first, end - first));
+    out.row_values.resize(out.rows.size() * d);
+    for (std::size_t r = 0; r < out.rows.size(); ++r) {
+      float* g = grad_.data() + n_dec + out.rows[r] * d;
+      std::copy_n(g, d, out.row_values.data() + r * d);
+      std::fill_n(g, d, 0.0f);
+    }
   }
 }
 
@@ -240,10 +259,7 @@ float Trainer::step() {
   const auto t0 = std::chrono::steady_clock::now();
   clear_latent_gradients();
   draw_local_blocks();
-  for (std::size_t b = 0; b < blocks_.size(); ++b) {
-    compute_block(block_samples_[b], blocks_[b]);
-    times_.samples += block_samples_[b].size();
-  }
+  compute_blocks();
   Gradients& sum = sum_own_blocks();
   const auto t1 = std::chrono::steady_clock::now();
   if (comm_.size() > 1) exchange_gradients(sum);

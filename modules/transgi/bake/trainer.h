@@ -41,7 +41,7 @@ struct TrainSettings {
   // count), so that a bake on any power-of-two number of ranks up to this
   // count takes the one process's steps bit for bit (docs/bake.md). Higher =
   // the same bits on more ranks, at the cost of smaller matrix products. A
-  // power of two from 1 to 256.
+  // power of two from 1 to 4096.
   int gradient_blocks = 8;
   model::GemmBackend backend = model::default_gemm_backend();
 };
@@ -117,7 +117,7 @@ class Trainer {
   // This rank's share of a batch drawn over every rank's training samples,
   // sorted into blocks (each in draw order).
   void draw_local_blocks();
-  void compute_block(std::span<const std::size_t> idx, Gradients& out);
+  void compute_blocks();
   // The rank's blocks summed in the tree's order, up to the level where the
   // ranks' partial sums meet; returns the rank's partial sum.
   Gradients& sum_own_blocks();
@@ -147,7 +147,7 @@ class Trainer {
   // The latent rows the last step's batch touched on every rank: the only
   // rows of grad_'s latent part that are not zero.
   std::vector<std::uint64_t> touched_rows_;
-  std::vector<std::uint8_t> block_of_point_;           // per local training point
+  std::vector<std::uint16_t> block_of_point_;           // per local training point
   std::vector<std::vector<std::size_t>> block_samples_;  // this step's, per block
   std::vector<Gradients> blocks_;
   int iteration_ = 0;

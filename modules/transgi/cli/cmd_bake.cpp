@@ -67,7 +67,7 @@ BakeCommand parse_bake_command(const Args& args) {
   s.keep_dataset = args.has("keep-dataset");
   if (args.choice("latent-updates", {"all", "touched"}, std::string("all")) == "touched")
     s.train.latent_updates = bake::LatentUpdates::Touched;
-  s.train.gradient_blocks = static_cast<int>(args.integer("gradient-blocks", 1, 256, s.train.gradient_blocks));
+  s.train.gradient_blocks = static_cast<int>(args.integer("gradient-blocks", 1, 4096, s.train.gradient_blocks));
   if ((s.train.gradient_blocks & (s.train.gradient_blocks - 1)) != 0)
     throw UsageError("--gradient-blocks must be a power of two, not " + std::to_string(s.train.gradient_blocks));
 
