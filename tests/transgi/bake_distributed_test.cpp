@@ -136,7 +136,10 @@ TEST(DistributedTraining, TwoAndFourRanksTakeTheOneProcessStepsBitForBit) {
     for (int r = 1; r < ranks; ++r) EXPECT_EQ(weights(models[r]), weights(models[0])) << "rank " << r << "'s replica differs";
     EXPECT_EQ(losses[0], solo_loss) << ranks << " ranks: the same batches' losses";
     EXPECT_EQ(weights(models[0]), weights(one)) << ranks << " ranks trained other weights";
-    EXPECT_NEAR(validation[0].total, solo_validation.total, 1e-12 * solo_validation.total);
+    // The same weights; the validation runs over each rank's own samples, in
+    // batches of other sizes, and a row of oneDNN's AVX2 products moves in its
+    // last bits with the batch's size.
+    EXPECT_NEAR(validation[0].total, solo_validation.total, 1e-9 * solo_validation.total);
     // What a step exchanges: the decoder's gradients and the loss (handed
     // over once here; MPI's recursive doubling sends them once per level of
     // the tree, log2 of the ranks), then the latent rows the rank's share of
@@ -267,8 +270,9 @@ TEST(BakeJob, TwoRanksBakeTheOneProcessModel) {
     EXPECT_EQ(r.validation.total, reports[0].validation.total);
     EXPECT_EQ(r.sampling_rates.size(), 2u);
   }
-  // The same weights; the validation's error sums part by rank, in double.
-  EXPECT_NEAR(reports[0].validation.total, solo.validation.total, 1e-12 * solo.validation.total);
+  // The same weights; the validation's error sums part by rank, in double,
+  // and its products run over each rank's samples (see above).
+  EXPECT_NEAR(reports[0].validation.total, solo.validation.total, 1e-9 * solo.validation.total);
   const auto m = model::load_model(out);
   EXPECT_EQ(weights(m), weights(model::load_model(dir.path / "one.tgm"))) << "two ranks baked another model";
   EXPECT_NO_THROW(model::validate_model(m, assets, out));

@@ -131,7 +131,7 @@ TEST_F(MpiBake, TwoAndFourRanksBakeTheOneProcessModelBitForBit) {
   const auto w1 = weights(dir_ / "one.tgm");
   EXPECT_EQ(weights(dir_ / "two.tgm"), w1) << "2 ranks trained another model";
   EXPECT_EQ(weights(dir_ / "four.tgm"), w1) << "4 ranks trained another model";
-  EXPECT_NEAR(two, one, 1e-9 * one);
+  EXPECT_NEAR(two, one, 1e-9 * one);  // the same weights; see bake_distributed_test.cpp
   EXPECT_NO_THROW(transgi::model::validate_model(transgi::model::load_model(dir_ / "two.tgm"), scene_assets(), dir_ / "two.tgm"));
   EXPECT_FALSE(fs::exists(transgi::bake::dataset_cache_path(dir_ / "two.tgm", {0, 2})));
   EXPECT_FALSE(fs::exists(transgi::bake::dataset_cache_path(dir_ / "two.tgm", {1, 2})));

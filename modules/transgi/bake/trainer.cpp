@@ -133,11 +133,17 @@ void Trainer::predict(std::span<const std::size_t> idx, std::vector<float>& x, s
   model_.decoder.forward(x.data(), static_cast<int>(idx.size()), y.data(), ws, settings_.backend);
 }
 
-void Trainer::Gradients::clear(std::size_t decoder_size) {
+void Trainer::Gradients::clear() {
+  empty = true;
   loss = 0;
-  decoder.assign(decoder_size, 0.0f);
   rows.clear();
   row_values.clear();
+}
+
+void Trainer::Gradients::zero(std::size_t decoder_size) {
+  clear();
+  empty = false;
+  decoder.assign(decoder_size, 0.0f);
 }
 
 void Trainer::draw_local_blocks() {
@@ -152,63 +158,57 @@ void Trainer::draw_local_blocks() {
   }
 }
 
-// One forward and one backward pass over the rank's samples, block after
-// block; each block's parameter gradients and latent rows are kept apart.
-// A matrix product's row does not depend on the other rows, so only the
-// blocks' sums over their rows need blocks of their own.
+// Each block this rank holds samples of, alone: its own forward and
+// backward pass, its parameter gradients and latent rows. Not one pass over
+// all of them: oneDNN's AVX2 products give a row other bits when the other
+// rows change (a 2-rank bake then left the one process's steps), while a
+// block's products are the same on any rank count.
 void Trainer::compute_blocks() {
-  const std::size_t n_dec = model_.decoder.params().size();
-  std::vector<std::size_t> idx;
-  std::vector<int> start{0};
-  for (const auto& b : block_samples_) {
-    idx.insert(idx.end(), b.begin(), b.end());
-    start.push_back(static_cast<int>(idx.size()));
+  for (std::size_t b = 0; b < blocks_.size(); ++b) {
+    blocks_[b].clear();
+    if (block_samples_[b].empty()) continue;
+    compute_block(block_samples_[b], blocks_[b]);
+    times_.samples += block_samples_[b].size();
   }
-  for (auto& b : blocks_) b.clear(n_dec);
-  times_.samples += idx.size();
-  if (idx.empty()) return;
+}
+
+void Trainer::compute_block(std::span<const std::size_t> idx, Gradients& out) {
+  const std::size_t n_dec = model_.decoder.params().size();
+  out.zero(n_dec);
   std::vector<float> x, y;
   predict(idx, x, y, ws_);
 
   // L1 loss and its gradient, scaled by the whole batch of every rank.
   const float scale = 1.0f / static_cast<float>(static_cast<std::size_t>(settings_.batch) * kTransferValues);
   std::vector<float> dy(y.size());
-  for (std::size_t b = 0; b < blocks_.size(); ++b)
-    for (auto i = static_cast<std::size_t>(start[b]); i < static_cast<std::size_t>(start[b + 1]); ++i) {
-      const float* t = data_.target(idx[i]);
-      for (int k = 0; k < kTransferValues; ++k) {
-        const float diff = y[i * kTransferValues + static_cast<std::size_t>(k)] - t[k];
-        blocks_[b].loss += std::abs(diff);
-        dy[i * kTransferValues + static_cast<std::size_t>(k)] = diff > 0 ? scale : diff < 0 ? -scale : 0.0f;
-      }
+  for (std::size_t i = 0; i < idx.size(); ++i) {
+    const float* t = data_.target(idx[i]);
+    for (int k = 0; k < kTransferValues; ++k) {
+      const float diff = y[i * kTransferValues + static_cast<std::size_t>(k)] - t[k];
+      out.loss += std::abs(diff);
+      dy[i * kTransferValues + static_cast<std::size_t>(k)] = diff > 0 ? scale : diff < 0 ? -scale : 0.0f;
     }
+  }
   const int in = model_.decoder.layout().inputs;
   std::vector<float> dx(x.size());
-  std::vector<std::span<float>> grads;
-  for (auto& b : blocks_) grads.emplace_back(b.decoder);
-  model_.decoder.backward_by_blocks(x.data(), start, dy.data(), ws_, grads, dx.data(), settings_.backend);
+  model_.decoder.backward(x.data(), static_cast<int>(idx.size()), dy.data(), ws_, out.decoder, dx.data(), settings_.backend);
 
-  // Each block's latent rows, summed in its samples' order in grad_'s latent
+  // The block's latent rows, summed in its samples' order in grad_'s latent
   // part (zero there: clear_latent_gradients), read out and zeroed again.
   const auto d = static_cast<std::size_t>(model_.latent_dim);
   if (d == 0) return;
-  for (std::size_t b = 0; b < blocks_.size(); ++b) {
-    const auto first = static_cast<std::size_t>(start[b]), end = static_cast<std::size_t>(start[b + 1]);
-    if (first == end) continue;
-    for (std::size_t i = first; i < end; ++i) {
-      const TransferSample& s = data_.samples[idx[i]];
-      model_.meshes[s.mesh].latents.scatter_gradient(*assets_.meshes[s.mesh], s.triangle, s.barycentric,
-                                                     dx.data() + i * static_cast<std::size_t>(in),
-                                                     std::span(grad_).subspan(n_dec + latent_offset_[s.mesh]));
-    }
-    Gradients& out = blocks_[b];
-    out.rows = latent_rows_of(std::span(idx).subspan(first, end - first));
-    out.row_values.resize(out.rows.size() * d);
-    for (std::size_t r = 0; r < out.rows.size(); ++r) {
-      float* g = grad_.data() + n_dec + out.rows[r] * d;
-      std::copy_n(g, d, out.row_values.data() + r * d);
-      std::fill_n(g, d, 0.0f);
-    }
+  for (std::size_t i = 0; i < idx.size(); ++i) {
+    const TransferSample& s = data_.samples[idx[i]];
+    model_.meshes[s.mesh].latents.scatter_gradient(*assets_.meshes[s.mesh], s.triangle, s.barycentric,
+                                                   dx.data() + i * static_cast<std::size_t>(in),
+                                                   std::span(grad_).subspan(n_dec + latent_offset_[s.mesh]));
+  }
+  out.rows = latent_rows_of(idx);
+  out.row_values.resize(out.rows.size() * d);
+  for (std::size_t r = 0; r < out.rows.size(); ++r) {
+    float* g = grad_.data() + n_dec + out.rows[r] * d;
+    std::copy_n(g, d, out.row_values.data() + r * d);
+    std::fill_n(g, d, 0.0f);
   }
 }
 
@@ -236,6 +236,11 @@ void Trainer::add_rows(Gradients& into, const Gradients& from) const {
 }
 
 void Trainer::add(Gradients& into, const Gradients& from) const {
+  if (from.empty) return;
+  if (into.empty) {
+    into = from;
+    return;
+  }
   into.loss += from.loss;
   for (std::size_t i = 0; i < into.decoder.size(); ++i) into.decoder[i] += from.decoder[i];
   add_rows(into, from);
@@ -261,6 +266,7 @@ float Trainer::step() {
   draw_local_blocks();
   compute_blocks();
   Gradients& sum = sum_own_blocks();
+  if (sum.empty) sum.zero(model_.decoder.params().size());  // none of the batch is this rank's
   const auto t1 = std::chrono::steady_clock::now();
   if (comm_.size() > 1) exchange_gradients(sum);
   const auto t2 = std::chrono::steady_clock::now();

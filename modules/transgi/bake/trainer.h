@@ -104,12 +104,17 @@ class Trainer {
   // One block's (or a subtree's) share of a step: its samples' summed L1
   // loss, the decoder's gradients and the latent rows its samples touched
   // (ascending) with their gradients, latent_dim floats a row.
+  // A block no sample of this rank fell in stays `empty`, its decoder
+  // gradients unallocated: it adds nothing to the tree (adding zero changes
+  // no sum), so a rank pays only for its own blocks whatever the count.
   struct Gradients {
+    bool empty = true;
     double loss = 0;
     std::vector<float> decoder;
     std::vector<std::uint64_t> rows;
     std::vector<float> row_values;
-    void clear(std::size_t decoder_size);
+    void clear();
+    void zero(std::size_t decoder_size);  // not empty, every value 0
   };
   // The step's stages, in order.
   // grad_'s latent part back to zero (only last step's rows held values).
@@ -118,6 +123,7 @@ class Trainer {
   // sorted into blocks (each in draw order).
   void draw_local_blocks();
   void compute_blocks();
+  void compute_block(std::span<const std::size_t> idx, Gradients& out);
   // The rank's blocks summed in the tree's order, up to the level where the
   // ranks' partial sums meet; returns the rank's partial sum.
   Gradients& sum_own_blocks();

@@ -67,17 +67,7 @@ void Mlp::forward(const float* x, int batch, float* y, MlpWorkspace& ws, GemmBac
 
 void Mlp::backward(const float* x, int batch, const float* dy, MlpWorkspace& ws, std::span<float> grad, float* dx,
                    GemmBackend backend) const {
-  const int starts[2] = {0, batch};
-  const std::span<float> grads[1] = {grad};
-  backward_by_blocks(x, starts, dy, ws, grads, dx, backend);
-}
-
-void Mlp::backward_by_blocks(const float* x, std::span<const int> block_start, const float* dy, MlpWorkspace& ws,
-                             std::span<const std::span<float>> grads, float* dx, GemmBackend backend) const {
-  if (block_start.size() != grads.size() + 1) throw std::invalid_argument("backward_by_blocks: one start per block, and the end");
-  for (const auto& grad : grads)
-    if (grad.size() != params_.size()) throw std::invalid_argument("gradient buffer has the wrong size");
-  const int batch = block_start.back();
+  if (grad.size() != params_.size()) throw std::invalid_argument("gradient buffer has the wrong size");
   ws.grad_a.assign(dy, dy + static_cast<std::size_t>(batch) * layout_.outputs);
   for (int l = layout_.hidden_layers; l >= 0; --l) {
     const int n_in = layout_.in_of(l), n_out = layout_.out_of(l);
@@ -88,18 +78,12 @@ void Mlp::backward_by_blocks(const float* x, std::span<const int> block_start, c
         if (act[i] <= 0.0f) g[i] = 0.0f;  // ReLU gate
     }
     const float* in = l == 0 ? x : ws.activations[static_cast<std::size_t>(l - 1)].data();
-    for (std::size_t b = 0; b < grads.size(); ++b) {
-      const int first = block_start[b], rows = block_start[b + 1] - first;
-      if (rows <= 0) continue;
-      const float* gb = g.data() + static_cast<std::size_t>(first) * n_out;
-      const float* inb = in + static_cast<std::size_t>(first) * n_in;
-      // dW (n_out x n_in) += g^T (n_out x rows) * in (rows x n_in)
-      gemm(backend, true, false, n_out, n_in, rows, 1.0f, gb, n_out, inb, n_in, 1.0f,
-           grads[b].data() + layout_.weight_offset(l), n_in);
-      float* db = grads[b].data() + layout_.bias_offset(l);
-      for (int i = 0; i < rows; ++i)
-        for (int j = 0; j < n_out; ++j) db[j] += gb[static_cast<std::size_t>(i) * n_out + j];
-    }
+    // dW (n_out x n_in) += g^T (n_out x batch) * in (batch x n_in)
+    gemm(backend, true, false, n_out, n_in, batch, 1.0f, g.data(), n_out, in, n_in, 1.0f,
+         grad.data() + layout_.weight_offset(l), n_in);
+    float* db = grad.data() + layout_.bias_offset(l);
+    for (int i = 0; i < batch; ++i)
+      for (int j = 0; j < n_out; ++j) db[j] += g[static_cast<std::size_t>(i) * n_out + j];
     if (l == 0 && !dx) break;
     // d(in) (batch x n_in) = g (batch x n_out) * W (n_out x n_in)
     ws.grad_b.assign(static_cast<std::size_t>(batch) * n_in, 0.0f);

@@ -47,12 +47,6 @@ class Mlp {
   // writes dL/dx (batch x inputs) if dx is non-null. Needs forward()'s ws.
   void backward(const float* x, int batch, const float* dy, MlpWorkspace& ws, std::span<float> grad, float* dx,
                 GemmBackend backend) const;
-  // The same, with the batch's rows in consecutive blocks (block b: rows
-  // block_start[b] to block_start[b + 1]) whose parameter gradients are
-  // accumulated apart, into grads[b]: each block's the bits backward() gives
-  // for its rows alone, while dx and the layers' products are one pass.
-  void backward_by_blocks(const float* x, std::span<const int> block_start, const float* dy, MlpWorkspace& ws,
-                          std::span<const std::span<float>> grads, float* dx, GemmBackend backend) const;
 
   [[nodiscard]] const MlpLayout& layout() const { return layout_; }
   [[nodiscard]] std::vector<float>& params() { return params_; }
