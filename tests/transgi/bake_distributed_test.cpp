@@ -42,6 +42,28 @@ std::vector<float> weights(const model::TransferModel& m) {
   return w;
 }
 
+// |a - b| / |a| over every weight.
+double relative_distance(const std::vector<float>& a, const std::vector<float>& b) {
+  double diff = 0, norm = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) diff += double(a[i] - b[i]) * (a[i] - b[i]), norm += double(a[i]) * a[i];
+  return std::sqrt(diff / norm);
+}
+
+// The one-process run the ranks are held to: `steps` steps from the model of seed 3.
+struct SoloRun {
+  model::TransferModel model;
+  std::vector<float> losses;
+  bake::BandErrors validation;
+};
+SoloRun train_alone(const engine::scene::SceneAssets& assets, const bake::TransferDataset& data, const bake::TrainSettings& ts,
+                    const model::MlpLayout& layout, int steps) {
+  SoloRun run{bake::make_untrained_model(assets, 7, layout, 3), {}, {}};
+  bake::Trainer trainer(data, assets, run.model, ts);
+  for (int i = 0; i < steps; ++i) run.losses.push_back(trainer.step());
+  run.validation = trainer.validate();
+  return run;
+}
+
 bool same_sample(const bake::TransferSample& a, const bake::TransferSample& b) {
   return std::memcmp(&a, &b, sizeof(a)) == 0;
 }
@@ -113,12 +135,10 @@ TEST(DistributedTraining, TwoAndFourRanksTakeTheOneProcessStepsBitForBit) {
   const model::MlpLayout layout{.width = 16, .hidden_layers = 1};
   constexpr int kSteps = 60;
 
-  const auto one_data = bake::generate_dataset(assets, s);
-  auto one = bake::make_untrained_model(assets, 7, layout, 3);
-  bake::Trainer solo_trainer(one_data, assets, one, ts);
-  std::vector<float> solo_loss;
-  for (int i = 0; i < kSteps; ++i) solo_loss.push_back(solo_trainer.step());
-  const auto solo_validation = solo_trainer.validate();
+  const SoloRun solo = train_alone(assets, bake::generate_dataset(assets, s), ts, layout, kSteps);
+  const model::TransferModel& one = solo.model;
+  const std::vector<float>& solo_loss = solo.losses;
+  const bake::BandErrors& solo_validation = solo.validation;
 
   for (int ranks : {2, 4}) {
     std::vector<model::TransferModel> models(static_cast<std::size_t>(ranks));
@@ -162,10 +182,7 @@ TEST(DistributedTraining, ThreeRanksTakeTheOneProcessStepsWithinRounding) {
   ts.batch = 256;
   const model::MlpLayout layout{.width = 16, .hidden_layers = 1};
   constexpr int kSteps = 40;
-  const auto one_data = bake::generate_dataset(assets, s);
-  auto one = bake::make_untrained_model(assets, 7, layout, 3);
-  bake::Trainer solo_trainer(one_data, assets, one, ts);
-  for (int i = 0; i < kSteps; ++i) solo_trainer.step();
+  const SoloRun solo = train_alone(assets, bake::generate_dataset(assets, s), ts, layout, kSteps);
   std::vector<model::TransferModel> models(3);
   on_ranks(3, [&](int r, bake::Communicator& comm) {
     const auto data = bake::generate_dataset(assets, s, {}, {r, 3});
@@ -175,11 +192,9 @@ TEST(DistributedTraining, ThreeRanksTakeTheOneProcessStepsWithinRounding) {
   });
   EXPECT_EQ(weights(models[1]), weights(models[0]));
   EXPECT_EQ(weights(models[2]), weights(models[0]));
-  const auto a = weights(one), b = weights(models[0]);
-  double diff = 0, norm = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) diff += double(a[i] - b[i]) * (a[i] - b[i]), norm += double(a[i]) * a[i];
-  std::printf("[ measured ] 3 ranks, after %d steps: weights %.2e apart (relative)\n", kSteps, std::sqrt(diff / norm));
-  EXPECT_LT(std::sqrt(diff / norm), 1e-5);
+  const double apart = relative_distance(weights(solo.model), weights(models[0]));
+  std::printf("[ measured ] 3 ranks, after %d steps: weights %.2e apart (relative)\n", kSteps, apart);
+  EXPECT_LT(apart, 1e-5);
 }
 
 // Blocks by any other count split the same batch's sums otherwise: the steps
@@ -200,10 +215,8 @@ TEST(DistributedTraining, TheBlockCountChangesTheStepsOnlyByRounding) {
     w.push_back(weights(m));
   }
   for (std::size_t k = 1; k < w.size(); ++k) {
-    double diff = 0, norm = 0;
-    for (std::size_t i = 0; i < w[0].size(); ++i) diff += double(w[0][i] - w[k][i]) * (w[0][i] - w[k][i]), norm += double(w[0][i]) * w[0][i];
-    EXPECT_GT(diff, 0.0) << "the sums' order should show in the last bits";
-    EXPECT_LT(std::sqrt(diff / norm), 1e-5);
+    EXPECT_GT(relative_distance(w[0], w[k]), 0.0) << "the sums' order should show in the last bits";
+    EXPECT_LT(relative_distance(w[0], w[k]), 1e-5);
   }
   bake::TrainSettings bad;
   bad.gradient_blocks = 6;
@@ -343,10 +356,7 @@ TEST(DistributedTraining, TouchedRowUpdatesOnTwoRanksTakeTheOneProcessSteps) {
   ts.batch = 256;
   ts.latent_updates = bake::LatentUpdates::Touched;
   const model::MlpLayout layout{.width = 16, .hidden_layers = 1};
-  const auto one_data = bake::generate_dataset(assets, s);
-  auto one = bake::make_untrained_model(assets, 7, layout, 3);
-  bake::Trainer solo_trainer(one_data, assets, one, ts);
-  for (int i = 0; i < 40; ++i) solo_trainer.step();
+  const SoloRun solo = train_alone(assets, bake::generate_dataset(assets, s), ts, layout, 40);
 
   std::vector<model::TransferModel> models(2);
   on_ranks(2, [&](int r, bake::Communicator& comm) {
@@ -356,5 +366,5 @@ TEST(DistributedTraining, TouchedRowUpdatesOnTwoRanksTakeTheOneProcessSteps) {
     for (int i = 0; i < 40; ++i) trainer.step();
   });
   EXPECT_EQ(weights(models[0]), weights(models[1]));
-  EXPECT_EQ(weights(models[0]), weights(one));
+  EXPECT_EQ(weights(models[0]), weights(solo.model));
 }
