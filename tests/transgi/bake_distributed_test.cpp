@@ -123,6 +123,28 @@ TEST(BakeShards, TheRanksShardsTogetherAreTheOneProcessDataset) {
   EXPECT_EQ(found, one.validation_count());
 }
 
+// Communicator::sum's contract on a power-of-two group: rank r + N/2 is added
+// to rank r first, then pairs at N/4, ..., 1, whatever the transport. Values
+// whose float sum depends on the order tell the tree from rank order: with
+// 1e8, 1, -1e8, 1 the tree gives (1e8 - 1e8) + (1 + 1) = 2, rank order
+// ((1e8 + 1) - 1e8) + 1 = 1 (1e8 + 1 rounds to 1e8).
+TEST(DistributedTraining, AGroupsSumIsTheFixedTreeOverItsRanks) {
+  const float mine[4] = {1e8f, 1.0f, -1e8f, 1.0f};
+  std::vector<float> sums(4), double_sums(4);
+  on_ranks(4, [&](int r, bake::Communicator& comm) {
+    std::vector<float> v{mine[r]};
+    comm.sum(std::span(v));
+    sums[static_cast<std::size_t>(r)] = v[0];
+    std::vector<double> d{r == 0 ? 1e17 : r == 2 ? -1e17 : 1.0};
+    comm.sum(std::span(d));
+    double_sums[static_cast<std::size_t>(r)] = static_cast<float>(d[0]);
+  });
+  for (int r = 0; r < 4; ++r) {
+    EXPECT_EQ(sums[static_cast<std::size_t>(r)], 2.0f) << "rank " << r;
+    EXPECT_EQ(double_sums[static_cast<std::size_t>(r)], 2.0f) << "rank " << r << ", in double";
+  }
+}
+
 // Two and four ranks draw the batches the one process draws, and the
 // gradients of each block of a batch are summed in the one process's tree:
 // the same steps, the same bits, on every rank.
