@@ -69,7 +69,7 @@ BakeCommand parse_bake_command(const Args& args) {
     s.train.latent_updates = bake::LatentUpdates::Touched;
   s.train.gradient_blocks = static_cast<int>(args.integer("gradient-blocks", 1, 4096, s.train.gradient_blocks));
   if ((s.train.gradient_blocks & (s.train.gradient_blocks - 1)) != 0)
-    throw UsageError("--gradient-blocks must be a power of two, not " + std::to_string(s.train.gradient_blocks));
+    throw UsageError("bake: --gradient-blocks: expected a power of two, got '" + std::to_string(s.train.gradient_blocks) + "'");
 
   return c;
 }
