@@ -50,6 +50,16 @@ class Communicator {
 // One process alone: sums are the values themselves, nothing is sent.
 Communicator& solo();
 
+// The order of Communicator::sum's tree over `count` values (a power of
+// two): visit(v, v + d), value v taking value v + d, for d = count / 2, ...,
+// down to `lowest`, and v < d at each d. With lowest = 1 value 0 ends with
+// the sum. The trainer walks the same tree over its gradient blocks.
+template <class Visit>
+void for_each_tree_pair(int count, int lowest, Visit visit) {
+  for (int d = count / 2; d >= lowest && d >= 1; d /= 2)
+    for (int v = 0; v < d; ++v) visit(v, v + d);
+}
+
 // Every rank's value of a plain type, in rank order, on every rank.
 template <class T>
   requires std::is_trivially_copyable_v<T>

@@ -50,8 +50,9 @@ class ThreadCommunicator final : public Communicator {
       for (std::size_t i = 0; i < v.size(); ++i) parts[into][i] += parts[from][i];
     };
     if ((n & (n - 1)) == 0) {
-      for (std::size_t d = n / 2; d >= 1; d /= 2)
-        for (std::size_t r = 0; r < d; ++r) add(r, r + d);
+      for_each_tree_pair(static_cast<int>(n), 1, [&](int into, int from) {
+        add(static_cast<std::size_t>(into), static_cast<std::size_t>(from));
+      });
     } else {
       for (std::size_t r = 1; r < n; ++r) add(0, r);
     }

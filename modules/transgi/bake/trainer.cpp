@@ -235,10 +235,10 @@ void Trainer::add_rows(Gradients& into, const Gradients& from) const {
   into.row_values = std::move(merged.row_values);
 }
 
-void Trainer::add(Gradients& into, const Gradients& from) const {
+void Trainer::add(Gradients& into, Gradients& from) const {
   if (from.empty) return;
-  if (into.empty) {
-    into = from;
+  if (into.empty) {  // `from` is not read again: its buffers are taken, not copied
+    std::swap(into, from);
     return;
   }
   into.loss += from.loss;
@@ -253,10 +253,9 @@ void Trainer::add(Gradients& into, const Gradients& from) const {
 Trainer::Gradients& Trainer::sum_own_blocks() {
   const int n = comm_.size(), rank = comm_.rank(), blocks = settings_.gradient_blocks;
   const bool aligned = power_of_two(n) && n <= blocks;
-  const int stop = aligned ? n : 1;
-  for (int d = blocks / 2; d >= stop; d /= 2)
-    for (int v = 0; v < d; ++v)
-      if (!aligned || v % n == rank) add(blocks_[static_cast<std::size_t>(v)], blocks_[static_cast<std::size_t>(v + d)]);
+  for_each_tree_pair(blocks, aligned ? n : 1, [&](int v, int w) {
+    if (!aligned || v % n == rank) add(blocks_[static_cast<std::size_t>(v)], blocks_[static_cast<std::size_t>(w)]);
+  });
   return blocks_[static_cast<std::size_t>(aligned ? rank : 0)];
 }
 
@@ -364,8 +363,9 @@ void Trainer::exchange_gradients(Gradients& mine) {
   }
   const int n = comm_.size();
   if (power_of_two(n)) {
-    for (int step = n / 2; step >= 1; step /= 2)
-      for (int r = 0; r < step; ++r) add_rows(parts[static_cast<std::size_t>(r)], parts[static_cast<std::size_t>(r + step)]);
+    for_each_tree_pair(n, 1, [&](int into, int from) {
+      add_rows(parts[static_cast<std::size_t>(into)], parts[static_cast<std::size_t>(from)]);
+    });
   } else {
     for (int r = 1; r < n; ++r) add_rows(parts[0], parts[static_cast<std::size_t>(r)]);
   }

@@ -133,7 +133,8 @@ class Trainer {
   void take_gradients(const Gradients& sum);
 
   void add_rows(Gradients& into, const Gradients& from) const;
-  void add(Gradients& into, const Gradients& from) const;
+  // into += from; `from` may be left with into's old buffers.
+  void add(Gradients& into, Gradients& from) const;
   // The flat latent rows (over every mesh) that these samples interpolate, sorted, once each.
   std::vector<std::uint64_t> latent_rows_of(std::span<const std::size_t> batch) const;
   [[nodiscard]] bool gradients_finite(double loss) const;
