@@ -7,7 +7,14 @@
 #include <cmath>
 #include <vector>
 
+#include <filesystem>
+#include <string>
+
 #include "bake/trainer.h"
+#include "engine/app/app.h"
+#include "engine/render/camera_rays.h"
+#include "eval/method_runs.h"
+#include "shading/gbuffer.h"
 #include "engine/jobs/job_system.h"
 #include "shading/fused_decoder.h"
 #include "shading/transfer_inference.h"
@@ -231,11 +238,57 @@ void BM_ProbeCage(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(points.size()));
 }
 
+// The G-buffer's samples of the sample level's 640 x 360 view, its hits
+// traced once beforehand, one thread: Arg 0 = make_gsample a pixel at a
+// time (the oracle), 1 = make_gsamples a 4 x 4 tile at a time (the frame's).
+void BM_GBufferSamples(benchmark::State& state) {
+  const std::string relative = "content/levels/living_room/scene.gltf";
+  const transgi::eval::LoadedScene scene =
+      transgi::eval::load_scene(std::filesystem::exists(relative) ? relative : std::string(TRANSGI_LEVEL_SCENE), "", 1);
+  const auto& w = scene.app->world();
+  const auto& rt = w.resource<engine::rt::RtScene>();
+  const auto& assets = w.resource<engine::scene::SceneAssets>();
+  const int width = 640, height = 360, tiles_x = width / 4, tiles = tiles_x * (height / 4);
+  const engine::render::CameraRays camera(w.get<engine::scene::Camera>(scene.camera), w.get<engine::transform::WorldTransform>(scene.camera),
+                                          width, height);
+  std::vector<engine::rt::Ray> rays(static_cast<std::size_t>(width) * height);
+  std::vector<engine::rt::Hit> hits(rays.size());
+  std::vector<std::uint8_t> found(rays.size());
+  for (int t = 0; t < tiles; ++t)
+    for (int i = 0; i < 16; ++i) {
+      const std::size_t k = static_cast<std::size_t>(t) * 16 + static_cast<std::size_t>(i);
+      rays[k] = camera.generate({static_cast<float>(t % tiles_x * 4 + i % 4) + 0.5f, static_cast<float>(t / tiles_x * 4 + i / 4) + 0.5f});
+      found[k] = rt.intersect(rays[k], hits[k]) ? 1 : 0;
+    }
+  std::vector<transgi::shading::GSample> samples(rays.size());
+  const bool tile = state.range(0) == 1;
+  const float spread = camera.pixel_spread();
+  for (auto _ : state)
+    for (int t = 0; t < tiles; ++t) {
+      const std::size_t first = static_cast<std::size_t>(t) * 16;
+      bool f[16];
+      transgi::shading::GSample* out[16];
+      for (std::size_t i = 0; i < 16; ++i) {
+        f[i] = found[first + i] != 0;
+        out[i] = &samples[first + i];
+      }
+      if (tile) {
+        transgi::shading::make_gsamples(rt, assets, &rays[first], &hits[first], f, 16, spread, out);
+      } else {
+        for (std::size_t i = 0; i < 16; ++i)
+          transgi::shading::make_gsample(rt, assets, rays[first + i], f[i] ? &hits[first + i] : nullptr, nullptr, spread, *out[i]);
+      }
+      benchmark::ClobberMemory();
+    }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(rays.size()));
+}
+
 BENCHMARK(BM_Bf16Peak)->Threads(1)->Threads(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_AmxPeak)->Threads(1)->Threads(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FusedShade)->Arg(3)->Arg(2)->Arg(1)->Arg(0)->Threads(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FusedShade)->Arg(3)->Arg(2)->Threads(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ProbeCage)->Arg(0)->Arg(1)->Arg(0)->Arg(1);
+BENCHMARK(BM_GBufferSamples)->Arg(0)->Arg(1)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_OneDnnBf16Chain)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_InferTransfer)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 // Argument: 32 = f32 sgemm, 16 = bf16 matmul.

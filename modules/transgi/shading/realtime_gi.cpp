@@ -266,8 +266,9 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
           hits[i] = batch_hits[first + static_cast<std::size_t>(i)];
         }
       }
-      for (int i = 0; i < n; ++i)
-        make_gsample(scene, assets, rays[i], found[i] ? &hits[i] : nullptr, nullptr, spread, g.samples[pixel[i]]);
+      GSample* out[kGSampleTile];
+      for (int i = 0; i < n; ++i) out[i] = &g.samples[pixel[i]];
+      make_gsamples(scene, assets, rays, hits, found, n, spread, out);
       // Read back a tile later, not at once: a field read right after
       // make_gsample stored it waits for a store it cannot forward.
       float tile_least = std::numeric_limits<float>::infinity();
