@@ -131,6 +131,7 @@ void choose_dielectric_rays(const GBuffer& g, float max_roughness, DielectricRay
     for (int row = r0; row < r1; ++row) {
       DielectricRays::Row& out = rays.rows[static_cast<std::size_t>(row)];
       out.glossy.clear();
+      out.glossy_albedo.clear();
       out.ray_pixel.clear();
       out.direction.clear();
       out.weight.clear();
@@ -140,28 +141,37 @@ void choose_dielectric_rays(const GBuffer& g, float max_roughness, DielectricRay
           for (int x = tile * 4; x < std::min(tile * 4 + 4, g.width); ++x) {
             const std::size_t p = static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x);
             if (!(g.dielectric_roughness[p] <= max_roughness)) continue;
+            const GSample& s = g.samples[p];
+            const glm::vec3 albedo = specular_layer_albedo(s);
             out.glossy.push_back(p);
+            out.glossy_albedo.push_back(albedo);
             if (x % 2 != ox || y % 2 != oy) continue;
             math::Pcg32 rng = math::make_rng(0xD1E1ull, p, phase);
             glm::vec3 wi, weight;
-            if (!sample_reflection(g.samples[p], false, {rng.next_float(), rng.next_float()}, wi, weight)) continue;
+            if (!sample_reflection(s, false, {rng.next_float(), rng.next_float()}, wi, weight)) continue;
             out.ray_pixel.push_back(p);
             out.direction.push_back(wi);
-            out.weight.push_back(weight);
+            out.weight.push_back(weight / glm::max(albedo, glm::vec3(1e-6f)));
           }
       }
     }
   });
   rays.glossy.clear();
+  rays.glossy_albedo.clear();
   rays.traced.clear();
+  rays.ray_x.clear();
+  rays.ray_y.clear();
   rays.ray_pixel.clear();
   rays.direction.clear();
   rays.weight.clear();
   for (const DielectricRays::Row& row : rays.rows) {
     rays.glossy.insert(rays.glossy.end(), row.glossy.begin(), row.glossy.end());
+    rays.glossy_albedo.insert(rays.glossy_albedo.end(), row.glossy_albedo.begin(), row.glossy_albedo.end());
     for (const std::size_t p : row.ray_pixel) {
       rays.ray_of_block[rays.block_of(p, width)] = static_cast<std::uint32_t>(rays.traced.size());
       rays.traced.push_back(rays.block_of(p, width));
+      rays.ray_x.push_back(static_cast<int>(p % width));
+      rays.ray_y.push_back(static_cast<int>(p / width));
     }
     rays.ray_pixel.insert(rays.ray_pixel.end(), row.ray_pixel.begin(), row.ray_pixel.end());
     rays.direction.insert(rays.direction.end(), row.direction.begin(), row.direction.end());
@@ -281,8 +291,6 @@ void trace_dielectric_rays(const GBuffer& g, const engine::rt::RtScene& scene, s
     ReflectionPacket packet;
     for (std::size_t pk = b; pk < e; ++pk) {
       const std::size_t k0 = pk * kPacket, k1 = std::min(n, k0 + kPacket);
-      for (std::size_t k = k0; k < k1; ++k)
-        rays.weight[k] /= glm::max(specular_layer_albedo(g.samples[rays.ray_pixel[k]]), glm::vec3(1e-6f));
       packet.reflect(g, scene, fields, lights, rays.ray_pixel.data() + k0, rays.direction.data() + k0, static_cast<int>(k1 - k0));
       for (std::size_t k = k0; k < k1; ++k) {
         rays.direct[k] = rays.weight[k] * packet.light[k - k0].direct;
@@ -423,8 +431,8 @@ std::size_t shade_dielectric_reflections(const GBuffer& g, const engine::rt::RtS
           const std::size_t q = rays.ray_pixel[j];
           // A tent over the blocks' spacing, so neighbouring pixels blend
           // between blocks instead of taking their own block's value.
-          const float dx = std::abs(static_cast<float>(static_cast<int>(q % width) - x));
-          const float dy = std::abs(static_cast<float>(static_cast<int>(q / width) - y));
+          const float dx = std::abs(static_cast<float>(rays.ray_x[j] - x));
+          const float dy = std::abs(static_cast<float>(rays.ray_y[j] - y));
           const float w = same_plane_weight(g, p, q) * std::max(0.0f, 1.0f - dx / 3.0f) * std::max(0.0f, 1.0f - dy / 3.0f);
           sum_direct += w * rays.mean_direct[j];
           sum_gi += w * rays.mean_gi[j];
@@ -433,7 +441,7 @@ std::size_t shade_dielectric_reflections(const GBuffer& g, const engine::rt::RtS
       if (!(sum_w > 0)) continue;
       glm::vec3 light_direct = sum_direct / sum_w, light_gi = sum_gi / sum_w;
       rays.history.blend(g, p, light_direct, light_gi);
-      const glm::vec3 albedo = specular_layer_albedo(g.samples[p]);
+      const glm::vec3& albedo = rays.glossy_albedo[i];
       image.pixels[p] += albedo * light_gi;
       if (direct_out) direct_out->pixels[p] += albedo * light_direct;
     }

@@ -65,19 +65,21 @@ class ReflectionHistory {
 constexpr std::uint32_t kNoRay = UINT32_MAX;
 struct DielectricRays {
   std::vector<std::size_t> glossy;           // the glossy dielectric pixels
+  std::vector<glm::vec3> glossy_albedo;      // per glossy pixel: its specular layer's albedo (specular_layer_albedo)
   int bw = 0, bh = 0;                        // blocks per row and column
   std::vector<std::uint32_t> ray_of_block;   // per block: its ray, or kNoRay
   std::vector<std::size_t> traced;           // per ray: its block
   std::vector<std::size_t> ray_pixel;        // per ray: the pixel it left from
+  std::vector<int> ray_x, ray_y;             // per ray: that pixel's column and row
   std::vector<glm::vec3> direction;          // per ray: where it goes
-  std::vector<glm::vec3> weight;             // per ray: F G1 over its pixel's specular albedo
+  std::vector<glm::vec3> weight;             // per ray: F G1 over its pixel's specular layer's albedo
   std::vector<glm::vec3> direct, gi;         // per ray: the light it found, times its weight
   std::vector<glm::vec3> mean_direct, mean_gi;  // per ray: its neighbourhood's mean (gather_rays)
   std::vector<std::uint8_t> has_mean;
   // choose_dielectric_rays' lists per row of 4x4 tiles, before they are joined.
   struct Row {
     std::vector<std::size_t> glossy, ray_pixel;
-    std::vector<glm::vec3> direction, weight;
+    std::vector<glm::vec3> glossy_albedo, direction, weight;
   };
   std::vector<Row> rows;
   // The glossy pixels' filtered light over their last frames.
