@@ -1,6 +1,6 @@
 // make_gsamples (a camera tile's G-buffer samples in SIMD lanes) against
-// make_gsample, its scalar oracle: every field of every sample equal, bit for
-// bit, at whichever instruction set the dispatch runs (CTest runs this suite
+// make_gsample, its scalar oracle: every field of every sample, and every
+// side-array entry it writes beside them, equal bit for bit, at whichever instruction set the dispatch runs (CTest runs this suite
 // again capped at AVX2 and at scalar). The scene has what each branch needs:
 // textured walls under rotated and scaled instances (the mip footprint), one
 // seen from the back (the normal turns to the viewer), a sphere with
@@ -9,7 +9,9 @@
 // finds (the geometric normal falls back to the shading normal).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
+#include <limits>
 
 #include <glm/gtc/quaternion.hpp>
 
@@ -60,6 +62,8 @@ struct TileScene {
     metal.roughness_factor = 0.3f;
     material::Material lamp = lambert(glm::vec3(0.5f));
     lamp.emissive_factor = glm::vec3(2.0f, 1.5f, 1.0f);
+    lamp.specular_factor = 0.5f;  // a glossy dielectric: finite dielectric_roughness
+    lamp.roughness_factor = 0.4f;
     a.materials = {wall, metal, lamp};
     app.world().insert_resource<scene::SceneAssets>(std::move(a));
     app.add_plugin<rt::RtPlugin>();
@@ -117,7 +121,7 @@ TEST(GSampleTile, EveryFieldEqualsTheScalarSamplesBitForBit) {
   const render::CameraRays camera(scene.app.world().get<scene::Camera>(scene.camera),
                                   scene.app.world().get<transform::WorldTransform>(scene.camera), width, height);
   const float spread = camera.pixel_spread();
-  int tiles = 0, hits = 0, misses = 0, turned = 0, textured = 0, different = 0;
+  int tiles = 0, hits = 0, misses = 0, turned = 0, textured = 0, different = 0, different_sides = 0, glossy = 0, metallic = 0;
   rt::Hit on_box{};
   bool box_seen = false;
   const auto compare_tile = [&](const rt::Ray* rays, const rt::Hit* found_hits, const bool* found, int count) {
@@ -128,10 +132,38 @@ TEST(GSampleTile, EveryFieldEqualsTheScalarSamplesBitForBit) {
       tile[i].depth = -1;  // every field must be written over
       shading::make_gsample(rt, assets, rays[i], found[i] ? &found_hits[i] : nullptr, nullptr, spread, oracle[i]);
     }
-    shading::make_gsamples(rt, assets, rays, found_hits, found, count, spread, out);
+    // The side arrays, each entry first set to a value no sample gives.
+    std::size_t pixel[shading::kGSampleTile];
+    glm::vec4 guide[shading::kGSampleTile];
+    glm::vec3 position[shading::kGSampleTile], albedo[shading::kGSampleTile];
+    float metal[shading::kGSampleTile], dielectric[shading::kGSampleTile];
+    ecs::Entity entity[shading::kGSampleTile];
+    for (int i = 0; i < count; ++i) {
+      pixel[i] = static_cast<std::size_t>(count - 1 - i);  // lanes land at other indices
+      guide[i] = glm::vec4(-7.0f);
+      position[i] = albedo[i] = glm::vec3(-7.0f);
+      metal[i] = dielectric[i] = -7.0f;
+      entity[i] = scene.camera;
+    }
+    const shading::GSampleSideArrays sides{pixel, guide, position, albedo, metal, dielectric, entity};
+    shading::make_gsamples(rt, assets, rays, found_hits, found, count, spread, out, &sides);
     ++tiles;
     for (int i = 0; i < count; ++i) {
       if (!same_bits(tile[i], oracle[i])) ++different;
+      // What each side array holds, from the oracle's sample.
+      const shading::GSample& o = oracle[i];
+      const std::size_t p = pixel[i];
+      const float inf = std::numeric_limits<float>::infinity();
+      const glm::vec4 want_guide = o.hit ? glm::vec4(o.normal_world, std::max(o.depth, 1e-30f)) : glm::vec4(0.0f);
+      const float want_metal = o.hit && o.brdf.metallic >= 0.5f ? o.brdf.roughness : inf;
+      const float want_dielectric = o.hit && o.brdf.metallic < 0.5f && o.brdf.specular > 0 ? o.brdf.roughness : inf;
+      const bool sides_equal = std::memcmp(&guide[p], &want_guide, sizeof(glm::vec4)) == 0 &&
+                               position[p] == (o.hit ? o.position : glm::vec3(0.0f)) &&
+                               albedo[p] == (o.hit ? o.albedo : glm::vec3(0.0f)) && metal[p] == want_metal &&
+                               dielectric[p] == want_dielectric && entity[p] == o.entity;
+      if (!sides_equal) ++different_sides;
+      if (std::isfinite(want_dielectric)) ++glossy;
+      if (std::isfinite(want_metal)) ++metallic;
       if (!found[i]) {
         ++misses;
         continue;
@@ -175,12 +207,15 @@ TEST(GSampleTile, EveryFieldEqualsTheScalarSamplesBitForBit) {
     found[i] = true;
   }
   compare_tile(rays, degenerate, found, shading::kGSampleTile);
-  std::printf("%d tiles: %d hits (%d textured, %d whose normal turned to the viewer, 16 on a triangle with no area), %d misses; %d samples differ\n",
-              tiles, hits, textured, turned, misses, different);
+  std::printf("%d tiles: %d hits (%d textured, %d metallic, %d glossy dielectric, %d whose normal turned to the viewer, 16 on a triangle with no area), %d misses; %d samples and %d side entries differ\n",
+              tiles, hits, textured, metallic, glossy, turned, misses, different, different_sides);
   EXPECT_EQ(different, 0);
+  EXPECT_EQ(different_sides, 0);
   // What the comparison covered (or it shows nothing).
   EXPECT_GT(textured, 100);
   EXPECT_GT(misses, 100);
   EXPECT_GT(hits, 1000);
   EXPECT_GT(turned, 100);
+  EXPECT_GT(glossy, 16);
+  EXPECT_GT(metallic, 100);
 }

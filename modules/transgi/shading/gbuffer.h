@@ -44,10 +44,25 @@ void make_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAs
 
 // The most samples make_gsamples makes at once: a 4 x 4 camera tile.
 inline constexpr int kGSampleTile = 16;
+// Per-pixel arrays a G-buffer keeps beside its samples (realtime_gi.h's
+// GBuffer says what each holds), written by make_gsamples for lane i at
+// index pixel[i] from the values it has in registers: read back from the
+// samples just stored, they cost a load that waits on those stores.
+struct GSampleSideArrays {
+  const std::size_t* pixel = nullptr;
+  glm::vec4* guide = nullptr;             // world normal, depth (0: a miss)
+  glm::vec3* position = nullptr;          // 0 for a miss
+  glm::vec3* albedo = nullptr;            // the base colour, 0 for a miss
+  float* metal_roughness = nullptr;       // roughness where metallic >= 0.5, else infinity
+  float* dielectric_roughness = nullptr;  // roughness of a non-metal with specular > 0, else infinity
+  engine::ecs::Entity* entity = nullptr;  // null for a miss
+};
 // make_gsample for n <= kGSampleTile rays at once (no background: a miss is
-// GSample{}), written to *out[i]: the same samples, bit for bit, faster (the
-// arithmetic runs across the rays in SIMD lanes; gbuffer_tile.cpp).
+// GSample{}), written to *out[i], and to `sides` where given: the same
+// samples, bit for bit, faster (the arithmetic runs across the rays in SIMD
+// lanes; gbuffer_tile.cpp).
 void make_gsamples(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets, const engine::rt::Ray* rays,
-                   const engine::rt::Hit* hits, const bool* found, int n, float spread, GSample* const* out);
+                   const engine::rt::Hit* hits, const bool* found, int n, float spread, GSample* const* out,
+                   const GSampleSideArrays* sides = nullptr);
 
 }  // namespace transgi::shading

@@ -1,4 +1,6 @@
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "engine/core/cpu_isa.h"
 #include "engine/render/surface.h"
@@ -103,7 +105,8 @@ ENGINE_ISA_DISPATCH(void, tile_geometry, (TileGeometry & g), (g))
 }  // namespace
 
 void make_gsamples(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets, const engine::rt::Ray* rays,
-                   const engine::rt::Hit* hits, const bool* found, int n, float spread, GSample* const* out) {
+                   const engine::rt::Hit* hits, const bool* found, int n, float spread, GSample* const* out,
+                   const GSampleSideArrays* sides) {
   using namespace engine;
   TileGeometry g;
   // The loads. A missed lane computes on zeros, and its result is dropped.
@@ -140,6 +143,15 @@ void make_gsamples(const engine::rt::RtScene& scene, const engine::scene::SceneA
     GSample& s = *out[i];
     if (!found[i]) {
       s = GSample{};
+      if (sides) {
+        const std::size_t p = sides->pixel[i];
+        sides->guide[p] = glm::vec4(0.0f);
+        sides->position[p] = glm::vec3(0.0f);
+        sides->albedo[p] = glm::vec3(0.0f);
+        sides->metal_roughness[p] = std::numeric_limits<float>::infinity();
+        sides->dielectric_roughness[p] = std::numeric_limits<float>::infinity();
+        sides->entity[p] = engine::ecs::Entity{};
+      }
       continue;
     }
     const rt::Hit& hit = hits[i];
@@ -174,6 +186,16 @@ void make_gsamples(const engine::rt::RtScene& scene, const engine::scene::SceneA
     const glm::vec3 ng(g.ng[0][i], g.ng[1][i], g.ng[2][i]);
     s.geometric_normal = ng_dot_wo < 0 ? -ng : ng;
     s.depth = hit.t;
+    if (sides) {
+      const std::size_t p = sides->pixel[i];
+      const material::BrdfParams& brdf = s.brdf;
+      sides->guide[p] = glm::vec4(g.nworld[0][i], g.nworld[1][i], g.nworld[2][i], std::max(hit.t, 1e-30f));
+      sides->position[p] = glm::vec3(g.position[0][i], g.position[1][i], g.position[2][i]);
+      sides->albedo[p] = brdf.base_color;
+      sides->metal_roughness[p] = brdf.metallic >= 0.5f ? brdf.roughness : std::numeric_limits<float>::infinity();
+      sides->dielectric_roughness[p] = brdf.metallic < 0.5f && brdf.specular > 0 ? brdf.roughness : std::numeric_limits<float>::infinity();
+      sides->entity[p] = hit.entity;
+    }
   }
 }
 

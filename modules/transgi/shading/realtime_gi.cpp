@@ -230,6 +230,13 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
     engine::rt::Hit hits[16];
     bool found[16];
     std::size_t pixel[16];
+    const GSampleSideArrays sides{.pixel = pixel,
+                                  .guide = g.guide.data(),
+                                  .position = g.position.data(),
+                                  .albedo = g.albedo.data(),
+                                  .metal_roughness = g.metal_roughness.data(),
+                                  .dielectric_roughness = g.dielectric_roughness.data(),
+                                  .entity = g.entity.data()};
     DirectTileShader::Scratch direct_scratch;
     for (int t = t0; t < t1; ++t) {
       const int tx = t % tiles_x * 4, ty = t / tiles_x * 4;
@@ -268,21 +275,9 @@ void trace_gbuffer(const engine::rt::RtScene& scene, const engine::scene::SceneA
       }
       GSample* out[kGSampleTile];
       for (int i = 0; i < n; ++i) out[i] = &g.samples[pixel[i]];
-      make_gsamples(scene, assets, rays, hits, found, n, spread, out);
-      // Read back a tile later, not at once: a field read right after
-      // make_gsample stored it waits for a store it cannot forward.
+      make_gsamples(scene, assets, rays, hits, found, n, spread, out, &sides);
       float tile_least = std::numeric_limits<float>::infinity();
-      for (int i = 0; i < n; ++i) {
-        const GSample& s = g.samples[pixel[i]];
-        g.guide[pixel[i]] = s.hit ? glm::vec4(s.normal_world, std::max(s.depth, 1e-30f)) : glm::vec4(0.0f);
-        g.position[pixel[i]] = s.hit ? s.position : glm::vec3(0.0f);
-        g.albedo[pixel[i]] = s.hit ? s.albedo : glm::vec3(0.0f);
-        g.metal_roughness[pixel[i]] = s.hit && s.brdf.metallic >= 0.5f ? s.brdf.roughness : std::numeric_limits<float>::infinity();
-        g.dielectric_roughness[pixel[i]] =
-            s.hit && s.brdf.metallic < 0.5f && s.brdf.specular > 0 ? s.brdf.roughness : std::numeric_limits<float>::infinity();
-        tile_least = std::min(tile_least, g.dielectric_roughness[pixel[i]]);
-        g.entity[pixel[i]] = s.entity;
-      }
+      for (int i = 0; i < n; ++i) tile_least = std::min(tile_least, g.dielectric_roughness[pixel[i]]);
       g.tile_dielectric_roughness[static_cast<std::size_t>(t)] = tile_least;
       if (direct) direct->shade_tile(g, tx, ty, direct_scratch);
     }
