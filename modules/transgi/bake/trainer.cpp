@@ -1,5 +1,7 @@
 #include "bake/trainer.h"
 
+#include "engine/jobs/parallel_for.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cstring>
@@ -162,21 +164,28 @@ void Trainer::draw_local_blocks() {
 // backward pass, its parameter gradients and latent rows. Not one pass over
 // all of them: oneDNN's AVX2 products give a row other bits when the other
 // rows change (a 2-rank bake then left the one process's steps), while a
-// block's products are the same on any rank count.
+// block's products are the same on any rank count. Each block's products
+// run on one thread, the blocks in parallel: oneDNN's AVX2 sgemm also
+// splits a product's rows by its thread count, so a block multiplied on
+// two threads rounds otherwise than on one, and the bake's bits followed
+// --threads.
 void Trainer::compute_blocks() {
-  for (std::size_t b = 0; b < blocks_.size(); ++b) {
-    blocks_[b].clear();
-    if (block_samples_[b].empty()) continue;
-    compute_block(block_samples_[b], blocks_[b]);
-    times_.samples += block_samples_[b].size();
-  }
+  block_ws_.resize(blocks_.size());
+  engine::jobs::parallel_for<std::size_t>(0, blocks_.size(), 1, [&](std::size_t b0, std::size_t b1) {
+    const model::GemmThreadsScope one_thread(1);
+    for (std::size_t b = b0; b < b1; ++b) {
+      blocks_[b].clear();
+      if (!block_samples_[b].empty()) compute_block(block_samples_[b], blocks_[b], block_ws_[b]);
+    }
+  });
+  for (const auto& samples : block_samples_) times_.samples += samples.size();
 }
 
-void Trainer::compute_block(std::span<const std::size_t> idx, Gradients& out) {
+void Trainer::compute_block(std::span<const std::size_t> idx, Gradients& out, model::MlpWorkspace& ws) const {
   const std::size_t n_dec = model_.decoder.params().size();
   out.zero(n_dec);
   std::vector<float> x, y;
-  predict(idx, x, y, ws_);
+  predict(idx, x, y, ws);
 
   // L1 loss and its gradient, scaled by the whole batch of every rank.
   const float scale = 1.0f / static_cast<float>(static_cast<std::size_t>(settings_.batch) * kTransferValues);
@@ -191,24 +200,18 @@ void Trainer::compute_block(std::span<const std::size_t> idx, Gradients& out) {
   }
   const int in = model_.decoder.layout().inputs;
   std::vector<float> dx(x.size());
-  model_.decoder.backward(x.data(), static_cast<int>(idx.size()), dy.data(), ws_, out.decoder, dx.data(), settings_.backend);
+  model_.decoder.backward(x.data(), static_cast<int>(idx.size()), dy.data(), ws, out.decoder, dx.data(), settings_.backend);
 
-  // The block's latent rows, summed in its samples' order in grad_'s latent
-  // part (zero there: clear_latent_gradients), read out and zeroed again.
+  // The block's latent rows, summed in its samples' order.
   const auto d = static_cast<std::size_t>(model_.latent_dim);
   if (d == 0) return;
+  out.rows = latent_rows_of(idx);
+  out.row_values.assign(out.rows.size() * d, 0.0f);
   for (std::size_t i = 0; i < idx.size(); ++i) {
     const TransferSample& s = data_.samples[idx[i]];
-    model_.meshes[s.mesh].latents.scatter_gradient(*assets_.meshes[s.mesh], s.triangle, s.barycentric,
-                                                   dx.data() + i * static_cast<std::size_t>(in),
-                                                   std::span(grad_).subspan(n_dec + latent_offset_[s.mesh]));
-  }
-  out.rows = latent_rows_of(idx);
-  out.row_values.resize(out.rows.size() * d);
-  for (std::size_t r = 0; r < out.rows.size(); ++r) {
-    float* g = grad_.data() + n_dec + out.rows[r] * d;
-    std::copy_n(g, d, out.row_values.data() + r * d);
-    std::fill_n(g, d, 0.0f);
+    model_.meshes[s.mesh].latents.scatter_gradient_rows(*assets_.meshes[s.mesh], s.triangle, s.barycentric,
+                                                        dx.data() + i * static_cast<std::size_t>(in), latent_offset_[s.mesh] / d, out.rows,
+                                                        out.row_values);
   }
 }
 

@@ -123,7 +123,7 @@ class Trainer {
   // sorted into blocks (each in draw order).
   void draw_local_blocks();
   void compute_blocks();
-  void compute_block(std::span<const std::size_t> idx, Gradients& out);
+  void compute_block(std::span<const std::size_t> idx, Gradients& out, model::MlpWorkspace& ws) const;
   // The rank's blocks summed in the tree's order, up to the level where the
   // ranks' partial sums meet; returns the rank's partial sum.
   Gradients& sum_own_blocks();
@@ -162,6 +162,7 @@ class Trainer {
   int rollbacks_ = 0;
   engine::math::Pcg32 rng_;
   model::MlpWorkspace ws_;
+  std::vector<model::MlpWorkspace> block_ws_;  // per gradient block (compute_blocks runs them in parallel)
   // Last good state, for rollback.
   std::vector<float> good_params_, good_latents_, good_m_, good_v_;
   int good_iteration_ = 0;

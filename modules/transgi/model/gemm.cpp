@@ -227,4 +227,7 @@ const char* gemm_backend_name(GemmBackend b) {
 
 void set_gemm_threads(int threads) { omp_set_num_threads(threads > 0 ? threads : omp_get_num_procs()); }
 
+GemmThreadsScope::GemmThreadsScope(int threads) : before_(omp_get_max_threads()) { omp_set_num_threads(threads); }
+GemmThreadsScope::~GemmThreadsScope() { omp_set_num_threads(before_); }
+
 }  // namespace transgi::model

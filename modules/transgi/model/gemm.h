@@ -32,5 +32,17 @@ std::string onednn_isa_name();
 // The OpenMP runtime reads OMP_NUM_THREADS once, when the program loads, so a
 // command's --threads (or a bake rank's share of its machine) is set here.
 void set_gemm_threads(int threads);
+// The calling thread's oneDNN products on `threads` threads until the scope
+// ends, then on as many as before (OpenMP keeps the setting per thread).
+class GemmThreadsScope {
+ public:
+  explicit GemmThreadsScope(int threads);
+  ~GemmThreadsScope();
+  GemmThreadsScope(const GemmThreadsScope&) = delete;
+  GemmThreadsScope& operator=(const GemmThreadsScope&) = delete;
+
+ private:
+  int before_;
+};
 
 }  // namespace transgi::model

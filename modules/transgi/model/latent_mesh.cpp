@@ -1,3 +1,4 @@
+#include <algorithm>
 #include "model/latent_mesh.h"
 
 #include <cmath>
@@ -20,6 +21,18 @@ void LatentTable::scatter_gradient(const engine::scene::MeshAsset& mesh, std::ui
   const std::uint32_t rows_[3] = {vertex_to_latent[t.x], vertex_to_latent[t.y], vertex_to_latent[t.z]};
   for (int v = 0; v < 3; ++v) {
     float* g = grad.data() + static_cast<std::size_t>(rows_[v]) * dimension;
+    for (int d = 0; d < dimension; ++d) g[d] += w[v] * dz[d];
+  }
+}
+
+void LatentTable::scatter_gradient_rows(const engine::scene::MeshAsset& mesh, std::uint32_t tri, glm::vec2 bary, const float* dz,
+                                        std::uint64_t first_row, std::span<const std::uint64_t> rows, std::span<float> row_values) const {
+  const glm::uvec3 t = mesh.triangles[tri];
+  const float w[3] = {1.0f - bary.x - bary.y, bary.x, bary.y};
+  const std::uint32_t rows_[3] = {vertex_to_latent[t.x], vertex_to_latent[t.y], vertex_to_latent[t.z]};
+  for (int v = 0; v < 3; ++v) {
+    const auto at = std::lower_bound(rows.begin(), rows.end(), first_row + rows_[v]);
+    float* g = row_values.data() + static_cast<std::size_t>(at - rows.begin()) * static_cast<std::size_t>(dimension);
     for (int d = 0; d < dimension; ++d) g[d] += w[v] * dz[d];
   }
 }

@@ -27,6 +27,11 @@ struct LatentTable {
   // Adds dL/dz scattered back to the three latent rows (the adjoint of interpolate).
   void scatter_gradient(const engine::scene::MeshAsset& mesh, std::uint32_t tri, glm::vec2 bary, const float* dz,
                         std::span<float> grad) const;
+  // scatter_gradient into the rows `rows` alone (ascending, each a row index
+  // plus `first_row`, holding every row the triangle's vertices use), their
+  // values `dimension` floats a row: the same additions in the same order.
+  void scatter_gradient_rows(const engine::scene::MeshAsset& mesh, std::uint32_t tri, glm::vec2 bary, const float* dz,
+                             std::uint64_t first_row, std::span<const std::uint64_t> rows, std::span<float> row_values) const;
 };
 
 // Welds vertices whose positions agree to `tolerance` (relative to the mesh
