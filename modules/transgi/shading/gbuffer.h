@@ -42,6 +42,14 @@ GSample make_gsample(const engine::rt::RtScene& scene, const engine::scene::Scen
 void make_gsample(const engine::rt::RtScene& scene, const engine::scene::SceneAssets& assets, const engine::rt::Ray& ray,
                   const engine::rt::Hit* hit, const engine::scene::Environment* background, float spread, GSample& out);
 
+// The sample's fields that follow from the hit and its material alone (the
+// ids, the material read at the hit's texture footprint, the depth), for
+// make_gsample and make_gsamples, which compute the geometry themselves;
+// ng_dot_wo: the world geometric normal's cosine with the direction back to
+// the camera (the footprint stretches at grazing angles).
+void set_gsample_material(const engine::scene::SceneAssets& assets, const engine::rt::Hit& hit, const engine::scene::MeshAsset& mesh,
+                          float instance_scale, float spread, float ng_dot_wo, GSample& out);
+
 // The most samples make_gsamples makes at once: a 4 x 4 camera tile.
 inline constexpr int kGSampleTile = 16;
 // Per-pixel arrays a G-buffer keeps beside its samples (realtime_gi.h's

@@ -11,7 +11,8 @@
 // rotate, normalise again), which a core runs one pixel at a time; here the
 // tile's loads come first, then that arithmetic as structure-of-arrays loops
 // over the lanes, which the compiler turns into 8- or 16-wide vectors, then
-// the material reads and the stores. This file is built without FMA
+// the material reads (set_gsample_material, shared with make_gsample) and the
+// stores. This file is built without FMA
 // contraction (CMakeLists.txt), and the loops state glm's arithmetic in
 // glm's order (normalize = v * (1 / sqrt(dot)), dot = (x x + y y) + z z,
 // q * v = v + ((cross(q, v) w) + cross(q, cross(q, v))) 2), so every lane
@@ -155,37 +156,15 @@ void make_gsamples(const engine::rt::RtScene& scene, const engine::scene::SceneA
       continue;
     }
     const rt::Hit& hit = hits[i];
-    const rt::InstanceRecord& inst = *scene.instance_of(hit);
-    const scene::MeshAsset& mesh = *assets.meshes[hit.mesh];
-    const float b1 = hit.barycentric.x, b2 = hit.barycentric.y, b0 = 1 - b1 - b2;
-    glm::vec2 uv(0.0f);
-    if (!mesh.uvs.empty()) {
-      const glm::uvec3 tri = mesh.triangles[hit.primitive];
-      uv = b0 * mesh.uvs[tri.x] + b1 * mesh.uvs[tri.y] + b2 * mesh.uvs[tri.z];
-    }
-    s.hit = true;
-    s.background = glm::vec3(0.0f);
-    s.entity = hit.entity;
-    s.mesh = hit.mesh;
-    s.triangle = hit.primitive;
-    s.bary = hit.barycentric;
+    const float ng_dot_wo = g.ng_dot_wo[i];
+    set_gsample_material(assets, hit, *assets.meshes[hit.mesh], scene.instance_of(hit)->to_world.scale, spread, ng_dot_wo, s);
     s.normal_obj = {g.nobj[0][i], g.nobj[1][i], g.nobj[2][i]};
     s.wo_obj = {g.wo[0][i], g.wo[1][i], g.wo[2][i]};
-    const std::uint32_t material = mesh.triangle_material[hit.primitive];
     s.position = {g.position[0][i], g.position[1][i], g.position[2][i]};
     s.normal_world = {g.nworld[0][i], g.nworld[1][i], g.nworld[2][i]};
     s.wo_world = {g.wo_world[0][i], g.wo_world[1][i], g.wo_world[2][i]};
-    const float ng_dot_wo = g.ng_dot_wo[i];
-    const float footprint = spread > 0 && assets.materials[material].is_textured()
-                                ? render::uv_footprint(mesh, hit.primitive, inst.to_world.scale, hit.t * spread, ng_dot_wo)
-                                : 0.0f;
-    s.brdf = render::evaluate_material(assets, material, uv, footprint);
-    s.albedo = s.brdf.base_color;
-    s.diffuse = material::diffuse_albedo(s.brdf);
-    s.emission = render::evaluate_emission(assets, material, uv, footprint);
     const glm::vec3 ng(g.ng[0][i], g.ng[1][i], g.ng[2][i]);
     s.geometric_normal = ng_dot_wo < 0 ? -ng : ng;
-    s.depth = hit.t;
     if (sides) {
       const std::size_t p = sides->pixel[i];
       const material::BrdfParams& brdf = s.brdf;
