@@ -3,6 +3,7 @@
 // the latent interpolation, and welding across seams.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -190,4 +191,48 @@ TEST(Latents, SeamVerticesAtOnePositionShareOneLatent) {
   EXPECT_EQ(t.rows(), 8u * 3u + 2u) << "3 rings of 8 plus the two poles";
   EXPECT_EQ(t.vertex_to_latent[0], t.vertex_to_latent[8]) << "pole vertices weld";
   EXPECT_EQ(t.vertex_to_latent[9], t.vertex_to_latent[17]) << "u = 0 and u = 1 weld";
+}
+
+// The bake's sparse latent gradient (each gradient block sums only the rows
+// its samples touch, Trainer::compute_block) against the dense scatter: the
+// same additions in the same order, so the same bits, for samples that share
+// rows (neighbouring triangles, the sphere's welded seam and poles).
+TEST(Latents, SparseRowScatterEqualsTheDenseScatterBitForBit) {
+  const auto mesh = engine::scene::make_uv_sphere(1.0f, 8, 4);
+  const LatentTable t = make_latent_table(mesh, 7);
+  engine::math::Pcg32 rng(5, 6);
+  std::vector<float> dense(t.values.size(), 0.0f);
+  struct Sample {
+    std::uint32_t tri;
+    glm::vec2 bary;
+    std::vector<float> dz;
+  };
+  std::vector<Sample> samples;
+  std::vector<std::uint64_t> rows;
+  constexpr std::uint64_t kFirstRow = 1000;  // the table's rows after another mesh's
+  for (int i = 0; i < 200; ++i) {
+    Sample s{static_cast<std::uint32_t>(rng.next_u32() % mesh.triangles.size()), {0.0f, 0.0f}, random_vector(7, 100 + i)};
+    s.bary.x = rng.next_float();
+    s.bary.y = (1.0f - s.bary.x) * rng.next_float();
+    t.scatter_gradient(mesh, s.tri, s.bary, s.dz.data(), dense);
+    const glm::uvec3 tri = mesh.triangles[s.tri];
+    for (std::uint32_t v : {tri.x, tri.y, tri.z}) rows.push_back(kFirstRow + t.vertex_to_latent[v]);
+    samples.push_back(std::move(s));
+  }
+  std::sort(rows.begin(), rows.end());
+  rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+  std::vector<float> sparse(rows.size() * 7, 0.0f);
+  for (const Sample& s : samples) t.scatter_gradient_rows(mesh, s.tri, s.bary, s.dz.data(), kFirstRow, rows, sparse);
+  ASSERT_LT(rows.size(), t.rows() + 1);
+  std::vector<float> expected;
+  for (const std::uint64_t r : rows) {
+    const float* g = dense.data() + (r - kFirstRow) * 7;
+    expected.insert(expected.end(), g, g + 7);
+  }
+  EXPECT_EQ(sparse, expected);
+  // Every row with a value is listed.
+  std::size_t nonzero_rows = 0;
+  for (std::size_t r = 0; r < t.rows(); ++r)
+    nonzero_rows += std::any_of(dense.begin() + r * 7, dense.begin() + r * 7 + 7, [](float v) { return v != 0.0f; }) ? 1 : 0;
+  EXPECT_EQ(nonzero_rows, rows.size());
 }

@@ -1,13 +1,13 @@
 #include "bake/trainer.h"
 
-#include "engine/jobs/parallel_for.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+
+#include "engine/jobs/parallel_for.h"
 
 namespace transgi::bake {
 

@@ -1,6 +1,6 @@
-#include <algorithm>
 #include "model/latent_mesh.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <tuple>
