@@ -39,9 +39,12 @@ struct TrainSettings {
   // A batch's gradients are summed as a fixed binary tree over this many
   // blocks of its samples (a sample's block: its point's point_hash mod the
   // count), so that a bake on any power-of-two number of ranks up to this
-  // count takes the one process's steps bit for bit (docs/bake.md). Higher =
-  // the same bits on more ranks, at the cost of smaller matrix products. A
-  // power of two from 1 to 4096.
+  // count takes the one process's steps bit for bit (docs/bake.md). The
+  // blocks are also what a rank's threads share (each block's products on
+  // one thread, so the bits do not depend on the thread count either): fewer
+  // blocks than threads leave cores idle. Higher = the same bits on more
+  // ranks, at the cost of smaller matrix products. A power of two from 1 to
+  // 4096.
   int gradient_blocks = 8;
   model::GemmBackend backend = model::default_gemm_backend();
 };
