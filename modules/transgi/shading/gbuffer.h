@@ -54,8 +54,8 @@ void set_gsample_material(const engine::scene::SceneAssets& assets, const engine
 inline constexpr int kGSampleTile = 16;
 // Per-pixel arrays a G-buffer keeps beside its samples (realtime_gi.h's
 // GBuffer says what each holds), written by make_gsamples for lane i at
-// index pixel[i] from the values it has in registers: read back from the
-// samples just stored, they cost a load that waits on those stores.
+// index pixel[i] from the values it computed, instead of read back from the
+// samples it has just stored.
 struct GSampleSideArrays {
   const std::size_t* pixel = nullptr;
   glm::vec4* guide = nullptr;             // world normal, depth (0: a miss)

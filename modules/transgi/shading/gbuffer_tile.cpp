@@ -1,10 +1,11 @@
+#include "shading/gbuffer.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "engine/core/cpu_isa.h"
 #include "engine/render/surface.h"
-#include "shading/gbuffer.h"
 
 // make_gsamples: a camera tile's G-buffer samples at once. make_gsample is a
 // long chain of dependent divisions and square roots per pixel (normalise,
@@ -12,11 +13,11 @@
 // tile's loads come first, then that arithmetic as structure-of-arrays loops
 // over the lanes, which the compiler turns into 8- or 16-wide vectors, then
 // the material reads (set_gsample_material, shared with make_gsample) and the
-// stores. This file is built without FMA
-// contraction (CMakeLists.txt), and the loops state glm's arithmetic in
-// glm's order (normalize = v * (1 / sqrt(dot)), dot = (x x + y y) + z z,
-// q * v = v + ((cross(q, v) w) + cross(q, cross(q, v))) 2), so every lane
-// rounds as make_gsample does: the samples are bit-identical (tested).
+// stores. This file is built without FMA contraction (CMakeLists.txt), and
+// the loops state glm's arithmetic in glm's order (normalize = v * (1 /
+// sqrt(dot)), dot = (x x + y y) + z z, q * v = v + ((cross(q, v) w) +
+// cross(q, cross(q, v))) 2), so every lane rounds as make_gsample does: the
+// samples are bit-identical (tested).
 
 namespace transgi::shading {
 
