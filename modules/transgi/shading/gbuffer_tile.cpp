@@ -111,13 +111,17 @@ void make_gsamples(const engine::rt::RtScene& scene, const engine::scene::SceneA
                    const GSampleSideArrays* sides) {
   using namespace engine;
   TileGeometry g;
+  // Each lane's instance and mesh, found once for the loads and the stores.
+  const rt::InstanceRecord* instance[kLanes];
+  const scene::MeshAsset* meshes[kLanes];
   // The loads. A missed lane computes on zeros, and its result is dropped.
   for (int i = 0; i < kLanes; ++i) {
     const bool lane = i < n && found[i];
     const rt::Hit* hit = lane ? &hits[i] : nullptr;
-    const scene::MeshAsset* mesh = lane ? assets.meshes[hit->mesh].get() : nullptr;
+    const scene::MeshAsset* mesh = meshes[i] = lane ? assets.meshes[hit->mesh].get() : nullptr;
+    instance[i] = lane ? scene.instance_of(*hit) : nullptr;
     const glm::uvec3 tri = lane ? mesh->triangles[hit->primitive] : glm::uvec3(0);
-    const glm::quat q = lane ? scene.instance_of(*hit)->to_world.rotation : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+    const glm::quat q = lane ? instance[i]->to_world.rotation : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
     g.b1[i] = lane ? hit->barycentric.x : 0.0f;
     g.b2[i] = lane ? hit->barycentric.y : 0.0f;
     g.t[i] = lane ? hit->t : 0.0f;
@@ -158,7 +162,7 @@ void make_gsamples(const engine::rt::RtScene& scene, const engine::scene::SceneA
     }
     const rt::Hit& hit = hits[i];
     const float ng_dot_wo = g.ng_dot_wo[i];
-    set_gsample_material(assets, hit, *assets.meshes[hit.mesh], scene.instance_of(hit)->to_world.scale, spread, ng_dot_wo, s);
+    set_gsample_material(assets, hit, *meshes[i], instance[i]->to_world.scale, spread, ng_dot_wo, s);
     s.normal_obj = {g.nobj[0][i], g.nobj[1][i], g.nobj[2][i]};
     s.wo_obj = {g.wo[0][i], g.wo[1][i], g.wo[2][i]};
     s.position = {g.position[0][i], g.position[1][i], g.position[2][i]};
